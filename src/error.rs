@@ -1,0 +1,76 @@
+//! One error type for the whole pipeline.
+//!
+//! Every variant says *where*: the file and line of a toolpath record, the field of a machine
+//! file, or the span / station / nearest CL line of a schedule that cannot be met. The CLI prints
+//! the `Display` form as one line on stderr and exits with code 2.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong between reading the input and writing the schedule.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A toolpath (or other line-oriented) input file has a bad record.
+    #[error("{}:{line}: {message}", file.display())]
+    Parse {
+        file: PathBuf,
+        /// 1-based line number of the record (its first line when `$`-continued).
+        line: usize,
+        message: String,
+    },
+    /// A machine file has a missing, unknown or invalid field.
+    #[error("{}: field `{field}`: {message}", file.display())]
+    Field {
+        file: PathBuf,
+        /// Dotted path of the field, e.g. `axes.C.velocity`.
+        field: String,
+        message: String,
+    },
+    /// A file could not be read or written.
+    #[error("{}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The request cannot be met by any schedule (names where on the path).
+    #[error("infeasible: {0}")]
+    Infeasible(String),
+    /// The convex solver did not return a usable answer.
+    #[error("solver: {0}")]
+    Solver(String),
+    /// A bad option or argument combination.
+    #[error("{0}")]
+    Usage(String),
+}
+
+/// Result alias used throughout the crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    pub(crate) fn parse(file: impl Into<PathBuf>, line: usize, message: impl Into<String>) -> Self {
+        Error::Parse {
+            file: file.into(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    pub(crate) fn field(
+        file: impl Into<PathBuf>,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Field {
+            file: file.into(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    pub(crate) fn io(file: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            file: file.into(),
+            source,
+        }
+    }
+}

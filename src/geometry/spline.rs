@@ -1,0 +1,248 @@
+//! Piecewise cubic interpolation (seed 000, eq. 1–3 and 17–18): the one spline of the crate.
+//!
+//! A [`CubicSpline`] interpolates `dim` coordinates through knots `u_0 < u_1 < … < u_n` with C²
+//! piecewise cubics and *not-a-knot* end conditions (the third derivative is continuous at
+//! `u_1` and `u_{n-1}`), the usual choice when nothing is known about the ends. Two knots give a
+//! straight line, three a parabola.
+
+/// Value and first two derivatives of every coordinate at one parameter value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jet<const D: usize> {
+    pub value: [f64; D],
+    pub d1: [f64; D],
+    pub d2: [f64; D],
+}
+
+/// A C² cubic spline through `D`-dimensional points.
+#[derive(Debug, Clone)]
+pub struct CubicSpline<const D: usize> {
+    knots: Vec<f64>,
+    /// Per segment `k` and coordinate: `y = c0 + c1 h + c2 h² + c3 h³`, `h = u − u_k`.
+    coef: Vec<[[f64; 4]; D]>,
+}
+
+impl<const D: usize> CubicSpline<D> {
+    /// Interpolates `values[k]` at `knots[k]`. Knots must be strictly increasing, at least two.
+    pub fn new(knots: &[f64], values: &[[f64; D]]) -> Self {
+        assert!(knots.len() >= 2 && knots.len() == values.len());
+        debug_assert!(knots.windows(2).all(|w| w[1] > w[0]));
+        let n = knots.len();
+        let dx: Vec<f64> = knots.windows(2).map(|w| w[1] - w[0]).collect();
+        let slope: Vec<[f64; D]> = (0..n - 1)
+            .map(|k| std::array::from_fn(|j| (values[k + 1][j] - values[k][j]) / dx[k]))
+            .collect();
+        let s = match n {
+            2 => vec![slope[0], slope[0]],
+            3 => parabola_slopes(&dx, &slope),
+            _ => not_a_knot_slopes(&dx, &slope),
+        };
+        let coef = (0..n - 1)
+            .map(|k| {
+                std::array::from_fn(|j| {
+                    let t = (s[k][j] + s[k + 1][j] - 2.0 * slope[k][j]) / dx[k];
+                    [
+                        values[k][j],
+                        s[k][j],
+                        (slope[k][j] - s[k][j]) / dx[k] - t,
+                        t / dx[k],
+                    ]
+                })
+            })
+            .collect();
+        CubicSpline {
+            knots: knots.to_vec(),
+            coef,
+        }
+    }
+
+    /// The knots `u_0 … u_n`.
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// Index of the segment containing `u` (clamped to the ends).
+    pub fn segment(&self, u: f64) -> usize {
+        let k = self.knots.partition_point(|&x| x <= u);
+        k.saturating_sub(1).min(self.coef.len() - 1)
+    }
+
+    /// Value and derivatives at `u` (extrapolates the end segments outside the knots).
+    pub fn eval(&self, u: f64) -> Jet<D> {
+        self.eval_in(self.segment(u), u)
+    }
+
+    /// Value and derivatives at `u`, using segment `k` (no search).
+    pub fn eval_in(&self, k: usize, u: f64) -> Jet<D> {
+        let h = u - self.knots[k];
+        let c = &self.coef[k];
+        Jet {
+            value: std::array::from_fn(|j| {
+                let [a, b, cc, d] = c[j];
+                a + h * (b + h * (cc + h * d))
+            }),
+            d1: std::array::from_fn(|j| {
+                let [_, b, cc, d] = c[j];
+                b + h * (2.0 * cc + 3.0 * h * d)
+            }),
+            d2: std::array::from_fn(|j| {
+                let [_, _, cc, d] = c[j];
+                2.0 * cc + 6.0 * h * d
+            }),
+        }
+    }
+}
+
+/// Three points: the one parabola through them (not-a-knot degenerates to it).
+fn parabola_slopes<const D: usize>(dx: &[f64], slope: &[[f64; D]]) -> Vec<[f64; D]> {
+    let mut s = vec![[0.0; D]; 3];
+    for j in 0..D {
+        let curv = (slope[1][j] - slope[0][j]) / (dx[0] + dx[1]); // half the second derivative
+        s[0][j] = slope[0][j] - curv * dx[0];
+        s[1][j] = slope[0][j] + curv * dx[0];
+        s[2][j] = slope[1][j] + curv * dx[1];
+    }
+    s
+}
+
+/// Slopes at the knots of the not-a-knot cubic spline: a tridiagonal system (n ≥ 4 knots),
+/// solved by Gaussian elimination with partial pivoting (the end rows are not diagonally
+/// dominant).
+fn not_a_knot_slopes<const D: usize>(dx: &[f64], slope: &[[f64; D]]) -> Vec<[f64; D]> {
+    let n = dx.len() + 1;
+    let mut lower = vec![0.0; n]; // lower[i]: coefficient of s[i-1] in row i
+    let mut diag = vec![0.0; n];
+    let mut upper = vec![0.0; n]; // upper[i]: coefficient of s[i+1] in row i
+    let mut rhs = vec![[0.0; D]; n];
+    for i in 1..n - 1 {
+        lower[i] = dx[i];
+        diag[i] = 2.0 * (dx[i - 1] + dx[i]);
+        upper[i] = dx[i - 1];
+        rhs[i] = std::array::from_fn(|j| 3.0 * (dx[i] * slope[i - 1][j] + dx[i - 1] * slope[i][j]));
+    }
+    let d = dx[0] + dx[1];
+    diag[0] = dx[1];
+    upper[0] = d;
+    rhs[0] = std::array::from_fn(|j| {
+        ((dx[0] + 2.0 * d) * dx[1] * slope[0][j] + dx[0] * dx[0] * slope[1][j]) / d
+    });
+    let (a, b) = (dx[n - 2], dx[n - 3]);
+    let d = a + b;
+    lower[n - 1] = d;
+    diag[n - 1] = b;
+    rhs[n - 1] = std::array::from_fn(|j| {
+        (a * a * slope[n - 3][j] + (2.0 * d + a) * b * slope[n - 2][j]) / d
+    });
+    solve_tridiagonal(&mut lower, &mut diag, &mut upper, &mut rhs);
+    rhs
+}
+
+/// Solves a tridiagonal system in place with partial pivoting (LAPACK `dgtsv`'s scheme: one
+/// extra super-diagonal of fill). `lower[i]` multiplies `x[i-1]` in row `i`, `upper[i]`
+/// multiplies `x[i+1]`. The solution overwrites `rhs`.
+fn solve_tridiagonal<const D: usize>(
+    lower: &mut [f64],
+    diag: &mut [f64],
+    upper: &mut [f64],
+    rhs: &mut [[f64; D]],
+) {
+    let n = diag.len();
+    // dl[i] = sub-diagonal entry of row i+1; after a row swap it holds the fill of row i.
+    let mut dl: Vec<f64> = lower[1..].to_vec();
+    for i in 0..n - 1 {
+        if diag[i].abs() >= dl[i].abs() {
+            let f = dl[i] / diag[i];
+            diag[i + 1] -= f * upper[i];
+            let ri = rhs[i];
+            for (r, x) in rhs[i + 1].iter_mut().zip(ri) {
+                *r -= f * x;
+            }
+            dl[i] = 0.0;
+        } else {
+            let f = diag[i] / dl[i];
+            diag[i] = dl[i];
+            let t = diag[i + 1];
+            diag[i + 1] = upper[i] - f * t;
+            if i + 2 < n {
+                dl[i] = upper[i + 1];
+                upper[i + 1] = -f * dl[i];
+            } else {
+                dl[i] = 0.0;
+            }
+            upper[i] = t;
+            let (ri, rn) = (rhs[i], rhs[i + 1]);
+            rhs[i] = rn;
+            rhs[i + 1] = std::array::from_fn(|j| ri[j] - f * rn[j]);
+        }
+    }
+    for i in (0..n).rev() {
+        for j in 0..D {
+            let mut r = rhs[i][j];
+            if i + 1 < n {
+                r -= upper[i] * rhs[i + 1][j];
+            }
+            if i + 2 < n {
+                r -= dl[i] * rhs[i + 2][j];
+            }
+            rhs[i][j] = r / diag[i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reproduces_a_cubic_exactly() {
+        // Not-a-knot reproduces any cubic polynomial, on uneven knots too.
+        let f = |u: f64| 1.0 - 2.0 * u + 0.5 * u * u - 0.25 * u * u * u;
+        let knots = [0.0, 0.3, 1.1, 1.5, 2.6, 3.0, 4.2];
+        let vals: Vec<[f64; 1]> = knots.iter().map(|&u| [f(u)]).collect();
+        let s = CubicSpline::new(&knots, &vals);
+        for &u in &[0.0, 0.2, 0.77, 1.3, 2.0, 2.9, 4.2] {
+            let j = s.eval(u);
+            assert!((j.value[0] - f(u)).abs() < 1e-12);
+            assert!((j.d1[0] - (-2.0 + u - 0.75 * u * u)).abs() < 1e-11);
+            assert!((j.d2[0] - (1.0 - 1.5 * u)).abs() < 1e-10);
+        }
+    }
+
+    #[test]
+    fn pivoting_path_reproduces_a_cubic() {
+        // Very uneven first knots make the first row's sub-diagonal larger than its diagonal.
+        let f = |u: f64| 3.0 + u * u * u;
+        let knots = [0.0, 5.0, 5.1, 5.2, 9.0, 9.01];
+        let vals: Vec<[f64; 1]> = knots.iter().map(|&u| [f(u)]).collect();
+        let s = CubicSpline::new(&knots, &vals);
+        for &u in &[1.0, 5.05, 7.0, 9.005] {
+            let j = s.eval(u);
+            assert!((j.value[0] - f(u)).abs() < 1e-9 * f(u));
+            assert!((j.d2[0] - 6.0 * u).abs() < 1e-8 * u);
+        }
+    }
+
+    #[test]
+    fn two_and_three_points() {
+        let s = CubicSpline::new(&[0.0, 2.0], &[[1.0], [5.0]]);
+        assert_eq!(s.eval(1.0).value[0], 3.0);
+        assert_eq!(s.eval(1.0).d2[0], 0.0);
+        let s = CubicSpline::new(&[0.0, 1.0, 3.0], &[[0.0], [1.0], [9.0]]);
+        let j = s.eval(2.0);
+        assert!((j.value[0] - 4.0).abs() < 1e-12 && (j.d2[0] - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn interpolates_and_is_c2() {
+        let knots: Vec<f64> = (0..20).map(|i| (i as f64).powf(1.3)).collect();
+        let vals: Vec<[f64; 2]> = knots.iter().map(|&u| [u.sin(), (0.3 * u).cos()]).collect();
+        let s = CubicSpline::new(&knots, &vals);
+        for k in 1..knots.len() - 1 {
+            let (a, b) = (s.eval_in(k - 1, knots[k]), s.eval_in(k, knots[k]));
+            for j in 0..2 {
+                assert!((a.value[j] - vals[k][j]).abs() < 1e-12);
+                assert!((a.d1[j] - b.d1[j]).abs() < 1e-10);
+                assert!((a.d2[j] - b.d2[j]).abs() < 1e-9);
+            }
+        }
+    }
+}

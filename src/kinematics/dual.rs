@@ -1,0 +1,112 @@
+//! Second-order dual numbers: the generic route to axis derivatives.
+//!
+//! A [`Dual2`] carries a value and its first two derivatives with respect to the path parameter
+//! u. Pushing the path's spline jets through a machine's inverse kinematics in `Dual2`
+//! arithmetic gives every axis's q, dq/du, d²q/du² by the chain rule, for any kinematics, without
+//! a hand-derived formula. It is the independent check of the closed forms (eq. 31–39).
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// `v + d·ε + ½·dd·ε²` truncated after second order: value, first and second derivative.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dual2 {
+    pub v: f64,
+    pub d: f64,
+    pub dd: f64,
+}
+
+impl Dual2 {
+    pub fn new(v: f64, d: f64, dd: f64) -> Self {
+        Dual2 { v, d, dd }
+    }
+}
+
+/// What inverse kinematics needs of a number type: field arithmetic, sin and cos.
+pub trait Real:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+{
+    fn cst(x: f64) -> Self;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    fn scale(self, k: f64) -> Self;
+}
+
+impl Real for f64 {
+    fn cst(x: f64) -> Self {
+        x
+    }
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    fn cos(self) -> Self {
+        f64::cos(self)
+    }
+    fn scale(self, k: f64) -> Self {
+        self * k
+    }
+}
+
+impl Add for Dual2 {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Dual2::new(self.v + o.v, self.d + o.d, self.dd + o.dd)
+    }
+}
+
+impl Sub for Dual2 {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        Dual2::new(self.v - o.v, self.d - o.d, self.dd - o.dd)
+    }
+}
+
+impl Mul for Dual2 {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        Dual2::new(
+            self.v * o.v,
+            self.d * o.v + self.v * o.d,
+            self.dd * o.v + 2.0 * self.d * o.d + self.v * o.dd,
+        )
+    }
+}
+
+impl Neg for Dual2 {
+    type Output = Self;
+    fn neg(self) -> Self {
+        Dual2::new(-self.v, -self.d, -self.dd)
+    }
+}
+
+impl Real for Dual2 {
+    fn cst(x: f64) -> Self {
+        Dual2::new(x, 0.0, 0.0)
+    }
+    fn sin(self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        Dual2::new(s, c * self.d, c * self.dd - s * self.d * self.d)
+    }
+    fn cos(self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        Dual2::new(c, -s * self.d, -s * self.dd - c * self.d * self.d)
+    }
+    fn scale(self, k: f64) -> Self {
+        Dual2::new(self.v * k, self.d * k, self.dd * k)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chain_rule_of_sin_of_product() {
+        // f(u) = sin(u²) at u = 0.7: f' = 2u cos(u²), f'' = 2 cos(u²) − 4u² sin(u²).
+        let u = Dual2::new(0.7, 1.0, 0.0);
+        let f = (u * u).sin();
+        let x: f64 = 0.49;
+        assert!((f.v - x.sin()).abs() < 1e-15);
+        assert!((f.d - 1.4 * x.cos()).abs() < 1e-15);
+        assert!((f.dd - (2.0 * x.cos() - 4.0 * x * x.sin())).abs() < 1e-14);
+    }
+}

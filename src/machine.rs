@@ -1,0 +1,257 @@
+//! Machine files: the kinematics and every axis's limits (JSON; mm, degrees, seconds).
+//!
+//! ```json
+//! {"name": "seed double swivel head",
+//!  "kinematics": {"type": "head_head", "tool_length": 200.0},
+//!  "axes": {"X": {"velocity": 400, "acceleration": 2000}, "Y": {...}, "Z": {...},
+//!           "C": {"velocity": 120, "acceleration": 600}, "A": {"velocity": 60, "acceleration": 400}},
+//!  "feed": {"max": 150}}
+//! ```
+//!
+//! A limit is a number (symmetric, `> 0`) or `[min, max]` with `min < 0 < max`. Linear axes are
+//! in mm/s and mm/s², rotary axes in °/s and °/s². `feed.max` (mm/s) caps the tool-tip feed V;
+//! the `feed` section is optional. Unknown fields, missing axes or limits and non-positive limits
+//! are errors that name the field.
+
+use serde_json::{Map, Value};
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+
+/// A two-sided limit on an axis quantity: `min < 0 < max`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limit {
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Limit {
+    /// A symmetric limit `[-v, v]`.
+    pub fn symmetric(v: f64) -> Self {
+        Limit { min: -v, max: v }
+    }
+
+    /// Ratio of `value` to the bound on its side (`value/max` or `value/min`), always ≥ 0.
+    pub fn ratio(&self, value: f64) -> f64 {
+        if value >= 0.0 {
+            value / self.max
+        } else {
+            value / self.min
+        }
+    }
+}
+
+/// Linear (mm) or rotary (degrees) axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisKind {
+    Linear,
+    Rotary,
+}
+
+/// One machine axis with its velocity and acceleration limits (file units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    pub name: String,
+    pub kind: AxisKind,
+    pub velocity: Limit,
+    pub acceleration: Limit,
+}
+
+/// The machine's kinematic structure.
+#[derive(Debug, Clone, PartialEq)]
+pub enum KinematicsSpec {
+    /// Three linear axes X, Y, Z follow the tool tip; orientation is ignored.
+    Xyz,
+    /// Seed 000's fixed-bed double swivel head: θ1 = axis C about z, θ2 = axis A,
+    /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
+    HeadHead { tool_length: f64 },
+}
+
+impl KinematicsSpec {
+    /// Axis names in the order the kinematics produces them.
+    pub fn axis_names(&self) -> &'static [&'static str] {
+        match self {
+            KinematicsSpec::Xyz => &["X", "Y", "Z"],
+            KinematicsSpec::HeadHead { .. } => &["X", "Y", "Z", "C", "A"],
+        }
+    }
+
+    fn axis_kind(name: &str) -> AxisKind {
+        match name {
+            "A" | "B" | "C" => AxisKind::Rotary,
+            _ => AxisKind::Linear,
+        }
+    }
+}
+
+/// A machine: kinematics, axes (in the kinematics' order) and the feed cap.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Machine {
+    pub name: String,
+    pub kinematics: KinematicsSpec,
+    pub axes: Vec<Axis>,
+    /// Maximum tool-tip feed, mm/s (`None`: only the axes limit the feed).
+    pub feed_max: Option<f64>,
+}
+
+impl Machine {
+    /// Reads and validates a machine file.
+    pub fn from_file(path: &Path) -> Result<Machine> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Machine::from_json(path, &text)
+    }
+
+    /// Parses and validates machine JSON; `source` names the file in errors.
+    pub fn from_json(source: &Path, text: &str) -> Result<Machine> {
+        let value: Value = serde_json::from_str(text).map_err(|e| Error::Parse {
+            file: source.to_path_buf(),
+            line: e.line(),
+            message: format!("invalid JSON: {e}"),
+        })?;
+        Parser {
+            file: source.to_path_buf(),
+        }
+        .machine(&value)
+    }
+}
+
+struct Parser {
+    file: PathBuf,
+}
+
+impl Parser {
+    fn err(&self, field: &str, message: impl Into<String>) -> Error {
+        Error::field(&self.file, field, message)
+    }
+
+    fn object<'a>(&self, v: &'a Value, field: &str) -> Result<&'a Map<String, Value>> {
+        v.as_object()
+            .ok_or_else(|| self.err(field, "expected a JSON object"))
+    }
+
+    fn only_known(&self, obj: &Map<String, Value>, field: &str, known: &[&str]) -> Result<()> {
+        for key in obj.keys() {
+            if !known.contains(&key.as_str()) {
+                let at = if field.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{field}.{key}")
+                };
+                return Err(self.err(
+                    &at,
+                    format!("unknown field (expected one of: {})", known.join(", ")),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn positive(&self, v: Option<&Value>, field: &str) -> Result<f64> {
+        let v = v.ok_or_else(|| self.err(field, "missing"))?;
+        let x = v
+            .as_f64()
+            .ok_or_else(|| self.err(field, format!("expected a number, found {v}")))?;
+        if !(x.is_finite() && x > 0.0) {
+            return Err(self.err(field, format!("must be a positive number, found {x}")));
+        }
+        Ok(x)
+    }
+
+    fn limit(&self, v: Option<&Value>, field: &str) -> Result<Limit> {
+        match v {
+            Some(Value::Array(items)) => {
+                let nums: Vec<f64> = items.iter().filter_map(Value::as_f64).collect();
+                if items.len() != 2 || nums.len() != 2 {
+                    return Err(self.err(field, "expected a number or [min, max]"));
+                }
+                let (min, max) = (nums[0], nums[1]);
+                if !(min.is_finite() && max.is_finite() && min < 0.0 && max > 0.0) {
+                    return Err(self.err(
+                        field,
+                        format!("[min, max] must have min < 0 < max, found [{min}, {max}]"),
+                    ));
+                }
+                Ok(Limit { min, max })
+            }
+            other => Ok(Limit::symmetric(self.positive(other, field)?)),
+        }
+    }
+
+    fn machine(&self, root: &Value) -> Result<Machine> {
+        let obj = self.object(root, "(top level)")?;
+        self.only_known(obj, "", &["name", "kinematics", "axes", "feed"])?;
+        let name = match obj.get("name") {
+            None => String::new(),
+            Some(Value::String(s)) => s.clone(),
+            Some(_) => return Err(self.err("name", "expected a string")),
+        };
+        let kinematics = self.kinematics(obj.get("kinematics"))?;
+        let axes = self.axes(obj.get("axes"), &kinematics)?;
+        let feed_max = match obj.get("feed") {
+            None => None,
+            Some(f) => {
+                let f = self.object(f, "feed")?;
+                self.only_known(f, "feed", &["max"])?;
+                Some(self.positive(f.get("max"), "feed.max")?)
+            }
+        };
+        Ok(Machine {
+            name,
+            kinematics,
+            axes,
+            feed_max,
+        })
+    }
+
+    fn kinematics(&self, v: Option<&Value>) -> Result<KinematicsSpec> {
+        let v = v.ok_or_else(|| self.err("kinematics", "missing"))?;
+        let obj = self.object(v, "kinematics")?;
+        let ty = obj
+            .get("type")
+            .ok_or_else(|| self.err("kinematics.type", "missing"))?;
+        match ty.as_str() {
+            Some("xyz") => {
+                self.only_known(obj, "kinematics", &["type"])?;
+                Ok(KinematicsSpec::Xyz)
+            }
+            Some("head_head") => {
+                self.only_known(obj, "kinematics", &["type", "tool_length"])?;
+                let tool_length =
+                    self.positive(obj.get("tool_length"), "kinematics.tool_length")?;
+                Ok(KinematicsSpec::HeadHead { tool_length })
+            }
+            _ => Err(self.err(
+                "kinematics.type",
+                format!("unknown kinematics {ty} (expected \"xyz\" or \"head_head\")"),
+            )),
+        }
+    }
+
+    fn axes(&self, v: Option<&Value>, kin: &KinematicsSpec) -> Result<Vec<Axis>> {
+        let v = v.ok_or_else(|| self.err("axes", "missing"))?;
+        let obj = self.object(v, "axes")?;
+        let names = kin.axis_names();
+        self.only_known(obj, "axes", names)?;
+        names
+            .iter()
+            .map(|&name| {
+                let field = format!("axes.{name}");
+                let a = obj.get(name).ok_or_else(|| {
+                    self.err(
+                        &field,
+                        "missing (this kinematics needs every one of its axes)",
+                    )
+                })?;
+                let a = self.object(a, &field)?;
+                self.only_known(a, &field, &["velocity", "acceleration"])?;
+                Ok(Axis {
+                    name: name.to_string(),
+                    kind: KinematicsSpec::axis_kind(name),
+                    velocity: self.limit(a.get("velocity"), &format!("{field}.velocity"))?,
+                    acceleration: self
+                        .limit(a.get("acceleration"), &format!("{field}.acceleration"))?,
+                })
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,217 @@
+//! The pipeline, end to end: machine + toolpath in, time-optimal [`Solution`] out.
+//!
+//! toolpath → kinematics (rotary angles on one branch) → geometry (spans, splines) →
+//! constraints (rows on b = u̇² at stations) → solver (Clarabel) → schedule (eq. 43).
+//!
+//! Every CL point is a station, and each CL segment is divided further (see
+//! [`constraints::stations`](crate::constraints::stations)). Unless a station count is given,
+//! the stations are refined automatically: every interval is halved until doubling the stations
+//! changes the cycle time by less than [`Options::convergence`] (0.1 %); the finer solution is
+//! returned.
+
+use crate::constraints::{Grid, SpanProblem};
+use crate::error::{Error, Result};
+use crate::geometry::{GeometryOptions, Path, SpanKind};
+use crate::kinematics::Kinematics;
+use crate::machine::Machine;
+use crate::schedule::Schedule;
+use crate::solver::{self, SolverSettings, SpanSolution, Status};
+use crate::toolpath::Toolpath;
+
+/// Options of a solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    pub geometry: GeometryOptions,
+    /// Station intervals over the whole path (at least; every CL point is also a station);
+    /// `None`: choose automatically.
+    pub stations: Option<usize>,
+    pub solver: SolverSettings,
+    /// Relative change of the cycle time under doubling the stations that counts as converged.
+    pub convergence: f64,
+    /// Stations to start the automatic refinement from.
+    pub initial_stations: usize,
+    /// Refinement stops with an error beyond this many stations.
+    pub max_stations: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            geometry: GeometryOptions::default(),
+            stations: None,
+            solver: SolverSettings::default(),
+            convergence: 1e-3,
+            initial_stations: 1000,
+            max_stations: 4_000_000,
+        }
+    }
+}
+
+/// One step of the automatic refinement.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Refinement {
+    pub stations: usize,
+    pub cycle_time_s: f64,
+}
+
+/// Everything a solve produced.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    pub path: Path,
+    pub kinematics: Kinematics,
+    pub problems: Vec<SpanProblem>,
+    pub solutions: Vec<SpanSolution>,
+    pub schedule: Schedule,
+    /// The worst status over all spans.
+    pub status: Status,
+    /// Interior-point iterations, summed over spans (final station count).
+    pub iterations: u32,
+    /// Solver time, summed over spans (final station count), s.
+    pub solve_time: f64,
+    /// Station counts tried and their cycle times.
+    pub refinement: Vec<Refinement>,
+}
+
+impl Solution {
+    /// Total number of stations.
+    pub fn stations(&self) -> usize {
+        self.schedule.stations.len()
+    }
+}
+
+/// Computes the time-optimal schedule of `toolpath` on `machine`.
+pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Result<Solution> {
+    let kin = Kinematics::new(machine);
+    let orientations: Vec<_> = toolpath.points.iter().map(|p| p.o).collect();
+    let lines: Vec<usize> = toolpath.points.iter().map(|p| p.line).collect();
+    let angles = kin.rotary_angles(&orientations, &lines)?;
+    let path = Path::build(
+        toolpath,
+        &angles,
+        machine.feed_max,
+        kin.uses_orientation(),
+        &options.geometry,
+    )?;
+    if path.spans.is_empty() {
+        return Err(Error::parse(
+            &toolpath.source,
+            toolpath.points.first().map_or(1, |p| p.line),
+            "no motion: every CL point is at the same position",
+        ));
+    }
+    let axes: Vec<String> = machine.axes.iter().map(|a| a.name.clone()).collect();
+    let weights = span_weights(&path);
+    let mut refinement = Vec::new();
+    let total = options.stations.unwrap_or(options.initial_stations);
+    let mut last: Option<Solution> = None;
+    for level in 0.. {
+        let sol = solve_at(machine, &kin, &path, &axes, &weights, total, level, options)?;
+        refinement.push(Refinement {
+            stations: sol.stations(),
+            cycle_time_s: sol.schedule.cycle_time,
+        });
+        if options.stations.is_some() {
+            return Ok(Solution { refinement, ..sol });
+        }
+        if let Some(prev) = &last {
+            let (a, b) = (prev.schedule.cycle_time, sol.schedule.cycle_time);
+            if (a - b).abs() <= options.convergence * b {
+                return Ok(Solution { refinement, ..sol });
+            }
+        }
+        if 2 * sol.stations() > options.max_stations {
+            return Err(Error::Solver(format!(
+                "the cycle time did not converge to {} within {} stations (last: {:?})",
+                options.convergence, options.max_stations, refinement
+            )));
+        }
+        last = Some(sol);
+    }
+    unreachable!("the refinement loop returns")
+}
+
+/// Each span's share of the stations: half by its share of CL moves, half by its share of
+/// the path parameter among spans of its kind.
+fn span_weights(path: &Path) -> Vec<f64> {
+    let segs: f64 = path.spans.iter().map(|s| s.feed_caps.len() as f64).sum();
+    let len_of = |kind| -> f64 {
+        path.spans
+            .iter()
+            .filter(|s| s.kind == kind)
+            .map(|s| s.length())
+            .sum()
+    };
+    let (lm, lr) = (len_of(SpanKind::Moving), len_of(SpanKind::Reorientation));
+    let share_kind = |kind| {
+        path.spans
+            .iter()
+            .filter(|s| s.kind == kind)
+            .map(|s| s.feed_caps.len() as f64)
+            .sum::<f64>()
+            / segs
+    };
+    let (sm, sr) = (
+        share_kind(SpanKind::Moving),
+        share_kind(SpanKind::Reorientation),
+    );
+    path.spans
+        .iter()
+        .map(|s| {
+            let by_len = match s.kind {
+                SpanKind::Moving => sm * s.length() / lm,
+                SpanKind::Reorientation => sr * s.length() / lr,
+            };
+            0.5 * s.feed_caps.len() as f64 / segs + 0.5 * by_len
+        })
+        .collect()
+}
+
+fn solve_at(
+    machine: &Machine,
+    kin: &Kinematics,
+    path: &Path,
+    axes: &[String],
+    weights: &[f64],
+    total: usize,
+    level: u32,
+    options: &Options,
+) -> Result<Solution> {
+    let mut problems = Vec::with_capacity(path.spans.len());
+    let mut solutions = Vec::with_capacity(path.spans.len());
+    let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
+    for (si, (span, w)) in path.spans.iter().zip(weights).enumerate() {
+        // Level ℓ halves every interval of level 0 ℓ times.
+        let parts = 1usize << level;
+        let spacing = span.length() / (total as f64 * w).max(8.0) / parts as f64;
+        let grid = Grid {
+            spacing,
+            min_parts: parts,
+        };
+        let p = SpanProblem::build(span, kin, machine, grid);
+        let s = solver::clarabel::solve(&p, &options.solver).map_err(|e| match e {
+            Error::Infeasible(m) => Error::Infeasible(format!(
+                "span {si} (CL lines {}–{}): {m}",
+                span.lines[0],
+                span.lines[span.lines.len() - 1]
+            )),
+            other => other,
+        })?;
+        status = status.worst(s.status);
+        iterations += s.iterations;
+        solve_time += s.solve_time;
+        problems.push(p);
+        solutions.push(s);
+    }
+    let schedule = Schedule::build(axes, &path.spans, &problems, &solutions)?;
+    Ok(Solution {
+        path: path.clone(),
+        kinematics: kin.clone(),
+        problems,
+        solutions,
+        schedule,
+        status,
+        iterations,
+        solve_time,
+        refinement: Vec::new(),
+    })
+}

@@ -1,0 +1,197 @@
+//! Report: what a person reads after a solve — cycle time, solver figures, how close each axis
+//! comes to its limits, and which limit holds the feed down over what share of the path.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use crate::constraints::Bound;
+use crate::machine::Machine;
+use crate::optimize::{Refinement, Solution};
+use crate::solver::Status;
+
+/// A constraint counts as binding when used to within this fraction of its limit.
+pub const BINDING_TOLERANCE: f64 = 1e-3;
+
+/// Peak use of an axis's limits.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct AxisPeaks {
+    /// max |q̇| / v over the schedule (on the side of the sign of q̇).
+    pub peak_velocity_ratio: f64,
+    /// max |q̈| / a over the schedule, at both ends of every interval.
+    pub peak_acceleration_ratio: f64,
+}
+
+/// Share of the path over which one limit holds the feed down.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BindingShare {
+    /// e.g. `"feed"`, `"C velocity"`, `"A acceleration"`, `"none"`.
+    pub limit: String,
+    /// Share of the tool-tip path length (0–1).
+    pub share_of_path: f64,
+    /// Share of the cycle time (0–1).
+    pub share_of_time: f64,
+}
+
+/// The summary of a solve (what `feedopt solve --json` prints).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Summary {
+    pub machine: String,
+    pub toolpath: String,
+    pub cycle_time_s: f64,
+    pub stations: usize,
+    pub spans: usize,
+    pub status: Status,
+    pub iterations: u32,
+    pub solve_time_s: f64,
+    /// Tool-tip path length, mm.
+    pub path_length_mm: f64,
+    pub axes: BTreeMap<String, AxisPeaks>,
+    pub binding: Vec<BindingShare>,
+    pub refinement: Vec<Refinement>,
+}
+
+impl Summary {
+    pub fn new(machine: &Machine, toolpath: &str, sol: &Solution) -> Summary {
+        let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
+        let na = names.len();
+        let mut vel = vec![0.0f64; na];
+        let mut acc = vec![0.0f64; na];
+        let mut by_bound: BTreeMap<Bound, (f64, f64)> = BTreeMap::new();
+        let st = &sol.schedule.stations;
+        let mut offset = 0;
+        for (p, s) in sol.problems.iter().zip(&sol.solutions) {
+            let b = &s.b;
+            for i in 0..p.u.len() {
+                for (j, axis) in machine.axes.iter().enumerate() {
+                    let qd = p.jets[i].dq[j] * b[i].sqrt();
+                    vel[j] = vel[j].max(axis.velocity.ratio(qd));
+                }
+            }
+            for k in 0..p.intervals() {
+                let mut best = (0.0, Bound::None);
+                for e in [k, k + 1] {
+                    if p.b_max[e].is_finite() && p.b_max[e] > 0.0 {
+                        let r = b[e] / p.b_max[e];
+                        if r > best.0 {
+                            best = (r, p.b_max_by[e]);
+                        }
+                    }
+                    for (j, lim) in p.acceleration.iter().enumerate() {
+                        let r = lim.ratio(p.axis_acceleration(b, k, e, j));
+                        acc[j] = acc[j].max(r);
+                        if r > best.0 {
+                            best = (r, Bound::AxisAcceleration(j));
+                        }
+                    }
+                }
+                let bound = if best.0 >= 1.0 - BINDING_TOLERANCE {
+                    best.1
+                } else {
+                    Bound::None
+                };
+                let (a, z) = (&st[offset + k], &st[offset + k + 1]);
+                let e = by_bound.entry(bound).or_insert((0.0, 0.0));
+                e.0 += z.s - a.s;
+                e.1 += z.t - a.t;
+            }
+            offset += p.u.len();
+        }
+        let length = st.last().map_or(0.0, |s| s.s);
+        let time = sol.schedule.cycle_time;
+        let label = |b: Bound| match b {
+            Bound::AxisVelocity(j) => format!("{} velocity", names[j]),
+            Bound::AxisAcceleration(j) => format!("{} acceleration", names[j]),
+            Bound::Feed => "feed".to_string(),
+            Bound::None => "none".to_string(),
+        };
+        let mut binding: Vec<BindingShare> = by_bound
+            .into_iter()
+            .map(|(b, (ds, dt))| BindingShare {
+                limit: label(b),
+                share_of_path: if length > 0.0 { ds / length } else { 0.0 },
+                share_of_time: if time > 0.0 { dt / time } else { 0.0 },
+            })
+            .collect();
+        binding.sort_by(|a, b| b.share_of_time.total_cmp(&a.share_of_time));
+        Summary {
+            machine: machine.name.clone(),
+            toolpath: toolpath.to_string(),
+            cycle_time_s: time,
+            stations: sol.stations(),
+            spans: sol.problems.len(),
+            status: sol.status,
+            iterations: sol.iterations,
+            solve_time_s: sol.solve_time,
+            path_length_mm: length,
+            axes: names
+                .iter()
+                .enumerate()
+                .map(|(j, n)| {
+                    (
+                        n.to_string(),
+                        AxisPeaks {
+                            peak_velocity_ratio: vel[j],
+                            peak_acceleration_ratio: acc[j],
+                        },
+                    )
+                })
+                .collect(),
+            binding,
+            refinement: sol.refinement.clone(),
+        }
+    }
+}
+
+impl fmt::Display for Summary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "toolpath      {}", self.toolpath)?;
+        writeln!(f, "machine       {}", self.machine)?;
+        writeln!(f, "cycle time    {:.4} s", self.cycle_time_s)?;
+        writeln!(f, "path length   {:.3} mm", self.path_length_mm)?;
+        let steps: Vec<String> = self
+            .refinement
+            .iter()
+            .map(|r| r.stations.to_string())
+            .collect();
+        writeln!(
+            f,
+            "stations      {} in {} span(s) (tried {})",
+            self.stations,
+            self.spans,
+            steps.join(" → ")
+        )?;
+        let status = match self.status {
+            Status::Optimal => "optimal",
+            Status::AlmostOptimal => "almost optimal (reduced accuracy)",
+        };
+        writeln!(
+            f,
+            "solver        Clarabel: {status}, {} iterations, {:.3} s",
+            self.iterations, self.solve_time_s
+        )?;
+        writeln!(f)?;
+        writeln!(f, "axis   peak |q̇|/v   peak |q̈|/a")?;
+        for (name, p) in &self.axes {
+            writeln!(
+                f,
+                "{name:<6} {:>10.3}   {:>10.3}",
+                p.peak_velocity_ratio, p.peak_acceleration_ratio
+            )?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "limit holding the feed down   share of path   share of time"
+        )?;
+        for b in &self.binding {
+            writeln!(
+                f,
+                "{:<29} {:>12.1} %  {:>12.1} %",
+                b.limit,
+                100.0 * b.share_of_path,
+                100.0 * b.share_of_time
+            )?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,231 @@
+//! The minimum-time profile as a second-order cone program, solved by Clarabel.
+//!
+//! Variables, with b scaled by a constant B so they are of order one (x = b/B): at every
+//! interior station x_i and c_i, and on every interval d_k. The problem is
+//!
+//! ```text
+//! minimise   Σ_k 2Δu_k/√B · d_k                   (= Σ 2Δu_k/(√b_k + √b_{k+1}), eq. 43)
+//! subject to c_i² ≤ x_i                              (rotated cone: c_i ≤ √x_i)
+//!            d_k (c_k + c_{k+1}) ≥ 1                 (rotated cone)
+//!            x_i ≤ b_max_i / B                       (all velocity limits and the feed)
+//!            a_min ≤ B (q''_e x_e + q'_e (x_{k+1} − x_k)/(2Δu_k)) ≤ a_max   at both ends e of k
+//! ```
+//!
+//! The end stations are not variables: b_0 and b_N (and c = √b there) are constants, so no
+//! cone is left without interior (a cone `c_0² ≤ b_0` with b_0 fixed to 0 has none and makes
+//! Clarabel stop at AlmostSolved). Rows whose coefficients all vanish (an axis that does not
+//! move) are dropped.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use super::{SolverSettings, SpanSolution, Status};
+use crate::constraints::SpanProblem;
+use crate::error::{Error, Result};
+
+/// Column indices of the variables.
+struct Layout {
+    n: usize,
+}
+
+impl Layout {
+    /// x_i for interior station i (1 ≤ i ≤ N−1).
+    fn x(&self, i: usize) -> usize {
+        3 * (i - 1)
+    }
+    fn c(&self, i: usize) -> usize {
+        3 * (i - 1) + 1
+    }
+    /// d_k for interval k (0 ≤ k ≤ N−1).
+    fn d(&self, k: usize) -> usize {
+        if k + 1 < self.n {
+            3 * k + 2
+        } else {
+            3 * (self.n - 1)
+        }
+    }
+    fn len(&self) -> usize {
+        3 * (self.n - 1) + 1
+    }
+}
+
+/// A sparse row block under construction (triplets), with its right-hand side.
+#[derive(Default)]
+struct Rows {
+    i: Vec<usize>,
+    j: Vec<usize>,
+    v: Vec<f64>,
+    h: Vec<f64>,
+}
+
+impl Rows {
+    fn push(&mut self, coefs: &[(usize, f64)], h: f64) {
+        let r = self.h.len();
+        for &(j, v) in coefs {
+            if v != 0.0 {
+                self.i.push(r);
+                self.j.push(j);
+                self.v.push(v);
+            }
+        }
+        self.h.push(h);
+    }
+}
+
+/// Solves one span's problem.
+pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution> {
+    let n = p.intervals();
+    let lay = Layout { n };
+    let scale = {
+        let finite = p.b_max.iter().copied().filter(|b| b.is_finite());
+        let m = finite.fold(0.0, f64::max);
+        if m > 0.0 { m } else { 1.0 }
+    };
+    let (x0, xn) = (p.b_start / scale, p.b_end / scale);
+    let (c0, cn) = (x0.sqrt(), xn.sqrt());
+    // A variable or a constant: Some(column) for interior stations.
+    let xvar = |i: usize| (i > 0 && i < n).then(|| lay.x(i));
+    let xconst = |i: usize| if i == 0 { x0 } else { xn };
+
+    // Nonnegative rows: A x + s = h, s ≥ 0, i.e. A x ≤ h.
+    let mut lin = Rows::default();
+    for i in 1..n {
+        if p.b_max[i].is_finite() {
+            lin.push(&[(lay.x(i), 1.0)], p.b_max[i] / scale);
+        }
+    }
+    for k in 0..n {
+        let inv2du = 1.0 / (2.0 * p.du(k));
+        for e in [k, k + 1] {
+            for (j, lim) in p.acceleration.iter().enumerate() {
+                let (dq, ddq) = (p.jets[e].dq[j], p.jets[e].ddq[j]);
+                if dq == 0.0 && ddq == 0.0 {
+                    continue;
+                }
+                // row(x) = B (ddq x_e + dq (x_{k+1} − x_k)/(2Δu)) as coefficients + constant.
+                let mut coefs: Vec<(usize, f64)> = Vec::with_capacity(3);
+                let mut constant = 0.0;
+                let mut add = |i: usize, v: f64| match xvar(i) {
+                    Some(col) => coefs.push((col, v * scale)),
+                    None => constant += v * scale * xconst(i),
+                };
+                add(e, ddq);
+                add(k + 1, dq * inv2du);
+                add(k, -dq * inv2du);
+                merge_duplicates(&mut coefs);
+                // ≤ a_max and ≥ a_min, each row normalised by its limit.
+                let up: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / lim.max)).collect();
+                lin.push(&up, 1.0 - constant / lim.max);
+                let lo: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / lim.min)).collect();
+                lin.push(&lo, 1.0 - constant / lim.min);
+            }
+        }
+    }
+    let n_lin = lin.h.len();
+
+    // Second-order cones (3 rows each), appended after the linear rows.
+    let mut soc = Rows::default();
+    for i in 1..n {
+        // (x + 1, x − 1, 2c) ∈ SOC  ⇔  c² ≤ x.
+        soc.push(&[(lay.x(i), -1.0)], 1.0);
+        soc.push(&[(lay.x(i), -1.0)], -1.0);
+        soc.push(&[(lay.c(i), -2.0)], 0.0);
+    }
+    for k in 0..n {
+        // (d + e, d − e, 2) ∈ SOC with e = c_k + c_{k+1}  ⇔  d e ≥ 1.
+        let mut plus = vec![(lay.d(k), -1.0)];
+        let mut minus = vec![(lay.d(k), -1.0)];
+        let mut e_const = 0.0;
+        for i in [k, k + 1] {
+            if i > 0 && i < n {
+                plus.push((lay.c(i), -1.0));
+                minus.push((lay.c(i), 1.0));
+            } else {
+                e_const += if i == 0 { c0 } else { cn };
+            }
+        }
+        soc.push(&plus, e_const);
+        soc.push(&minus, -e_const);
+        soc.push(&[], 2.0);
+    }
+    let n_soc = soc.h.len() / 3;
+
+    // Assemble A = [lin; soc].
+    let m = n_lin + soc.h.len();
+    let mut ri = lin.i;
+    ri.extend(soc.i.iter().map(|r| r + n_lin));
+    let mut cj = lin.j;
+    cj.extend(soc.j);
+    let mut vv = lin.v;
+    vv.extend(soc.v);
+    let mut h = lin.h;
+    h.extend(soc.h);
+    let nv = lay.len();
+    let a = CscMatrix::new_from_triplets(m, nv, ri, cj, vv);
+    let pmat = CscMatrix::zeros((nv, nv));
+    let mut q = vec![0.0; nv];
+    for k in 0..n {
+        q[lay.d(k)] = 2.0 * p.du(k) / scale.sqrt();
+    }
+    let mut cones = Vec::with_capacity(1 + n_soc);
+    if n_lin > 0 {
+        cones.push(SupportedConeT::NonnegativeConeT(n_lin));
+    }
+    cones.extend(std::iter::repeat_n(
+        SupportedConeT::SecondOrderConeT(3),
+        n_soc,
+    ));
+
+    let s = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(settings.max_iter)
+        .tol_gap_rel(settings.tol_gap_rel)
+        .build()
+        .map_err(|e| Error::Solver(format!("settings: {e:?}")))?;
+    let mut solver = DefaultSolver::new(&pmat, &q, &a, &h, &cones, s)
+        .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
+    solver.solve();
+    let sol = &solver.solution;
+    let status = match sol.status {
+        SolverStatus::Solved => Status::Optimal,
+        SolverStatus::AlmostSolved => Status::AlmostOptimal,
+        other => {
+            return Err(match other {
+                SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                    Error::Infeasible(
+                        "no feed profile meets every limit on this span (Clarabel: primal infeasible)"
+                            .into(),
+                    )
+                }
+                _ => Error::Solver(format!("Clarabel stopped with status {other:?}")),
+            });
+        }
+    };
+    let mut b = Vec::with_capacity(n + 1);
+    b.push(p.b_start);
+    for i in 1..n {
+        b.push((sol.x[lay.x(i)] * scale).max(0.0));
+    }
+    b.push(p.b_end);
+    Ok(SpanSolution {
+        b,
+        status,
+        iterations: sol.iterations,
+        solve_time: sol.solve_time,
+    })
+}
+
+/// Sums coefficients that share a column (x_e may also be x_k or x_{k+1}).
+fn merge_duplicates(coefs: &mut Vec<(usize, f64)>) {
+    coefs.sort_by_key(|c| c.0);
+    coefs.dedup_by(|later, first| {
+        if later.0 == first.0 {
+            first.1 += later.1;
+            true
+        } else {
+            false
+        }
+    });
+}

@@ -1,0 +1,53 @@
+//! Solvers: a [`SpanProblem`](crate::constraints::SpanProblem) in, the optimal b = u̇² at every
+//! station out.
+//!
+//! [`clarabel`] states the minimum-time problem as a second-order cone program (Verscheure et
+//! al. 2009; Lipp & Boyd 2014) and solves it with the Clarabel interior-point solver.
+
+pub mod clarabel;
+
+/// How a solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Solved to the solver's full tolerances.
+    Optimal,
+    /// Solved to the solver's reduced tolerances.
+    AlmostOptimal,
+}
+
+impl Status {
+    /// The worse of two statuses.
+    pub fn worst(self, other: Status) -> Status {
+        if self == Status::Optimal { other } else { self }
+    }
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// Interior-point iteration cap.
+    pub max_iter: u32,
+    /// Relative duality-gap tolerance.
+    pub tol_gap_rel: f64,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            max_iter: 200,
+            tol_gap_rel: 1e-8,
+        }
+    }
+}
+
+/// The optimal profile of one span.
+#[derive(Debug, Clone)]
+pub struct SpanSolution {
+    /// b = u̇² at every station.
+    pub b: Vec<f64>,
+    pub status: Status,
+    pub iterations: u32,
+    /// Wall time of the solver proper (s), excluding problem build.
+    pub solve_time: f64,
+}

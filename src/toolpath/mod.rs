@@ -1,0 +1,61 @@
+//! Toolpath readers: files in, plain [`Toolpath`] data out.
+//!
+//! A toolpath is a list of cutter-location (CL) points in workpiece coordinates: tool-tip
+//! position **P** (mm), unit tool orientation **O**, and the feed programmed for the move that
+//! arrives at the point. Readers never interpolate or judge geometry; that is
+//! [`crate::geometry`]'s job.
+
+pub mod apt;
+
+use nalgebra::Vector3;
+use std::path::{Path, PathBuf};
+
+use crate::error::Result;
+
+/// How fast the move that arrives at a CL point may run, as the program says.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Feed {
+    /// A programmed feed in mm/s (already converted from the file's per-minute unit).
+    Programmed(f64),
+    /// A rapid move: the machine's maximum feed applies.
+    Rapid,
+    /// No feed was programmed before this move: the machine's maximum feed applies.
+    Unspecified,
+}
+
+/// One cutter-location point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClPoint {
+    /// Tool-tip position in workpiece coordinates, mm.
+    pub p: Vector3<f64>,
+    /// Unit tool orientation (from tip towards the spindle), normalised by the reader.
+    pub o: Vector3<f64>,
+    /// Feed of the move that ends at this point (the first point's feed is unused).
+    pub feed: Feed,
+    /// 1-based line in the source file where the record starts.
+    pub line: usize,
+}
+
+/// A toolpath as read from a file: CL points in program order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Toolpath {
+    /// The file it came from (for error messages).
+    pub source: PathBuf,
+    pub points: Vec<ClPoint>,
+}
+
+/// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL).
+pub fn read(path: &Path) -> Result<Toolpath> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "cls" | "apt" | "cl" => apt::read(path),
+        other => Err(crate::error::Error::Usage(format!(
+            "{}: unknown toolpath format `.{other}` (expected .cls or .apt)",
+            path.display()
+        ))),
+    }
+}
