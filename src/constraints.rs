@@ -48,6 +48,10 @@ pub struct SpanProblem {
     pub jets: Vec<AxisJets>,
     /// Acceleration limit of each axis.
     pub acceleration: Vec<Limit>,
+    /// Acceleration rows that shape the feasible set at each station (bit 2j: axis j's
+    /// `≤ a_max` row, bit 2j+1: its `≥ a_min` row); the others are implied (see
+    /// [`essential_rows`]).
+    pub essential: Vec<u16>,
     /// b at the first and last station (0: at rest).
     pub b_start: f64,
     pub b_end: f64,
@@ -97,18 +101,30 @@ impl SpanProblem {
             b_max.push(best.0);
             b_max_by.push(best.1);
         }
+        let acceleration: Vec<Limit> = machine
+            .axes
+            .iter()
+            .take(na)
+            .map(|a| a.acceleration)
+            .collect();
+        let mut essential = Vec::with_capacity(n + 1);
+        for i in 0..=n {
+            let (rows, b_star, by) = essential_rows(&jets[i], &acceleration, b_max[i]);
+            essential.push(rows);
+            // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
+            if b_star < b_max[i] {
+                b_max[i] = b_star;
+                b_max_by[i] = by;
+            }
+        }
         SpanProblem {
             u,
             b_max,
             b_max_by,
             tip_speed,
             jets,
-            acceleration: machine
-                .axes
-                .iter()
-                .take(na)
-                .map(|a| a.acceleration)
-                .collect(),
+            acceleration,
+            essential,
             b_start: 0.0,
             b_end: 0.0,
         }
@@ -185,4 +201,141 @@ fn station_feed_caps(span: &Span, u: &[f64]) -> Vec<f64> {
                 .fold(f64::INFINITY, f64::min)
         })
         .collect()
+}
+
+/// The acceleration rows at one station that are edges of its feasible polygon.
+///
+/// At station e every acceleration row involves only (b_e, ü) — with ü of either neighbouring
+/// interval, but the same rows for both. So the rows and `0 ≤ b ≤ b_max` cut out one polygon in
+/// the (b, ü) plane. A row that is no edge of it is implied by the others and can be dropped
+/// without changing the problem: an exact presolve, which leaves typically two to four of the
+/// 2 × axes rows. Writing each row as a line ü = α + β b, the polygon is bounded above by the
+/// lower envelope of the "ü ≤" lines and below by the upper envelope of the "ü ≥" lines; the
+/// rows kept are those on an envelope somewhere on the feasible b range.
+///
+/// Returns the row mask, the largest feasible b* (the acceleration-limited maximum-velocity
+/// curve at the station, at most `b_max`) and the limit that sets it.
+pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64, Bound) {
+    const ALL: u16 = u16::MAX;
+    // (α, β, row bit, is an upper bound on ü)
+    let mut lines: [(f64, f64, u16, bool); 2 * crate::kinematics::MAX_AXES] =
+        [(0.0, 0.0, 0, false); 2 * crate::kinematics::MAX_AXES];
+    let mut nl = 0;
+    let mut b_hi = b_max;
+    let mut b_rows: u16 = 0; // rows with q' = 0: a bound on b alone
+    let mut b_row_bound = f64::INFINITY;
+    for (j, lim) in limits.iter().enumerate() {
+        let (d, dd) = (jet.dq[j], jet.ddq[j]);
+        for (bit, a, is_max) in [
+            (1u16 << (2 * j), lim.max, true),
+            (1u16 << (2 * j + 1), lim.min, false),
+        ] {
+            if d != 0.0 {
+                // dd b + d ü ≤ a (is_max) or ≥ a: ü on the side given by the sign of d.
+                lines[nl] = (a / d, -dd / d, bit, is_max == (d > 0.0));
+                nl += 1;
+            } else if dd != 0.0 && (a / dd) > 0.0 {
+                // dd b ≤ a_max (dd > 0) or dd b ≥ a_min (dd < 0): b ≤ a/dd.
+                let bound = a / dd;
+                if bound < b_row_bound {
+                    b_row_bound = bound;
+                    b_rows = bit;
+                }
+            }
+        }
+    }
+    let mut keep: u16 = 0;
+    if b_row_bound <= b_hi {
+        b_hi = b_row_bound;
+        keep |= b_rows;
+    }
+    let row_axis = |bits: u16| Bound::AxisAcceleration(bits.trailing_zeros() as usize / 2);
+    if nl == 0 {
+        return if b_hi.is_finite() {
+            (
+                keep,
+                b_hi,
+                if keep != 0 {
+                    row_axis(keep)
+                } else {
+                    Bound::None
+                },
+            )
+        } else {
+            (ALL, b_max, Bound::None)
+        };
+    }
+    let lines = &lines[..nl];
+    let upper = |b: f64| {
+        lines
+            .iter()
+            .filter(|l| l.3)
+            .map(|l| (l.0 + l.1 * b, l.2))
+            .fold((f64::INFINITY, 0u16), |m, x| if x.0 < m.0 { x } else { m })
+    };
+    let lower = |b: f64| {
+        lines
+            .iter()
+            .filter(|l| !l.3)
+            .map(|l| (l.0 + l.1 * b, l.2))
+            .fold(
+                (f64::NEG_INFINITY, 0u16),
+                |m, x| if x.0 > m.0 { x } else { m },
+            )
+    };
+    // Breakpoints: every pairwise intersection inside (0, b_hi).
+    let mut pts: Vec<f64> = Vec::with_capacity(2 + nl * (nl - 1) / 2);
+    pts.push(0.0);
+    pts.push(b_hi);
+    for (i, a) in lines.iter().enumerate() {
+        for c in &lines[i + 1..] {
+            if a.1 != c.1 {
+                let b = (c.0 - a.0) / (a.1 - c.1);
+                if b > 0.0 && b < b_hi {
+                    pts.push(b);
+                }
+            }
+        }
+    }
+    pts.sort_by(f64::total_cmp);
+    // The gap U(b) − L(b) is concave and ≥ 0 at b = 0: the feasible b form [0, b*].
+    let gap = |b: f64| upper(b).0 - lower(b).0;
+    let mut b_star = b_hi;
+    for w in pts.windows(2) {
+        let (g0, g1) = (gap(w[0]), gap(w[1]));
+        if g1 < 0.0 {
+            b_star = if g0 > 0.0 {
+                w[0] + (w[1] - w[0]) * g0 / (g0 - g1)
+            } else {
+                w[0]
+            };
+            break;
+        }
+    }
+    if !(b_star > 0.0 && b_star.is_finite()) {
+        // Degenerate (only rest is feasible here) or unbounded: keep every row.
+        return (ALL, b_max, Bound::None);
+    }
+    if b_star < b_hi {
+        keep &= 0; // the b-only rows are not edges if the envelopes close the polygon first
+    }
+    let mut prev = 0.0;
+    for &p in pts.iter().skip(1).chain(std::iter::once(&b_star)) {
+        let p = p.min(b_star);
+        if p > prev {
+            let mid = 0.5 * (prev + p);
+            keep |= upper(mid).1 | lower(mid).1;
+            prev = p;
+        }
+    }
+    // The rows meeting at b = 0 and at b* (vertices) are edges adjacent to the kept ones.
+    keep |= upper(0.0).1 | lower(0.0).1 | upper(b_star).1 | lower(b_star).1;
+    let by = if b_star < b_hi {
+        row_axis(upper(b_star).1)
+    } else if b_rows != 0 && b_hi < b_max {
+        row_axis(b_rows)
+    } else {
+        Bound::None
+    };
+    (keep, b_star, by)
 }

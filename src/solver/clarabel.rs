@@ -14,7 +14,8 @@
 //! The end stations are not variables: b_0 and b_N (and c = √b there) are constants, so no
 //! cone is left without interior (a cone `c_0² ≤ b_0` with b_0 fixed to 0 has none and makes
 //! Clarabel stop at AlmostSolved). Rows whose coefficients all vanish (an axis that does not
-//! move) are dropped.
+//! move) are dropped, and so are acceleration rows implied by the others at their station
+//! ([`essential_rows`](crate::constraints::essential_rows)).
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -79,9 +80,19 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
     let n = p.intervals();
     let lay = Layout { n };
     let scale = {
-        let finite = p.b_max.iter().copied().filter(|b| b.is_finite());
-        let m = finite.fold(0.0, f64::max);
-        if m > 0.0 { m } else { 1.0 }
+        // The median finite bound: robust against stations where an axis barely moves.
+        let mut finite: Vec<f64> = p
+            .b_max
+            .iter()
+            .copied()
+            .filter(|b| b.is_finite() && *b > 0.0)
+            .collect();
+        if finite.is_empty() {
+            1.0
+        } else {
+            let mid = finite.len() / 2;
+            *finite.select_nth_unstable_by(mid, f64::total_cmp).1
+        }
     };
     let (x0, xn) = (p.b_start / scale, p.b_end / scale);
     let (c0, cn) = (x0.sqrt(), xn.sqrt());
@@ -101,7 +112,8 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
         for e in [k, k + 1] {
             for (j, lim) in p.acceleration.iter().enumerate() {
                 let (dq, ddq) = (p.jets[e].dq[j], p.jets[e].ddq[j]);
-                if dq == 0.0 && ddq == 0.0 {
+                let rows = p.essential[e] >> (2 * j);
+                if (dq == 0.0 && ddq == 0.0) || rows & 3 == 0 {
                     continue;
                 }
                 // row(x) = B (ddq x_e + dq (x_{k+1} − x_k)/(2Δu)) as coefficients + constant.
@@ -116,10 +128,12 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
                 add(k, -dq * inv2du);
                 merge_duplicates(&mut coefs);
                 // ≤ a_max and ≥ a_min, each row normalised by its limit.
-                let up: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / lim.max)).collect();
-                lin.push(&up, 1.0 - constant / lim.max);
-                let lo: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / lim.min)).collect();
-                lin.push(&lo, 1.0 - constant / lim.min);
+                for (bit, a) in [(1, lim.max), (2, lim.min)] {
+                    if rows & bit != 0 {
+                        let c: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / a)).collect();
+                        lin.push(&c, 1.0 - constant / a);
+                    }
+                }
             }
         }
     }
