@@ -193,9 +193,11 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
     ));
 
     let s = DefaultSettingsBuilder::default()
-        .verbose(false)
+        .verbose(std::env::var_os("FEEDOPT_SOLVER_VERBOSE").is_some())
         .max_iter(settings.max_iter)
-        .tol_gap_rel(settings.tol_gap_rel)
+        .tol_gap_rel(settings.tol_gap)
+        .tol_gap_abs(settings.tol_gap)
+        .tol_feas(settings.tol_feas)
         .build()
         .map_err(|e| Error::Solver(format!("settings: {e:?}")))?;
     let mut solver = DefaultSolver::new(&pmat, &q, &a, &h, &cones, s)

@@ -28,15 +28,20 @@ impl Status {
 pub struct SolverSettings {
     /// Interior-point iteration cap.
     pub max_iter: u32,
-    /// Relative duality-gap tolerance.
-    pub tol_gap_rel: f64,
+    /// Duality-gap tolerance (absolute and relative) on the cycle time. 1e-7 is far below the
+    /// discretisation error the station refinement accepts (1e-3), and spares the solver the
+    /// last iterations, where it can stall at 1e-8 and report reduced accuracy.
+    pub tol_gap: f64,
+    /// Primal and dual feasibility tolerance (relative): how far a row may be violated.
+    pub tol_feas: f64,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
         SolverSettings {
             max_iter: 200,
-            tol_gap_rel: 1e-8,
+            tol_gap: 1e-7,
+            tol_feas: 1e-8,
         }
     }
 }

@@ -1,0 +1,220 @@
+//! Closed-form physics: cases whose time-optimal answer is known exactly.
+
+use std::path::PathBuf;
+
+use feedopt::machine::Machine;
+use feedopt::optimize::{Options, Solution, optimize};
+use feedopt::toolpath::{ClPoint, Feed, Toolpath};
+use nalgebra::Vector3;
+
+fn machine(json: &str) -> Machine {
+    Machine::from_json("test.json".as_ref(), json).expect("valid machine")
+}
+
+fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>) -> Toolpath {
+    Toolpath {
+        source: PathBuf::from("test.cls"),
+        points: points
+            .iter()
+            .enumerate()
+            .map(|(k, (p, o))| ClPoint {
+                p: *p,
+                o: o.normalize(),
+                feed: feed_mm_s.map_or(Feed::Unspecified, Feed::Programmed),
+                line: k + 1,
+            })
+            .collect(),
+    }
+}
+
+fn solve(m: &Machine, t: &Toolpath) -> Solution {
+    optimize(m, t, &Options::default()).expect("solves")
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+const UP: Vector3<f64> = Vector3::new(0.0, 0.0, 1.0);
+
+/// Tool tip on a circle of radius r, `turns` times round, starting at angle 0.
+fn circle(r: f64, turns: usize, per_turn: usize) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    (0..=turns * per_turn)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / per_turn as f64;
+            (Vector3::new(r * a.cos(), r * a.sin(), 0.0), UP)
+        })
+        .collect()
+}
+
+/// Stations in the middle turn of a multi-turn path (by arc length).
+fn middle(sol: &Solution, turns: f64) -> Vec<f64> {
+    let len = sol.schedule.stations.last().unwrap().s;
+    let (lo, hi) = (len * (0.5 - 0.5 / turns), len * (0.5 + 0.5 / turns));
+    sol.schedule
+        .stations
+        .iter()
+        .filter(|s| s.s >= lo && s.s <= hi)
+        .map(|s| s.v)
+        .collect()
+}
+
+const XYZ_2000: &str = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+    "axes": {"X": {"velocity": 10000, "acceleration": 2000},
+             "Y": {"velocity": 10000, "acceleration": 2000},
+             "Z": {"velocity": 10000, "acceleration": 2000}}}"#;
+
+#[test]
+fn circle_limited_by_centripetal_acceleration_runs_at_sqrt_a_r() {
+    // With equal X/Y limits a, the axis-aligned points of the circle need V²/R ≤ a from one
+    // axis alone (its tangent is zero there), so the feed dips to exactly √(aR) there and
+    // nowhere lower.
+    let (r, a) = (20.0, 2000.0);
+    let m = machine(XYZ_2000);
+    let sol = solve(&m, &toolpath(&circle(r, 7, 240), None));
+    let v = middle(&sol, 7.0);
+    let vmin = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let expect = (a * r).sqrt();
+    assert!(rel(vmin, expect) < 1e-3, "V_min {vmin} vs √(aR) {expect}");
+}
+
+#[test]
+fn circle_limited_by_the_feed_runs_at_the_feed() {
+    // F below √(aR) = 200 mm/s: the whole middle turn runs at F.
+    let m = machine(XYZ_2000);
+    let f = 150.0;
+    let sol = solve(&m, &toolpath(&circle(20.0, 7, 240), Some(f)));
+    for v in middle(&sol, 7.0) {
+        assert!(rel(v, f) < 1e-3, "V {v} vs F {f}");
+    }
+}
+
+fn line(len: f64) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    vec![(Vector3::zeros(), UP), (Vector3::new(len, 0.0, 0.0), UP)]
+}
+
+#[test]
+fn long_line_rest_to_rest_is_a_trapezoid() {
+    // T = L/F + F/a when the line is long enough to reach F (L ≥ F²/a).
+    let m = machine(XYZ_2000);
+    let (l, f, a) = (120.0, 100.0, 2000.0);
+    let sol = solve(&m, &toolpath(&line(l), Some(f)));
+    let expect = l / f + f / a;
+    assert!(
+        rel(sol.schedule.cycle_time, expect) < 1e-3,
+        "T {} vs {expect}",
+        sol.schedule.cycle_time
+    );
+}
+
+#[test]
+fn short_line_rest_to_rest_is_a_triangle() {
+    // Too short to reach F: accelerate half-way, brake the other half, T = 2√(L/a).
+    let m = machine(XYZ_2000);
+    let (l, f, a) = (2.0, 100.0, 2000.0);
+    assert!(l < f * f / a);
+    let sol = solve(&m, &toolpath(&line(l), Some(f)));
+    let expect = 2.0 * (l / a).sqrt();
+    assert!(
+        rel(sol.schedule.cycle_time, expect) < 1e-3,
+        "T {} vs {expect}",
+        sol.schedule.cycle_time
+    );
+}
+
+#[test]
+fn pure_reorientation_on_head_head_is_limited_by_c() {
+    // The tip stays put while the tool turns by Δ about the vertical at a fixed tilt: only C
+    // moves by Δ (A stays, X/Y follow with generous limits). T = Δ/v + v/a.
+    let m = machine(
+        r#"{"name": "hh", "kinematics": {"type": "head_head", "tool_length": 200},
+            "axes": {"X": {"velocity": 1e5, "acceleration": 1e6},
+                     "Y": {"velocity": 1e5, "acceleration": 1e6},
+                     "Z": {"velocity": 1e5, "acceleration": 1e6},
+                     "C": {"velocity": 120, "acceleration": 600},
+                     "A": {"velocity": 60, "acceleration": 400}},
+            "feed": {"max": 150}}"#,
+    );
+    let (delta, v, a) = (90.0f64, 120.0, 600.0);
+    let tilt = 30f64.to_radians();
+    let tip = Vector3::new(10.0, -5.0, 3.0);
+    let pts: Vec<_> = (0..=60)
+        .map(|k| {
+            let t1 = (delta * k as f64 / 60.0).to_radians();
+            let o = Vector3::new(tilt.sin() * t1.sin(), -tilt.sin() * t1.cos(), tilt.cos());
+            (tip, o)
+        })
+        .collect();
+    let sol = solve(&m, &toolpath(&pts, Some(100.0)));
+    let expect = delta / v + v / a;
+    assert!(
+        rel(sol.schedule.cycle_time, expect) < 1e-3,
+        "T {} vs {expect}",
+        sol.schedule.cycle_time
+    );
+    // The tool tip never moves, so the feed is zero throughout.
+    assert!(sol.schedule.stations.iter().all(|s| s.v == 0.0));
+}
+
+#[test]
+fn a_sharp_corner_is_an_exact_stop() {
+    // Two lines at 90°: two rest-to-rest trapezoids.
+    let m = machine(XYZ_2000);
+    let (l, f, a) = (50.0, 100.0, 2000.0);
+    let pts = vec![
+        (Vector3::zeros(), UP),
+        (Vector3::new(l, 0.0, 0.0), UP),
+        (Vector3::new(l, l, 0.0), UP),
+    ];
+    let sol = solve(&m, &toolpath(&pts, Some(f)));
+    assert_eq!(sol.problems.len(), 2);
+    let expect = 2.0 * (l / f + f / a);
+    assert!(rel(sol.schedule.cycle_time, expect) < 1e-3);
+}
+
+#[test]
+fn the_schedule_respects_every_limit_at_every_station() {
+    // A 5-axis path; peaks from the report must not exceed 1 beyond solver tolerance.
+    let m = machine(
+        r#"{"name": "hh", "kinematics": {"type": "head_head", "tool_length": 150},
+            "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                     "Y": {"velocity": 400, "acceleration": 2000},
+                     "Z": {"velocity": [-300, 200], "acceleration": [-1000, 1500]},
+                     "C": {"velocity": 90, "acceleration": 450},
+                     "A": {"velocity": 45, "acceleration": 300}},
+            "feed": {"max": 120}}"#,
+    );
+    let pts: Vec<_> = (0..=300)
+        .map(|k| {
+            let s = k as f64 / 300.0;
+            let a = std::f64::consts::TAU * s;
+            let p = Vector3::new(40.0 * a.cos(), 25.0 * (2.0 * a).sin(), 8.0 * s);
+            let t2 = (20.0 + 10.0 * a.sin()).to_radians();
+            let t1 = 1.5 * a;
+            (
+                p,
+                Vector3::new(t2.sin() * t1.sin(), -t2.sin() * t1.cos(), t2.cos()),
+            )
+        })
+        .collect();
+    let sol = solve(&m, &toolpath(&pts, None));
+    let summary = feedopt::report::Summary::new(&m, "test", &sol);
+    let mut binding = 0;
+    for (name, p) in &summary.axes {
+        assert!(p.peak_velocity_ratio <= 1.0 + 1e-6, "{name} {p:?}");
+        assert!(p.peak_acceleration_ratio <= 1.0 + 1e-6, "{name} {p:?}");
+        if p.peak_velocity_ratio > 0.999 || p.peak_acceleration_ratio > 0.999 {
+            binding += 1;
+        }
+    }
+    assert!(
+        binding >= 1,
+        "a time-optimal schedule uses some limit fully"
+    );
+    assert!(
+        sol.schedule
+            .stations
+            .iter()
+            .all(|s| s.t.is_finite() && s.v.is_finite())
+    );
+}

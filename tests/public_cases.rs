@@ -1,0 +1,49 @@
+//! The public reference cases in ../shared/cases (machine + APT CL file + a cycle time computed
+//! independently with TOPP-RA): each must come within 0.5 %. Skipped when ../shared is absent.
+
+use std::path::{Path, PathBuf};
+
+use feedopt::machine::Machine;
+use feedopt::optimize::{Options, optimize};
+use feedopt::solver::Status;
+use feedopt::toolpath;
+
+fn cases_dir() -> Option<PathBuf> {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cases");
+    d.join("references.json").exists().then_some(d)
+}
+
+#[test]
+fn public_cases_match_the_independent_reference_within_half_a_percent() {
+    let Some(dir) = cases_dir() else {
+        eprintln!("../shared/cases not present: skipped");
+        return;
+    };
+    let refs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("references.json")).unwrap())
+            .unwrap();
+    let refs = refs.as_array().expect("a list of cases");
+    assert!(!refs.is_empty());
+    for r in refs {
+        let name = r["case"].as_str().unwrap();
+        let expect = r["cycle_time_s"].as_f64().unwrap();
+        let m = Machine::from_file(&dir.join(format!("{name}.machine.json"))).unwrap();
+        let t = toolpath::read(&dir.join(format!("{name}.cls"))).unwrap();
+        let sol = optimize(&m, &t, &Options::default()).unwrap();
+        let got = sol.schedule.cycle_time;
+        let err = (got - expect) / expect;
+        eprintln!(
+            "{name}: {got:.6} s vs reference {expect:.6} s ({:+.3} %), {} stations, {:?}",
+            100.0 * err,
+            sol.stations(),
+            sol.status
+        );
+        assert!(err.abs() < 5e-3, "{name}: {got} vs {expect}");
+        assert_eq!(sol.status, Status::Optimal, "{name}");
+        assert_eq!(
+            sol.problems.len() as u64,
+            r["spans"].as_u64().unwrap(),
+            "{name}: spans"
+        );
+    }
+}
