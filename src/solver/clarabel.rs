@@ -147,22 +147,33 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
         soc.push(&[(lay.x(i), -1.0)], -1.0);
         soc.push(&[(lay.c(i), -2.0)], 0.0);
     }
+    let r = std::f64::consts::FRAC_1_SQRT_2;
     for k in 0..n {
-        // (d + e, d − e, 2) ∈ SOC with e = c_k + c_{k+1}  ⇔  d e ≥ 1.
-        let mut plus = vec![(lay.d(k), -1.0)];
-        let mut minus = vec![(lay.d(k), -1.0)];
-        let mut e_const = 0.0;
+        // d e ≥ 1 with e = c_k + c_{k+1}  ⇔  (d + e, d − e, 2) ∈ SOC. The last two coordinates
+        // are turned by 45° (which maps the cone onto itself) to (d − e − 2, d − e + 2)/√2, so
+        // that no row is a bare constant: Clarabel scales all rows of a cone alike, and a row
+        // without variables distorts that scale and stalls the solver at a 2e-7 gap.
+        let (dcol, mut e_const) = (lay.d(k), 0.0);
+        let mut cs: Vec<usize> = Vec::with_capacity(2);
         for i in [k, k + 1] {
             if i > 0 && i < n {
-                plus.push((lay.c(i), -1.0));
-                minus.push((lay.c(i), 1.0));
+                cs.push(lay.c(i));
             } else {
                 e_const += if i == 0 { c0 } else { cn };
             }
         }
-        soc.push(&plus, e_const);
-        soc.push(&minus, -e_const);
-        soc.push(&[], 2.0);
+        // Rows of s = h − A z: s0 = d + e, s1 = (d − e − 2)/√2, s2 = (d − e + 2)/√2.
+        let mut row0 = vec![(dcol, -1.0)];
+        let mut row1 = vec![(dcol, -r)];
+        let mut row2 = vec![(dcol, -r)];
+        for &c in &cs {
+            row0.push((c, -1.0));
+            row1.push((c, r));
+            row2.push((c, r));
+        }
+        soc.push(&row0, e_const);
+        soc.push(&row1, r * (-e_const - 2.0));
+        soc.push(&row2, r * (-e_const + 2.0));
     }
     let n_soc = soc.h.len() / 3;
 
