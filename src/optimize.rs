@@ -99,13 +99,18 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
             "no motion: every CL point is at the same position",
         ));
     }
-    let axes: Vec<String> = machine.axes.iter().map(|a| a.name.clone()).collect();
-    let weights = span_weights(&path);
+    let plan = Plan {
+        machine,
+        weights: span_weights(&path),
+        axes: machine.axes.iter().map(|a| a.name.clone()).collect(),
+        kin,
+        path,
+    };
     let mut refinement = Vec::new();
     let total = options.stations.unwrap_or(options.initial_stations);
     let mut last: Option<Solution> = None;
     for level in 0.. {
-        let sol = solve_at(machine, &kin, &path, &axes, &weights, total, level, options)?;
+        let sol = plan.solve_at(total, level, options)?;
         refinement.push(Refinement {
             stations: sol.stations(),
             cycle_time_s: sol.schedule.cycle_time,
@@ -166,52 +171,57 @@ fn span_weights(path: &Path) -> Vec<f64> {
         .collect()
 }
 
-fn solve_at(
-    machine: &Machine,
-    kin: &Kinematics,
-    path: &Path,
-    axes: &[String],
-    weights: &[f64],
-    total: usize,
-    level: u32,
-    options: &Options,
-) -> Result<Solution> {
-    let mut problems = Vec::with_capacity(path.spans.len());
-    let mut solutions = Vec::with_capacity(path.spans.len());
-    let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
-    for (si, (span, w)) in path.spans.iter().zip(weights).enumerate() {
-        // Level ℓ halves every interval of level 0 ℓ times.
-        let parts = 1usize << level;
-        let spacing = span.length() / (total as f64 * w).max(8.0) / parts as f64;
-        let grid = Grid {
-            spacing,
-            min_parts: parts,
-        };
-        let p = SpanProblem::build(span, kin, machine, grid);
-        let s = solver::clarabel::solve(&p, &options.solver).map_err(|e| match e {
-            Error::Infeasible(m) => Error::Infeasible(format!(
-                "span {si} (CL lines {}–{}): {m}",
-                span.lines[0],
-                span.lines[span.lines.len() - 1]
-            )),
-            other => other,
-        })?;
-        status = status.worst(s.status);
-        iterations += s.iterations;
-        solve_time += s.solve_time;
-        problems.push(p);
-        solutions.push(s);
+/// What stays fixed while the stations are refined.
+struct Plan<'a> {
+    machine: &'a Machine,
+    kin: Kinematics,
+    path: Path,
+    axes: Vec<String>,
+    /// Each span's share of the stations.
+    weights: Vec<f64>,
+}
+
+impl Plan<'_> {
+    /// Solves every span with about `total` stations at refinement `level`.
+    fn solve_at(&self, total: usize, level: u32, options: &Options) -> Result<Solution> {
+        let spans = &self.path.spans;
+        let mut problems = Vec::with_capacity(spans.len());
+        let mut solutions = Vec::with_capacity(spans.len());
+        let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
+        for (si, (span, w)) in spans.iter().zip(&self.weights).enumerate() {
+            // Level ℓ halves every interval of level 0 ℓ times.
+            let parts = 1usize << level;
+            let spacing = span.length() / (total as f64 * w).max(8.0) / parts as f64;
+            let grid = Grid {
+                spacing,
+                min_parts: parts,
+            };
+            let p = SpanProblem::build(span, &self.kin, self.machine, grid);
+            let s = solver::clarabel::solve(&p, &options.solver).map_err(|e| match e {
+                Error::Infeasible(m) => Error::Infeasible(format!(
+                    "span {si} (CL lines {}–{}): {m}",
+                    span.lines[0],
+                    span.lines[span.lines.len() - 1]
+                )),
+                other => other,
+            })?;
+            status = status.worst(s.status);
+            iterations += s.iterations;
+            solve_time += s.solve_time;
+            problems.push(p);
+            solutions.push(s);
+        }
+        let schedule = Schedule::build(&self.axes, spans, &problems, &solutions)?;
+        Ok(Solution {
+            path: self.path.clone(),
+            kinematics: self.kin.clone(),
+            problems,
+            solutions,
+            schedule,
+            status,
+            iterations,
+            solve_time,
+            refinement: Vec::new(),
+        })
     }
-    let schedule = Schedule::build(axes, &path.spans, &problems, &solutions)?;
-    Ok(Solution {
-        path: path.clone(),
-        kinematics: kin.clone(),
-        problems,
-        solutions,
-        schedule,
-        status,
-        iterations,
-        solve_time,
-        refinement: Vec::new(),
-    })
 }

@@ -45,7 +45,9 @@ pub struct Summary {
     pub solve_time_s: f64,
     /// Tool-tip path length, mm.
     pub path_length_mm: f64,
-    pub axes: BTreeMap<String, AxisPeaks>,
+    /// Per axis, in the machine's order (a JSON object keyed by axis name).
+    #[serde(serialize_with = "as_map")]
+    pub axes: Vec<(String, AxisPeaks)>,
     pub binding: Vec<BindingShare>,
     pub refinement: Vec<Refinement>,
 }
@@ -139,6 +141,17 @@ impl Summary {
             binding,
             refinement: sol.refinement.clone(),
         }
+    }
+}
+
+fn as_map<S: serde::Serializer>(v: &[(String, AxisPeaks)], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(v.iter().map(|(k, p)| (k, p)))
+}
+
+impl Summary {
+    /// Peaks of the axis called `name`.
+    pub fn axis(&self, name: &str) -> Option<&AxisPeaks> {
+        self.axes.iter().find(|(n, _)| n == name).map(|(_, p)| p)
     }
 }
 
