@@ -59,6 +59,9 @@ impl SolveArgs {
         if matches!(self.stations, Some(n) if n < 2) {
             return Err(Error::Usage("--stations must be at least 2".into()));
         }
+        if let Some(out) = &self.output {
+            writers::schedule_format(out)?;
+        }
         let mut o = Options::default();
         o.geometry.corner_angle_deg = self.corner_angle;
         o.stations = self.stations;

@@ -7,15 +7,22 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::schedule::Schedule;
 
-/// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).
-pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
+/// Formats a schedule can be written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScheduleFormat {
+    Json,
+    Csv,
+}
+
+/// Checks an output path before any work is done: a known extension and an existing directory.
+pub fn schedule_format(path: &Path) -> Result<ScheduleFormat> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    let bytes = match ext.as_deref() {
-        Some("json") => schedule_json(schedule)?,
-        Some("csv") => schedule_csv(schedule).into_bytes(),
+    let format = match ext.as_deref() {
+        Some("json") => ScheduleFormat::Json,
+        Some("csv") => ScheduleFormat::Csv,
         _ => {
             return Err(Error::Usage(format!(
                 "{}: unknown output format (use .json or .csv)",
@@ -23,7 +30,31 @@ pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
             )));
         }
     };
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        )));
+    }
+    Ok(format)
+}
+
+/// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).
+pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
+    let bytes = match schedule_format(path)? {
+        ScheduleFormat::Json => schedule_json(schedule)?,
+        ScheduleFormat::Csv => schedule_csv(schedule).into_bytes(),
+    };
     write_atomically(path, &bytes)
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
 }
 
 /// The schedule as JSON: `{"axes": [...], "cycle_time_s": …, "stations": [{span, u, s, t, v,
@@ -82,13 +113,11 @@ pub fn schedule_csv(schedule: &Schedule) -> String {
 
 /// Writes `bytes` to a temporary file next to `path`, then renames it over `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(path, e))?;
+    // The temporary file's own name stays out of messages: they name the target.
+    let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
+    let mut tmp = tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(plain)?;
     tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    tmp.persist(path).map_err(|e| plain(e.error))?;
     Ok(())
 }

@@ -53,6 +53,10 @@ pub fn read(path: &Path) -> Result<Toolpath> {
         .unwrap_or_default();
     match ext.as_str() {
         "cls" | "apt" | "cl" => apt::read(path),
+        "" => Err(crate::error::Error::Usage(format!(
+            "{}: the toolpath file has no extension (expected .cls or .apt)",
+            path.display()
+        ))),
         other => Err(crate::error::Error::Usage(format!(
             "{}: unknown toolpath format `.{other}` (expected .cls or .apt)",
             path.display()

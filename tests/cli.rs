@@ -1,0 +1,611 @@
+//! End-to-end tests of the `feedopt` binary: `feedopt solve` on tiny machine and APT CL files
+//! written into a temporary directory.
+//!
+//! Every solve passes `--stations` so that a debug build finishes well under a second (the
+//! automatic refinement starts at 1000 stations).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use tempfile::TempDir;
+
+/// X velocity 400 mm/s, acceleration 2000 mm/s²: a 100 mm/s feed binds, not the X velocity.
+const XYZ_MACHINE: &str = r#"{
+  "name": "test router",
+  "kinematics": {"type": "xyz"},
+  "axes": {
+    "X": {"velocity": 400, "acceleration": 2000},
+    "Y": {"velocity": 400, "acceleration": 2000},
+    "Z": {"velocity": 300, "acceleration": 1500}
+  },
+  "feed": {"max": 150}
+}
+"#;
+
+const HEAD_HEAD_MACHINE: &str = r#"{
+  "name": "test double swivel head",
+  "kinematics": {"type": "head_head", "tool_length": 200.0},
+  "axes": {
+    "X": {"velocity": 400, "acceleration": 2000},
+    "Y": {"velocity": 400, "acceleration": 2000},
+    "Z": {"velocity": 300, "acceleration": 1500},
+    "C": {"velocity": 120, "acceleration": 600},
+    "A": {"velocity": 60, "acceleration": 400}
+  },
+  "feed": {"max": 150}
+}
+"#;
+
+/// 6000 mm/min = 100 mm/s along a 100 mm straight line in X.
+const LINE: &str = "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/100,0,0\n";
+const LENGTH_MM: f64 = 100.0;
+const FEED_MM_S: f64 = 100.0;
+const X_ACCELERATION: f64 = 2000.0;
+
+/// Station intervals for every solve (keeps debug builds fast; the acceleration ramps of
+/// F²/(2a) = 2.5 mm fall on stations, so the discrete optimum is the exact one).
+const STATIONS: &str = "200";
+
+/// A temporary working directory; the binary runs inside it and files are named relative to it.
+struct Work {
+    dir: TempDir,
+}
+
+impl Work {
+    fn new() -> Work {
+        Work {
+            dir: tempfile::tempdir().expect("create temp dir"),
+        }
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+
+    fn write(&self, name: &str, text: &str) {
+        std::fs::write(self.path(name), text).expect("write input file");
+    }
+
+    fn read(&self, name: &str) -> String {
+        std::fs::read_to_string(self.path(name))
+            .unwrap_or_else(|e| panic!("cannot read {name}: {e}"))
+    }
+
+    /// Runs `feedopt` with `args` in the directory.
+    fn run(&self, args: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .args(args)
+            .current_dir(self.dir.path())
+            .output()
+            .expect("run feedopt")
+    }
+
+    /// Every entry of the directory, hidden ones included.
+    fn listing(&self) -> BTreeSet<String> {
+        std::fs::read_dir(self.dir.path())
+            .expect("list temp dir")
+            .map(|e| {
+                e.expect("dir entry")
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect()
+    }
+
+    fn assert_listing(&self, expected: &[&str]) {
+        let expected: BTreeSet<String> = expected.iter().map(|s| s.to_string()).collect();
+        assert_eq!(
+            self.listing(),
+            expected,
+            "unexpected files in {}",
+            self.dir.path().display()
+        );
+    }
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn assert_success(out: &Output) {
+    assert!(
+        out.status.success(),
+        "feedopt failed with {:?}\nstderr: {}",
+        out.status,
+        stderr(out)
+    );
+}
+
+/// Asserts exit code 2, nothing on stdout and exactly one line on stderr containing every one
+/// of `needles`; returns that line.
+fn assert_error(out: &Output, needles: &[&str]) -> String {
+    let err = stderr(out);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "expected exit code 2\nstdout: {}\nstderr: {err}",
+        stdout(out)
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "stdout not empty on error: {}",
+        stdout(out)
+    );
+    assert!(
+        err.ends_with('\n'),
+        "stderr not newline-terminated: {err:?}"
+    );
+    assert_eq!(err.lines().count(), 1, "stderr is not one line: {err:?}");
+    for needle in needles {
+        assert!(
+            err.contains(needle),
+            "stderr does not mention `{needle}`: {err}"
+        );
+    }
+    err
+}
+
+fn num(v: &Value, what: &str) -> f64 {
+    v.as_f64()
+        .unwrap_or_else(|| panic!("`{what}` is not a number: {v}"))
+}
+
+fn parse_json(text: &str, what: &str) -> Value {
+    serde_json::from_str(text)
+        .unwrap_or_else(|e| panic!("{what} is not one JSON value: {e}\n{text}"))
+}
+
+fn assert_rel(got: f64, want: f64, rel: f64, what: &str) {
+    assert!(
+        (got - want).abs() <= rel * want.abs(),
+        "{what}: got {got}, want {want} (within {rel})"
+    );
+}
+
+/// Rest-to-rest straight line with the feed binding: accelerate at `a` to `f`, cruise, brake.
+fn closed_form_cycle_time() -> f64 {
+    const { assert!(LENGTH_MM >= FEED_MM_S * FEED_MM_S / X_ACCELERATION) };
+    LENGTH_MM / FEED_MM_S + FEED_MM_S / X_ACCELERATION
+}
+
+// ---------------------------------------------------------------------------------------------
+// Success
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn json_summary_of_a_straight_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let out = w.run(&[
+        "solve",
+        "--machine",
+        "machine.json",
+        "line.cls",
+        "--json",
+        "--stations",
+        STATIONS,
+    ]);
+    assert_success(&out);
+    let text = stdout(&out);
+    // Exactly one JSON object on stdout (from_str rejects trailing values).
+    let v = parse_json(&text, "stdout");
+    assert!(v.is_object(), "stdout is not a JSON object: {text}");
+
+    let t = num(&v["cycle_time_s"], "cycle_time_s");
+    let expected = closed_form_cycle_time();
+    assert!((expected - 1.05).abs() < 1e-12);
+    assert_rel(t, expected, 1e-3, "cycle_time_s");
+
+    let stations = v["stations"]
+        .as_u64()
+        .unwrap_or_else(|| panic!("`stations` is not an integer: {}", v["stations"]));
+    assert!(stations >= 200, "stations = {stations}");
+    assert_eq!(v["status"], "optimal");
+    let solve_time = num(&v["solve_time_s"], "solve_time_s");
+    assert!((0.0..60.0).contains(&solve_time), "{solve_time}");
+    assert_rel(
+        num(&v["path_length_mm"], "path_length_mm"),
+        LENGTH_MM,
+        1e-9,
+        "path_length_mm",
+    );
+
+    // X does all the moving: it reaches F/v = 0.25 of its velocity limit and all of its
+    // acceleration; Y and Z stand still.
+    let x = &v["axes"]["X"];
+    assert_rel(
+        num(&x["peak_velocity_ratio"], "axes.X.peak_velocity_ratio"),
+        FEED_MM_S / 400.0,
+        1e-3,
+        "axes.X.peak_velocity_ratio",
+    );
+    assert_rel(
+        num(
+            &x["peak_acceleration_ratio"],
+            "axes.X.peak_acceleration_ratio",
+        ),
+        1.0,
+        1e-3,
+        "axes.X.peak_acceleration_ratio",
+    );
+    for axis in ["Y", "Z"] {
+        let a = &v["axes"][axis];
+        assert!(num(&a["peak_velocity_ratio"], "peak_velocity_ratio").abs() < 1e-6);
+        assert!(num(&a["peak_acceleration_ratio"], "peak_acceleration_ratio").abs() < 1e-6);
+    }
+    w.assert_listing(&["machine.json", "line.cls"]);
+}
+
+#[test]
+fn readable_report_mentions_cycle_time() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.apt", LINE);
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "line.apt",
+        "--stations",
+        STATIONS,
+    ]);
+    assert_success(&out);
+    let text = stdout(&out);
+    assert!(text.contains("cycle time"), "report: {text}");
+    assert!(
+        text.contains("1.05"),
+        "report lacks the cycle time 1.05: {text}"
+    );
+    assert!(
+        text.contains("line.apt"),
+        "report lacks the toolpath: {text}"
+    );
+    assert!(
+        serde_json::from_str::<Value>(&text).is_err(),
+        "readable report is JSON"
+    );
+}
+
+#[test]
+fn csv_schedule() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "line.cls",
+        "--json",
+        "--stations",
+        STATIONS,
+        "-o",
+        "out.csv",
+    ]);
+    assert_success(&out);
+    let summary = parse_json(&stdout(&out), "stdout");
+    let cycle_time = num(&summary["cycle_time_s"], "cycle_time_s");
+    let stations = summary["stations"].as_u64().expect("stations") as usize;
+
+    let csv = w.read("out.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("CSV header").split(',').collect();
+    assert_eq!(header[..6], ["span", "u", "s", "t", "v", "a"]);
+    for col in [
+        "q_X", "q_Y", "q_Z", "qd_X", "qd_Y", "qd_Z", "qdd_X", "qdd_Y", "qdd_Z",
+    ] {
+        assert!(header.contains(&col), "CSV header lacks {col}: {header:?}");
+    }
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            let row: Vec<f64> = l
+                .split(',')
+                .map(|x| x.parse().unwrap_or_else(|_| panic!("bad CSV value `{x}`")))
+                .collect();
+            assert_eq!(row.len(), header.len(), "CSV row width: {l}");
+            row
+        })
+        .collect();
+    assert_eq!(rows.len(), stations, "one CSV row per station");
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+    assert_eq!(first[col("t")], 0.0);
+    assert_rel(last[col("t")], cycle_time, 1e-9, "last t vs cycle_time_s");
+    assert_rel(last[col("s")], LENGTH_MM, 1e-9, "last s");
+    assert_rel(last[col("q_X")], LENGTH_MM, 1e-9, "last q_X");
+    // Rest to rest; cruising at the programmed feed in the middle.
+    assert!(first[col("v")].abs() < 1e-6 && last[col("v")].abs() < 1e-6);
+    assert_rel(
+        rows[rows.len() / 2][col("v")],
+        FEED_MM_S,
+        1e-3,
+        "mid-path feed",
+    );
+    w.assert_listing(&["machine.json", "line.cls", "out.csv"]);
+}
+
+#[test]
+fn json_schedule() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "line.cls",
+        "--json",
+        "--stations",
+        STATIONS,
+        "--output",
+        "out.json",
+    ]);
+    assert_success(&out);
+    let summary = parse_json(&stdout(&out), "stdout");
+    let cycle_time = num(&summary["cycle_time_s"], "cycle_time_s");
+    assert_rel(cycle_time, closed_form_cycle_time(), 1e-3, "cycle_time_s");
+
+    let doc = parse_json(&w.read("out.json"), "out.json");
+    assert_rel(
+        num(&doc["cycle_time_s"], "out.json cycle_time_s"),
+        cycle_time,
+        1e-12,
+        "out.json cycle_time_s",
+    );
+    assert_eq!(doc["axes"], serde_json::json!(["X", "Y", "Z"]));
+    let stations = doc["stations"].as_array().expect("`stations` array");
+    assert_eq!(
+        stations.len() as u64,
+        summary["stations"].as_u64().unwrap(),
+        "station count"
+    );
+    let first = &stations[0];
+    let last = stations.last().unwrap();
+    assert_eq!(num(&first["t"], "t"), 0.0);
+    assert_rel(num(&last["t"], "t"), cycle_time, 1e-9, "last t");
+    assert_rel(num(&last["s"], "s"), LENGTH_MM, 1e-9, "last s");
+    assert_rel(num(&last["q"]["X"], "q.X"), LENGTH_MM, 1e-9, "last q.X");
+    for key in ["span", "u", "v", "a"] {
+        num(&last[key], key);
+    }
+    for key in ["qd", "qdd"] {
+        num(&last[key]["X"], key);
+    }
+    // Time increases along the schedule.
+    let times: Vec<f64> = stations.iter().map(|s| num(&s["t"], "t")).collect();
+    assert!(times.windows(2).all(|p| p[1] > p[0]), "t not increasing");
+    w.assert_listing(&["machine.json", "line.cls", "out.json"]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors: exit code 2, one line on stderr, no output file and no temp file left behind
+// ---------------------------------------------------------------------------------------------
+
+/// Runs a solve that must fail with `-o out.json`; checks stderr and that the directory holds
+/// exactly the input files afterwards.
+fn solve_fails(
+    w: &Work,
+    machine: &str,
+    toolpath: &str,
+    inputs: &[&str],
+    needles: &[&str],
+) -> String {
+    let out = w.run(&[
+        "solve",
+        "-m",
+        machine,
+        toolpath,
+        "--stations",
+        STATIONS,
+        "-o",
+        "out.json",
+    ]);
+    let line = assert_error(&out, needles);
+    assert!(!w.path("out.json").exists(), "out.json written on error");
+    w.assert_listing(inputs);
+    line
+}
+
+#[test]
+fn bad_number_in_toolpath_names_file_and_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write(
+        "bad.cls",
+        "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/1.0,abc,3\nGOTO/5,0,0\n",
+    );
+    let line = solve_fails(
+        &w,
+        "machine.json",
+        "bad.cls",
+        &["machine.json", "bad.cls"],
+        &["bad.cls:3:", "abc"],
+    );
+    assert!(line.contains("GOTO"), "stderr: {line}");
+}
+
+#[test]
+fn machine_missing_limit_names_file_and_field() {
+    let w = Work::new();
+    let machine = XYZ_MACHINE.replace(
+        r#""Y": {"velocity": 400, "acceleration": 2000}"#,
+        r#""Y": {"velocity": 400}"#,
+    );
+    assert_ne!(machine, XYZ_MACHINE);
+    w.write("machine.json", &machine);
+    w.write("line.cls", LINE);
+    solve_fails(
+        &w,
+        "machine.json",
+        "line.cls",
+        &["machine.json", "line.cls"],
+        &["machine.json", "axes.Y.acceleration", "missing"],
+    );
+}
+
+#[test]
+fn machine_negative_limit_names_file_and_field() {
+    let w = Work::new();
+    let machine = XYZ_MACHINE.replace(r#""Y": {"velocity": 400,"#, r#""Y": {"velocity": -5,"#);
+    assert_ne!(machine, XYZ_MACHINE);
+    w.write("machine.json", &machine);
+    w.write("line.cls", LINE);
+    solve_fails(
+        &w,
+        "machine.json",
+        "line.cls",
+        &["machine.json", "line.cls"],
+        &["machine.json", "axes.Y.velocity", "-5"],
+    );
+}
+
+#[test]
+fn machine_invalid_json_names_file_and_line() {
+    let w = Work::new();
+    // Line 5 (axis X) lacks its trailing comma; the parser notices on line 6.
+    let machine = XYZ_MACHINE.replace(
+        r#""X": {"velocity": 400, "acceleration": 2000},"#,
+        r#""X": {"velocity": 400, "acceleration": 2000}"#,
+    );
+    assert_ne!(machine, XYZ_MACHINE);
+    w.write("machine.json", &machine);
+    w.write("line.cls", LINE);
+    solve_fails(
+        &w,
+        "machine.json",
+        "line.cls",
+        &["machine.json", "line.cls"],
+        &["machine.json:6:"],
+    );
+}
+
+#[test]
+fn zero_tool_vector_on_five_axis_machine() {
+    let w = Work::new();
+    w.write("machine.json", HEAD_HEAD_MACHINE);
+    w.write(
+        "five.cls",
+        "MULTAX/ON\nFEDRAT/MMPM,3000\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,0\nGOTO/20,0,0,0,0,1\n",
+    );
+    let line = solve_fails(
+        &w,
+        "machine.json",
+        "five.cls",
+        &["machine.json", "five.cls"],
+        &["five.cls:4:"],
+    );
+    assert!(line.contains("tool vector"), "stderr: {line}");
+}
+
+#[test]
+fn missing_toolpath_file() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    solve_fails(
+        &w,
+        "machine.json",
+        "nowhere.cls",
+        &["machine.json"],
+        &["nowhere.cls"],
+    );
+}
+
+#[test]
+fn missing_machine_file() {
+    let w = Work::new();
+    w.write("line.cls", LINE);
+    solve_fails(
+        &w,
+        "nomachine.json",
+        "line.cls",
+        &["line.cls"],
+        &["nomachine.json"],
+    );
+}
+
+#[test]
+fn unknown_toolpath_extension() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.txt", LINE);
+    let line = solve_fails(
+        &w,
+        "machine.json",
+        "line.txt",
+        &["machine.json", "line.txt"],
+        &["line.txt", ".txt"],
+    );
+    let lower = line.to_lowercase();
+    assert!(
+        lower.contains("unknown") && lower.contains(".cls"),
+        "message does not say what is wrong and what is expected: {line}"
+    );
+}
+
+#[test]
+fn unknown_output_extension() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "line.cls",
+        "--stations",
+        STATIONS,
+        "-o",
+        "out.txt",
+    ]);
+    assert_error(&out, &["out.txt", ".json", ".csv"]);
+    w.assert_listing(&["machine.json", "line.cls"]);
+}
+
+#[test]
+fn bad_station_count_is_a_usage_error() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "line.cls",
+        "--stations",
+        "1",
+        "-o",
+        "out.json",
+    ]);
+    assert_error(&out, &["--stations"]);
+    w.assert_listing(&["machine.json", "line.cls"]);
+}
+
+/// Absolute paths work as well as names relative to the current directory.
+#[test]
+fn absolute_paths() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    let abs_out = w.path("abs.json");
+    let out = w.run(&[
+        "solve",
+        "-m",
+        w.path("machine.json").to_str().unwrap(),
+        w.path("line.cls").to_str().unwrap(),
+        "--stations",
+        "20",
+        "-o",
+        abs_out.to_str().unwrap(),
+    ]);
+    assert_success(&out);
+    assert!(Path::new(&abs_out).is_file());
+    w.assert_listing(&["machine.json", "line.cls", "abs.json"]);
+}

@@ -1,0 +1,542 @@
+//! Tests of machine files (`feedopt::machine::Machine::from_json`): what a valid file gives and
+//! that every invalid one is rejected with the exact dotted field and a message saying what is
+//! wrong.
+
+use feedopt::error::Error;
+use feedopt::machine::{AxisKind, KinematicsSpec, Limit, Machine};
+use std::path::Path;
+
+const FILE: &str = "machines/test_machine.json";
+
+fn parse(text: &str) -> Result<Machine, Error> {
+    Machine::from_json(Path::new(FILE), text)
+}
+
+fn ok(text: &str) -> Machine {
+    match parse(text) {
+        Ok(m) => m,
+        Err(e) => panic!("unexpected error: {e}\n--- input ---\n{text}"),
+    }
+}
+
+/// Asserts an `Error::Field` for exactly `field` whose message contains every one of `needles`
+/// (case-insensitive); returns the error for further checks.
+fn field_err(text: &str, field: &str, needles: &[&str]) -> Error {
+    match parse(text) {
+        Ok(m) => panic!("expected an error on `{field}`, got {m:?}\n--- input ---\n{text}"),
+        Err(e) => {
+            match &e {
+                Error::Field {
+                    file,
+                    field: got,
+                    message,
+                } => {
+                    assert_eq!(file, Path::new(FILE));
+                    assert_eq!(got, field, "wrong field (message `{message}`)");
+                    let lower = message.to_lowercase();
+                    for needle in needles {
+                        assert!(
+                            lower.contains(&needle.to_lowercase()),
+                            "message `{message}` for `{field}` does not mention `{needle}`"
+                        );
+                    }
+                }
+                other => panic!("expected Error::Field on `{field}`, got {other:?}"),
+            }
+            e
+        }
+    }
+}
+
+/// A valid xyz machine with `axis_x` as the X axis object (no feed section).
+fn xyz_with_x(axis_x: &str) -> String {
+    format!(
+        r#"{{"name": "xyz", "kinematics": {{"type": "xyz"}},
+            "axes": {{"X": {axis_x},
+                      "Y": {{"velocity": 300, "acceleration": 1500}},
+                      "Z": {{"velocity": 200, "acceleration": 1000}}}}}}"#
+    )
+}
+
+/// A valid xyz machine with `axis_y` as the Y axis object.
+fn xyz_with_y(axis_y: &str) -> String {
+    format!(
+        r#"{{"name": "xyz", "kinematics": {{"type": "xyz"}},
+            "axes": {{"X": {{"velocity": 400, "acceleration": 2000}},
+                      "Y": {axis_y},
+                      "Z": {{"velocity": 200, "acceleration": 1000}}}}}}"#
+    )
+}
+
+const XYZ_AXES: &str = r#"{"X": {"velocity": 400, "acceleration": 2000},
+                          "Y": {"velocity": 300, "acceleration": 1500},
+                          "Z": {"velocity": 200, "acceleration": 1000}}"#;
+
+const HEAD_HEAD_AXES: &str = r#"{"X": {"velocity": 400, "acceleration": 2000},
+                                "Y": {"velocity": 400, "acceleration": 2000},
+                                "Z": {"velocity": 300, "acceleration": 1500},
+                                "C": {"velocity": 120, "acceleration": 600},
+                                "A": {"velocity": 60, "acceleration": 400}}"#;
+
+fn head_head(kinematics: &str, feed: &str) -> String {
+    format!(r#"{{"name": "hh", "kinematics": {kinematics}, "axes": {HEAD_HEAD_AXES}{feed}}}"#)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Valid files
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn valid_head_head() {
+    // Axes deliberately listed out of order: the machine keeps the kinematics' order.
+    let m = ok(r#"{
+        "name": "seed double swivel head",
+        "kinematics": {"type": "head_head", "tool_length": 200.0},
+        "axes": {
+            "A": {"velocity": 60, "acceleration": [-300, 400]},
+            "C": {"velocity": 120, "acceleration": 600},
+            "Z": {"velocity": [-250.5, 300], "acceleration": 1500},
+            "Y": {"velocity": 400, "acceleration": 2000},
+            "X": {"velocity": 410.5, "acceleration": 2100}
+        },
+        "feed": {"max": 150}
+    }"#);
+    assert_eq!(m.name, "seed double swivel head");
+    assert_eq!(
+        m.kinematics,
+        KinematicsSpec::HeadHead { tool_length: 200.0 }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "C", "A"]);
+    let kinds: Vec<AxisKind> = m.axes.iter().map(|a| a.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            AxisKind::Linear,
+            AxisKind::Linear,
+            AxisKind::Linear,
+            AxisKind::Rotary,
+            AxisKind::Rotary
+        ]
+    );
+    // Symmetric numbers become [-v, v].
+    assert_eq!(
+        m.axes[0].velocity,
+        Limit {
+            min: -410.5,
+            max: 410.5
+        }
+    );
+    assert_eq!(
+        m.axes[0].acceleration,
+        Limit {
+            min: -2100.0,
+            max: 2100.0
+        }
+    );
+    assert_eq!(
+        m.axes[3].velocity,
+        Limit {
+            min: -120.0,
+            max: 120.0
+        }
+    );
+    assert_eq!(
+        m.axes[3].acceleration,
+        Limit {
+            min: -600.0,
+            max: 600.0
+        }
+    );
+    // Asymmetric [min, max] is kept as written.
+    assert_eq!(
+        m.axes[2].velocity,
+        Limit {
+            min: -250.5,
+            max: 300.0
+        }
+    );
+    assert_eq!(
+        m.axes[4].acceleration,
+        Limit {
+            min: -300.0,
+            max: 400.0
+        }
+    );
+    assert_eq!(m.axes[4].velocity, Limit::symmetric(60.0));
+    assert_eq!(m.feed_max, Some(150.0));
+}
+
+#[test]
+fn valid_xyz_without_feed_section() {
+    let m = ok(&format!(
+        r#"{{"name": "router", "kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}}}"#
+    ));
+    assert_eq!(m.name, "router");
+    assert_eq!(m.kinematics, KinematicsSpec::Xyz);
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z"]);
+    assert!(m.axes.iter().all(|a| a.kind == AxisKind::Linear));
+    assert_eq!(m.axes[0].velocity, Limit::symmetric(400.0));
+    assert_eq!(m.axes[1].acceleration, Limit::symmetric(1500.0));
+    assert_eq!(
+        m.axes[2].velocity,
+        Limit {
+            min: -200.0,
+            max: 200.0
+        }
+    );
+    assert_eq!(m.feed_max, None);
+}
+
+#[test]
+fn valid_xyz_with_feed_and_without_name() {
+    let m = ok(&format!(
+        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}, "feed": {{"max": 83.5}}}}"#
+    ));
+    assert_eq!(m.name, "");
+    assert_eq!(m.feed_max, Some(83.5));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Axes and limits
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn missing_axis() {
+    let text = r#"{"kinematics": {"type": "head_head", "tool_length": 200},
+        "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                 "Y": {"velocity": 400, "acceleration": 2000},
+                 "Z": {"velocity": 300, "acceleration": 1500},
+                 "A": {"velocity": 60, "acceleration": 400}}}"#;
+    field_err(text, "axes.C", &["missing"]);
+}
+
+#[test]
+fn missing_axes_section() {
+    field_err(r#"{"kinematics": {"type": "xyz"}}"#, "axes", &["missing"]);
+}
+
+#[test]
+fn missing_limit() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400}"#),
+        "axes.X.acceleration",
+        &["missing"],
+    );
+    field_err(
+        &xyz_with_y(r#"{"acceleration": 400}"#),
+        "axes.Y.velocity",
+        &["missing"],
+    );
+}
+
+#[test]
+fn negative_limit() {
+    field_err(
+        &xyz_with_y(r#"{"velocity": -5, "acceleration": 1500}"#),
+        "axes.Y.velocity",
+        &["positive", "-5"],
+    );
+}
+
+#[test]
+fn zero_limit() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 0}"#),
+        "axes.X.acceleration",
+        &["positive", "0"],
+    );
+    field_err(
+        &xyz_with_y(r#"{"velocity": 0.0, "acceleration": 1500}"#),
+        "axes.Y.velocity",
+        &["positive"],
+    );
+}
+
+#[test]
+fn limit_of_wrong_type() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": "400", "acceleration": 2000}"#),
+        "axes.X.velocity",
+        &["number"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": null, "acceleration": 2000}"#),
+        "axes.X.velocity",
+        &["number"],
+    );
+}
+
+#[test]
+fn min_max_with_nonnegative_min() {
+    for pair in ["[0, 500]", "[10, 500]"] {
+        field_err(
+            &xyz_with_x(&format!(r#"{{"velocity": {pair}, "acceleration": 2000}}"#)),
+            "axes.X.velocity",
+            &["min < 0 < max"],
+        );
+    }
+    // The message repeats what was found.
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": [10, 2000]}"#),
+        "axes.X.acceleration",
+        &["min < 0 < max", "10", "2000"],
+    );
+}
+
+#[test]
+fn min_max_with_nonpositive_max() {
+    for pair in ["[-500, 0]", "[-500, -10]"] {
+        field_err(
+            &xyz_with_y(&format!(r#"{{"velocity": {pair}, "acceleration": 1500}}"#)),
+            "axes.Y.velocity",
+            &["min < 0 < max"],
+        );
+    }
+    // Reversed order (max first) is not silently accepted either.
+    field_err(
+        &xyz_with_y(r#"{"velocity": 300, "acceleration": [1500, -1500]}"#),
+        "axes.Y.acceleration",
+        &["min < 0 < max", "1500", "-1500"],
+    );
+}
+
+#[test]
+fn min_max_of_wrong_shape() {
+    for bad in ["[-1, 2, 3]", "[5]", "[]", r#"[-1, "2"]"#] {
+        field_err(
+            &xyz_with_x(&format!(r#"{{"velocity": {bad}, "acceleration": 2000}}"#)),
+            "axes.X.velocity",
+            &["[min, max]"],
+        );
+    }
+}
+
+#[test]
+fn unknown_field_inside_axis() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "jerk_typo": 1}"#),
+        "axes.X.jerk_typo",
+        &["unknown field", "velocity", "acceleration"],
+    );
+}
+
+#[test]
+fn axis_that_is_not_an_object() {
+    field_err(&xyz_with_x("400"), "axes.X", &["object"]);
+}
+
+#[test]
+fn unknown_axis_for_the_kinematics() {
+    let text = r#"{"kinematics": {"type": "xyz"},
+        "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                 "Y": {"velocity": 400, "acceleration": 2000},
+                 "Z": {"velocity": 300, "acceleration": 1500},
+                 "B": {"velocity": 60, "acceleration": 400}}}"#;
+    // The message should say which axes this kinematics has.
+    field_err(text, "axes.B", &["unknown", "X", "Y", "Z"]);
+    // A rotary axis on a 3-axis machine is unknown too.
+    let text = r#"{"kinematics": {"type": "xyz"},
+        "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                 "Y": {"velocity": 400, "acceleration": 2000},
+                 "Z": {"velocity": 300, "acceleration": 1500},
+                 "C": {"velocity": 60, "acceleration": 400}}}"#;
+    field_err(text, "axes.C", &["unknown"]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Top level, kinematics, feed
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn unknown_top_level_field() {
+    let text =
+        format!(r#"{{"kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}, "colour": "red"}}"#);
+    field_err(&text, "colour", &["unknown field", "kinematics", "axes"]);
+}
+
+#[test]
+fn top_level_not_an_object() {
+    match parse("[1, 2, 3]") {
+        Err(Error::Field { message, .. }) => {
+            assert!(message.contains("object"), "message: {message}")
+        }
+        other => panic!("expected a field error, got {other:?}"),
+    }
+}
+
+#[test]
+fn name_not_a_string() {
+    let text = format!(r#"{{"name": 5, "kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}}}"#);
+    field_err(&text, "name", &["string"]);
+}
+
+#[test]
+fn missing_kinematics() {
+    field_err(
+        &format!(r#"{{"axes": {XYZ_AXES}}}"#),
+        "kinematics",
+        &["missing"],
+    );
+    field_err(
+        &format!(r#"{{"kinematics": {{}}, "axes": {XYZ_AXES}}}"#),
+        "kinematics.type",
+        &["missing"],
+    );
+}
+
+#[test]
+fn unknown_kinematics_type() {
+    let e = field_err(
+        &head_head(r#"{"type": "table_table", "tool_length": 200}"#, ""),
+        "kinematics.type",
+        &["unknown kinematics", "table_table", "xyz", "head_head"],
+    );
+    assert!(e.to_string().contains("kinematics.type"));
+    field_err(
+        &format!(r#"{{"kinematics": {{"type": 3}}, "axes": {XYZ_AXES}}}"#),
+        "kinematics.type",
+        &["unknown kinematics"],
+    );
+}
+
+#[test]
+fn head_head_without_tool_length() {
+    field_err(
+        &head_head(r#"{"type": "head_head"}"#, ""),
+        "kinematics.tool_length",
+        &["missing"],
+    );
+}
+
+#[test]
+fn head_head_with_nonpositive_tool_length() {
+    field_err(
+        &head_head(r#"{"type": "head_head", "tool_length": -200}"#, ""),
+        "kinematics.tool_length",
+        &["positive", "-200"],
+    );
+    field_err(
+        &head_head(r#"{"type": "head_head", "tool_length": 0}"#, ""),
+        "kinematics.tool_length",
+        &["positive"],
+    );
+}
+
+#[test]
+fn unknown_field_in_kinematics() {
+    // tool_length means nothing to an xyz machine.
+    field_err(
+        &format!(r#"{{"kinematics": {{"type": "xyz", "tool_length": 200}}, "axes": {XYZ_AXES}}}"#),
+        "kinematics.tool_length",
+        &["unknown field"],
+    );
+}
+
+#[test]
+fn nonpositive_feed_max() {
+    let hh = r#"{"type": "head_head", "tool_length": 200}"#;
+    field_err(
+        &head_head(hh, r#", "feed": {"max": 0}"#),
+        "feed.max",
+        &["positive", "0"],
+    );
+    field_err(
+        &head_head(hh, r#", "feed": {"max": -150}"#),
+        "feed.max",
+        &["positive", "-150"],
+    );
+    // A feed section must say its max.
+    field_err(&head_head(hh, r#", "feed": {}"#), "feed.max", &["missing"]);
+    field_err(
+        &head_head(hh, r#", "feed": {"max": 150, "min": 1}"#),
+        "feed.min",
+        &["unknown field"],
+    );
+    // And the whole head_head file is otherwise valid.
+    let m = ok(&head_head(hh, r#", "feed": {"max": 150}"#));
+    assert_eq!(m.feed_max, Some(150.0));
+    assert_eq!(m.axes.len(), 5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON syntax and Display
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn invalid_json_names_the_line() {
+    // Missing comma after line 3's value: the error is found on line 4.
+    let text = "{\n  \"name\": \"m\",\n  \"kinematics\": {\"type\": \"xyz\"}\n  \"axes\": {}\n}\n";
+    match parse(text) {
+        Err(Error::Parse {
+            file,
+            line,
+            message,
+        }) => {
+            assert_eq!(file, Path::new(FILE));
+            assert_eq!(line, 4, "message: {message}");
+            assert!(
+                message.to_lowercase().contains("json"),
+                "message: {message}"
+            );
+        }
+        other => panic!("expected Error::Parse, got {other:?}"),
+    }
+    // Truncated file: the error is at the last line.
+    let text = "{\n  \"name\": \"m\",\n  \"axes\": {\n";
+    match parse(text) {
+        Err(Error::Parse { line, .. }) => assert_eq!(line, 4),
+        other => panic!("expected Error::Parse, got {other:?}"),
+    }
+    // Trailing comma on line 2.
+    let text = "{\"kinematics\": {\"type\": \"xyz\"},\n \"axes\": {},\n}";
+    let e = parse(text).expect_err("trailing comma must be rejected");
+    assert!(
+        matches!(e, Error::Parse { line: 3, .. }),
+        "expected Error::Parse on line 3, got {e:?}"
+    );
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with(&format!("{FILE}:3: ")),
+        "display: {shown}"
+    );
+}
+
+#[test]
+fn field_error_display_starts_with_file_and_names_field() {
+    let e = field_err(
+        &xyz_with_y(r#"{"velocity": -5, "acceleration": 1500}"#),
+        "axes.Y.velocity",
+        &[],
+    );
+    let shown = e.to_string();
+    assert!(shown.starts_with(FILE), "display: {shown}");
+    assert!(shown.contains("axes.Y.velocity"), "display: {shown}");
+    assert!(shown.contains("-5"), "display: {shown}");
+    assert!(!shown.contains('\n'), "display spans lines: {shown}");
+}
+
+#[test]
+fn from_file_reads_and_names_missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    std::fs::write(
+        &path,
+        format!(r#"{{"kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}}}"#),
+    )
+    .unwrap();
+    let m = Machine::from_file(&path).unwrap();
+    assert_eq!(m.axes.len(), 3);
+
+    let missing = dir.path().join("nope.json");
+    match Machine::from_file(&missing) {
+        Err(e @ Error::Io { .. }) => {
+            assert!(
+                e.to_string().starts_with(&missing.display().to_string()),
+                "display: {e}"
+            );
+        }
+        other => panic!("expected Error::Io, got {other:?}"),
+    }
+}
