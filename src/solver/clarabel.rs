@@ -209,6 +209,7 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
         .tol_gap_rel(settings.tol_gap)
         .tol_gap_abs(settings.tol_gap)
         .tol_feas(settings.tol_feas)
+        .iterative_refinement_enable(settings.iterative_refinement)
         .build()
         .map_err(|e| Error::Solver(format!("settings: {e:?}")))?;
     let mut solver = DefaultSolver::new(&pmat, &q, &a, &h, &cones, s)

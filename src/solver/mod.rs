@@ -35,6 +35,10 @@ pub struct SolverSettings {
     pub tol_gap: f64,
     /// Primal and dual feasibility tolerance (relative): how far a row may be violated.
     pub tol_feas: f64,
+    /// Iterative refinement of each KKT solve. Off by default: on these problems it cost a third
+    /// to almost half of the solve time without changing the answer or the status, and
+    /// Clarabel's termination test uses the true residuals either way.
+    pub iterative_refinement: bool,
 }
 
 impl Default for SolverSettings {
@@ -43,6 +47,7 @@ impl Default for SolverSettings {
             max_iter: 200,
             tol_gap: 1e-6,
             tol_feas: 1e-8,
+            iterative_refinement: false,
         }
     }
 }
