@@ -317,7 +317,7 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
         return (ALL, b_max, Bound::None);
     }
     if b_star < b_hi {
-        keep &= 0; // the b-only rows are not edges if the envelopes close the polygon first
+        keep = 0; // the b-only rows are no edges if the envelopes close the polygon first
     }
     let mut prev = 0.0;
     for &p in pts.iter().skip(1).chain(std::iter::once(&b_star)) {
@@ -338,4 +338,96 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
         Bound::None
     };
     (keep, b_star, by)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (no dependency needed for a unit test).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.next()
+        }
+    }
+
+    fn row_ok(jet: &AxisJets, limits: &[Limit], b: f64, udd: f64) -> bool {
+        limits.iter().enumerate().all(|(j, l)| {
+            let a = jet.ddq[j] * b + jet.dq[j] * udd;
+            a <= l.max * (1.0 + 1e-9) && a >= l.min * (1.0 + 1e-9)
+        })
+    }
+
+    fn kept_ok(jet: &AxisJets, limits: &[Limit], keep: u16, b: f64, udd: f64) -> bool {
+        limits.iter().enumerate().all(|(j, l)| {
+            let a = jet.ddq[j] * b + jet.dq[j] * udd;
+            (keep >> (2 * j) & 1 == 0 || a <= l.max) && (keep >> (2 * j + 1) & 1 == 0 || a >= l.min)
+        })
+    }
+
+    #[test]
+    fn dropped_rows_are_implied_by_the_kept_ones() {
+        let mut rng = Lcg(7);
+        for case in 0..2000 {
+            let na = 1 + case % 5;
+            let mut jet = AxisJets::default();
+            let limits: Vec<Limit> = (0..na)
+                .map(|j| {
+                    // Some axes do not move along the path at all, or only curve.
+                    jet.dq[j] = if rng.next() < 0.15 {
+                        0.0
+                    } else {
+                        rng.range(-2.0, 2.0)
+                    };
+                    jet.ddq[j] = if rng.next() < 0.15 {
+                        0.0
+                    } else {
+                        rng.range(-0.05, 0.05)
+                    };
+                    Limit {
+                        min: -rng.range(100.0, 3000.0),
+                        max: rng.range(100.0, 3000.0),
+                    }
+                })
+                .collect();
+            let b_max = rng.range(1e3, 1e6);
+            let (keep, b_star, _) = essential_rows(&jet, &limits, b_max);
+            assert!(b_star <= b_max && b_star > 0.0);
+            // Any (b, ü) with 0 ≤ b ≤ b* that meets the kept rows meets every row.
+            for _ in 0..200 {
+                let b = rng.range(0.0, b_star);
+                let udd = rng.range(-1e4, 1e4);
+                if kept_ok(&jet, &limits, keep, b, udd) {
+                    assert!(
+                        row_ok(&jet, &limits, b, udd),
+                        "case {case}: b {b} ü {udd} keep {keep:b}"
+                    );
+                }
+            }
+            // b* itself is feasible: the ü allowed by every row there form a non-empty interval.
+            let b = b_star * (1.0 - 1e-9);
+            let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+            let mut reachable = true;
+            for (j, l) in limits.iter().enumerate() {
+                let (d, dd) = (jet.dq[j], jet.ddq[j]);
+                if d == 0.0 {
+                    reachable &= dd * b <= l.max * (1.0 + 1e-9) && dd * b >= l.min * (1.0 + 1e-9);
+                } else {
+                    let (x, y) = ((l.max - dd * b) / d, (l.min - dd * b) / d);
+                    lo = lo.max(x.min(y));
+                    hi = hi.min(x.max(y));
+                }
+            }
+            reachable &= lo <= hi + 1e-6 * (1.0 + hi.abs());
+            assert!(reachable, "case {case}: b* {b_star} not feasible");
+        }
+    }
 }

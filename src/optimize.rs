@@ -108,31 +108,47 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
     };
     let mut refinement = Vec::new();
     let total = options.stations.unwrap_or(options.initial_stations);
-    let mut last: Option<Solution> = None;
+    let mut last_time: Option<f64> = None;
     for level in 0.. {
-        let sol = plan.solve_at(total, level, options)?;
+        let lv = plan.solve_at(total, level, options)?;
+        let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
         refinement.push(Refinement {
-            stations: sol.stations(),
-            cycle_time_s: sol.schedule.cycle_time,
+            stations,
+            cycle_time_s: time,
         });
-        if options.stations.is_some() {
-            return Ok(Solution { refinement, ..sol });
+        let converged = last_time.is_some_and(|a| (a - time).abs() <= options.convergence * time);
+        if options.stations.is_some() || converged {
+            return Ok(Solution {
+                path: plan.path,
+                kinematics: plan.kin,
+                problems: lv.problems,
+                solutions: lv.solutions,
+                schedule: lv.schedule,
+                status: lv.status,
+                iterations: lv.iterations,
+                solve_time: lv.solve_time,
+                refinement,
+            });
         }
-        if let Some(prev) = &last {
-            let (a, b) = (prev.schedule.cycle_time, sol.schedule.cycle_time);
-            if (a - b).abs() <= options.convergence * b {
-                return Ok(Solution { refinement, ..sol });
-            }
-        }
-        if 2 * sol.stations() > options.max_stations {
+        if 2 * stations > options.max_stations {
             return Err(Error::Solver(format!(
                 "the cycle time did not converge to {} within {} stations (last: {:?})",
                 options.convergence, options.max_stations, refinement
             )));
         }
-        last = Some(sol);
+        last_time = Some(time);
     }
     unreachable!("the refinement loop returns")
+}
+
+/// The solve of every span at one refinement level.
+struct Level {
+    problems: Vec<SpanProblem>,
+    solutions: Vec<SpanSolution>,
+    schedule: Schedule,
+    status: Status,
+    iterations: u32,
+    solve_time: f64,
 }
 
 /// Each span's share of the stations: half by its share of CL moves, half by its share of
@@ -183,7 +199,7 @@ struct Plan<'a> {
 
 impl Plan<'_> {
     /// Solves every span with about `total` stations at refinement `level`.
-    fn solve_at(&self, total: usize, level: u32, options: &Options) -> Result<Solution> {
+    fn solve_at(&self, total: usize, level: u32, options: &Options) -> Result<Level> {
         let spans = &self.path.spans;
         let mut problems = Vec::with_capacity(spans.len());
         let mut solutions = Vec::with_capacity(spans.len());
@@ -212,16 +228,13 @@ impl Plan<'_> {
             solutions.push(s);
         }
         let schedule = Schedule::build(&self.axes, spans, &problems, &solutions)?;
-        Ok(Solution {
-            path: self.path.clone(),
-            kinematics: self.kin.clone(),
+        Ok(Level {
             problems,
             solutions,
             schedule,
             status,
             iterations,
             solve_time,
-            refinement: Vec::new(),
         })
     }
 }
