@@ -73,6 +73,20 @@ impl Work {
             .unwrap_or_else(|e| panic!("cannot read {name}: {e}"))
     }
 
+    /// `feedopt solve -m machine.json line.cls --stations STATIONS` plus `extra`.
+    fn solve_line(&self, extra: &[&str]) -> Output {
+        let mut args = vec![
+            "solve",
+            "-m",
+            "machine.json",
+            "line.cls",
+            "--stations",
+            STATIONS,
+        ];
+        args.extend_from_slice(extra);
+        self.run(&args)
+    }
+
     /// Runs `feedopt` with `args` in the directory.
     fn run(&self, args: &[&str]) -> Output {
         Command::new(env!("CARGO_BIN_EXE_feedopt"))
@@ -279,17 +293,7 @@ fn csv_schedule() {
     let w = Work::new();
     w.write("machine.json", XYZ_MACHINE);
     w.write("line.cls", LINE);
-    let out = w.run(&[
-        "solve",
-        "-m",
-        "machine.json",
-        "line.cls",
-        "--json",
-        "--stations",
-        STATIONS,
-        "-o",
-        "out.csv",
-    ]);
+    let out = w.solve_line(&["--json", "-o", "out.csv"]);
     assert_success(&out);
     let summary = parse_json(&stdout(&out), "stdout");
     let cycle_time = num(&summary["cycle_time_s"], "cycle_time_s");
@@ -337,17 +341,7 @@ fn json_schedule() {
     let w = Work::new();
     w.write("machine.json", XYZ_MACHINE);
     w.write("line.cls", LINE);
-    let out = w.run(&[
-        "solve",
-        "-m",
-        "machine.json",
-        "line.cls",
-        "--json",
-        "--stations",
-        STATIONS,
-        "--output",
-        "out.json",
-    ]);
+    let out = w.solve_line(&["--json", "--output", "out.json"]);
     assert_success(&out);
     let summary = parse_json(&stdout(&out), "stdout");
     let cycle_time = num(&summary["cycle_time_s"], "cycle_time_s");
@@ -555,16 +549,7 @@ fn unknown_output_extension() {
     let w = Work::new();
     w.write("machine.json", XYZ_MACHINE);
     w.write("line.cls", LINE);
-    let out = w.run(&[
-        "solve",
-        "-m",
-        "machine.json",
-        "line.cls",
-        "--stations",
-        STATIONS,
-        "-o",
-        "out.txt",
-    ]);
+    let out = w.solve_line(&["-o", "out.txt"]);
     assert_error(&out, &["out.txt", ".json", ".csv"]);
     w.assert_listing(&["machine.json", "line.cls"]);
 }
