@@ -2,12 +2,13 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::error::{Error, Result};
 use crate::machine::Machine;
 use crate::optimize::{self, Options};
 use crate::report::Summary;
+use crate::solver::SolverKind;
 use crate::{toolpath, writers};
 
 /// feedopt: time-optimal feedrate along CNC toolpaths.
@@ -45,6 +46,23 @@ pub struct SolveArgs {
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
     #[arg(long, default_value_t = 10.0)]
     pub corner_angle: f64,
+    /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
+    /// reachability pass: within O(Δu²) of it, much faster).
+    #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
+    pub solver: SolverChoice,
+    /// Tool-tip feed at the start of the path, mm/s (default: at rest).
+    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
+    pub start_feed: f64,
+    /// Tool-tip feed at the end of the path, mm/s (default: at rest).
+    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
+    pub end_feed: f64,
+}
+
+/// `--solver` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SolverChoice {
+    Clarabel,
+    Reach,
 }
 
 impl SolveArgs {
@@ -62,9 +80,17 @@ impl SolveArgs {
         if let Some(out) = &self.output {
             writers::schedule_format(out)?;
         }
-        let mut o = Options::default();
+        let mut o = Options {
+            stations: self.stations,
+            solver_kind: match self.solver {
+                SolverChoice::Clarabel => SolverKind::Clarabel,
+                SolverChoice::Reach => SolverKind::Reach,
+            },
+            start_feed: self.start_feed,
+            end_feed: self.end_feed,
+            ..Options::default()
+        };
         o.geometry.corner_angle_deg = self.corner_angle;
-        o.stations = self.stations;
         Ok(o)
     }
 }

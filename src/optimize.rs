@@ -15,7 +15,7 @@ use crate::geometry::{GeometryOptions, Path, SpanKind};
 use crate::kinematics::Kinematics;
 use crate::machine::Machine;
 use crate::schedule::Schedule;
-use crate::solver::{self, SolverSettings, SpanSolution, Status};
+use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::Toolpath;
 
 /// Options of a solve.
@@ -26,6 +26,12 @@ pub struct Options {
     /// `None`: choose automatically.
     pub stations: Option<usize>,
     pub solver: SolverSettings,
+    /// Which solver computes the profile.
+    pub solver_kind: SolverKind,
+    /// Tool-tip feed at the start of the path and at its end, mm/s (0: at rest). Inner span
+    /// boundaries are exact stops.
+    pub start_feed: f64,
+    pub end_feed: f64,
     /// Relative change of the cycle time under doubling the stations that counts as converged.
     pub convergence: f64,
     /// Stations to start the automatic refinement from.
@@ -40,6 +46,9 @@ impl Default for Options {
             geometry: GeometryOptions::default(),
             stations: None,
             solver: SolverSettings::default(),
+            solver_kind: SolverKind::default(),
+            start_feed: 0.0,
+            end_feed: 0.0,
             convergence: 1e-3,
             initial_stations: 1000,
             max_stations: 4_000_000,
@@ -187,6 +196,26 @@ fn span_weights(path: &Path) -> Vec<f64> {
         .collect()
 }
 
+/// b at an end station for a tool-tip feed (mm/s); an error where the tip cannot move.
+fn end_speed(p: &SpanProblem, i: usize, feed: f64, which: &str) -> Result<f64> {
+    if !(feed.is_finite() && feed >= 0.0) {
+        return Err(Error::Usage(format!(
+            "the {which} feed must be ≥ 0 mm/s, got {feed}"
+        )));
+    }
+    if feed == 0.0 {
+        return Ok(0.0);
+    }
+    let speed = p.tip_speed[i];
+    if speed <= 0.0 {
+        return Err(Error::Infeasible(format!(
+            "the path's {which} is a pure reorientation (the tool tip stands still): the {which} \
+             feed must be 0, got {feed} mm/s"
+        )));
+    }
+    Ok((feed / speed).powi(2))
+}
+
 /// What stays fixed while the stations are refined.
 struct Plan<'a> {
     machine: &'a Machine,
@@ -198,6 +227,25 @@ struct Plan<'a> {
 }
 
 impl Plan<'_> {
+    /// Turns the reach pass's finding into an error naming span, station, u, CL line and axes.
+    fn infeasible(&self, si: usize, p: &SpanProblem, inf: &solver::reach::Infeasible) -> Error {
+        let span = &self.path.spans[si];
+        let u = p.u[inf.station];
+        let axes: Vec<&str> = inf.axes.iter().map(|&j| self.axes[j].as_str()).collect();
+        let binding = if axes.is_empty() {
+            String::new()
+        } else {
+            format!("; binding: {} limits", axes.join(", "))
+        };
+        Error::Infeasible(format!(
+            "span {si}, station {} of {}, u = {u:.6}, nearest CL line {}: {}{binding}",
+            inf.station,
+            p.intervals(),
+            span.nearest_line(u),
+            inf.what
+        ))
+    }
+
     /// Solves every span with about `total` stations at refinement `level`.
     fn solve_at(&self, total: usize, level: u32, options: &Options) -> Result<Level> {
         let spans = &self.path.spans;
@@ -212,15 +260,20 @@ impl Plan<'_> {
                 spacing,
                 min_parts: parts,
             };
-            let p = SpanProblem::build(span, &self.kin, self.machine, grid);
-            let s = solver::clarabel::solve(&p, &options.solver).map_err(|e| match e {
-                Error::Infeasible(m) => Error::Infeasible(format!(
-                    "span {si} (CL lines {}–{}): {m}",
-                    span.lines[0],
-                    span.lines[span.lines.len() - 1]
-                )),
-                other => other,
-            })?;
+            let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
+            if si == 0 {
+                p.b_start = end_speed(&p, 0, options.start_feed, "start")?;
+            }
+            if si + 1 == spans.len() {
+                p.b_end = end_speed(&p, p.intervals(), options.end_feed, "end")?;
+            }
+            // The O(N) pass runs first whatever the solver: it finds an impossible request and
+            // says where, which a convex solver's infeasibility certificate cannot.
+            let greedy = solver::reach::solve(&p).map_err(|inf| self.infeasible(si, &p, &inf))?;
+            let s = match options.solver_kind {
+                SolverKind::Reach => greedy,
+                SolverKind::Clarabel => solver::clarabel::solve(&p, &options.solver)?,
+            };
             status = status.worst(s.status);
             iterations += s.iterations;
             solve_time += s.solve_time;

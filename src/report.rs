@@ -176,12 +176,21 @@ impl fmt::Display for Summary {
         let status = match self.status {
             Status::Optimal => "optimal",
             Status::AlmostOptimal => "almost optimal (reduced accuracy)",
+            Status::Greedy => "maximal reachable profile",
         };
-        writeln!(
-            f,
-            "solver        Clarabel: {status}, {} iterations, {:.3} s",
-            self.iterations, self.solve_time_s
-        )?;
+        if self.status == Status::Greedy {
+            writeln!(
+                f,
+                "solver        reachability pass: {status}, {:.4} s",
+                self.solve_time_s
+            )?;
+        } else {
+            writeln!(
+                f,
+                "solver        Clarabel: {status}, {} iterations, {:.3} s",
+                self.iterations, self.solve_time_s
+            )?;
+        }
         writeln!(f)?;
         writeln!(f, "axis   peak |q̇|/v   peak |q̈|/a")?;
         for (name, p) in &self.axes {

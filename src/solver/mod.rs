@@ -3,8 +3,21 @@
 //!
 //! [`clarabel`] states the minimum-time problem as a second-order cone program (Verscheure et
 //! al. 2009; Lipp & Boyd 2014) and solves it with the Clarabel interior-point solver.
+//! [`reach`] is the exact O(N) reachability pass on the same discretisation: the fast path, the
+//! cross-check, and the source of precise infeasibility errors.
 
 pub mod clarabel;
+pub mod reach;
+
+/// Which solver computes the profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// The convex solve (second-order cone program, Clarabel): the optimum of the discretisation.
+    #[default]
+    Clarabel,
+    /// The O(N) reachability pass: the maximal reachable profile, within O(Δu²) of the optimum.
+    Reach,
+}
 
 /// How a solve ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -14,12 +27,18 @@ pub enum Status {
     Optimal,
     /// Solved to the solver's reduced tolerances.
     AlmostOptimal,
+    /// The reachability pass's maximal profile (feasible; within O(Δu²) of the optimum).
+    Greedy,
 }
 
 impl Status {
     /// The worse of two statuses.
     pub fn worst(self, other: Status) -> Status {
-        if self == Status::Optimal { other } else { self }
+        match (self, other) {
+            (Status::AlmostOptimal, _) | (_, Status::AlmostOptimal) => Status::AlmostOptimal,
+            (Status::Greedy, _) | (_, Status::Greedy) => Status::Greedy,
+            _ => Status::Optimal,
+        }
     }
 }
 
