@@ -30,7 +30,7 @@ pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
     pub machine: PathBuf,
-    /// Toolpath file (APT CL: .cls, .apt).
+    /// Toolpath file (APT CL: .cls, .apt; joint-space CSV: .csv).
     pub toolpath: PathBuf,
     /// Print one JSON object with the summary instead of the readable report.
     #[arg(long)]
@@ -99,8 +99,8 @@ impl SolveArgs {
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
-    let path = toolpath::read(&args.toolpath)?;
-    let solution = optimize::optimize(&machine, &path, &options)?;
+    let input = toolpath::read_input(&args.toolpath)?;
+    let solution = optimize::optimize_input(&machine, &input, &options)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }

@@ -70,7 +70,7 @@ impl SpanProblem {
             jets.push(kin.axis_jets(&w));
             tip_speed.push(match span.kind {
                 SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
-                SpanKind::Reorientation => 0.0,
+                SpanKind::Reorientation | SpanKind::Joint => 0.0,
             });
         }
         let feed = station_feed_caps(span, &u);
@@ -176,7 +176,8 @@ pub fn stations(span: &Span, grid: Grid) -> Vec<f64> {
     u.push(knots[0]);
     for w in knots.windows(2) {
         let len = w[1] - w[0];
-        let parts = ((len / spacing).ceil() as usize).max(min_parts);
+        // (a hair of tolerance so a segment exactly `spacing` long stays one part)
+        let parts = ((len / spacing * (1.0 - 1e-9)).ceil() as usize).max(min_parts);
         for p in 1..parts {
             u.push(w[0] + len * p as f64 / parts as f64);
         }

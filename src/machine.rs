@@ -65,14 +65,19 @@ pub enum KinematicsSpec {
     /// Seed 000's fixed-bed double swivel head: θ1 = axis C about z, θ2 = axis A,
     /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
     HeadHead { tool_length: f64 },
+    /// A joint-space path (CSV of axis positions along a parameter s): any axes, named as in
+    /// the CSV's `q_<axis>` columns, in the file's order; no feed limit applies.
+    Joint,
 }
 
 impl KinematicsSpec {
-    /// Axis names in the order the kinematics produces them.
+    /// Axis names in the order the kinematics produces them (empty for `Joint`: the machine
+    /// file names its axes).
     pub fn axis_names(&self) -> &'static [&'static str] {
         match self {
             KinematicsSpec::Xyz => &["X", "Y", "Z"],
             KinematicsSpec::HeadHead { .. } => &["X", "Y", "Z", "C", "A"],
+            KinematicsSpec::Joint => &[],
         }
     }
 
@@ -189,6 +194,12 @@ impl Parser {
         let axes = self.axes(obj.get("axes"), &kinematics)?;
         let feed_max = match obj.get("feed") {
             None => None,
+            Some(_) if kinematics == KinematicsSpec::Joint => {
+                return Err(self.err(
+                    "feed",
+                    "a joint-space machine has no tool-tip feed limit; remove the section",
+                ));
+            }
             Some(f) => {
                 let f = self.object(f, "feed")?;
                 self.only_known(f, "feed", &["max"])?;
@@ -214,6 +225,10 @@ impl Parser {
                 self.only_known(obj, "kinematics", &["type"])?;
                 Ok(KinematicsSpec::Xyz)
             }
+            Some("joint") => {
+                self.only_known(obj, "kinematics", &["type"])?;
+                Ok(KinematicsSpec::Joint)
+            }
             Some("head_head") => {
                 self.only_known(obj, "kinematics", &["type", "tool_length"])?;
                 let tool_length =
@@ -222,7 +237,7 @@ impl Parser {
             }
             _ => Err(self.err(
                 "kinematics.type",
-                format!("unknown kinematics {ty} (expected \"xyz\" or \"head_head\")"),
+                format!("unknown kinematics {ty} (expected \"xyz\", \"head_head\" or \"joint\")"),
             )),
         }
     }
@@ -230,7 +245,23 @@ impl Parser {
     fn axes(&self, v: Option<&Value>, kin: &KinematicsSpec) -> Result<Vec<Axis>> {
         let v = v.ok_or_else(|| self.err("axes", "missing"))?;
         let obj = self.object(v, "axes")?;
-        let names = kin.axis_names();
+        let file_names: Vec<&str> = obj.keys().map(String::as_str).collect();
+        let names: &[&str] = match kin {
+            KinematicsSpec::Joint => {
+                if file_names.is_empty() || file_names.len() > crate::kinematics::MAX_AXES {
+                    return Err(self.err(
+                        "axes",
+                        format!(
+                            "a joint-space machine needs 1 to {} axes, found {}",
+                            crate::kinematics::MAX_AXES,
+                            file_names.len()
+                        ),
+                    ));
+                }
+                &file_names
+            }
+            _ => kin.axis_names(),
+        };
         self.only_known(obj, "axes", names)?;
         names
             .iter()
@@ -246,7 +277,11 @@ impl Parser {
                 self.only_known(a, &field, &["velocity", "acceleration"])?;
                 Ok(Axis {
                     name: name.to_string(),
-                    kind: KinematicsSpec::axis_kind(name),
+                    kind: if *kin == KinematicsSpec::Joint {
+                        AxisKind::Linear
+                    } else {
+                        KinematicsSpec::axis_kind(name)
+                    },
                     velocity: self.limit(a.get("velocity"), &format!("{field}.velocity"))?,
                     acceleration: self
                         .limit(a.get("acceleration"), &format!("{field}.acceleration"))?,

@@ -11,12 +11,13 @@
 
 use crate::constraints::{Grid, SpanProblem};
 use crate::error::{Error, Result};
-use crate::geometry::{GeometryOptions, Path, SpanKind};
+use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
-use crate::machine::Machine;
+use crate::machine::{KinematicsSpec, Machine};
 use crate::schedule::Schedule;
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
-use crate::toolpath::Toolpath;
+use crate::toolpath::joint_csv::JointPath;
+use crate::toolpath::{Input, Toolpath};
 
 /// Options of a solve.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,6 +91,13 @@ impl Solution {
 
 /// Computes the time-optimal schedule of `toolpath` on `machine`.
 pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Result<Solution> {
+    if machine.kinematics == KinematicsSpec::Joint {
+        return Err(Error::Usage(format!(
+            "{}: a CL toolpath needs a machine with kinematics (xyz, head_head), not a \
+             joint-space machine",
+            toolpath.source.display()
+        )));
+    }
     let kin = Kinematics::new(machine);
     let orientations: Vec<_> = toolpath.points.iter().map(|p| p.o).collect();
     let lines: Vec<usize> = toolpath.points.iter().map(|p| p.line).collect();
@@ -108,11 +116,36 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
             "no motion: every CL point is at the same position",
         ));
     }
+    optimize_path(machine, path, options)
+}
+
+/// Computes the time-optimal schedule of a joint-space path (axis positions along s) on a
+/// machine of kinematics `joint`. The feed options are path speeds ds/dt there.
+pub fn optimize_joint(machine: &Machine, path: &JointPath, options: &Options) -> Result<Solution> {
+    if machine.kinematics != KinematicsSpec::Joint {
+        return Err(Error::Usage(format!(
+            "{}: a joint-space path needs a machine file with \"kinematics\": {{\"type\": \"joint\"}}",
+            path.source.display()
+        )));
+    }
+    optimize_path(machine, Path::from_joint(path, machine)?, options)
+}
+
+/// Computes the time-optimal schedule of any input.
+pub fn optimize_input(machine: &Machine, input: &Input, options: &Options) -> Result<Solution> {
+    match input {
+        Input::Cl(t) => optimize(machine, t, options),
+        Input::Joint(j) => optimize_joint(machine, j, options),
+    }
+}
+
+/// The refinement loop over a built path.
+fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Solution> {
     let plan = Plan {
         machine,
         weights: span_weights(&path),
         axes: machine.axes.iter().map(|a| a.name.clone()).collect(),
-        kin,
+        kin: Kinematics::new(machine),
         path,
     };
     let mut refinement = Vec::new();
@@ -171,7 +204,10 @@ fn span_weights(path: &Path) -> Vec<f64> {
             .map(|s| s.length())
             .sum()
     };
-    let (lm, lr) = (len_of(SpanKind::Moving), len_of(SpanKind::Reorientation));
+    let (lm, lr) = (
+        len_of(SpanKind::Moving) + len_of(SpanKind::Joint),
+        len_of(SpanKind::Reorientation),
+    );
     let share_kind = |kind| {
         path.spans
             .iter()
@@ -181,14 +217,14 @@ fn span_weights(path: &Path) -> Vec<f64> {
             / segs
     };
     let (sm, sr) = (
-        share_kind(SpanKind::Moving),
+        share_kind(SpanKind::Moving) + share_kind(SpanKind::Joint),
         share_kind(SpanKind::Reorientation),
     );
     path.spans
         .iter()
         .map(|s| {
             let by_len = match s.kind {
-                SpanKind::Moving => sm * s.length() / lm,
+                SpanKind::Moving | SpanKind::Joint => sm * s.length() / lm,
                 SpanKind::Reorientation => sr * s.length() / lr,
             };
             0.5 * s.feed_caps.len() as f64 / segs + 0.5 * by_len
@@ -197,7 +233,7 @@ fn span_weights(path: &Path) -> Vec<f64> {
 }
 
 /// b at an end station for a tool-tip feed (mm/s); an error where the tip cannot move.
-fn end_speed(p: &SpanProblem, i: usize, feed: f64, which: &str) -> Result<f64> {
+fn end_speed(span: &Span, p: &SpanProblem, i: usize, feed: f64, which: &str) -> Result<f64> {
     if !(feed.is_finite() && feed >= 0.0) {
         return Err(Error::Usage(format!(
             "the {which} feed must be ≥ 0 mm/s, got {feed}"
@@ -205,6 +241,9 @@ fn end_speed(p: &SpanProblem, i: usize, feed: f64, which: &str) -> Result<f64> {
     }
     if feed == 0.0 {
         return Ok(0.0);
+    }
+    if span.kind == SpanKind::Joint {
+        return Ok(feed * feed); // u̇ = ds/dt itself
     }
     let speed = p.tip_speed[i];
     if speed <= 0.0 {
@@ -262,10 +301,10 @@ impl Plan<'_> {
             };
             let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
             if si == 0 {
-                p.b_start = end_speed(&p, 0, options.start_feed, "start")?;
+                p.b_start = end_speed(span, &p, 0, options.start_feed, "start")?;
             }
             if si + 1 == spans.len() {
-                p.b_end = end_speed(&p, p.intervals(), options.end_feed, "end")?;
+                p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
             }
             // The O(N) pass runs first whatever the solver: it finds an impossible request and
             // says where, which a convex solver's infeasibility certificate cannot.

@@ -19,7 +19,8 @@ pub struct Station {
     pub span: usize,
     /// Path parameter within the span (mm of chord, or radians on a reorientation span).
     pub u: f64,
-    /// Tool-tip arc length from the start of the path, mm.
+    /// Tool-tip arc length from the start of the path, mm (for a joint-space path: its
+    /// parameter s).
     pub s: f64,
     /// Time from the start of the path, s.
     pub t: f64,
@@ -112,7 +113,9 @@ impl Schedule {
                     t += dt[i];
                     // Arc length by Simpson's rule on |P'(u)|.
                     let du = p.du(i);
-                    if speed > 0.0 || p.tip_speed[i + 1] > 0.0 {
+                    if span.kind == crate::geometry::SpanKind::Joint {
+                        s += du; // a joint path's s is its own parameter
+                    } else if speed > 0.0 || p.tip_speed[i + 1] > 0.0 {
                         let mid = span.eval(p.u[i] + 0.5 * du);
                         let sm = (mid.d1[0].powi(2) + mid.d1[1].powi(2) + mid.d1[2].powi(2)).sqrt();
                         s += du / 6.0 * (speed + 4.0 * sm + p.tip_speed[i + 1]);

@@ -8,16 +8,17 @@ use feedopt::kinematics::{Effective, Kinematics, PathJet, head_head};
 fn path(u: f64) -> PathJet {
     let (s, c) = u.sin_cos();
     let (s2, c2) = (2.0 * u).sin_cos();
+    let pad = |w: [f64; 5]| std::array::from_fn(|i| if i < 5 { w[i] } else { 0.0 });
     Jet {
-        value: [
+        value: pad([
             30.0 * c,
             20.0 * s2,
             5.0 * u,
             0.3 + 0.5 * u + 0.1 * s,
             0.4 + 0.2 * s,
-        ],
-        d1: [-30.0 * s, 40.0 * c2, 5.0, 0.5 + 0.1 * c, 0.2 * c],
-        d2: [-30.0 * c, -80.0 * s2, 0.0, -0.1 * s, -0.2 * s],
+        ]),
+        d1: pad([-30.0 * s, 40.0 * c2, 5.0, 0.5 + 0.1 * c, 0.2 * c]),
+        d2: pad([-30.0 * c, -80.0 * s2, 0.0, -0.1 * s, -0.2 * s]),
     }
 }
 
@@ -87,8 +88,8 @@ fn effective_tangent_is_the_arc_length_derivative_of_eq_27() {
     let e = head_head::effective(d2, &w).unwrap();
     let speed = (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt();
     let h = 1e-5;
-    let mut qp = [0.0; 5];
-    let mut qm = [0.0; 5];
+    let mut qp = [0.0; feedopt::kinematics::MAX_AXES];
+    let mut qm = [0.0; feedopt::kinematics::MAX_AXES];
     kin.axis_positions(path(u0 + h).value, &mut qp);
     kin.axis_positions(path(u0 - h).value, &mut qm);
     for q in 0..5 {

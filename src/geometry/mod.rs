@@ -18,6 +18,8 @@ use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
 use crate::kinematics::{PATH_DIM, PathJet};
+use crate::machine::Machine;
+use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Feed, Toolpath};
 use spline::CubicSpline;
 
@@ -48,6 +50,8 @@ pub enum SpanKind {
     Moving,
     /// The tool tip stands still while the tool turns; u is the turned angle (radians).
     Reorientation,
+    /// A joint-space path: u is the file's parameter s; the path coordinates are the axes.
+    Joint,
 }
 
 /// A rest-to-rest piece of the path.
@@ -172,7 +176,9 @@ impl Path {
                 .iter()
                 .map(|&i| {
                     let p = if moving { pts[i].p } else { p0 };
-                    [p.x, p.y, p.z, angles[i][0], angles[i][1]]
+                    let mut w = [0.0; PATH_DIM];
+                    w[..5].copy_from_slice(&[p.x, p.y, p.z, angles[i][0], angles[i][1]]);
+                    w
                 })
                 .collect();
             spans.push(Span {
@@ -187,6 +193,62 @@ impl Path {
             });
         }
         Ok(Path { spans })
+    }
+}
+
+impl Path {
+    /// The one span of a joint-space path, with its axes put in the machine's order. With
+    /// derivatives in the file the curve is the Hermite interpolant that takes them; without,
+    /// a not-a-knot cubic spline. Rest to rest, unless start and end speeds are given.
+    pub fn from_joint(jp: &JointPath, machine: &Machine) -> Result<Path> {
+        let first = jp.lines.first().copied().unwrap_or(1);
+        let err = |msg: String| Error::parse(&jp.source, first.saturating_sub(1).max(1), msg);
+        // Column of each machine axis.
+        let cols: Vec<usize> = machine
+            .axes
+            .iter()
+            .map(|a| {
+                jp.axes.iter().position(|n| *n == a.name).ok_or_else(|| {
+                    err(format!(
+                        "no column `q_{}` for the machine's axis `{}`",
+                        a.name, a.name
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?;
+        if let Some(extra) = jp
+            .axes
+            .iter()
+            .find(|n| !machine.axes.iter().any(|a| &a.name == *n))
+        {
+            return Err(err(format!(
+                "column `q_{extra}` names an axis the machine does not have"
+            )));
+        }
+        let reorder = |rows: &[[f64; PATH_DIM]]| -> Vec<[f64; PATH_DIM]> {
+            rows.iter()
+                .map(|r| std::array::from_fn(|j| cols.get(j).map_or(0.0, |&c| r[c])))
+                .collect()
+        };
+        let u: Vec<f64> = jp.s.iter().map(|s| s - jp.s[0]).collect();
+        let q = reorder(&jp.q);
+        let spline = match &jp.dq {
+            Some(dq) => CubicSpline::hermite(
+                &u,
+                &q,
+                &reorder(dq),
+                jp.ddq.as_deref().map(reorder).as_deref(),
+            ),
+            None => CubicSpline::new(&u, &q),
+        };
+        Ok(Path {
+            spans: vec![Span {
+                kind: SpanKind::Joint,
+                spline,
+                feed_caps: vec![f64::INFINITY; u.len() - 1],
+                lines: jp.lines.clone(),
+            }],
+        })
     }
 }
 

@@ -1,9 +1,14 @@
-//! Piecewise cubic interpolation (seed 000, eq. 1–3 and 17–18): the one spline of the crate.
+//! Piecewise polynomial curves in one parameter u: the path geometry of every span.
 //!
-//! A [`CubicSpline`] interpolates `dim` coordinates through knots `u_0 < u_1 < … < u_n` with C²
-//! piecewise cubics and *not-a-knot* end conditions (the third derivative is continuous at
-//! `u_1` and `u_{n-1}`), the usual choice when nothing is known about the ends. Two knots give a
-//! straight line, three a parabola.
+//! - [`CubicSpline`] (seed 000, eq. 1–3 and 17–18) interpolates points through knots
+//!   `u_0 < u_1 < … < u_n` with C² piecewise cubics and *not-a-knot* end conditions (the third
+//!   derivative is continuous at `u_1` and `u_{n-1}`), the usual choice when nothing is known
+//!   about the ends. Two knots give a straight line, three a parabola.
+//! - When the derivatives at the knots are given (joint-space input with `dq`, `ddq` columns),
+//!   [`CubicSpline::hermite`] builds the piecewise quintic (or, with first derivatives only,
+//!   cubic) Hermite interpolant that takes them exactly.
+//!
+//! Both are stored alike: per segment, polynomial coefficients in h = u − u_k.
 
 /// Value and first two derivatives of every coordinate at one parameter value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,12 +18,12 @@ pub struct Jet<const D: usize> {
     pub d2: [f64; D],
 }
 
-/// A C² cubic spline through `D`-dimensional points.
+/// A piecewise polynomial curve through `D`-dimensional points (cubic spline or Hermite).
 #[derive(Debug, Clone)]
 pub struct CubicSpline<const D: usize> {
     knots: Vec<f64>,
-    /// Per segment `k` and coordinate: `y = c0 + c1 h + c2 h² + c3 h³`, `h = u − u_k`.
-    coef: Vec<[[f64; 4]; D]>,
+    /// Per segment `k` and coordinate: `y = Σ c_p h^p`, `h = u − u_k`, degree ≤ 5.
+    coef: Vec<[[f64; 6]; D]>,
 }
 
 impl<const D: usize> CubicSpline<D> {
@@ -45,7 +50,55 @@ impl<const D: usize> CubicSpline<D> {
                         s[k][j],
                         (slope[k][j] - s[k][j]) / dx[k] - t,
                         t / dx[k],
+                        0.0,
+                        0.0,
                     ]
+                })
+            })
+            .collect();
+        CubicSpline {
+            knots: knots.to_vec(),
+            coef,
+        }
+    }
+
+    /// The Hermite interpolant taking the given values, first and (if given) second
+    /// derivatives at the knots: quintic per segment with second derivatives, cubic without.
+    pub fn hermite(
+        knots: &[f64],
+        values: &[[f64; D]],
+        d1: &[[f64; D]],
+        d2: Option<&[[f64; D]]>,
+    ) -> Self {
+        assert!(knots.len() >= 2 && knots.len() == values.len() && d1.len() == values.len());
+        let coef = (0..knots.len() - 1)
+            .map(|k| {
+                let h = knots[k + 1] - knots[k];
+                std::array::from_fn(|j| {
+                    let (y0, y1, v0, v1) = (values[k][j], values[k + 1][j], d1[k][j], d1[k + 1][j]);
+                    let (a0, a1) = d2.map_or((0.0, 0.0), |d| (d[k][j], d[k + 1][j]));
+                    match d2 {
+                        // Quintic: matches value, slope and curvature at both ends.
+                        Some(_) => {
+                            let c2 = a0 / 2.0;
+                            // Residuals at u_{k+1} after the known low-order terms.
+                            let r0 = y1 - (y0 + v0 * h + c2 * h * h);
+                            let r1 = v1 - (v0 + 2.0 * c2 * h);
+                            let r2 = a1 - a0;
+                            let (h2, h3) = (h * h, h * h * h);
+                            let c3 = (20.0 * r0 - 8.0 * r1 * h + r2 * h2) / (2.0 * h3);
+                            let c4 = (-30.0 * r0 + 14.0 * r1 * h - 2.0 * r2 * h2) / (2.0 * h3 * h);
+                            let c5 = (12.0 * r0 - 6.0 * r1 * h + r2 * h2) / (2.0 * h3 * h2);
+                            [y0, v0, c2, c3, c4, c5]
+                        }
+                        // Cubic: matches value and slope at both ends.
+                        None => {
+                            let m = (y1 - y0) / h;
+                            let c2 = (3.0 * m - 2.0 * v0 - v1) / h;
+                            let c3 = (v0 + v1 - 2.0 * m) / (h * h);
+                            [y0, v0, c2, c3, 0.0, 0.0]
+                        }
+                    }
                 })
             })
             .collect();
@@ -77,16 +130,16 @@ impl<const D: usize> CubicSpline<D> {
         let c = &self.coef[k];
         Jet {
             value: std::array::from_fn(|j| {
-                let [a, b, cc, d] = c[j];
-                a + h * (b + h * (cc + h * d))
+                let [a, b, cc, d, e, f] = c[j];
+                a + h * (b + h * (cc + h * (d + h * (e + h * f))))
             }),
             d1: std::array::from_fn(|j| {
-                let [_, b, cc, d] = c[j];
-                b + h * (2.0 * cc + 3.0 * h * d)
+                let [_, b, cc, d, e, f] = c[j];
+                b + h * (2.0 * cc + h * (3.0 * d + h * (4.0 * e + h * 5.0 * f)))
             }),
             d2: std::array::from_fn(|j| {
-                let [_, _, cc, d] = c[j];
-                2.0 * cc + 6.0 * h * d
+                let [_, _, cc, d, e, f] = c[j];
+                2.0 * cc + h * (6.0 * d + h * (12.0 * e + h * 20.0 * f))
             }),
         }
     }
@@ -219,6 +272,33 @@ mod tests {
             assert!((j.value[0] - f(u)).abs() < 1e-9 * f(u));
             assert!((j.d2[0] - 6.0 * u).abs() < 1e-8 * u);
         }
+    }
+
+    #[test]
+    fn quintic_hermite_takes_the_given_derivatives_and_reproduces_a_quintic() {
+        let f = |u: f64| {
+            0.3 - u + 0.5 * u.powi(2) + 0.2 * u.powi(3) - 0.1 * u.powi(4) + 0.03 * u.powi(5)
+        };
+        let f1 = |u: f64| -1.0 + u + 0.6 * u.powi(2) - 0.4 * u.powi(3) + 0.15 * u.powi(4);
+        let f2 = |u: f64| 1.0 + 1.2 * u - 1.2 * u.powi(2) + 0.6 * u.powi(3);
+        let knots = [0.0, 0.4, 1.5, 2.0];
+        let v: Vec<[f64; 1]> = knots.iter().map(|&u| [f(u)]).collect();
+        let d1: Vec<[f64; 1]> = knots.iter().map(|&u| [f1(u)]).collect();
+        let d2: Vec<[f64; 1]> = knots.iter().map(|&u| [f2(u)]).collect();
+        let s = CubicSpline::hermite(&knots, &v, &d1, Some(&d2));
+        for &u in &[0.0, 0.1, 0.4, 0.9, 1.5, 1.77, 2.0] {
+            let j = s.eval(u);
+            assert!((j.value[0] - f(u)).abs() < 1e-12, "value at {u}");
+            assert!((j.d1[0] - f1(u)).abs() < 1e-11, "d1 at {u}");
+            assert!((j.d2[0] - f2(u)).abs() < 1e-10, "d2 at {u}");
+        }
+        // Without second derivatives: the cubic Hermite, exact for cubics.
+        let g = |u: f64| 1.0 + 2.0 * u - u * u * u;
+        let v: Vec<[f64; 1]> = knots.iter().map(|&u| [g(u)]).collect();
+        let d1: Vec<[f64; 1]> = knots.iter().map(|&u| [2.0 - 3.0 * u * u]).collect();
+        let s = CubicSpline::hermite(&knots, &v, &d1, None);
+        let j = s.eval(1.1);
+        assert!((j.value[0] - g(1.1)).abs() < 1e-12 && (j.d2[0] + 6.6).abs() < 1e-10);
     }
 
     #[test]

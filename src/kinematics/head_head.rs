@@ -12,7 +12,7 @@ use crate::error::Result;
 /// Eq. 27: x = −Px + d2 sin θ2 sin θ1, y = −Py − d2 sin θ2 cos θ1, z = Pz + d2 − d2 cos θ2;
 /// C = θ1 and A = θ2 in degrees.
 pub fn axis_positions<T: Real>(d2: f64, w: [T; PATH_DIM], out: &mut [T; MAX_AXES]) {
-    let [px, py, pz, t1, t2] = w;
+    let [px, py, pz, t1, t2] = [w[0], w[1], w[2], w[3], w[4]];
     let (s1, c1, s2, c2) = (t1.sin(), t1.cos(), t2.sin(), t2.cos());
     out[0] = -px + (s2 * s1).scale(d2);
     out[1] = -py - (s2 * c1).scale(d2);

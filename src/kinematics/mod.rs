@@ -26,14 +26,16 @@ use crate::geometry::spline::Jet;
 use crate::machine::{KinematicsSpec, Machine};
 use dual::{Dual2, Real};
 
-/// Number of path coordinates: tool tip x, y, z (mm) and up to two rotary angles (radians).
-pub const PATH_DIM: usize = 5;
-
-/// Path coordinates w = (Px, Py, Pz, θ1, θ2) and their first two u-derivatives.
-pub type PathJet = Jet<PATH_DIM>;
-
 /// Largest number of machine axes.
-pub const MAX_AXES: usize = 5;
+pub const MAX_AXES: usize = 8;
+
+/// Number of path coordinates: for a CL path the tool tip x, y, z (mm) and two rotary angles
+/// (radians), the rest zero; for a joint-space path the axis positions themselves.
+pub const PATH_DIM: usize = MAX_AXES;
+
+/// Path coordinates w = (Px, Py, Pz, θ1, θ2, 0, …) or (q_1, …, q_n) and their first two
+/// u-derivatives.
+pub type PathJet = Jet<PATH_DIM>;
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -49,7 +51,13 @@ pub struct AxisJets {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Kinematics {
     Xyz,
-    HeadHead { d2: f64 },
+    HeadHead {
+        d2: f64,
+    },
+    /// A joint-space path: the path coordinates are the `n` axis positions.
+    Joint {
+        n: usize,
+    },
 }
 
 impl Kinematics {
@@ -57,6 +65,9 @@ impl Kinematics {
         match machine.kinematics {
             KinematicsSpec::Xyz => Kinematics::Xyz,
             KinematicsSpec::HeadHead { tool_length } => Kinematics::HeadHead { d2: tool_length },
+            KinematicsSpec::Joint => Kinematics::Joint {
+                n: machine.axes.len(),
+            },
         }
     }
 
@@ -65,12 +76,13 @@ impl Kinematics {
         match self {
             Kinematics::Xyz => 3,
             Kinematics::HeadHead { .. } => 5,
+            Kinematics::Joint { n } => *n,
         }
     }
 
     /// Whether the tool orientation moves any axis (false: pure reorientations take no time).
     pub fn uses_orientation(&self) -> bool {
-        !matches!(self, Kinematics::Xyz)
+        matches!(self, Kinematics::HeadHead { .. })
     }
 
     /// Rotary angles (θ1, θ2) in radians at each CL orientation, on one continuous branch:
@@ -82,7 +94,7 @@ impl Kinematics {
         lines: &[usize],
     ) -> Result<Vec<[f64; 2]>> {
         match self {
-            Kinematics::Xyz => Ok(vec![[0.0; 2]; orientations.len()]),
+            Kinematics::Xyz | Kinematics::Joint { .. } => Ok(vec![[0.0; 2]; orientations.len()]),
             Kinematics::HeadHead { .. } => head_head::continuous_angles(orientations, lines),
         }
     }
@@ -97,6 +109,7 @@ impl Kinematics {
                 out[2] = w[2];
             }
             Kinematics::HeadHead { d2 } => head_head::axis_positions(*d2, w, out),
+            Kinematics::Joint { n } => out[..*n].copy_from_slice(&w[..*n]),
         }
     }
 

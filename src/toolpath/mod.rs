@@ -6,6 +6,7 @@
 //! [`crate::geometry`]'s job.
 
 pub mod apt;
+pub mod joint_csv;
 
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -44,6 +45,27 @@ pub struct Toolpath {
     pub points: Vec<ClPoint>,
 }
 
+/// Any input path: cutter locations or joint positions.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Input {
+    Cl(Toolpath),
+    Joint(joint_csv::JointPath),
+}
+
+/// Reads any input path, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.csv`:
+/// joint space).
+pub fn read_input(path: &Path) -> Result<Input> {
+    let is_csv = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if is_csv {
+        joint_csv::read(path).map(Input::Joint)
+    } else {
+        read(path).map(Input::Cl)
+    }
+}
+
 /// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL).
 pub fn read(path: &Path) -> Result<Toolpath> {
     let ext = path
@@ -54,11 +76,11 @@ pub fn read(path: &Path) -> Result<Toolpath> {
     match ext.as_str() {
         "cls" | "apt" | "cl" => apt::read(path),
         "" => Err(crate::error::Error::Usage(format!(
-            "{}: the toolpath file has no extension (expected .cls or .apt)",
+            "{}: the toolpath file has no extension (expected .cls, .apt or .csv)",
             path.display()
         ))),
         other => Err(crate::error::Error::Usage(format!(
-            "{}: unknown toolpath format `.{other}` (expected .cls or .apt)",
+            "{}: unknown toolpath format `.{other}` (expected .cls, .apt or .csv)",
             path.display()
         ))),
     }
