@@ -56,6 +56,30 @@ pub struct SolveArgs {
     /// Tool-tip feed at the end of the path, mm/s (default: at rest).
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub end_feed: f64,
+    /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
+    /// (seconds).
+    #[arg(long, default_value = "1ms", value_parser = parse_period)]
+    pub period: f64,
+}
+
+/// A duration: a number of seconds, or with unit `s`, `ms` or `us`.
+fn parse_period(text: &str) -> std::result::Result<f64, String> {
+    let t = text.trim();
+    let (num, scale) = if let Some(n) = t.strip_suffix("us") {
+        (n, 1e-6)
+    } else if let Some(n) = t.strip_suffix("ms") {
+        (n, 1e-3)
+    } else if let Some(n) = t.strip_suffix('s') {
+        (n, 1.0)
+    } else {
+        (t, 1.0)
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
+        _ => Err(format!(
+            "`{text}` is not a positive duration (e.g. 1ms, 500us, 0.002)"
+        )),
+    }
 }
 
 /// `--solver` values.
@@ -88,6 +112,10 @@ impl SolveArgs {
             },
             start_feed: self.start_feed,
             end_feed: self.end_feed,
+            verify: crate::verify::VerifyOptions {
+                period: self.period,
+                ..Default::default()
+            },
             ..Options::default()
         };
         o.geometry.corner_angle_deg = self.corner_angle;

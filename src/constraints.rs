@@ -60,7 +60,11 @@ pub struct SpanProblem {
 impl SpanProblem {
     /// Discretises `span` at the stations of [`stations`].
     pub fn build(span: &Span, kin: &Kinematics, machine: &Machine, grid: Grid) -> Self {
-        let u = stations(span, grid);
+        Self::at_stations(span, kin, machine, stations(span, grid))
+    }
+
+    /// Discretises `span` at the given stations (increasing, from 0 to the span's length).
+    pub fn at_stations(span: &Span, kin: &Kinematics, machine: &Machine, u: Vec<f64>) -> Self {
         let n = u.len() - 1;
         let na = kin.n_axes();
         let mut jets = Vec::with_capacity(n + 1);

@@ -57,4 +57,5 @@ pub mod report;
 pub mod schedule;
 pub mod solver;
 pub mod toolpath;
+pub mod verify;
 pub mod writers;

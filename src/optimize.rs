@@ -8,6 +8,12 @@
 //! the stations are refined automatically: every interval is halved until doubling the stations
 //! changes the cycle time by less than [`Options::convergence`] (0.1 %); the finer solution is
 //! returned.
+//!
+//! Every schedule is then re-simulated at the servo period ([`crate::verify`]); one that exceeds
+//! any limit by more than the tolerance (0.1 %) between stations is not returned: the
+//! intervals where the check failed are split (their midpoints become stations) and the spans
+//! concerned solved again, until it verifies; on a grid the user fixed, that grid stays and
+//! only those stations are added.
 
 use crate::constraints::{Grid, SpanProblem};
 use crate::error::{Error, Result};
@@ -18,6 +24,7 @@ use crate::schedule::Schedule;
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
+use crate::verify::{Verification, VerifyOptions, verify};
 
 /// Options of a solve.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +46,12 @@ pub struct Options {
     pub initial_stations: usize,
     /// Refinement stops with an error beyond this many stations.
     pub max_stations: usize,
+    /// Re-simulation of the schedule (servo period, tolerance).
+    pub verify: VerifyOptions,
+    /// Add stations until the re-simulation verifies (default). When false, the schedule of the
+    /// first converged (or the fixed) grid is returned as it is, with its verification: for
+    /// like-for-like comparisons with other solvers on their grid. The CLI always refines.
+    pub refine_until_verified: bool,
 }
 
 impl Default for Options {
@@ -53,6 +66,8 @@ impl Default for Options {
             convergence: 1e-3,
             initial_stations: 1000,
             max_stations: 4_000_000,
+            verify: VerifyOptions::default(),
+            refine_until_verified: true,
         }
     }
 }
@@ -80,6 +95,10 @@ pub struct Solution {
     pub solve_time: f64,
     /// Station counts tried and their cycle times.
     pub refinement: Vec<Refinement>,
+    /// The re-simulation of the returned schedule at the servo period.
+    pub verification: Verification,
+    /// Its servo period, s.
+    pub verify_period: f64,
 }
 
 impl Solution {
@@ -152,14 +171,34 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
     let total = options.stations.unwrap_or(options.initial_stations);
     let mut last_time: Option<f64> = None;
     for level in 0.. {
-        let lv = plan.solve_at(total, level, options)?;
+        let mut lv = plan.solve_at(total, level, options)?;
         let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
         refinement.push(Refinement {
             stations,
             cycle_time_s: time,
         });
         let converged = last_time.is_some_and(|a| (a - time).abs() <= options.convergence * time);
-        if options.stations.is_some() || converged {
+        let verification = if options.stations.is_some() || converged {
+            let mut v = plan.verify(&lv, options)?;
+            let mut round = 0;
+            while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
+                plan.refine_where_violated(&mut lv, &v, options)?;
+                v = plan.verify(&lv, options)?;
+                round += 1;
+            }
+            if round > 0 {
+                refinement.push(Refinement {
+                    stations: lv.schedule.stations.len(),
+                    cycle_time_s: lv.schedule.cycle_time,
+                });
+            }
+            Some(v)
+        } else {
+            None
+        };
+        if let Some(verification) =
+            verification.filter(|v| v.verified || !options.refine_until_verified)
+        {
             return Ok(Solution {
                 path: plan.path,
                 kinematics: plan.kin,
@@ -170,18 +209,23 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
                 iterations: lv.iterations,
                 solve_time: lv.solve_time,
                 refinement,
+                verification,
+                verify_period: options.verify.period,
             });
         }
         if 2 * stations > options.max_stations {
             return Err(Error::Solver(format!(
-                "the cycle time did not converge to {} within {} stations (last: {:?})",
-                options.convergence, options.max_stations, refinement
+                "no converged schedule that verifies within {} stations (tried: {:?})",
+                options.max_stations, refinement
             )));
         }
         last_time = Some(time);
     }
     unreachable!("the refinement loop returns")
 }
+
+/// Rounds of local refinement where the re-simulation failed, before refining everywhere.
+const MAX_LOCAL_ROUNDS: usize = 8;
 
 /// The solve of every span at one refinement level.
 struct Level {
@@ -266,6 +310,73 @@ struct Plan<'a> {
 }
 
 impl Plan<'_> {
+    /// Re-simulates one level's schedule.
+    fn verify(&self, lv: &Level, options: &Options) -> Result<Verification> {
+        verify(
+            self.machine,
+            &self.kin,
+            &self.path.spans,
+            &lv.problems,
+            &lv.solutions,
+            &options.verify,
+        )
+    }
+
+    /// Splits every interval where the re-simulation found a limit exceeded (adds its
+    /// midpoint as a station) and solves the spans concerned again: the excess between stations
+    /// falls as Δu², so a few rounds suffice, and only where the path needs it.
+    fn refine_where_violated(
+        &self,
+        lv: &mut Level,
+        v: &Verification,
+        options: &Options,
+    ) -> Result<()> {
+        let mut split: Vec<Vec<usize>> = vec![Vec::new(); lv.problems.len()];
+        for viol in &v.violations {
+            split[viol.span].push(viol.interval);
+        }
+        for (si, mut ks) in split.into_iter().enumerate() {
+            if ks.is_empty() {
+                continue;
+            }
+            ks.sort_unstable();
+            ks.dedup();
+            let old = &lv.problems[si];
+            let mut u = Vec::with_capacity(old.u.len() + ks.len());
+            let mut next = ks.iter().peekable();
+            for k in 0..old.intervals() {
+                u.push(old.u[k]);
+                if next.peek() == Some(&&k) {
+                    u.push(0.5 * (old.u[k] + old.u[k + 1]));
+                    next.next();
+                }
+            }
+            u.push(old.u[old.intervals()]);
+            let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
+            (p.b_start, p.b_end) = (old.b_start, old.b_end);
+            let s = self.solve_span(si, &p, options)?;
+            lv.iterations += s.iterations;
+            lv.solve_time += s.solve_time;
+            lv.status = lv.status.worst(s.status);
+            lv.problems[si] = p;
+            lv.solutions[si] = s;
+        }
+        lv.schedule = Schedule::build(&self.axes, &self.path.spans, &lv.problems, &lv.solutions)?;
+        Ok(())
+    }
+
+    /// Solves one span's problem with the chosen solver, after the reach pass has checked that a
+    /// schedule exists (and said where not).
+    fn solve_span(&self, si: usize, p: &SpanProblem, options: &Options) -> Result<SpanSolution> {
+        // The O(N) pass runs first whatever the solver: it finds an impossible request and
+        // says where, which a convex solver's infeasibility certificate cannot.
+        let greedy = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
+        Ok(match options.solver_kind {
+            SolverKind::Reach => greedy,
+            SolverKind::Clarabel => solver::clarabel::solve(p, &options.solver)?,
+        })
+    }
+
     /// Turns the reach pass's finding into an error naming span, station, u, CL line and axes.
     fn infeasible(&self, si: usize, p: &SpanProblem, inf: &solver::reach::Infeasible) -> Error {
         let span = &self.path.spans[si];
@@ -306,13 +417,7 @@ impl Plan<'_> {
             if si + 1 == spans.len() {
                 p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
             }
-            // The O(N) pass runs first whatever the solver: it finds an impossible request and
-            // says where, which a convex solver's infeasibility certificate cannot.
-            let greedy = solver::reach::solve(&p).map_err(|inf| self.infeasible(si, &p, &inf))?;
-            let s = match options.solver_kind {
-                SolverKind::Reach => greedy,
-                SolverKind::Clarabel => solver::clarabel::solve(&p, &options.solver)?,
-            };
+            let s = self.solve_span(si, &p, options)?;
             status = status.worst(s.status);
             iterations += s.iterations;
             solve_time += s.solve_time;

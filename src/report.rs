@@ -50,6 +50,26 @@ pub struct Summary {
     pub axes: Vec<(String, AxisPeaks)>,
     pub binding: Vec<BindingShare>,
     pub refinement: Vec<Refinement>,
+    /// The re-simulation at the servo period found every limit kept (within its tolerance).
+    pub verified: bool,
+    /// Servo period of the re-simulation, s.
+    pub verify_period_s: f64,
+    /// Worst ratio to each axis's limits over the re-simulated motion (between stations too).
+    #[serde(serialize_with = "worst_as_map")]
+    pub worst_ratio: Vec<(String, WorstRatio)>,
+    /// Worst ratio of the tool-tip feed to its cap (0 without a cap).
+    pub worst_feed_ratio: f64,
+}
+
+/// Worst use of one axis's limits in the re-simulation.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WorstRatio {
+    pub velocity: f64,
+    pub acceleration: f64,
+}
+
+fn worst_as_map<S: serde::Serializer>(v: &[(String, WorstRatio)], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(v.iter().map(|(k, p)| (k, p)))
 }
 
 impl Summary {
@@ -140,6 +160,23 @@ impl Summary {
                 .collect(),
             binding,
             refinement: sol.refinement.clone(),
+            verified: sol.verification.verified,
+            verify_period_s: sol.verify_period,
+            worst_ratio: sol
+                .verification
+                .worst
+                .iter()
+                .map(|w| {
+                    (
+                        w.name.clone(),
+                        WorstRatio {
+                            velocity: w.velocity,
+                            acceleration: w.acceleration,
+                        },
+                    )
+                })
+                .collect(),
+            worst_feed_ratio: sol.verification.worst_feed,
         }
     }
 }
@@ -191,13 +228,26 @@ impl fmt::Display for Summary {
                 self.iterations, self.solve_time_s
             )?;
         }
+        writeln!(
+            f,
+            "verified      {} (re-simulated every {} ms: worst ratio to a limit {:.5})",
+            if self.verified { "yes" } else { "NO" },
+            self.verify_period_s * 1e3,
+            self.worst_ratio
+                .iter()
+                .map(|(_, w)| w.velocity.max(w.acceleration))
+                .fold(self.worst_feed_ratio, f64::max)
+        )?;
         writeln!(f)?;
-        writeln!(f, "axis   peak |q̇|/v   peak |q̈|/a")?;
-        for (name, p) in &self.axes {
+        writeln!(
+            f,
+            "axis   peak |q̇|/v   peak |q̈|/a   (at stations; re-simulated: |q̇|/v  |q̈|/a)"
+        )?;
+        for ((name, p), (_, w)) in self.axes.iter().zip(&self.worst_ratio) {
             writeln!(
                 f,
-                "{name:<6} {:>10.3}   {:>10.3}",
-                p.peak_velocity_ratio, p.peak_acceleration_ratio
+                "{name:<6} {:>10.3}   {:>10.3}                   {:>10.4} {:>7.4}",
+                p.peak_velocity_ratio, p.peak_acceleration_ratio, w.velocity, w.acceleration
             )?;
         }
         writeln!(f)?;

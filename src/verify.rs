@@ -1,0 +1,584 @@
+//! Re-simulation: an independent check of a schedule at the servo period of a controller.
+//!
+//! The solver bounds the axis accelerations and the feed only at its stations. A controller
+//! runs the motion at a fixed interpolation period (seed 004: data-sampling interpolation), so
+//! what matters is whether every axis stays within its limits *at every servo instant*. This
+//! module replays the schedule on that clock and checks every limit from scratch:
+//!
+//! - time comes from eq. 43 per interval ([`crate::schedule::interval_times`]); within an
+//!   interval b = u̇² is linear in u, so ü is constant and the motion integrates exactly:
+//!   `√b(t) = √b_i + ü (t − t_i)`, `u(t) = u_i + (t − t_i)(√b_i + √b(t))/2`
+//!   (the second form stays exact and finite for ü → 0 and from rest);
+//! - the geometry is evaluated from the path spline at each sampled u (not taken from the
+//!   solver's station data), then through the kinematics to every axis:
+//!   `q̇ = q' u̇`, `q̈ = q'' b + q' ü`, and on a moving span `V = |P'| u̇`;
+//! - every quantity is compared with its limit as a ratio ([`Limit::ratio`]); a ratio above
+//!   `1 + tolerance` is a [`Violation`].
+//!
+//! Samples are the instants `t = j · period` of one global clock (time accumulates over the
+//! spans, run one after the other) plus the last instant of each span. In addition, both ends
+//! of every station interval are checked with that interval's own ü (q̈ jumps at stations), so
+//! the check is at least as strict as the solver's own rows.
+
+use crate::constraints::SpanProblem;
+use crate::error::{Error, Result};
+use crate::geometry::{Span, SpanKind};
+use crate::kinematics::{AxisJets, Kinematics};
+use crate::machine::{Limit, Machine};
+use crate::schedule::interval_times;
+use crate::solver::SpanSolution;
+
+/// Most violations kept in [`Verification::violations`] (the worst ones).
+pub const MAX_VIOLATIONS: usize = 1000;
+
+/// Options of a re-simulation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifyOptions {
+    /// Servo (interpolation) period, s.
+    pub period: f64,
+    /// Allowed relative excess over a limit: a ratio above `1 + tolerance` is a violation.
+    pub tolerance: f64,
+}
+
+impl Default for VerifyOptions {
+    fn default() -> Self {
+        VerifyOptions {
+            period: 1e-3,
+            tolerance: 1e-3,
+        }
+    }
+}
+
+/// Which limit a check concerns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// An axis velocity q̇.
+    Velocity,
+    /// An axis acceleration q̈.
+    Acceleration,
+    /// The tool-tip feed V against the programmed or maximum feed.
+    Feed,
+}
+
+/// The worst use of one axis's limits over all samples.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct AxisWorst {
+    /// Axis name, as in the machine file.
+    pub name: String,
+    /// Largest q̇ / limit on its side (≥ 0).
+    pub velocity: f64,
+    /// Largest q̈ / limit on its side (≥ 0).
+    pub acceleration: f64,
+}
+
+/// A limit exceeded by more than the tolerance: the worst excess within one station interval.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Violation {
+    /// Index of the span (a rest-to-rest piece of the path).
+    pub span: usize,
+    /// Station interval k within the span (between stations k and k+1).
+    pub interval: usize,
+    /// Path parameter of the worst sample.
+    pub u: f64,
+    /// Time of the worst sample from the start of the path, s.
+    pub t: f64,
+    /// The axis (index into the machine's axes); `None` for the feed.
+    pub axis: Option<usize>,
+    /// What exceeds its limit.
+    pub kind: Quantity,
+    /// The value (mm/s, mm/s², °/s, °/s²).
+    pub value: f64,
+    /// The limit on the value's side (`min` for a negative value).
+    pub limit: f64,
+    /// `value / limit` (> 1 + tolerance; infinite if the value could not be evaluated).
+    pub ratio: f64,
+}
+
+/// The outcome of a re-simulation.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Verification {
+    /// No sample exceeds any limit by more than the tolerance.
+    pub verified: bool,
+    /// Servo instants checked: every `j · period` within the schedule and the last instant of
+    /// each span.
+    pub samples: usize,
+    /// Additional checks at station instants: both ends of every station interval, each with
+    /// that interval's ü (the last instant of a span is among them and among `samples`).
+    pub station_checks: usize,
+    /// Per machine axis, in the machine's order.
+    pub worst: Vec<AxisWorst>,
+    /// Largest V / feed cap (0 where no cap applies).
+    pub worst_feed: f64,
+    /// Station intervals with a violation, before [`MAX_VIOLATIONS`] truncation.
+    pub violating_intervals: usize,
+    /// The worst violation of each offending (span, interval), worst first, at most
+    /// [`MAX_VIOLATIONS`].
+    pub violations: Vec<Violation>,
+}
+
+impl Verification {
+    /// The largest ratio over every axis, quantity and the feed.
+    pub fn worst_ratio(&self) -> f64 {
+        self.worst
+            .iter()
+            .flat_map(|w| [w.velocity, w.acceleration])
+            .fold(self.worst_feed, f64::max)
+    }
+}
+
+/// Re-simulates the schedule given by `solutions` (b = u̇² at the stations of `problems`, one
+/// per span of `spans`, in order) at `options.period` and checks every axis limit of `machine`
+/// and every feed cap at every sample.
+///
+/// Errors: a non-positive or non-finite period, a negative or non-finite tolerance, inputs of
+/// mismatched lengths, and a schedule that stalls (b = 0 over a whole interval).
+///
+/// Cost: O((samples + stations) × axes), no allocation per sample.
+pub fn verify(
+    machine: &Machine,
+    kin: &Kinematics,
+    spans: &[Span],
+    problems: &[SpanProblem],
+    solutions: &[SpanSolution],
+    options: &VerifyOptions,
+) -> Result<Verification> {
+    let period = options.period;
+    if !(period.is_finite() && period > 0.0) {
+        return Err(Error::Usage(format!(
+            "the verification period must be a positive number of seconds, found {period}"
+        )));
+    }
+    if !(options.tolerance.is_finite() && options.tolerance >= 0.0) {
+        return Err(Error::Usage(format!(
+            "the verification tolerance must be a non-negative number, found {}",
+            options.tolerance
+        )));
+    }
+    if spans.len() != problems.len() || spans.len() != solutions.len() {
+        return Err(Error::Usage(format!(
+            "verify: {} spans, {} problems and {} solutions",
+            spans.len(),
+            problems.len(),
+            solutions.len()
+        )));
+    }
+    let na = kin.n_axes().min(machine.axes.len());
+    let mut acc = Accumulator {
+        limits: machine
+            .axes
+            .iter()
+            .take(na)
+            .map(|a| (a.velocity, a.acceleration))
+            .collect(),
+        threshold: 1.0 + options.tolerance,
+        worst: vec![[0.0; 2]; na],
+        worst_feed: 0.0,
+        current: None,
+        violations: Vec::new(),
+    };
+    let (mut samples, mut station_checks) = (0usize, 0usize);
+    let mut t0 = 0.0f64; // start of the current span on the global clock
+    for (si, ((span, p), sol)) in spans.iter().zip(problems).zip(solutions).enumerate() {
+        let b = &sol.b;
+        if b.len() != p.u.len() || p.u.len() < 2 {
+            return Err(Error::Usage(format!(
+                "verify: span {si} has {} stations but {} values of b",
+                p.u.len(),
+                b.len()
+            )));
+        }
+        let dt = interval_times(p, b)?;
+        let knots = span.spline.knots();
+        let last_seg = knots.len() - 2;
+        let moving = span.kind == SpanKind::Moving;
+        let mut seg = 0usize;
+        // First instant of the global clock in this span ([t0, t_end): the end belongs to the
+        // next span's start, except for the final instant, checked explicitly).
+        let mut j = (t0 / period).ceil().max(0.0) as u64;
+        let mut ta = t0;
+        // Geometry at the interval's start station (shared with the previous interval's end).
+        while seg < last_seg && knots[seg + 1] <= p.u[0] {
+            seg += 1;
+        }
+        let mut at_start = Point::new(span, kin, seg, p.u[0], moving);
+        let n = p.intervals();
+        for i in 0..n {
+            let (ua, ub) = (p.u[i], p.u[i + 1]);
+            let (ba, bb) = (b[i].max(0.0), b[i + 1].max(0.0));
+            let (ra, rb) = (ba.sqrt(), bb.sqrt());
+            // ü of the clamped profile: ü Δt = √b_{i+1} − √b_i exactly (eq. 43).
+            let udd = (bb - ba) / (2.0 * (ub - ua));
+            let tb = ta + dt[i];
+            // The segment of the spline this interval starts in (a station at a knot starts
+            // the next segment: its feed cap applies from there on).
+            while seg < last_seg && knots[seg + 1] <= ua {
+                seg += 1;
+            }
+            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            acc.check(
+                &at_start.jets,
+                at_start.speed,
+                ra,
+                ba,
+                udd,
+                cap,
+                ua,
+                ta,
+                si,
+                i,
+            );
+            station_checks += 1;
+            // Servo instants strictly inside the interval (and at its start).
+            loop {
+                let t = j as f64 * period;
+                if t >= tb {
+                    break;
+                }
+                let (r, u) = state(ra, rb, udd, ua, ub, t - ta, dt[i]);
+                // Stay in the left segment at a knot: the interval's own side.
+                while seg < last_seg && knots[seg + 1] < u {
+                    seg += 1;
+                }
+                let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+                let pt = Point::new(span, kin, seg, u, moving);
+                acc.check(&pt.jets, pt.speed, r, r * r, udd, cap, u, t, si, i);
+                samples += 1;
+                j += 1;
+            }
+            // The interval's end, with this interval's ü.
+            while seg < last_seg && knots[seg + 1] < ub {
+                seg += 1;
+            }
+            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            let at_end = Point::new(span, kin, seg, ub, moving);
+            acc.check(&at_end.jets, at_end.speed, rb, bb, udd, cap, ub, tb, si, i);
+            station_checks += 1;
+            acc.close_interval();
+            at_start = at_end;
+            ta = tb;
+        }
+        samples += 1; // the span's last instant (checked as the last interval's end)
+        t0 = ta;
+    }
+    let violating_intervals = acc.violations.len();
+    let mut violations = acc.violations;
+    violations.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
+    violations.truncate(MAX_VIOLATIONS);
+    Ok(Verification {
+        verified: violating_intervals == 0,
+        samples,
+        station_checks,
+        worst: machine
+            .axes
+            .iter()
+            .take(na)
+            .zip(&acc.worst)
+            .map(|(a, w)| AxisWorst {
+                name: a.name.clone(),
+                velocity: w[0],
+                acceleration: w[1],
+            })
+            .collect(),
+        worst_feed: acc.worst_feed,
+        violating_intervals,
+        violations,
+    })
+}
+
+/// √b and u at local time `tau` into an interval with constant ü (eq. 43 integrated exactly),
+/// clamped to the interval so rounding never leaves it.
+fn state(ra: f64, rb: f64, udd: f64, ua: f64, ub: f64, tau: f64, dt: f64) -> (f64, f64) {
+    let tau = tau.clamp(0.0, dt);
+    let r = (ra + udd * tau).clamp(ra.min(rb), ra.max(rb));
+    let u = (ua + 0.5 * tau * (ra + r)).clamp(ua, ub);
+    (r, u)
+}
+
+/// The path geometry at one sample: every axis's u-derivatives and |P'|.
+struct Point {
+    jets: AxisJets,
+    /// |P'(u)| on a moving span, 0 on a reorientation.
+    speed: f64,
+}
+
+impl Point {
+    fn new(span: &Span, kin: &Kinematics, seg: usize, u: f64, moving: bool) -> Point {
+        let w = span.spline.eval_in(seg, u);
+        let speed = if moving {
+            (w.d1[0] * w.d1[0] + w.d1[1] * w.d1[1] + w.d1[2] * w.d1[2]).sqrt()
+        } else {
+            0.0
+        };
+        Point {
+            jets: kin.axis_jets(&w),
+            speed,
+        }
+    }
+}
+
+/// Worst ratios so far and the violations found.
+struct Accumulator {
+    /// (velocity, acceleration) limits per axis.
+    limits: Vec<(Limit, Limit)>,
+    threshold: f64,
+    /// [velocity, acceleration] worst ratio per axis.
+    worst: Vec<[f64; 2]>,
+    worst_feed: f64,
+    /// The worst violation of the interval being checked.
+    current: Option<Violation>,
+    violations: Vec<Violation>,
+}
+
+/// A ratio that is never NaN: a value that cannot be evaluated counts as an infinite excess.
+fn ratio(limit: f64, value: f64) -> f64 {
+    let r = value / limit;
+    if r.is_nan() { f64::INFINITY } else { r }
+}
+
+impl Accumulator {
+    /// Checks every limit at one sample: √b = `r`, b, ü, feed cap `cap`.
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        &mut self,
+        jets: &AxisJets,
+        speed: f64,
+        r: f64,
+        b: f64,
+        udd: f64,
+        cap: f64,
+        u: f64,
+        t: f64,
+        span: usize,
+        interval: usize,
+    ) {
+        for (j, (vl, al)) in self.limits.iter().enumerate() {
+            let qd = jets.dq[j] * r;
+            let qdd = jets.ddq[j] * b + jets.dq[j] * udd;
+            for (k, (value, lim, kind)) in [
+                (qd, vl, Quantity::Velocity),
+                (qdd, al, Quantity::Acceleration),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let limit = if value >= 0.0 { lim.max } else { lim.min };
+                let x = ratio(limit, value);
+                if x > self.worst[j][k] {
+                    self.worst[j][k] = x;
+                }
+                if x > self.threshold {
+                    record(
+                        &mut self.current,
+                        span,
+                        interval,
+                        u,
+                        t,
+                        Some(j),
+                        kind,
+                        value,
+                        limit,
+                        x,
+                    );
+                }
+            }
+        }
+        if cap.is_finite() && speed > 0.0 {
+            let v = speed * r;
+            let x = if v > 0.0 { ratio(cap, v) } else { 0.0 };
+            if x > self.worst_feed {
+                self.worst_feed = x;
+            }
+            if x > self.threshold {
+                record(
+                    &mut self.current,
+                    span,
+                    interval,
+                    u,
+                    t,
+                    None,
+                    Quantity::Feed,
+                    v,
+                    cap,
+                    x,
+                );
+            }
+        }
+    }
+
+    /// Ends an interval: keeps its worst violation, if any.
+    fn close_interval(&mut self) {
+        if let Some(v) = self.current.take() {
+            self.violations.push(v);
+        }
+    }
+}
+
+/// Keeps `x` as the interval's worst violation if it is worse than the one kept.
+#[allow(clippy::too_many_arguments)]
+fn record(
+    current: &mut Option<Violation>,
+    span: usize,
+    interval: usize,
+    u: f64,
+    t: f64,
+    axis: Option<usize>,
+    kind: Quantity,
+    value: f64,
+    limit: f64,
+    x: f64,
+) {
+    if current.as_ref().is_none_or(|c| x > c.ratio) {
+        *current = Some(Violation {
+            span,
+            interval,
+            u,
+            t,
+            axis,
+            kind,
+            value: if value.is_nan() { f64::INFINITY } else { value },
+            limit,
+            ratio: x,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::Grid;
+    use crate::geometry::spline::CubicSpline;
+    use crate::kinematics::PATH_DIM;
+    use crate::machine::{Axis, AxisKind, KinematicsSpec};
+    use crate::solver::Status;
+
+    fn xyz(a: f64, v: f64, feed: Option<f64>) -> Machine {
+        let axis = |name: &str| Axis {
+            name: name.to_string(),
+            kind: AxisKind::Linear,
+            velocity: Limit::symmetric(v),
+            acceleration: Limit::symmetric(a),
+        };
+        Machine {
+            name: "xyz".into(),
+            kinematics: KinematicsSpec::Xyz,
+            axes: vec![axis("X"), axis("Y"), axis("Z")],
+            feed_max: feed,
+        }
+    }
+
+    /// A straight line along X of length `len`, one CL segment.
+    fn line(len: f64, cap: f64) -> Span {
+        let mut end = [0.0; PATH_DIM];
+        end[0] = len;
+        Span {
+            kind: SpanKind::Moving,
+            spline: CubicSpline::new(&[0.0, len], &[[0.0; PATH_DIM], end]),
+            feed_caps: vec![cap],
+            lines: vec![1, 2],
+        }
+    }
+
+    fn solution(b: Vec<f64>) -> SpanSolution {
+        SpanSolution {
+            b,
+            status: Status::Optimal,
+            iterations: 0,
+            solve_time: 0.0,
+        }
+    }
+
+    #[test]
+    fn exact_integration_with_constant_path_acceleration() {
+        // From rest with ü = 3: √b = 3τ, u = 1.5 τ².
+        let (r, u) = state(0.0, 6.0, 3.0, 0.0, 6.0, 1.5, 2.0);
+        assert!((r - 4.5).abs() < 1e-15 && (u - 1.5 * 2.25).abs() < 1e-15);
+        // ü = 0: uniform motion, no division anywhere.
+        let (r, u) = state(2.0, 2.0, 0.0, 1.0, 5.0, 0.5, 2.0);
+        assert_eq!((r, u), (2.0, 2.0));
+        // Braking to rest ends exactly at the interval's end.
+        let (r, u) = state(4.0, 0.0, -2.0, 0.0, 4.0, 2.0, 2.0);
+        assert_eq!((r, u), (0.0, 4.0));
+    }
+
+    #[test]
+    fn a_triangular_profile_at_the_acceleration_limit_is_exact() {
+        // b = 2 a u up to mid-line, then symmetric: X accelerates at exactly ±a throughout.
+        let (len, a) = (2.0, 2000.0);
+        let m = xyz(a, 1e4, None);
+        let kin = Kinematics::new(&m);
+        let span = line(len, f64::INFINITY);
+        let p = SpanProblem::build(
+            &span,
+            &kin,
+            &m,
+            Grid {
+                spacing: len / 8.0,
+                min_parts: 1,
+            },
+        );
+        let b: Vec<f64> = p.u.iter().map(|&u| 2.0 * a * u.min(len - u)).collect();
+        let options = VerifyOptions::default();
+        let v = verify(&m, &kin, &[span], &[p], &[solution(b)], &options).unwrap();
+        assert!(v.verified, "{v:?}");
+        assert!((v.worst[0].acceleration - 1.0).abs() < 1e-12, "{v:?}");
+        let vpeak = (a * len).sqrt();
+        assert!((v.worst[0].velocity - vpeak / 1e4).abs() < 1e-12);
+        assert_eq!(v.worst_feed, 0.0);
+        // T = 2√(L/a) = 63.2 ms: instants 0 … 63 ms and the end.
+        assert_eq!(v.samples, 65);
+        assert_eq!(v.station_checks, 16);
+    }
+
+    #[test]
+    fn an_excess_names_the_axis_the_quantity_and_the_cap() {
+        let (len, a) = (2.0, 2000.0);
+        let m = xyz(a, 1e4, None);
+        let kin = Kinematics::new(&m);
+        let span = line(len, 65.0);
+        let grid = Grid {
+            spacing: len / 8.0,
+            min_parts: 1,
+        };
+        let p = SpanProblem::build(&span, &kin, &m, grid);
+        let b: Vec<f64> =
+            p.u.iter()
+                .map(|&u| 1.1 * 2.0 * a * u.min(len - u))
+                .collect();
+        let v = verify(&m, &kin, &[span], &[p], &[solution(b)], &Default::default()).unwrap();
+        assert!(!v.verified);
+        let w = &v.violations[0];
+        assert_eq!((w.axis, w.kind), (Some(0), Quantity::Acceleration));
+        assert!((w.ratio - 1.1).abs() < 1e-9);
+        assert!((v.worst_feed - (1.1 * a * len).sqrt() / 65.0).abs() < 1e-9);
+        assert!(
+            v.violations
+                .iter()
+                .all(|x| x.ratio.is_finite() && x.u.is_finite() && x.t.is_finite())
+        );
+        assert_eq!(v.violating_intervals, v.violations.len());
+    }
+
+    #[test]
+    fn bad_options_and_stalls_are_errors() {
+        let m = xyz(2000.0, 1e4, None);
+        let kin = Kinematics::new(&m);
+        let span = line(1.0, f64::INFINITY);
+        let grid = Grid {
+            spacing: 0.25,
+            min_parts: 1,
+        };
+        let p = SpanProblem::build(&span, &kin, &m, grid);
+        let sol = solution(vec![0.0; p.u.len()]);
+        let (spans, ps, ss) = ([span], [p], [sol]);
+        for period in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let o = VerifyOptions {
+                period,
+                ..Default::default()
+            };
+            assert!(verify(&m, &kin, &spans, &ps, &ss, &o).is_err());
+        }
+        // b = 0 everywhere: the path is never traversed.
+        assert!(verify(&m, &kin, &spans, &ps, &ss, &Default::default()).is_err());
+    }
+}
