@@ -134,6 +134,22 @@ impl SpanProblem {
         }
     }
 
+    /// Stations `a..=b` as a problem of their own, with b fixed at both ends to the given
+    /// values (a window of a long span).
+    pub fn window(&self, a: usize, b: usize, b_start: f64, b_end: f64) -> SpanProblem {
+        SpanProblem {
+            u: self.u[a..=b].to_vec(),
+            b_max: self.b_max[a..=b].to_vec(),
+            b_max_by: self.b_max_by[a..=b].to_vec(),
+            tip_speed: self.tip_speed[a..=b].to_vec(),
+            jets: self.jets[a..=b].to_vec(),
+            acceleration: self.acceleration.clone(),
+            essential: self.essential[a..=b].to_vec(),
+            b_start,
+            b_end,
+        }
+    }
+
     /// Number of intervals N.
     pub fn intervals(&self) -> usize {
         self.u.len() - 1

@@ -373,7 +373,9 @@ impl Plan<'_> {
         let greedy = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
         Ok(match options.solver_kind {
             SolverKind::Reach => greedy,
-            SolverKind::Clarabel => solver::clarabel::solve(p, &options.solver)?,
+            SolverKind::Clarabel => {
+                solver::clarabel::solve_windowed(p, &greedy.b, &options.solver)?
+            }
         })
     }
 

@@ -253,6 +253,8 @@ fn too_few_stations_on_a_circle_exceed_the_limits_between_them() {
     let m = machine(XYZ_2000);
     let options = Options {
         stations: Some(20),
+        // Keep the coarse grid as it is: this test is about what the check finds there.
+        refine_until_verified: false,
         ..Options::default()
     };
     let sol = solve(&m, &toolpath(&circle(10.0, 3, 37), None), &options);
@@ -293,6 +295,7 @@ fn a_curvature_peak_between_stations_is_found() {
     let tp = toolpath(&pts, None);
     let options = Options {
         stations: Some(8),
+        refine_until_verified: false,
         geometry: GeometryOptions {
             corner_angle_deg: 30.0,
         },
@@ -431,5 +434,30 @@ fn timing_on_the_bundled_problems() {
         for x in v.violations.iter().take(3) {
             eprintln!("    {x:?}");
         }
+    }
+}
+
+#[test]
+fn the_pipeline_splits_intervals_until_the_schedule_verifies() {
+    // The coarse circle of the test above, with the default: refine until verified. The grid
+    // the user asked for stays, stations are added only where the check failed.
+    let m = machine(XYZ_2000);
+    let coarse = Options {
+        stations: Some(20),
+        ..Options::default()
+    };
+    let sol = solve(&m, &toolpath(&circle(10.0, 3, 37), None), &coarse);
+    assert!(
+        sol.verification.verified,
+        "{:?}",
+        sol.verification.violations.first()
+    );
+    assert!(sol.verification.worst_ratio() <= 1.001);
+    assert!(sol.stations() > 3 * 37 + 1, "stations were added");
+    assert!(sol.stations() < 2 * (3 * 37 + 1), "only where needed");
+    // Every CL point is still a station.
+    let u: Vec<f64> = sol.problems[0].u.clone();
+    for knot in sol.path.spans[0].spline.knots() {
+        assert!(u.iter().any(|x| (x - knot).abs() < 1e-12));
     }
 }

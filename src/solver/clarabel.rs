@@ -16,6 +16,13 @@
 //! Clarabel stop at AlmostSolved). Rows whose coefficients all vanish (an axis that does not
 //! move) are dropped, and so are acceleration rows implied by the others at their station
 //! ([`essential_rows`](crate::constraints::essential_rows)).
+//!
+//! **Windows.** [`solve_windowed`] splits a long span into windows at stations where the O(N)
+//! reachability profile sits on the velocity bound (b = b_max: there the optimum almost surely
+//! does too), fixes b there to that value, and solves the windows in parallel. Each window is
+//! solved to optimality; the stitched profile is feasible by construction and never slower than
+//! the reachability profile (which is feasible for every window). Cost and memory then grow
+//! linearly with the stations, and both cores work on one span.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -242,6 +249,104 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
         status,
         iterations: sol.iterations,
         solve_time: sol.solve_time,
+    })
+}
+
+/// Solves one span in windows of at most `settings.window` stations (at least one per thread
+/// when the span is long enough), stitched at stations of the reachability profile `greedy`
+/// (b at every station, feasible). Falls back to one window when no stitch is worth it.
+pub fn solve_windowed(
+    p: &SpanProblem,
+    greedy: &[f64],
+    settings: &SolverSettings,
+) -> Result<SpanSolution> {
+    let n = p.intervals();
+    let threads = if settings.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |t| t.get())
+    } else {
+        settings.threads
+    };
+    const MIN_WINDOW: usize = 200;
+    let windows = n
+        .div_ceil(settings.window.max(MIN_WINDOW))
+        .max(threads.min(n / MIN_WINDOW))
+        .max(1);
+    if windows == 1 {
+        return solve(p, settings);
+    }
+    // Cut near every k·n/windows, at the station within ±10 % of a window whose greedy b is
+    // closest to its bound (relative), preferring the target position on ties.
+    let len = n / windows;
+    let mut cuts = vec![0usize];
+    for w in 1..windows {
+        let target = w * n / windows;
+        let reach = (len / 10).max(1);
+        let (lo, hi) = (
+            target.saturating_sub(reach).max(cuts[w - 1] + 2),
+            (target + reach).min(n - 2),
+        );
+        let score = |i: usize| {
+            let r = if p.b_max[i].is_finite() && p.b_max[i] > 0.0 {
+                greedy[i] / p.b_max[i]
+            } else {
+                0.0
+            };
+            (r, std::cmp::Reverse(i.abs_diff(target)))
+        };
+        let best = (lo..=hi.max(lo)).max_by(|&a, &b| {
+            score(a)
+                .partial_cmp(&score(b))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        cuts.push(best.unwrap_or(target));
+    }
+    cuts.push(n);
+    let parts: Vec<SpanProblem> = cuts
+        .windows(2)
+        .map(|c| {
+            let bs = if c[0] == 0 { p.b_start } else { greedy[c[0]] };
+            let be = if c[1] == n { p.b_end } else { greedy[c[1]] };
+            p.window(c[0], c[1], bs, be)
+        })
+        .collect();
+    // Solve the windows on `threads` workers, each taking every threads-th window.
+    let workers = threads.min(parts.len()).max(1);
+    let t0 = std::time::Instant::now();
+    let results: Vec<Result<SpanSolution>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|wk| {
+                let parts = &parts;
+                scope.spawn(move || {
+                    (wk..parts.len())
+                        .step_by(workers)
+                        .map(|i| (i, solve(&parts[i], settings)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut all: Vec<(usize, Result<SpanSolution>)> = handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect();
+        all.sort_by_key(|(i, _)| *i);
+        all.into_iter().map(|(_, r)| r).collect()
+    });
+    if results.len() != parts.len() {
+        return Err(Error::Solver("a window solver thread failed".into()));
+    }
+    let mut b = Vec::with_capacity(n + 1);
+    let (mut status, mut iterations) = (Status::Optimal, 0);
+    for (i, r) in results.into_iter().enumerate() {
+        let s = r?;
+        status = status.worst(s.status);
+        iterations += s.iterations;
+        b.extend_from_slice(if i == 0 { &s.b[..] } else { &s.b[1..] });
+    }
+    Ok(SpanSolution {
+        b,
+        status,
+        iterations,
+        solve_time: t0.elapsed().as_secs_f64(),
     })
 }
 

@@ -58,6 +58,11 @@ pub struct SolverSettings {
     /// to almost half of the solve time without changing the answer or the status, and
     /// Clarabel's termination test uses the true residuals either way.
     pub iterative_refinement: bool,
+    /// Longest window (stations) solved as one cone program; longer spans are split (see
+    /// [`clarabel::solve_windowed`]).
+    pub window: usize,
+    /// Threads for windows solved in parallel (0: as many as the machine has).
+    pub threads: usize,
 }
 
 impl Default for SolverSettings {
@@ -67,6 +72,8 @@ impl Default for SolverSettings {
             tol_gap: 1e-6,
             tol_feas: 1e-8,
             iterative_refinement: false,
+            window: 2000,
+            threads: 0,
         }
     }
 }
