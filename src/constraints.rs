@@ -21,7 +21,7 @@ use crate::kinematics::{AxisJets, Kinematics};
 use crate::machine::{Limit, Machine};
 
 /// Which limit gives a station's velocity bound.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub enum Bound {
     /// The velocity limit of axis `j`.
     AxisVelocity(usize),
@@ -30,6 +30,7 @@ pub enum Bound {
     /// The programmed feed or the machine's maximum feed.
     Feed,
     /// Nothing binds (no finite bound).
+    #[default]
     None,
 }
 

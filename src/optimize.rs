@@ -15,7 +15,7 @@
 //! concerned solved again, until it verifies; on a grid the user fixed, that grid stays and
 //! only those stations are added.
 
-use crate::constraints::{Grid, SpanProblem};
+use crate::constraints::{Bound, Grid, SpanProblem};
 use crate::error::{Error, Result};
 use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
@@ -383,11 +383,20 @@ impl Plan<'_> {
     fn infeasible(&self, si: usize, p: &SpanProblem, inf: &solver::reach::Infeasible) -> Error {
         let span = &self.path.spans[si];
         let u = p.u[inf.station];
-        let axes: Vec<&str> = inf.axes.iter().map(|&j| self.axes[j].as_str()).collect();
-        let binding = if axes.is_empty() {
+        let names: Vec<String> = inf
+            .binding
+            .iter()
+            .filter_map(|b| match *b {
+                Bound::AxisVelocity(j) => Some(format!("{} velocity", self.axes[j])),
+                Bound::AxisAcceleration(j) => Some(format!("{} acceleration", self.axes[j])),
+                Bound::Feed => Some("the feed cap".to_string()),
+                Bound::None => None,
+            })
+            .collect();
+        let binding = if names.is_empty() {
             String::new()
         } else {
-            format!("; binding: {} limits", axes.join(", "))
+            format!("; binding: {}", names.join(", "))
         };
         Error::Infeasible(format!(
             "span {si}, station {} of {}, u = {u:.6}, nearest CL line {}: {}{binding}",

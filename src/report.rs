@@ -43,8 +43,10 @@ pub struct Summary {
     pub status: Status,
     pub iterations: u32,
     pub solve_time_s: f64,
-    /// Tool-tip path length, mm.
+    /// Tool-tip path length, mm (joint-space path: the length of its parameter s).
     pub path_length_mm: f64,
+    /// Whether the input was a joint-space path (so lengths and feeds are in s, not mm).
+    pub joint_space: bool,
     /// Per axis, in the machine's order (a JSON object keyed by axis name).
     #[serde(serialize_with = "as_map")]
     pub axes: Vec<(String, AxisPeaks)>,
@@ -145,6 +147,7 @@ impl Summary {
             iterations: sol.iterations,
             solve_time_s: sol.solve_time,
             path_length_mm: length,
+            joint_space: machine.kinematics == crate::machine::KinematicsSpec::Joint,
             axes: names
                 .iter()
                 .enumerate()
@@ -197,7 +200,15 @@ impl fmt::Display for Summary {
         writeln!(f, "toolpath      {}", self.toolpath)?;
         writeln!(f, "machine       {}", self.machine)?;
         writeln!(f, "cycle time    {:.4} s", self.cycle_time_s)?;
-        writeln!(f, "path length   {:.3} mm", self.path_length_mm)?;
+        if self.joint_space {
+            writeln!(
+                f,
+                "path length   {:.6} (the file's parameter s)",
+                self.path_length_mm
+            )?;
+        } else {
+            writeln!(f, "path length   {:.3} mm", self.path_length_mm)?;
+        }
         let steps: Vec<String> = self
             .refinement
             .iter()

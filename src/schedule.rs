@@ -24,9 +24,10 @@ pub struct Station {
     pub s: f64,
     /// Time from the start of the path, s.
     pub t: f64,
-    /// Tool-tip feed V = |P'| u̇, mm/s.
+    /// Tool-tip feed V = |P'| u̇, mm/s (joint-space path: the path speed ds/dt).
     pub v: f64,
-    /// Tangential acceleration A = dV/dt, mm/s² (of the interval that starts here).
+    /// Tangential acceleration A = dV/dt, mm/s² (of the interval that starts here; joint-space
+    /// path: d²s/dt²).
     pub a: f64,
     /// Axis positions (mm or degrees).
     pub q: [f64; MAX_AXES],
@@ -92,13 +93,18 @@ impl Schedule {
                 } else {
                     0.0
                 };
+                let joint = span.kind == crate::geometry::SpanKind::Joint;
                 let mut st = Station {
                     span: si,
                     u: p.u[i],
                     s,
                     t,
-                    v: speed * ud,
-                    a: along * b[i] + speed * udd,
+                    v: if joint { ud } else { speed * ud },
+                    a: if joint {
+                        udd
+                    } else {
+                        along * b[i] + speed * udd
+                    },
                     q: [0.0; MAX_AXES],
                     qd: [0.0; MAX_AXES],
                     qdd: [0.0; MAX_AXES],

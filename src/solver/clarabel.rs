@@ -20,8 +20,9 @@
 //! **Windows.** [`solve_windowed`] splits a long span into windows at stations where the O(N)
 //! reachability profile sits on the velocity bound (b = b_max: there the optimum almost surely
 //! does too), fixes b there to that value, and solves the windows in parallel. Each window is
-//! solved to optimality; the stitched profile is feasible by construction and never slower than
-//! the reachability profile (which is feasible for every window). Cost and memory then grow
+//! solved to optimality; the stitched profile is feasible by construction and, within the
+//! solver's gap tolerance, never slower than the reachability profile (which is feasible for
+//! every window). Cost and memory then grow
 //! linearly with the stations, and both cores work on one span.
 
 use clarabel::algebra::CscMatrix;
