@@ -40,7 +40,7 @@ pub struct SolveArgs {
     #[arg(long, short, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Total station count (default: refined automatically until doubling changes the cycle
-    /// time by less than 0.1 %).
+    /// time by less than 0.01 %).
     #[arg(long)]
     pub stations: Option<usize>,
     /// Turning angle between CL moves (degrees) above which the path stops exactly.

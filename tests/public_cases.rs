@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, optimize};
-use feedopt::solver::Status;
+use feedopt::solver::{SolverKind, Status};
 use feedopt::toolpath;
 
 fn cases_dir() -> Option<PathBuf> {
@@ -45,5 +45,45 @@ fn public_cases_match_the_independent_reference_within_half_a_percent() {
             r["spans"].as_u64().unwrap(),
             "{name}: spans"
         );
+    }
+}
+
+#[test]
+fn both_solvers_agree_on_the_public_cases_and_every_schedule_verifies() {
+    let Some(dir) = cases_dir() else {
+        eprintln!("../shared/cases not present: skipped");
+        return;
+    };
+    for name in ["p1_spiral_tilt", "p2_xyz_rounded_square", "p3_s_curve_lean"] {
+        let m = Machine::from_file(&dir.join(format!("{name}.machine.json"))).unwrap();
+        let t = toolpath::read(&dir.join(format!("{name}.cls"))).unwrap();
+        let solve = |solver_kind| {
+            optimize(
+                &m,
+                &t,
+                &Options {
+                    solver_kind,
+                    ..Options::default()
+                },
+            )
+            .unwrap()
+        };
+        let (c, r) = (solve(SolverKind::Clarabel), solve(SolverKind::Reach));
+        let (tc, tr) = (c.schedule.cycle_time, r.schedule.cycle_time);
+        eprintln!(
+            "{name}: clarabel {tc:.7} s ({} st), reach {tr:.7} s ({} st), {:+.2e}",
+            c.stations(),
+            r.stations(),
+            (tr - tc) / tc
+        );
+        assert!(((tr - tc) / tc).abs() < 1e-4, "{name}: {tc} vs {tr}");
+        for s in [&c, &r] {
+            assert!(
+                s.verification.verified,
+                "{name}: {:?}",
+                s.verification.violations.first()
+            );
+            assert!(s.verification.worst_ratio() <= 1.001);
+        }
     }
 }

@@ -275,24 +275,33 @@ pub fn solve_windowed(
     if windows == 1 {
         return solve(p, settings);
     }
-    // Cut near every k·n/windows, at the station within ±10 % of a window whose greedy b is
-    // closest to its bound (relative), preferring the target position on ties.
+    // Cut near every k·n/windows, within ±40 % of a window, at a station in the interior of a
+    // plateau of the reach profile (it and both neighbours at their velocity bound: there the
+    // optimum sits on the bound too, so fixing b there loses nothing); nearest the target
+    // first. Without such a station in range, the station closest to its bound.
     let len = n / windows;
+    let on_bound = |i: usize| {
+        if p.b_max[i].is_finite() && p.b_max[i] > 0.0 {
+            greedy[i] / p.b_max[i]
+        } else {
+            0.0
+        }
+    };
+    let plateau = |i: usize| (i - 1..=i + 1).all(|k| on_bound(k) >= 1.0 - 1e-9);
     let mut cuts = vec![0usize];
     for w in 1..windows {
         let target = w * n / windows;
-        let reach = (len / 10).max(1);
+        let reach = (2 * len / 5).max(1);
         let (lo, hi) = (
             target.saturating_sub(reach).max(cuts[w - 1] + 2),
             (target + reach).min(n - 2),
         );
         let score = |i: usize| {
-            let r = if p.b_max[i].is_finite() && p.b_max[i] > 0.0 {
-                greedy[i] / p.b_max[i]
-            } else {
-                0.0
-            };
-            (r, std::cmp::Reverse(i.abs_diff(target)))
+            (
+                plateau(i),
+                on_bound(i),
+                std::cmp::Reverse(i.abs_diff(target)),
+            )
         };
         let best = (lo..=hi.max(lo)).max_by(|&a, &b| {
             score(a)
