@@ -31,8 +31,10 @@
 //!
 //! Each stage is a module with one job and plain data between stages:
 //! [`toolpath`] (readers) → [`geometry`] (spans, splines) → [`kinematics`] (q, t_q, K_q) →
-//! [`constraints`] (rows on b) → [`solver`] (Clarabel) → [`schedule`] (time, eq. 43) →
-//! [`report`] (summary) and [`writers`] (JSON, CSV). [`optimize::optimize`] runs them all.
+//! [`constraints`] (rows on b) → [`solver`] (Clarabel; the O(N) reachability pass) →
+//! [`schedule`] (time, eq. 43) → [`verify`] (re-simulation at the servo period) → [`report`]
+//! (summary) and [`writers`] (JSON, CSV). [`optimize::optimize`] runs them all (and
+//! [`optimize::optimize_joint`] for joint-space paths).
 //!
 //! ```no_run
 //! use feedopt::{machine::Machine, optimize, toolpath};
