@@ -47,6 +47,7 @@ fn toolpath() -> Toolpath {
                 p,
                 o,
                 feed: Feed::Programmed(100.0),
+                rotary: None,
                 line: k + 1,
             }
         })
@@ -54,6 +55,7 @@ fn toolpath() -> Toolpath {
     Toolpath {
         source: PathBuf::from("bench.cls"),
         points,
+        warnings: Vec::new(),
     }
 }
 

@@ -46,9 +46,11 @@ fn line() -> Toolpath {
                 p,
                 o: up,
                 feed: Feed::Unspecified,
+                rotary: None,
                 line: k + 1,
             })
             .collect(),
+        warnings: Vec::new(),
     }
 }
 
@@ -223,6 +225,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
             p: Vector3::zeros(),
             o: o((4.0 * k as f64).to_radians()),
             feed: Feed::Unspecified,
+            rotary: None,
             line: k + 1,
         })
         .collect();
@@ -230,11 +233,13 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         p: Vector3::new(k as f64, 0.0, 0.0),
         o: o(40f64.to_radians()),
         feed: Feed::Unspecified,
+        rotary: None,
         line: k + 11,
     }));
     let path = Toolpath {
         source: PathBuf::from("reorient.cls"),
         points,
+        warnings: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -206,6 +206,7 @@ fn random_cl(seed: u64) -> Case {
                 p,
                 o,
                 feed: feeds[(k * blocks / (n + 1)).min(blocks - 1)],
+                rotary: None,
                 line: k + 1,
             }
         })
@@ -215,6 +216,7 @@ fn random_cl(seed: u64) -> Case {
         path: Toolpath {
             source: PathBuf::from(format!("random_{seed}.cls")),
             points,
+            warnings: Vec::new(),
         },
     }
 }

@@ -24,9 +24,11 @@ fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>) -> 
                 p: *p,
                 o: o.normalize(),
                 feed: feed_mm_s.map_or(Feed::Unspecified, Feed::Programmed),
+                rotary: None,
                 line: k + 1,
             })
             .collect(),
+        warnings: Vec::new(),
     }
 }
 

@@ -115,10 +115,13 @@ impl Path {
                 "the toolpath needs at least two CL points",
             ));
         }
-        let cap = |f: Feed| -> f64 {
+        // The cap of the move from point `a` to point `b`: a G93 block's programmed time
+        // implies the tool-tip speed chord/time.
+        let cap = |a: usize, b: usize| -> f64 {
             let m = feed_max.unwrap_or(f64::INFINITY);
-            match f {
+            match pts[b].feed {
                 Feed::Programmed(v) => v.min(m),
+                Feed::BlockTime(t) => ((pts[b].p - pts[a].p).norm() / t).min(m),
                 Feed::Rapid | Feed::Unspecified => m,
             }
         };
@@ -188,7 +191,7 @@ impl Path {
                     SpanKind::Reorientation
                 },
                 spline: CubicSpline::new(&u, &values),
-                feed_caps: idx[1..].iter().map(|&i| cap(pts[i].feed)).collect(),
+                feed_caps: idx.windows(2).map(|w| cap(w[0], w[1])).collect(),
                 lines: idx.iter().map(|&i| pts[i].line).collect(),
             });
         }

@@ -174,6 +174,7 @@ pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
     Ok(Toolpath {
         source: source.to_path_buf(),
         points: reader.points,
+        warnings: Vec::new(),
     })
 }
 
@@ -328,6 +329,7 @@ impl<'a> Reader<'a> {
             p,
             o: self.orientation,
             feed,
+            rotary: None,
             line,
         });
         Ok(())

@@ -20,6 +20,8 @@ pub enum Feed {
     Programmed(f64),
     /// A rapid move: the machine's maximum feed applies.
     Rapid,
+    /// G-code inverse-time feed (G93): the block is programmed to take this long, seconds.
+    BlockTime(f64),
     /// No feed was programmed before this move: the machine's maximum feed applies.
     Unspecified,
 }
@@ -33,6 +35,9 @@ pub struct ClPoint {
     pub o: Vector3<f64>,
     /// Feed of the move that ends at this point (the first point's feed is unused).
     pub feed: Feed,
+    /// Rotary axis positions programmed for this point, degrees, as `[A, B, C]` (G-code in
+    /// tool-tip mode gives them; `None` where the input gives a tool vector instead).
+    pub rotary: Option<[f64; 3]>,
     /// 1-based line in the source file where the record starts.
     pub line: usize,
 }
@@ -43,6 +48,15 @@ pub struct Toolpath {
     /// The file it came from (for error messages).
     pub source: PathBuf,
     pub points: Vec<ClPoint>,
+    /// Things the reader skipped or doubted, with their lines (never silently dropped).
+    pub warnings: Vec<Warning>,
+}
+
+/// A reader's warning: a line and what about it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Warning {
+    pub line: usize,
+    pub message: String,
 }
 
 /// Any input path: cutter locations or joint positions.
