@@ -46,6 +46,13 @@ pub struct SolveArgs {
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
     #[arg(long, default_value_t = 10.0)]
     pub corner_angle: f64,
+    /// How far the fitted path may stray from the programmed tool-tip positions, mm (0: through
+    /// every point exactly).
+    #[arg(long, default_value_t = 0.005, value_name = "MM")]
+    pub tolerance: f64,
+    /// How far the fitted rotary angles may stray from the programmed ones, degrees.
+    #[arg(long, default_value_t = 0.01, value_name = "DEG")]
+    pub tolerance_deg: f64,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -119,6 +126,13 @@ impl SolveArgs {
             ..Options::default()
         };
         o.geometry.corner_angle_deg = self.corner_angle;
+        if !(self.tolerance >= 0.0 && self.tolerance_deg >= 0.0) {
+            return Err(Error::Usage(
+                "--tolerance and --tolerance-deg must be ≥ 0".into(),
+            ));
+        }
+        o.geometry.tolerance_mm = self.tolerance;
+        o.geometry.tolerance_deg = self.tolerance_deg;
         Ok(o)
     }
 }

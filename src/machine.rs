@@ -9,9 +9,22 @@
 //! ```
 //!
 //! A limit is a number (symmetric, `> 0`) or `[min, max]` with `min < 0 < max`. Linear axes are
-//! in mm/s and mm/s², rotary axes in °/s and °/s². `feed.max` (mm/s) caps the tool-tip feed V;
-//! the `feed` section is optional. Unknown fields, missing axes or limits and non-positive limits
-//! are errors that name the field.
+//! in mm/s and mm/s², rotary axes in °/s and °/s². An axis may also give its travel, `"min"` and
+//! `"max"` (mm or degrees, both or neither, `min < max`). `feed.max` (mm/s) caps the tool-tip
+//! feed V; the `feed` section is optional. Unknown fields, missing axes or limits and
+//! non-positive limits are errors that name the field.
+//!
+//! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
+//!
+//! | `type` | axes | parameters |
+//! |---|---|---|
+//! | `xyz` | X Y Z | – |
+//! | `head_head` | X Y Z C A | `tool_length` (> 0) |
+//! | `table_table_ac` | X Y Z A C | LinuxCNC xyzac-trt: `x-rot-point`, `y-rot-point`, `z-rot-point`, `y-offset`, `z-offset` (required); `tool-offset` (0), `conventional-directions` (false), `work-offset` ([0, 0, 0]) |
+//! | `table_table_bc` | X Y Z B C | LinuxCNC xyzbc-trt: the same with `x-offset` instead of `y-offset` |
+//! | `head_table` | X Y Z B C | `pivot_length` (≥ 0) |
+//! | `dresser` | X Z B | `tool_length` (≥ 0) |
+//! | `joint` | as the file names them | – |
 
 use serde_json::{Map, Value};
 use std::path::{Path, PathBuf};
@@ -55,6 +68,48 @@ pub struct Axis {
     pub kind: AxisKind,
     pub velocity: Limit,
     pub acceleration: Limit,
+    /// Travel `(min, max)` of the axis position (mm or degrees), `None` when the file gives
+    /// none.
+    pub travel: Option<(f64, f64)>,
+}
+
+impl Axis {
+    /// Whether position `x` (mm or degrees) lies within the axis's travel (always, without
+    /// travel).
+    pub fn within_travel(&self, x: f64) -> bool {
+        self.travel.is_none_or(|(lo, hi)| x >= lo && x <= hi)
+    }
+}
+
+/// Which table tilts in a LinuxCNC trunnion ("table-rotary-tilting") machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrunnionTilt {
+    /// xyzac-trt: the tilt axis A is parallel to X.
+    A,
+    /// xyzbc-trt: the tilt axis B is parallel to Y.
+    B,
+}
+
+/// The parameters of LinuxCNC's xyzac-trt / xyzbc-trt kinematics (HAL pin names in the
+/// machine file), plus the work offset (G54) added to the program coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrunnionParams {
+    /// `x-rot-point`, `y-rot-point`, `z-rot-point`: the C rotary's centre in machine
+    /// coordinates, mm.
+    pub rot_point: [f64; 3],
+    /// The tilt axis's offset from the C centre across it: `y-offset` for AC, `x-offset` for BC,
+    /// mm.
+    pub tilt_offset: f64,
+    /// `z-offset`: the tilt axis's height above the C centre, mm.
+    pub z_offset: f64,
+    /// `tool-offset`: the tool length L in force, mm (default 0).
+    pub tool_offset: f64,
+    /// `conventional-directions` (default false): `true` turns both rotary axes the other way
+    /// (σ = −1).
+    pub conventional_directions: bool,
+    /// `work-offset` [x, y, z]: the work offset added to the program coordinates, mm
+    /// (default 0).
+    pub work_offset: [f64; 3],
 }
 
 /// The machine's kinematic structure.
@@ -65,6 +120,18 @@ pub enum KinematicsSpec {
     /// Seed 000's fixed-bed double swivel head: θ1 = axis C about z, θ2 = axis A,
     /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
     HeadHead { tool_length: f64 },
+    /// LinuxCNC's xyzac-trt (`tilt` A, axes X Y Z A C) or xyzbc-trt (`tilt` B, axes
+    /// X Y Z B C) table-rotary-tilting machine.
+    TableTable {
+        tilt: TrunnionTilt,
+        params: TrunnionParams,
+    },
+    /// A tilting head B (about Y) on a fixed bed with a rotary table C; `pivot_length` (mm)
+    /// from the B pivot to the tool tip. Axes X Y Z B C.
+    HeadTable { pivot_length: f64 },
+    /// Seed 001's dresser: planar X–Z slides and a rotary axis B that keeps the dressing tool
+    /// on the profile normal; `tool_length` (mm) from the B axis to the tool tip. Axes X Z B.
+    Dresser { tool_length: f64 },
     /// A joint-space path (CSV of axis positions along a parameter s): any axes, named as in
     /// the CSV's `q_<axis>` columns, in the file's order; no feed limit applies.
     Joint,
@@ -77,11 +144,23 @@ impl KinematicsSpec {
         match self {
             KinematicsSpec::Xyz => &["X", "Y", "Z"],
             KinematicsSpec::HeadHead { .. } => &["X", "Y", "Z", "C", "A"],
+            KinematicsSpec::TableTable {
+                tilt: TrunnionTilt::A,
+                ..
+            } => &["X", "Y", "Z", "A", "C"],
+            KinematicsSpec::TableTable {
+                tilt: TrunnionTilt::B,
+                ..
+            } => &["X", "Y", "Z", "B", "C"],
+            KinematicsSpec::HeadTable { .. } => &["X", "Y", "Z", "B", "C"],
+            KinematicsSpec::Dresser { .. } => &["X", "Z", "B"],
             KinematicsSpec::Joint => &[],
         }
     }
 
-    fn axis_kind(name: &str) -> AxisKind {
+    /// Whether an axis of this name is rotary (A, B, C: degrees) or linear (mm) in a machine
+    /// with kinematics (a joint-space machine's axes are all treated as linear).
+    pub fn axis_kind(name: &str) -> AxisKind {
         match name {
             "A" | "B" | "C" => AxisKind::Rotary,
             _ => AxisKind::Linear,
@@ -162,6 +241,25 @@ impl Parser {
         Ok(x)
     }
 
+    fn number(&self, v: Option<&Value>, field: &str) -> Result<f64> {
+        let v = v.ok_or_else(|| self.err(field, "missing"))?;
+        let x = v
+            .as_f64()
+            .ok_or_else(|| self.err(field, format!("expected a number, found {v}")))?;
+        if !x.is_finite() {
+            return Err(self.err(field, format!("must be a finite number, found {x}")));
+        }
+        Ok(x)
+    }
+
+    fn non_negative(&self, v: Option<&Value>, field: &str) -> Result<f64> {
+        let x = self.number(v, field)?;
+        if x < 0.0 {
+            return Err(self.err(field, format!("must be zero or positive, found {x}")));
+        }
+        Ok(x)
+    }
+
     fn limit(&self, v: Option<&Value>, field: &str) -> Result<Limit> {
         match v {
             Some(Value::Array(items)) => {
@@ -235,10 +333,128 @@ impl Parser {
                     self.positive(obj.get("tool_length"), "kinematics.tool_length")?;
                 Ok(KinematicsSpec::HeadHead { tool_length })
             }
+            Some("table_table_ac") => self.trunnion(obj, TrunnionTilt::A),
+            Some("table_table_bc") => self.trunnion(obj, TrunnionTilt::B),
+            Some("head_table") => {
+                self.only_known(obj, "kinematics", &["type", "pivot_length"])?;
+                let pivot_length =
+                    self.non_negative(obj.get("pivot_length"), "kinematics.pivot_length")?;
+                Ok(KinematicsSpec::HeadTable { pivot_length })
+            }
+            Some("dresser") => {
+                self.only_known(obj, "kinematics", &["type", "tool_length"])?;
+                let tool_length =
+                    self.non_negative(obj.get("tool_length"), "kinematics.tool_length")?;
+                Ok(KinematicsSpec::Dresser { tool_length })
+            }
             _ => Err(self.err(
                 "kinematics.type",
-                format!("unknown kinematics {ty} (expected \"xyz\", \"head_head\" or \"joint\")"),
+                format!(
+                    "unknown kinematics {ty} (expected \"xyz\", \"head_head\", \
+                     \"table_table_ac\", \"table_table_bc\", \"head_table\", \"dresser\" \
+                     or \"joint\")"
+                ),
             )),
+        }
+    }
+
+    /// The parameters of LinuxCNC's xyzac-trt / xyzbc-trt under their HAL pin names.
+    fn trunnion(&self, obj: &Map<String, Value>, tilt: TrunnionTilt) -> Result<KinematicsSpec> {
+        let (offset, other, module) = match tilt {
+            TrunnionTilt::A => ("y-offset", "x-offset", "xyzac-trt"),
+            TrunnionTilt::B => ("x-offset", "y-offset", "xyzbc-trt"),
+        };
+        if obj.contains_key(other) {
+            return Err(self.err(
+                &format!("kinematics.{other}"),
+                format!(
+                    "unknown field: {module} does not use {other} (its tilt axis is placed by \
+                     {offset} and z-offset)"
+                ),
+            ));
+        }
+        self.only_known(
+            obj,
+            "kinematics",
+            &[
+                "type",
+                "x-rot-point",
+                "y-rot-point",
+                "z-rot-point",
+                offset,
+                "z-offset",
+                "tool-offset",
+                "conventional-directions",
+                "work-offset",
+            ],
+        )?;
+        let num = |name: &str| self.number(obj.get(name), &format!("kinematics.{name}"));
+        let rot_point = [
+            num("x-rot-point")?,
+            num("y-rot-point")?,
+            num("z-rot-point")?,
+        ];
+        let tilt_offset = num(offset)?;
+        let z_offset = num("z-offset")?;
+        let tool_offset = match obj.get("tool-offset") {
+            None => 0.0,
+            v => self.number(v, "kinematics.tool-offset")?,
+        };
+        let conventional_directions = match obj.get("conventional-directions") {
+            None => false,
+            Some(Value::Bool(b)) => *b,
+            Some(v) => {
+                return Err(self.err(
+                    "kinematics.conventional-directions",
+                    format!("expected true or false, found {v}"),
+                ));
+            }
+        };
+        let work_offset = match obj.get("work-offset") {
+            None => [0.0; 3],
+            Some(Value::Array(items))
+                if items.len() == 3
+                    && items.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)) =>
+            {
+                std::array::from_fn(|i| items[i].as_f64().unwrap_or(0.0))
+            }
+            Some(v) => {
+                return Err(self.err(
+                    "kinematics.work-offset",
+                    format!("expected [x, y, z] (three numbers, mm), found {v}"),
+                ));
+            }
+        };
+        Ok(KinematicsSpec::TableTable {
+            tilt,
+            params: TrunnionParams {
+                rot_point,
+                tilt_offset,
+                z_offset,
+                tool_offset,
+                conventional_directions,
+                work_offset,
+            },
+        })
+    }
+
+    /// The optional travel `min`, `max` of an axis object: both or neither, `min < max`.
+    fn travel(&self, a: &Map<String, Value>, field: &str) -> Result<Option<(f64, f64)>> {
+        let (min_f, max_f) = (format!("{field}.min"), format!("{field}.max"));
+        match (a.get("min"), a.get("max")) {
+            (None, None) => Ok(None),
+            (Some(_), None) => Err(self.err(&max_f, "missing (travel needs both min and max)")),
+            (None, Some(_)) => Err(self.err(&min_f, "missing (travel needs both min and max)")),
+            (lo, hi) => {
+                let (min, max) = (self.number(lo, &min_f)?, self.number(hi, &max_f)?);
+                if min >= max {
+                    return Err(self.err(
+                        &min_f,
+                        format!("travel min must be less than max, found min {min}, max {max}"),
+                    ));
+                }
+                Ok(Some((min, max)))
+            }
         }
     }
 
@@ -274,7 +490,7 @@ impl Parser {
                     )
                 })?;
                 let a = self.object(a, &field)?;
-                self.only_known(a, &field, &["velocity", "acceleration"])?;
+                self.only_known(a, &field, &["velocity", "acceleration", "min", "max"])?;
                 Ok(Axis {
                     name: name.to_string(),
                     kind: if *kin == KinematicsSpec::Joint {
@@ -285,6 +501,7 @@ impl Parser {
                     velocity: self.limit(a.get("velocity"), &format!("{field}.velocity"))?,
                     acceleration: self
                         .limit(a.get("acceleration"), &format!("{field}.acceleration"))?,
+                    travel: self.travel(a, &field)?,
                 })
             })
             .collect()

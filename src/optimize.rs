@@ -121,9 +121,7 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
         )));
     }
     let kin = Kinematics::new(machine);
-    let orientations: Vec<_> = toolpath.points.iter().map(|p| p.o).collect();
-    let lines: Vec<usize> = toolpath.points.iter().map(|p| p.line).collect();
-    let angles = kin.rotary_angles(&orientations, &lines)?;
+    let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
     let path = Path::build(
         toolpath,
         &angles,

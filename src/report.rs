@@ -47,6 +47,10 @@ pub struct Summary {
     pub path_length_mm: f64,
     /// Whether the input was a joint-space path (so lengths and feeds are in s, not mm).
     pub joint_space: bool,
+    /// Largest distance of the fitted path from a programmed point (smoothing within
+    /// `--tolerance`): tool tip, mm; rotary angles, degrees.
+    pub max_deviation_mm: f64,
+    pub max_deviation_deg: f64,
     /// Per axis, in the machine's order (a JSON object keyed by axis name).
     #[serde(serialize_with = "as_map")]
     pub axes: Vec<(String, AxisPeaks)>,
@@ -148,6 +152,18 @@ impl Summary {
             solve_time_s: sol.solve_time,
             path_length_mm: length,
             joint_space: machine.kinematics == crate::machine::KinematicsSpec::Joint,
+            max_deviation_mm: sol
+                .path
+                .spans
+                .iter()
+                .map(|s| s.deviation.0)
+                .fold(0.0, f64::max),
+            max_deviation_deg: sol
+                .path
+                .spans
+                .iter()
+                .map(|s| s.deviation.1.to_degrees())
+                .fold(0.0, f64::max),
             axes: names
                 .iter()
                 .enumerate()
@@ -200,6 +216,13 @@ impl fmt::Display for Summary {
         writeln!(f, "toolpath      {}", self.toolpath)?;
         writeln!(f, "machine       {}", self.machine)?;
         writeln!(f, "cycle time    {:.4} s", self.cycle_time_s)?;
+        if self.max_deviation_mm > 0.0 || self.max_deviation_deg > 0.0 {
+            writeln!(
+                f,
+                "fitted path   within {:.4} mm and {:.4}° of the programmed points",
+                self.max_deviation_mm, self.max_deviation_deg
+            )?;
+        }
         if self.joint_space {
             writeln!(
                 f,

@@ -458,6 +458,7 @@ mod tests {
             kind: AxisKind::Linear,
             velocity: Limit::symmetric(v),
             acceleration: Limit::symmetric(a),
+            travel: None,
         };
         Machine {
             name: "xyz".into(),
@@ -472,6 +473,7 @@ mod tests {
         let mut end = [0.0; PATH_DIM];
         end[0] = len;
         Span {
+            deviation: (0.0, 0.0),
             kind: SpanKind::Moving,
             spline: CubicSpline::new(&[0.0, len], &[[0.0; PATH_DIM], end]),
             feed_caps: vec![cap],

@@ -3,7 +3,7 @@
 //! wrong.
 
 use feedopt::error::Error;
-use feedopt::machine::{AxisKind, KinematicsSpec, Limit, Machine};
+use feedopt::machine::{AxisKind, KinematicsSpec, Limit, Machine, TrunnionParams, TrunnionTilt};
 use std::path::Path;
 
 const FILE: &str = "machines/test_machine.json";
@@ -165,6 +165,8 @@ fn valid_head_head() {
     );
     assert_eq!(m.axes[4].velocity, Limit::symmetric(60.0));
     assert_eq!(m.feed_max, Some(150.0));
+    // No travel given: none stored.
+    assert!(m.axes.iter().all(|a| a.travel.is_none()));
 }
 
 #[test]
@@ -539,4 +541,308 @@ fn from_file_reads_and_names_missing_file() {
         }
         other => panic!("expected Error::Io, got {other:?}"),
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Trunnion (LinuxCNC xyzac-trt / xyzbc-trt), head_table, dresser; axis travel
+// ---------------------------------------------------------------------------------------------
+
+/// Five axes X Y Z plus `tilt` and C, with travel on every axis.
+fn five_axes(tilt: &str) -> String {
+    format!(
+        r#"{{"X": {{"velocity": 20, "acceleration": 300, "min": -200, "max": 200}},
+            "Y": {{"velocity": 20, "acceleration": 300, "min": -100, "max": 100}},
+            "Z": {{"velocity": 20, "acceleration": 300, "min": -120, "max": 120}},
+            "{tilt}": {{"velocity": 30, "acceleration": 300, "min": -100, "max": 50}},
+            "C": {{"velocity": 30, "acceleration": 300, "min": -36000, "max": 36000}}}}"#
+    )
+}
+
+fn with_kinematics(kinematics: &str, axes: &str) -> String {
+    format!(r#"{{"name": "m", "kinematics": {kinematics}, "axes": {axes}}}"#)
+}
+
+const AC_FULL: &str = r#"{"type": "table_table_ac",
+    "x-rot-point": 1.5, "y-rot-point": -2.0, "z-rot-point": 3.25,
+    "y-offset": 20.0, "z-offset": 10.0, "tool-offset": 7.5,
+    "conventional-directions": true, "work-offset": [0.5, -0.25, 13.25]}"#;
+
+const BC_REQUIRED: &str = r#"{"type": "table_table_bc",
+    "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+    "x-offset": -20, "z-offset": -15}"#;
+
+#[test]
+fn valid_table_table_ac_with_every_parameter() {
+    let m = ok(&with_kinematics(AC_FULL, &five_axes("A")));
+    assert_eq!(
+        m.kinematics,
+        KinematicsSpec::TableTable {
+            tilt: TrunnionTilt::A,
+            params: TrunnionParams {
+                rot_point: [1.5, -2.0, 3.25],
+                tilt_offset: 20.0,
+                z_offset: 10.0,
+                tool_offset: 7.5,
+                conventional_directions: true,
+                work_offset: [0.5, -0.25, 13.25],
+            }
+        }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "A", "C"]);
+    let kinds: Vec<AxisKind> = m.axes.iter().map(|a| a.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            AxisKind::Linear,
+            AxisKind::Linear,
+            AxisKind::Linear,
+            AxisKind::Rotary,
+            AxisKind::Rotary
+        ]
+    );
+    assert_eq!(m.axes[0].travel, Some((-200.0, 200.0)));
+    assert_eq!(m.axes[3].travel, Some((-100.0, 50.0)));
+    assert_eq!(m.axes[4].travel, Some((-36000.0, 36000.0)));
+    assert!(m.axes[3].within_travel(50.0) && m.axes[3].within_travel(-100.0));
+    assert!(!m.axes[3].within_travel(50.001) && !m.axes[3].within_travel(-100.5));
+}
+
+#[test]
+fn valid_table_table_bc_defaults_the_optional_parameters() {
+    let m = ok(&with_kinematics(BC_REQUIRED, &five_axes("B")));
+    assert_eq!(
+        m.kinematics,
+        KinematicsSpec::TableTable {
+            tilt: TrunnionTilt::B,
+            params: TrunnionParams {
+                rot_point: [0.0; 3],
+                tilt_offset: -20.0,
+                z_offset: -15.0,
+                tool_offset: 0.0,
+                conventional_directions: false,
+                work_offset: [0.0; 3],
+            }
+        }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "B", "C"]);
+}
+
+#[test]
+fn valid_head_table_and_dresser() {
+    let m = ok(&with_kinematics(
+        r#"{"type": "head_table", "pivot_length": 150}"#,
+        &five_axes("B"),
+    ));
+    assert_eq!(
+        m.kinematics,
+        KinematicsSpec::HeadTable {
+            pivot_length: 150.0
+        }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "B", "C"]);
+
+    // The dresser: X Z B, in that order whatever the file's order; a zero tool length (tip on
+    // the B axis) is allowed.
+    let m = ok(&with_kinematics(
+        r#"{"type": "dresser", "tool_length": 0}"#,
+        r#"{"B": {"velocity": 90, "acceleration": 500, "min": -135, "max": 135},
+            "Z": {"velocity": 50, "acceleration": 400},
+            "X": {"velocity": 50, "acceleration": 400}}"#,
+    ));
+    assert_eq!(m.kinematics, KinematicsSpec::Dresser { tool_length: 0.0 });
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Z", "B"]);
+    assert_eq!(m.axes[2].kind, AxisKind::Rotary);
+    assert_eq!(m.axes[2].travel, Some((-135.0, 135.0)));
+    assert_eq!(m.axes[0].travel, None);
+}
+
+#[test]
+fn unknown_kinematics_type_lists_the_new_types() {
+    field_err(
+        &with_kinematics(r#"{"type": "table_table_ab"}"#, &five_axes("A")),
+        "kinematics.type",
+        &[
+            "table_table_ab",
+            "table_table_ac",
+            "table_table_bc",
+            "head_table",
+            "dresser",
+        ],
+    );
+}
+
+#[test]
+fn trunnion_unknown_parameters_are_named() {
+    // xyzac-trt has no x-offset (its A axis is placed by y-offset), xyzbc-trt no y-offset.
+    let ac = AC_FULL.replace("\"y-offset\": 20.0", "\"x-offset\": 20.0");
+    field_err(
+        &with_kinematics(&ac, &five_axes("A")),
+        "kinematics.x-offset",
+        &["unknown field", "y-offset"],
+    );
+    let bc = BC_REQUIRED.replace("\"z-offset\"", "\"y-offset\": 1, \"z-offset\"");
+    field_err(
+        &with_kinematics(&bc, &five_axes("B")),
+        "kinematics.y-offset",
+        &["unknown field", "x-offset"],
+    );
+    // Underscored spellings are not LinuxCNC's pin names.
+    let ac = AC_FULL.replace("\"tool-offset\"", "\"tool_offset\"");
+    field_err(
+        &with_kinematics(&ac, &five_axes("A")),
+        "kinematics.tool_offset",
+        &["unknown field", "tool-offset"],
+    );
+    field_err(
+        &with_kinematics(
+            r#"{"type": "head_table", "pivot_length": 150, "tool_length": 5}"#,
+            &five_axes("B"),
+        ),
+        "kinematics.tool_length",
+        &["unknown field", "pivot_length"],
+    );
+    field_err(
+        &with_kinematics(
+            r#"{"type": "dresser", "tool_length": 5, "pivot_length": 5}"#,
+            r#"{"X": {"velocity": 1, "acceleration": 1}, "Z": {"velocity": 1, "acceleration": 1},
+                "B": {"velocity": 1, "acceleration": 1}}"#,
+        ),
+        "kinematics.pivot_length",
+        &["unknown field"],
+    );
+}
+
+#[test]
+fn trunnion_missing_parameters_are_named() {
+    for (field, text) in [
+        ("z-offset", BC_REQUIRED.replace(", \"z-offset\": -15", "")),
+        ("x-offset", BC_REQUIRED.replace("\"x-offset\": -20,", "")),
+        (
+            "y-rot-point",
+            BC_REQUIRED.replace("\"y-rot-point\": 0,", ""),
+        ),
+        ("y-offset", AC_FULL.replace("\"y-offset\": 20.0,", "")),
+    ] {
+        let tilt = if text.contains("_ac") { "A" } else { "B" };
+        field_err(
+            &with_kinematics(&text, &five_axes(tilt)),
+            &format!("kinematics.{field}"),
+            &["missing"],
+        );
+    }
+    field_err(
+        &with_kinematics(r#"{"type": "head_table"}"#, &five_axes("B")),
+        "kinematics.pivot_length",
+        &["missing"],
+    );
+    field_err(
+        &with_kinematics(
+            r#"{"type": "dresser"}"#,
+            r#"{"X": {"velocity": 1, "acceleration": 1}, "Z": {"velocity": 1, "acceleration": 1},
+                "B": {"velocity": 1, "acceleration": 1}}"#,
+        ),
+        "kinematics.tool_length",
+        &["missing"],
+    );
+}
+
+#[test]
+fn trunnion_parameters_of_the_wrong_type() {
+    let ac = AC_FULL.replace(
+        "\"conventional-directions\": true",
+        "\"conventional-directions\": 1",
+    );
+    field_err(
+        &with_kinematics(&ac, &five_axes("A")),
+        "kinematics.conventional-directions",
+        &["true or false"],
+    );
+    for bad in ["[0, 0]", "[0, 0, \"1\"]", "13.25", "[0, 0, 0, 0]"] {
+        let ac = AC_FULL.replace("[0.5, -0.25, 13.25]", bad);
+        field_err(
+            &with_kinematics(&ac, &five_axes("A")),
+            "kinematics.work-offset",
+            &["[x, y, z]"],
+        );
+    }
+    let ac = AC_FULL.replace("\"z-offset\": 10.0", "\"z-offset\": \"10\"");
+    field_err(
+        &with_kinematics(&ac, &five_axes("A")),
+        "kinematics.z-offset",
+        &["number"],
+    );
+    field_err(
+        &with_kinematics(
+            r#"{"type": "head_table", "pivot_length": -1}"#,
+            &five_axes("B"),
+        ),
+        "kinematics.pivot_length",
+        &["zero or positive", "-1"],
+    );
+}
+
+#[test]
+fn trunnion_axes_follow_the_tilt() {
+    // An AC machine with a B axis: B is unknown, and A is missing.
+    field_err(
+        &with_kinematics(AC_FULL, &five_axes("B")),
+        "axes.B",
+        &["unknown", "A", "C"],
+    );
+    let axes = r#"{"X": {"velocity": 1, "acceleration": 1}, "Y": {"velocity": 1, "acceleration": 1},
+        "Z": {"velocity": 1, "acceleration": 1}, "C": {"velocity": 1, "acceleration": 1}}"#;
+    field_err(&with_kinematics(AC_FULL, axes), "axes.A", &["missing"]);
+}
+
+#[test]
+fn travel_min_must_be_below_max() {
+    for (min, max) in [("50", "50"), ("60", "50")] {
+        field_err(
+            &xyz_with_x(&format!(
+                r#"{{"velocity": 400, "acceleration": 2000, "min": {min}, "max": {max}}}"#
+            )),
+            "axes.X.min",
+            &["less than max", min, max],
+        );
+    }
+}
+
+#[test]
+fn travel_needs_both_ends_as_numbers() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "min": -5}"#),
+        "axes.X.max",
+        &["missing", "min and max"],
+    );
+    field_err(
+        &xyz_with_y(r#"{"velocity": 400, "acceleration": 2000, "max": 5}"#),
+        "axes.Y.min",
+        &["missing", "min and max"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "min": "a", "max": 5}"#),
+        "axes.X.min",
+        &["number"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "min": -5, "max": null}"#),
+        "axes.X.max",
+        &["number"],
+    );
+    // Travel may be one-sided of zero (it is a position, not a rate).
+    let m = ok(&xyz_with_x(
+        r#"{"velocity": 400, "acceleration": 2000, "min": 10, "max": 500}"#,
+    ));
+    assert_eq!(m.axes[0].travel, Some((10.0, 500.0)));
+}
+
+#[test]
+fn joint_machines_may_give_travel() {
+    let m = ok(r#"{"kinematics": {"type": "joint"},
+        "axes": {"J1": {"velocity": 1, "acceleration": 2, "min": -3, "max": 3}}}"#);
+    assert_eq!(m.axes[0].travel, Some((-3.0, 3.0)));
 }

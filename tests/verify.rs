@@ -300,6 +300,7 @@ fn a_curvature_peak_between_stations_is_found() {
         refine_until_verified: false,
         geometry: GeometryOptions {
             corner_angle_deg: 30.0,
+            ..GeometryOptions::default()
         },
         ..Options::default()
     };

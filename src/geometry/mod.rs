@@ -33,12 +33,19 @@ pub const SAME_ORIENTATION_RAD: f64 = 1e-9;
 pub struct GeometryOptions {
     /// Turning angle (degrees) above which a corner is an exact stop.
     pub corner_angle_deg: f64,
+    /// How far the fitted path may stray from the programmed tool-tip positions, mm
+    /// (0: interpolate them exactly). See [`smooth_within`].
+    pub tolerance_mm: f64,
+    /// How far the fitted rotary angles may stray from the programmed ones, degrees.
+    pub tolerance_deg: f64,
 }
 
 impl Default for GeometryOptions {
     fn default() -> Self {
         GeometryOptions {
             corner_angle_deg: 10.0,
+            tolerance_mm: 0.005,
+            tolerance_deg: 0.01,
         }
     }
 }
@@ -57,6 +64,9 @@ pub enum SpanKind {
 /// A rest-to-rest piece of the path.
 #[derive(Debug, Clone)]
 pub struct Span {
+    /// Largest distance of a fitted point from its programmed position: mm (tool tip) and
+    /// radians (rotary angles).
+    pub deviation: (f64, f64),
     pub kind: SpanKind,
     /// w(u) = (Px, Py, Pz, θ1, θ2); its knots are the CL points of the span.
     pub spline: CubicSpline<PATH_DIM>,
@@ -130,8 +140,11 @@ impl Path {
         for k in 1..pts.len() {
             let last = &pts[*keep.last().unwrap_or(&0)];
             let moved = (pts[k].p - last.p).norm() > SAME_POSITION_MM;
-            let turned =
-                orientation_moves_axes && angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD;
+            let last_k = *keep.last().unwrap_or(&0);
+            let turned = orientation_moves_axes
+                && (angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD
+                    || (0..2)
+                        .any(|j| (angles[k][j] - angles[last_k][j]).abs() > SAME_ORIENTATION_RAD));
             if moved || turned {
                 keep.push(k);
             }
@@ -162,20 +175,8 @@ impl Path {
         for c in cuts.windows(2) {
             let idx = &keep[c[0]..=c[1]];
             let moving = seg_moving[c[0]];
-            let mut u = Vec::with_capacity(idx.len());
-            let mut acc = 0.0;
-            u.push(0.0);
-            for w in idx.windows(2) {
-                let (a, b) = (&pts[w[0]], &pts[w[1]]);
-                acc += if moving {
-                    (b.p - a.p).norm()
-                } else {
-                    angle_between(&a.o, &b.o)
-                };
-                u.push(acc);
-            }
             let p0: Vector3<f64> = pts[idx[0]].p;
-            let values: Vec<[f64; PATH_DIM]> = idx
+            let mut values: Vec<[f64; PATH_DIM]> = idx
                 .iter()
                 .map(|&i| {
                     let p = if moving { pts[i].p } else { p0 };
@@ -184,7 +185,24 @@ impl Path {
                     w
                 })
                 .collect();
+            let deviation = smooth_within(
+                &mut values,
+                if moving { options.tolerance_mm } else { 0.0 },
+                options.tolerance_deg.to_radians(),
+            );
+            // u: the tip's chord length, or on a reorientation the rotary angles' travel.
+            let mut u = Vec::with_capacity(idx.len());
+            let mut acc = 0.0;
+            u.push(0.0);
+            for w in values.windows(2) {
+                let d = |r: std::ops::Range<usize>| {
+                    r.map(|j| (w[1][j] - w[0][j]).powi(2)).sum::<f64>().sqrt()
+                };
+                acc += if moving { d(0..3) } else { d(3..5) };
+                u.push(acc);
+            }
             spans.push(Span {
+                deviation,
                 kind: if moving {
                     SpanKind::Moving
                 } else {
@@ -246,6 +264,7 @@ impl Path {
         };
         Ok(Path {
             spans: vec![Span {
+                deviation: (0.0, 0.0),
                 kind: SpanKind::Joint,
                 spline,
                 feed_caps: vec![f64::INFINITY; u.len() - 1],
@@ -255,7 +274,167 @@ impl Path {
     }
 }
 
+/// Smooths a span's points within a tolerance tube: projected gradient descent on the bending
+/// energy Σ|D²w|² (second differences over the programmed spacing, per coordinate), every step
+/// followed by a projection back into the tube — a ball of radius `tol_mm` around each
+/// programmed tool-tip position and ±`tol_rad` around each programmed rotary angle; the span's
+/// end points stay. CAM writes points to a few decimals (the LinuxCNC impeller to 0.001 mm and
+/// 0.001°); a cubic through every point turns that noise into curvature, and curvature into
+/// slow feed. (Minimising length instead — moving each point to its neighbours' chord — would
+/// converge to a taut string with kinks at the tube's wall, the opposite of smooth.) Returns
+/// the largest deviation (mm, rad). Zero tolerances leave the points as they are.
+pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) -> (f64, f64) {
+    const ITERATIONS: usize = 500;
+    let n = values.len();
+    if n < 4 || (tol_mm <= 0.0 && tol_rad <= 0.0) {
+        return (0.0, 0.0);
+    }
+    let orig = values.to_vec();
+    let dist = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
+        (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt()
+    };
+    // Parameter spacing: the programmed tip chords, or angle steps on a reorientation.
+    let h: Vec<f64> = orig
+        .windows(2)
+        .map(|w| {
+            let d = dist(&w[0], &w[1]);
+            let a = ((w[1][3] - w[0][3]).powi(2) + (w[1][4] - w[0][4]).powi(2)).sqrt();
+            if d > 0.0 { d } else { a.max(f64::MIN_POSITIVE) }
+        })
+        .collect();
+    // D² row i (1 ≤ i ≤ n−2): coefficients on w[i−1], w[i], w[i+1].
+    let row = |i: usize| {
+        let (a, b) = (h[i - 1], h[i]);
+        [2.0 / (a * (a + b)), -2.0 / (a * b), 2.0 / (b * (a + b))]
+    };
+    // Step 1/L with L ≥ the largest eigenvalue of D²ᵀD² (Gershgorin: the largest absolute row
+    // sum of D² squared is a bound on ‖D²‖²).
+    let l = (1..n - 1)
+        .map(|i| row(i).iter().map(|c| c.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+        .powi(2);
+    let step = 1.0 / l;
+    let mut d2 = vec![[0.0; 5]; n];
+    for _ in 0..ITERATIONS {
+        for i in 1..n - 1 {
+            let r = row(i);
+            for j in 0..5 {
+                d2[i][j] = r[0] * values[i - 1][j] + r[1] * values[i][j] + r[2] * values[i + 1][j];
+            }
+        }
+        let mut moved = 0.0f64;
+        for k in 1..n - 1 {
+            let mut w = values[k];
+            for j in 0..5 {
+                // (D²ᵀ D² w)_k = Σ_i D²[i][k] · (D² w)_i over the rows i = k−1, k, k+1.
+                let mut g = 0.0;
+                for (i, c) in [(k - 1, 2usize), (k, 1), (k + 1, 0)] {
+                    if i >= 1 && i < n - 1 {
+                        g += row(i)[c] * d2[i][j];
+                    }
+                }
+                w[j] -= step * g;
+            }
+            if tol_mm > 0.0 {
+                let d = dist(&w, &orig[k]);
+                if d > tol_mm {
+                    for j in 0..3 {
+                        w[j] = orig[k][j] + (w[j] - orig[k][j]) * tol_mm / d;
+                    }
+                }
+            } else {
+                w[..3].copy_from_slice(&orig[k][..3]);
+            }
+            for j in 3..5 {
+                w[j] = w[j].clamp(orig[k][j] - tol_rad, orig[k][j] + tol_rad);
+            }
+            moved = moved.max(
+                (0..5)
+                    .map(|j| (w[j] - values[k][j]).abs())
+                    .fold(0.0, f64::max),
+            );
+            values[k] = w;
+        }
+        if moved < 1e-12 {
+            break;
+        }
+    }
+    let dev_mm = (0..n)
+        .map(|i| dist(&values[i], &orig[i]))
+        .fold(0.0, f64::max);
+    let dev_rad = (0..n)
+        .flat_map(|i| (3..5).map(move |j| (i, j)))
+        .map(|(i, j)| (values[i][j] - orig[i][j]).abs())
+        .fold(0.0, f64::max);
+    (dev_mm, dev_rad)
+}
+
 /// Angle between two unit vectors, accurate for small angles.
 pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(n: usize, noise: f64) -> Vec<[f64; PATH_DIM]> {
+        // Radius 20 mm, points 0.2 mm apart, rounded to `noise` like a CAM post.
+        let round = |x: f64| {
+            if noise > 0.0 {
+                (x / noise).round() * noise
+            } else {
+                x
+            }
+        };
+        (0..n)
+            .map(|k| {
+                let a = k as f64 * 0.01;
+                let mut w = [0.0; PATH_DIM];
+                w[0] = round(20.0 * a.cos());
+                w[1] = round(20.0 * a.sin());
+                w
+            })
+            .collect()
+    }
+
+    /// Largest curvature of the circle through three neighbouring points (Menger curvature,
+    /// 4·area / product of the sides: blind to uneven spacing along the path), 1/mm, away from
+    /// the two ends (which stay where they were programmed, rounding and all).
+    fn roughness(w: &[[f64; PATH_DIM]]) -> f64 {
+        w[3..w.len() - 3]
+            .windows(3)
+            .map(|t| {
+                let (a, b, c) = ([t[0][0], t[0][1]], [t[1][0], t[1][1]], [t[2][0], t[2][1]]);
+                let len = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+                let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+                2.0 * cross.abs() / (len(a, b) * len(b, c) * len(a, c))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn smoothing_removes_rounding_noise_within_the_tube() {
+        let orig = circle(300, 0.001);
+        let mut w = orig.clone();
+        let (dev, _) = smooth_within(&mut w, 0.005, 0.0);
+        assert!(dev <= 0.005 + 1e-12, "deviation {dev}");
+        for (a, b) in w.iter().zip(&orig) {
+            assert!(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt() <= 0.005 + 1e-12);
+        }
+        // 1 µm rounding on 0.2 mm spacing puts curvature noise of ~0.05 /mm on a 0.05 /mm
+        // circle; smoothed, the curvature is the circle's again.
+        let (before, after) = (roughness(&orig), roughness(&w));
+        assert!(before > 0.08, "noisy curvature {before}");
+        assert!(after < 0.06, "smoothed curvature {after} (circle: 0.05)");
+        assert_eq!((w[0], w[299]), (orig[0], orig[299]), "ends stay");
+    }
+
+    #[test]
+    fn zero_tolerance_keeps_every_point() {
+        let orig = circle(50, 0.001);
+        let mut w = orig.clone();
+        assert_eq!(smooth_within(&mut w, 0.0, 0.0), (0.0, 0.0));
+        assert_eq!(w, orig);
+    }
 }

@@ -3,10 +3,10 @@
 //! length from the swivel pivot to the tool tip.
 
 use nalgebra::Vector3;
-use std::f64::consts::{PI, TAU};
 
+use super::branch::{self, Layout, Target};
 use super::dual::Real;
-use super::{Effective, MAX_AXES, PATH_DIM, PathJet, rad_to_deg, tip_derivatives};
+use super::{Effective, MAX_AXES, PATH_DIM, PathJet, ToolPose, rad_to_deg, tip_derivatives};
 use crate::error::Result;
 
 /// Eq. 27: x = −Px + d2 sin θ2 sin θ1, y = −Py − d2 sin θ2 cos θ1, z = Pz + d2 − d2 cos θ2;
@@ -26,35 +26,61 @@ pub fn orientation(t1: f64, t2: f64) -> Vector3<f64> {
     Vector3::new(t2.sin() * t1.sin(), -t2.sin() * t1.cos(), t2.cos())
 }
 
-/// Eq. 16 on one continuous branch. Of the two solutions (θ1, θ2) and (θ1 + π, −θ2) the first
-/// point takes θ2 ≥ 0; every later point takes the solution, with θ1 unwrapped by a multiple of
-/// 2π, nearest to its predecessor, so the angles never jump by 2π nor switch branch. At the
-/// singular pose (tool parallel to z1, θ2 = 0) θ1 is undefined and keeps its previous value.
-pub fn continuous_angles(orientations: &[Vector3<f64>], _lines: &[usize]) -> Result<Vec<[f64; 2]>> {
-    const SINGULAR: f64 = 1e-12;
-    let mut out: Vec<[f64; 2]> = Vec::with_capacity(orientations.len());
-    for o in orientations {
-        let h = o.x.hypot(o.y);
-        let t2 = h.atan2(o.z);
-        let prev = out.last().copied();
-        let t1 = if h < SINGULAR {
-            prev.map_or(0.0, |p| p[0])
-        } else {
-            o.x.atan2(-o.y)
-        };
-        let chosen = match prev {
-            None => [t1, t2],
-            Some([p1, p2]) => {
-                let nearest = |a: f64| a + TAU * ((p1 - a) / TAU).round();
-                let a = [nearest(t1), t2];
-                let b = [nearest(t1 + PI), -t2];
-                let dist = |c: [f64; 2]| (c[0] - p1).powi(2) + (c[1] - p2).powi(2);
-                if dist(b) < dist(a) { b } else { a }
-            }
-        };
-        out.push(chosen);
+/// The forward kinematics of eq. 27: X, Y, Z (mm), C, A (degrees) to the tool tip
+/// P = (−x + d2 sin θ2 sin θ1, −y − d2 sin θ2 cos θ1, z − d2 + d2 cos θ2) and the tool axis.
+pub fn forward(d2: f64, q: &[f64]) -> ToolPose {
+    let (t1, t2) = (q[3].to_radians(), q[4].to_radians());
+    let (s1, c1) = t1.sin_cos();
+    let (s2, c2) = t2.sin_cos();
+    ToolPose {
+        p: Vector3::new(
+            -q[0] + d2 * s2 * s1,
+            -q[1] - d2 * s2 * c1,
+            q[2] - d2 + d2 * c2,
+        ),
+        k: orientation(t1, t2),
+        angles: [t1, t2],
     }
-    Ok(out)
+}
+
+/// Eq. 16: θ2 ≥ 0 and θ1 (`None` at the singular pose, tool parallel to z1) with
+/// [`orientation`]`(θ1, θ2) = o`; the other solution is (θ1 + π, −θ2).
+pub fn tool_vector_ik(o: &Vector3<f64>) -> (f64, Option<f64>) {
+    let h = o.x.hypot(o.y);
+    let t2 = h.atan2(o.z);
+    if h < branch::SINGULAR {
+        return (t2, None);
+    }
+    (t2, Some(o.x.atan2(-o.y)))
+}
+
+/// Eq. 16 on one continuous branch, without travel limits. Of the two solutions (θ1, θ2) and
+/// (θ1 + π, −θ2) the first point takes θ2 ≥ 0; every later point takes the solution, with the
+/// angles unwrapped by multiples of 2π, nearest to its predecessor, so the angles never jump by
+/// 2π nor switch branch. At the singular pose (tool parallel to z1, θ2 = 0) θ1 is undefined and
+/// keeps its previous value; within [`branch::POLE_CONE`] of it θ1 is interpolated
+/// ([`branch`], rule 3). ([`crate::kinematics::Kinematics::rotary_angles`] adds travel and
+/// programmed rotary positions.)
+pub fn continuous_angles(orientations: &[Vector3<f64>], lines: &[usize]) -> Result<Vec<[f64; 2]>> {
+    let targets: Vec<Target> = orientations
+        .iter()
+        .map(|o| {
+            let (tilt, spin) = tool_vector_ik(o);
+            Target::Vector { k: *o, tilt, spin }
+        })
+        .collect();
+    branch::follow(&targets, lines, &layout([None, None]), &|a| {
+        orientation(a[0], a[1])
+    })
+}
+
+/// θ2 (A) is the tilt, θ1 (C) the spin.
+pub(crate) fn layout(travel: [Option<(f64, f64)>; 2]) -> Layout {
+    Layout {
+        tilt: 1,
+        travel,
+        names: ["C", "A"],
+    }
 }
 
 /// The closed forms of seed 000 at one point of a moving path: effective tangents (eq. 31–33)

@@ -11,19 +11,41 @@
 //! stands still (pure reorientation, |P'| = 0) only the u-form exists; the solver works in u
 //! throughout, so nothing divides by |P'|.
 //!
+//! Machines (each module states its maths and conventions):
+//!
+//! | kinematics | axes | path coordinates w | module |
+//! |---|---|---|---|
+//! | xyz | X Y Z | (Px, Py, Pz) | – |
+//! | head_head (seed 000) | X Y Z C A | (Px, Py, Pz, θ1 = C, θ2 = A) | [`head_head`] |
+//! | table_table_ac / _bc (LinuxCNC xyzac-trt / xyzbc-trt) | X Y Z A C / X Y Z B C | (Px, Py, Pz, T, C) | [`trunnion`] |
+//! | head_table (like LinuxCNC maxkins) | X Y Z B C | (Px, Py, Pz, B, C) | [`head_table`] |
+//! | dresser (seed 001) | X Z B | (Px, ·, Pz, θ) | [`dresser`] |
+//! | joint | as named | the axis positions | – |
+//!
+//! P is the tool tip in program coordinates (mm), angles are in radians in w and in degrees on
+//! the axes. [`Kinematics::rotary_angles`] gives the angles of each CL point ([`branch`]),
+//! [`Kinematics::axis_positions`] is the inverse kinematics and [`Kinematics::forward`] the
+//! forward one.
+//!
 //! Two independent routes compute the derivatives: the closed forms of seed 000 for the double
 //! swivel head ([`head_head::effective`], eq. 31–39), and the generic route, which pushes
 //! second-order dual numbers ([`dual::Dual2`]) through the inverse kinematics. Tests hold them
 //! to 1e-9 relative agreement.
 
+pub mod branch;
+pub mod dresser;
 pub mod dual;
 pub mod head_head;
+pub mod head_table;
+pub mod trunnion;
 
 use nalgebra::Vector3;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::spline::Jet;
-use crate::machine::{KinematicsSpec, Machine};
+use crate::machine::{Axis, KinematicsSpec, Machine, TrunnionTilt};
+use crate::toolpath::ClPoint;
+use branch::{Layout, Target};
 use dual::{Dual2, Real};
 
 /// Largest number of machine axes.
@@ -47,6 +69,16 @@ pub struct AxisJets {
     pub ddq: [f64; MAX_AXES],
 }
 
+/// The tool tip in program coordinates, the tool axis there (unit, from the tip towards the
+/// spindle or holder) and the path angles (radians) of one machine pose: what the forward
+/// kinematics gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolPose {
+    pub p: Vector3<f64>,
+    pub k: Vector3<f64>,
+    pub angles: [f64; 2],
+}
+
 /// A machine's kinematics, ready to evaluate.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Kinematics {
@@ -54,6 +86,12 @@ pub enum Kinematics {
     HeadHead {
         d2: f64,
     },
+    /// LinuxCNC's xyzac-trt / xyzbc-trt.
+    TableTable(trunnion::Trunnion),
+    /// Tilting head B, rotary table C.
+    HeadTable(head_table::HeadTable),
+    /// Seed 001's dresser: X, Z and B on the profile normal.
+    Dresser(dresser::Dresser),
     /// A joint-space path: the path coordinates are the `n` axis positions.
     Joint {
         n: usize,
@@ -65,6 +103,15 @@ impl Kinematics {
         match machine.kinematics {
             KinematicsSpec::Xyz => Kinematics::Xyz,
             KinematicsSpec::HeadHead { tool_length } => Kinematics::HeadHead { d2: tool_length },
+            KinematicsSpec::TableTable { tilt, params } => {
+                Kinematics::TableTable(trunnion::Trunnion { tilt, params })
+            }
+            KinematicsSpec::HeadTable { pivot_length } => {
+                Kinematics::HeadTable(head_table::HeadTable { pivot_length })
+            }
+            KinematicsSpec::Dresser { tool_length } => {
+                Kinematics::Dresser(dresser::Dresser { tool_length })
+            }
             KinematicsSpec::Joint => Kinematics::Joint {
                 n: machine.axes.len(),
             },
@@ -74,29 +121,139 @@ impl Kinematics {
     /// Number of machine axes this kinematics drives.
     pub fn n_axes(&self) -> usize {
         match self {
-            Kinematics::Xyz => 3,
-            Kinematics::HeadHead { .. } => 5,
+            Kinematics::Xyz | Kinematics::Dresser(_) => 3,
+            Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_) => 5,
             Kinematics::Joint { n } => *n,
         }
     }
 
     /// Whether the tool orientation moves any axis (false: pure reorientations take no time).
     pub fn uses_orientation(&self) -> bool {
-        matches!(self, Kinematics::HeadHead { .. })
+        !matches!(self, Kinematics::Xyz | Kinematics::Joint { .. })
     }
 
-    /// Rotary angles (θ1, θ2) in radians at each CL orientation, on one continuous branch:
-    /// angles unwrapped (no 2π jumps) and no switch between the two inverse solutions.
-    /// `lines` names the CL line of each orientation for errors.
-    pub fn rotary_angles(
-        &self,
-        orientations: &[Vector3<f64>],
-        lines: &[usize],
-    ) -> Result<Vec<[f64; 2]>> {
+    /// The machine axis index of path angle 0 and 1 (`None`: no such angle).
+    pub fn rotary_axes(&self) -> [Option<usize>; 2] {
         match self {
-            Kinematics::Xyz | Kinematics::Joint { .. } => Ok(vec![[0.0; 2]; orientations.len()]),
-            Kinematics::HeadHead { .. } => head_head::continuous_angles(orientations, lines),
+            Kinematics::Xyz | Kinematics::Joint { .. } => [None, None],
+            Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_) => {
+                [Some(3), Some(4)]
+            }
+            Kinematics::Dresser(_) => [Some(2), None],
         }
+    }
+
+    /// The path angles (radians) of rotary axis positions `[A, B, C]` in degrees as a program
+    /// gives them (never reduced modulo 360°): (C, A) for head_head, (A, C) for
+    /// table_table_ac, (B, C) for table_table_bc and head_table, (B, 0) for the dresser, zero
+    /// for xyz and joint.
+    pub fn angles_from_rotary(&self, rotary: [f64; 3]) -> [f64; 2] {
+        let [a, b, c] = rotary.map(f64::to_radians);
+        match self {
+            Kinematics::Xyz | Kinematics::Joint { .. } => [0.0, 0.0],
+            Kinematics::HeadHead { .. } => [c, a],
+            Kinematics::TableTable(t) => match t.tilt {
+                TrunnionTilt::A => [a, c],
+                TrunnionTilt::B => [b, c],
+            },
+            Kinematics::HeadTable(_) => [b, c],
+            Kinematics::Dresser(_) => [b, 0.0],
+        }
+    }
+
+    /// The unit tool axis in program coordinates for path angles in radians (+z for xyz and
+    /// joint).
+    pub fn tool_axis(&self, angles: [f64; 2]) -> Vector3<f64> {
+        let [a0, a1] = angles;
+        match self {
+            Kinematics::Xyz | Kinematics::Joint { .. } => Vector3::z(),
+            Kinematics::HeadHead { .. } => head_head::orientation(a0, a1),
+            Kinematics::TableTable(t) => t.tool_axis(a0, a1),
+            Kinematics::HeadTable(h) => h.tool_axis(a0, a1),
+            Kinematics::Dresser(d) => d.tool_axis(a0),
+        }
+    }
+
+    /// The forward kinematics: axis positions (file units, the kinematics' axis order) to the
+    /// tool tip in program coordinates, the tool axis and the path angles. `None` for a
+    /// joint-space machine, which has no tool tip.
+    pub fn forward(&self, q: &[f64]) -> Option<ToolPose> {
+        Some(match self {
+            Kinematics::Xyz => ToolPose {
+                p: Vector3::new(q[0], q[1], q[2]),
+                k: Vector3::z(),
+                angles: [0.0; 2],
+            },
+            Kinematics::HeadHead { d2 } => head_head::forward(*d2, q),
+            Kinematics::TableTable(t) => t.forward(q),
+            Kinematics::HeadTable(h) => h.forward(q),
+            Kinematics::Dresser(d) => d.forward(q),
+            Kinematics::Joint { .. } => return None,
+        })
+    }
+
+    /// The path angles (radians) of every CL point, on one continuous branch within the
+    /// rotary axes' travel (`axes`: the machine's axes in the kinematics' order; their `travel`
+    /// bounds the angles, an empty slice means no travel limits).
+    ///
+    /// A point with programmed rotary words (`rotary`, tool-tip mode) takes the machine's
+    /// rotary axes from them ([`Kinematics::angles_from_rotary`]; no inverse kinematics, never
+    /// reduced modulo 360°). A point given by its tool vector `o` is solved by the tool-vector
+    /// inverse kinematics, unwrapped by multiples of 2π, on the solution nearest to the previous
+    /// point, which must lie within travel; at the singular pose (tool parallel to the C axis)
+    /// C keeps its previous value, and within [`branch::POLE_CONE`] of it C is interpolated
+    /// across the pass, the tool vector then deviating by at most [`branch::POLE_TOLERANCE`]
+    /// ([`branch`] states the rules). A path that cannot be followed continuously within
+    /// travel, a programmed position outside travel, or a dresser point off the X–Z plane is
+    /// an error naming its CL line.
+    pub fn rotary_angles(&self, points: &[ClPoint], axes: &[Axis]) -> Result<Vec<[f64; 2]>> {
+        let travel = self.rotary_axes().map(|i| {
+            i.and_then(|i| axes.get(i))
+                .and_then(|a| a.travel)
+                .map(|(lo, hi)| (lo.to_radians(), hi.to_radians()))
+        });
+        let lines: Vec<usize> = points.iter().map(|p| p.line).collect();
+        let names = match self {
+            Kinematics::Xyz | Kinematics::Joint { .. } => return Ok(vec![[0.0; 2]; points.len()]),
+            Kinematics::Dresser(d) => return dresser_angles(d, points, travel[0]),
+            Kinematics::HeadHead { .. } => {
+                return self.follow(points, &lines, head_head::layout(travel));
+            }
+            Kinematics::TableTable(t) => match t.tilt {
+                TrunnionTilt::A => ["A", "C"],
+                TrunnionTilt::B => ["B", "C"],
+            },
+            Kinematics::HeadTable(_) => ["B", "C"],
+        };
+        self.follow(
+            points,
+            &lines,
+            Layout {
+                tilt: 0,
+                travel,
+                names,
+            },
+        )
+    }
+
+    /// [`branch::follow`] for a two-rotary kinematics.
+    fn follow(&self, points: &[ClPoint], lines: &[usize], layout: Layout) -> Result<Vec<[f64; 2]>> {
+        let targets: Vec<Target> = points
+            .iter()
+            .map(|p| match p.rotary {
+                Some(r) => Target::Programmed(self.angles_from_rotary(r)),
+                None => {
+                    let (tilt, spin) = match self {
+                        Kinematics::HeadHead { .. } => head_head::tool_vector_ik(&p.o),
+                        Kinematics::TableTable(t) => t.tool_vector_ik(&p.o),
+                        Kinematics::HeadTable(h) => h.tool_vector_ik(&p.o),
+                        _ => (0.0, None),
+                    };
+                    Target::Vector { k: p.o, tilt, spin }
+                }
+            })
+            .collect();
+        branch::follow(&targets, lines, &layout, &|a| self.tool_axis(a))
     }
 
     /// Axis positions for path coordinates `w` in any [`Real`] type (eq. 27 for head_head).
@@ -109,6 +266,9 @@ impl Kinematics {
                 out[2] = w[2];
             }
             Kinematics::HeadHead { d2 } => head_head::axis_positions(*d2, w, out),
+            Kinematics::TableTable(t) => t.axis_positions(w, out),
+            Kinematics::HeadTable(h) => h.axis_positions(w, out),
+            Kinematics::Dresser(d) => d.axis_positions(w, out),
             Kinematics::Joint { n } => out[..*n].copy_from_slice(&w[..*n]),
         }
     }
@@ -183,6 +343,78 @@ impl Effective {
         }
         Some(e)
     }
+}
+
+/// The dresser's B along the path: programmed, or the profile normal's angle unwrapped nearest
+/// to the previous point within travel. Points must lie in the X–Z plane.
+fn dresser_angles(
+    d: &dresser::Dresser,
+    points: &[ClPoint],
+    travel: Option<(f64, f64)>,
+) -> Result<Vec<[f64; 2]>> {
+    /// Largest |Py| (mm) and |o_y| accepted as "in the X–Z plane".
+    const OFF_PLANE: f64 = 1e-6;
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(points.len());
+    for p in points {
+        let line = p.line;
+        let prev = out.last().map_or(0.0, |a| a[0]);
+        if p.p.y.abs() > OFF_PLANE {
+            return Err(Error::Infeasible(format!(
+                "CL point at line {line}: a dresser works in the X–Z plane, but this point has \
+                 y = {} mm",
+                p.p.y
+            )));
+        }
+        let theta = match p.rotary {
+            Some(r) => {
+                let b = r[1].to_radians();
+                if !branch::within(b, travel) {
+                    let (lo, hi) = travel.unwrap_or_default();
+                    return Err(Error::Infeasible(format!(
+                        "CL point at line {line}: programmed B = {}° is outside its travel \
+                         [{}, {}]°",
+                        r[1],
+                        lo.to_degrees(),
+                        hi.to_degrees()
+                    )));
+                }
+                b
+            }
+            None => {
+                if p.o.y.abs() > OFF_PLANE {
+                    return Err(Error::Infeasible(format!(
+                        "CL point at line {line}: a dresser works in the X–Z plane, but this \
+                         point's tool vector has y = {}",
+                        p.o.y
+                    )));
+                }
+                let raw = d.tool_vector_ik(&p.o).ok_or_else(|| {
+                    Error::Infeasible(format!(
+                        "CL point at line {line}: the tool vector has no direction in the X–Z plane"
+                    ))
+                })?;
+                // Continuous: the shift nearest the previous point (the first: nearest zero,
+                // within travel), which must lie within travel.
+                let theta = if out.is_empty() {
+                    branch::fit(raw, 0.0, travel)
+                } else {
+                    branch::fit(raw, prev, None).filter(|t| branch::within(*t, travel))
+                };
+                theta.ok_or_else(|| {
+                    let (lo, hi) = travel.unwrap_or_default();
+                    Error::Infeasible(format!(
+                        "CL point at line {line}: following the profile normal continuously \
+                         needs B = {:.4}°, outside its travel [{}, {}]°",
+                        branch::fit(raw, prev, None).unwrap_or(raw).to_degrees(),
+                        lo.to_degrees(),
+                        hi.to_degrees()
+                    ))
+                })?
+            }
+        };
+        out.push([theta, 0.0]);
+    }
+    Ok(out)
 }
 
 /// P'(u) and P''(u) of a path jet.

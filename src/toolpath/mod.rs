@@ -6,6 +6,7 @@
 //! [`crate::geometry`]'s job.
 
 pub mod apt;
+pub mod gcode;
 pub mod joint_csv;
 
 use nalgebra::Vector3;
@@ -66,8 +67,8 @@ pub enum Input {
     Joint(joint_csv::JointPath),
 }
 
-/// Reads any input path, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.csv`:
-/// joint space).
+/// Reads any input path, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
+/// `.nc`, `.gcode`, `.tap`: G-code in the default dialect, LinuxCNC; `.csv`: joint space).
 pub fn read_input(path: &Path) -> Result<Input> {
     let is_csv = path
         .extension()
@@ -80,7 +81,8 @@ pub fn read_input(path: &Path) -> Result<Input> {
     }
 }
 
-/// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL).
+/// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
+/// `.nc`, `.gcode`, `.tap`: G-code in the default dialect, LinuxCNC).
 pub fn read(path: &Path) -> Result<Toolpath> {
     let ext = path
         .extension()
@@ -89,12 +91,15 @@ pub fn read(path: &Path) -> Result<Toolpath> {
         .unwrap_or_default();
     match ext.as_str() {
         "cls" | "apt" | "cl" => apt::read(path),
+        "ngc" | "nc" | "gcode" | "tap" => gcode::read(path, gcode::Dialect::default()),
         "" => Err(crate::error::Error::Usage(format!(
-            "{}: the toolpath file has no extension (expected .cls, .apt or .csv)",
+            "{}: the toolpath file has no extension (expected .cls, .apt, .ngc, .nc, .gcode, \
+             .tap or .csv)",
             path.display()
         ))),
         other => Err(crate::error::Error::Usage(format!(
-            "{}: unknown toolpath format `.{other}` (expected .cls, .apt or .csv)",
+            "{}: unknown toolpath format `.{other}` (expected .cls, .apt, .ngc, .nc, .gcode, \
+             .tap or .csv)",
             path.display()
         ))),
     }

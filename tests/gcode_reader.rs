@@ -1,0 +1,840 @@
+//! Tests of the G-code reader (`feedopt::toolpath::gcode`).
+//!
+//! The LinuxCNC programs are third-party test data read from `../shared/realworld/linuxcnc`
+//! when that folder exists (skipped otherwise); they are never copied into the crate.
+
+use feedopt::error::Error;
+use feedopt::toolpath::gcode::{Dialect, MAX_CHORD_ERROR_MM, parse};
+use feedopt::toolpath::{ClPoint, Feed, Toolpath};
+use nalgebra::Vector3;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn ok_in(dialect: Dialect, text: &str) -> Toolpath {
+    match parse(Path::new("test.ngc"), text, dialect) {
+        Ok(tp) => tp,
+        Err(e) => panic!("unexpected error: {e}\n--- input ---\n{text}"),
+    }
+}
+
+fn ok(text: &str) -> Toolpath {
+    ok_in(Dialect::LinuxCnc, text)
+}
+
+/// Asserts a parse error at `line` whose message contains every one of `needles`
+/// (case-insensitive).
+fn err_in(dialect: Dialect, text: &str, line: usize, needles: &[&str]) {
+    match parse(Path::new("bad.ngc"), text, dialect) {
+        Ok(tp) => panic!("expected an error, got {} points\n{text}", tp.points.len()),
+        Err(Error::Parse {
+            file,
+            line: got_line,
+            message,
+        }) => {
+            assert_eq!(file, Path::new("bad.ngc"));
+            assert_eq!(got_line, line, "wrong line for `{message}`");
+            let lower = message.to_lowercase();
+            for needle in needles {
+                assert!(
+                    lower.contains(&needle.to_lowercase()),
+                    "message `{message}` does not mention `{needle}`"
+                );
+            }
+        }
+        Err(other) => panic!("expected Error::Parse, got {other:?}"),
+    }
+}
+
+fn err(text: &str, line: usize, needles: &[&str]) {
+    err_in(Dialect::LinuxCnc, text, line, needles);
+}
+
+fn close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) -> bool {
+    (a - b).norm() <= tol
+}
+
+fn assert_close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) {
+    assert!(close(a, b, tol), "{a:?} != {b:?} (tolerance {tol})");
+}
+
+fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
+    Vector3::new(x, y, z)
+}
+
+fn programmed(feed: Feed) -> f64 {
+    match feed {
+        Feed::Programmed(f) => f,
+        other => panic!("expected a programmed feed, got {other:?}"),
+    }
+}
+
+fn block_time(feed: Feed) -> f64 {
+    match feed {
+        Feed::BlockTime(t) => t,
+        other => panic!("expected a block time, got {other:?}"),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dialect names
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn dialect_from_str_and_default() {
+    assert_eq!(Dialect::default(), Dialect::LinuxCnc);
+    assert_eq!("linuxcnc".parse::<Dialect>().unwrap(), Dialect::LinuxCnc);
+    assert_eq!("Fanuc".parse::<Dialect>().unwrap(), Dialect::Fanuc);
+    assert_eq!("SINUMERIK".parse::<Dialect>().unwrap(), Dialect::Sinumerik);
+    let e = "heidenhain".parse::<Dialect>().unwrap_err().to_string();
+    assert!(e.contains("heidenhain") && e.contains("linuxcnc"), "{e}");
+    for d in Dialect::ALL {
+        assert_eq!(d.to_string().parse::<Dialect>().unwrap(), d);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Modal motion, distance mode, units
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn modal_g0_g1_and_feeds() {
+    let tp = ok("G0 X1 Y2 Z3\nX4\nG1 X5 F600\nY6\nG0 Z10\nX0\nG1 X1\n");
+    let f: Vec<Feed> = tp.points.iter().map(|p| p.feed).collect();
+    assert_eq!(
+        f,
+        vec![
+            Feed::Rapid,
+            Feed::Rapid,
+            Feed::Programmed(10.0),
+            Feed::Programmed(10.0),
+            Feed::Rapid,
+            Feed::Rapid,
+            Feed::Programmed(10.0),
+        ]
+    );
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(p[0], v(1.0, 2.0, 3.0));
+    assert_eq!(p[1], v(4.0, 2.0, 3.0));
+    assert_eq!(p[2], v(5.0, 2.0, 3.0));
+    assert_eq!(p[3], v(5.0, 6.0, 3.0));
+    assert_eq!(p[6], v(1.0, 6.0, 10.0));
+    let lines: Vec<usize> = tp.points.iter().map(|p| p.line).collect();
+    assert_eq!(lines, vec![1, 2, 3, 4, 5, 6, 7]);
+    // No rotary word anywhere: no rotary positions; no tool vector: +Z.
+    assert!(tp.points.iter().all(|p| p.rotary.is_none()));
+    assert!(tp.points.iter().all(|p| p.o == v(0.0, 0.0, 1.0)));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+}
+
+#[test]
+fn feed_before_any_f_is_unspecified() {
+    let tp = ok("G0 X0 Y0 Z0\nG1 X1\nF120 X2\n");
+    assert_eq!(tp.points[1].feed, Feed::Unspecified);
+    assert_eq!(tp.points[2].feed, Feed::Programmed(2.0));
+}
+
+#[test]
+fn g90_g91() {
+    let tp = ok("G90 G0 X1 Y1 Z1\nG91 X1 Y-2\nG1 Z0.5 F60\nG90 X0\n");
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(
+        p,
+        vec![
+            v(1.0, 1.0, 1.0),
+            v(2.0, -1.0, 1.0),
+            v(2.0, -1.0, 1.5),
+            v(0.0, -1.0, 1.5)
+        ]
+    );
+}
+
+#[test]
+fn g20_scales_positions_increments_arcs_and_feed() {
+    let tp = ok("G20 G90 G0 X1 Y2 Z0\nG91 G1 X1 F10\nG90 G21 X10\n");
+    assert_close(tp.points[0].p, v(25.4, 50.8, 0.0), 1e-12);
+    assert_close(tp.points[1].p, v(50.8, 50.8, 0.0), 1e-12);
+    // 10 inch/min = 254 mm/min.
+    assert!((programmed(tp.points[1].feed) - 254.0 / 60.0).abs() < 1e-12);
+    // Back in mm: positions as written, and the feed keeps its mm value.
+    assert_close(tp.points[2].p, v(10.0, 50.8, 0.0), 1e-12);
+    assert!((programmed(tp.points[2].feed) - 254.0 / 60.0).abs() < 1e-12);
+
+    // An inch arc: radius 1 inch.
+    let tp = ok("G20 G17 G0 X1 Y0 Z0\nG3 X0 Y1 I-1 J0 F10\n");
+    for p in &tp.points[1..] {
+        assert!(((p.p.x.hypot(p.p.y)) - 25.4).abs() <= 1e-9);
+    }
+    assert_eq!(tp.points.last().unwrap().p, v(0.0, 25.4, 0.0));
+}
+
+#[test]
+fn g93_inverse_time() {
+    let tp = ok("G0 X0 Y0 Z0\nG93 G1 X10 F2\nY5 F0.5\nG0 X0\nG1 X1 F120\n");
+    assert_eq!(tp.points[1].feed, Feed::BlockTime(30.0));
+    assert_eq!(tp.points[2].feed, Feed::BlockTime(120.0));
+    assert_eq!(tp.points[3].feed, Feed::Rapid);
+    assert_eq!(tp.points[4].feed, Feed::BlockTime(0.5));
+    // F on every G93 feed block, or an error naming the line.
+    err("G0 X0 Y0 Z0\nG93\nG1 X1 F10\nX2\n", 4, &["G93", "F"]);
+    err("G0 X0 Y0 Z0\nG93 G1 X1 F0\n", 2, &["F"]);
+    // Leaving G93 forgets F (LinuxCNC: G94 sets F to 0).
+    let tp = ok("G0 X0 Y0 Z0\nG93 G1 X1 F10\nG94 G1 X2\nX3 F60\n");
+    assert_eq!(tp.points[2].feed, Feed::Unspecified);
+    assert_eq!(tp.points[3].feed, Feed::Programmed(1.0));
+}
+
+#[test]
+fn g94_rotary_only_move_uses_degrees() {
+    // A rotary-only move at F90 (deg/min): 30° take 20 s; A and C together: their Euclidean
+    // distance in degrees.
+    let tp = ok("G0 X0 Y0 Z0 A0 C0\nG1 A30 F90\nA0 C40\nX1 A10\nX1.00000001 A20\n");
+    assert!((block_time(tp.points[1].feed) - 20.0).abs() < 1e-12);
+    assert!((block_time(tp.points[2].feed) - 50.0 / 1.5).abs() < 1e-12);
+    // X moves too: the XYZ length rules, F is mm/min.
+    assert_eq!(tp.points[3].feed, Feed::Programmed(1.5));
+    // X moves by 1e-8 mm (below LinuxCNC's 1e-7): rotary only again.
+    assert!((block_time(tp.points[4].feed) - 10.0 / 1.5).abs() < 1e-9);
+    // Rotary-only under G20: F is still degrees per minute.
+    let tp = ok("G20 G0 X0 Y0 Z0 C0\nG1 C60 F60\n");
+    assert!((block_time(tp.points[1].feed) - 60.0).abs() < 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Arcs
+// ---------------------------------------------------------------------------------------------
+
+/// Checks an arc's points: every chord end on the circle about `centre` (in the plane axes
+/// `a`, `b`) within 1 µm, every chord's midpoint within the chord error, the last point exact.
+fn check_arc(
+    points: &[ClPoint],
+    start: Vector3<f64>,
+    end: Vector3<f64>,
+    centre: Vector3<f64>,
+    radius: f64,
+    (a, b): (usize, usize),
+) {
+    assert!(points.len() > 1, "an arc gives several chords");
+    let in_plane =
+        |p: Vector3<f64>| ((p[a] - centre[a]).powi(2) + (p[b] - centre[b]).powi(2)).sqrt();
+    let mut prev = start;
+    for p in points {
+        let r = in_plane(p.p);
+        assert!(
+            (r - radius).abs() <= 1e-6,
+            "chord end {:?} off the circle by {}",
+            p.p,
+            r - radius
+        );
+        let mid = (prev + p.p) / 2.0;
+        let sagitta = radius - in_plane(mid);
+        assert!(
+            (-1e-9..=MAX_CHORD_ERROR_MM + 1e-12).contains(&sagitta),
+            "chord sagitta {sagitta}"
+        );
+        prev = p.p;
+    }
+    assert_eq!(points.last().unwrap().p, end, "end point exact");
+    let line = points[0].line;
+    assert!(points.iter().all(|p| p.line == line));
+}
+
+/// Signed swept angle of an arc's points about `centre` in the (a, b) plane.
+fn swept(
+    points: &[ClPoint],
+    start: Vector3<f64>,
+    centre: Vector3<f64>,
+    (a, b): (usize, usize),
+) -> f64 {
+    let angle = |p: Vector3<f64>| (p[b] - centre[b]).atan2(p[a] - centre[a]);
+    let mut total = 0.0;
+    let mut prev = angle(start);
+    for p in points {
+        let now = angle(p.p);
+        let mut d = now - prev;
+        if d > std::f64::consts::PI {
+            d -= std::f64::consts::TAU;
+        } else if d < -std::f64::consts::PI {
+            d += std::f64::consts::TAU;
+        }
+        total += d;
+        prev = now;
+    }
+    total
+}
+
+#[test]
+fn xy_arcs_ijk_and_r_cw_and_ccw() {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let xy = (0, 1);
+    let s = v(10.0, 0.0, 0.0);
+    let e = v(0.0, 10.0, 0.0);
+    let o = v(0.0, 0.0, 0.0);
+    // CCW quarter by IJK.
+    let tp = ok("G17 G0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 F600\n");
+    check_arc(&tp.points[1..], s, e, o, 10.0, xy);
+    assert!((swept(&tp.points[1..], s, o, xy) - FRAC_PI_2).abs() < 1e-9);
+    // CW the long way round (three quarters).
+    let tp = ok("G17 G0 X10 Y0 Z0\nG2 X0 Y10 I-10 J0 F600\n");
+    check_arc(&tp.points[1..], s, e, o, 10.0, xy);
+    assert!((swept(&tp.points[1..], s, o, xy) + 3.0 * FRAC_PI_2).abs() < 1e-9);
+    // R > 0: the short arc; R < 0: the long one.
+    let tp = ok("G17 G0 X10 Y0 Z0\nG3 X0 Y10 R10 F600\n");
+    check_arc(&tp.points[1..], s, e, o, 10.0, xy);
+    assert!((swept(&tp.points[1..], s, o, xy) - FRAC_PI_2).abs() < 1e-9);
+    let tp = ok("G17 G0 X10 Y0 Z0\nG2 X0 Y10 R-10 F600\n");
+    check_arc(&tp.points[1..], s, e, o, 10.0, xy);
+    assert!((swept(&tp.points[1..], s, o, xy) + 3.0 * FRAC_PI_2).abs() < 1e-9);
+    // CW short arc by R: centre (10, 10).
+    let tp = ok("G17 G0 X10 Y0 Z0\nG2 X0 Y10 R10 F600\n");
+    let c = v(10.0, 10.0, 0.0);
+    check_arc(&tp.points[1..], s, e, c, 10.0, xy);
+    assert!((swept(&tp.points[1..], s, c, xy) + FRAC_PI_2).abs() < 1e-9);
+    // Half circle by R (centre on the chord).
+    let tp = ok("G0 X-5 Y0 Z0\nG2 X5 Y0 R5 F600\n");
+    check_arc(
+        &tp.points[1..],
+        v(-5.0, 0.0, 0.0),
+        v(5.0, 0.0, 0.0),
+        o,
+        5.0,
+        xy,
+    );
+    assert!((swept(&tp.points[1..], v(-5.0, 0.0, 0.0), o, xy) + PI).abs() < 1e-9);
+    // Every chord feeds at F.
+    assert!(
+        tp.points[1..]
+            .iter()
+            .all(|p| p.feed == Feed::Programmed(10.0))
+    );
+}
+
+#[test]
+fn full_circle_and_chord_count() {
+    let tp = ok("G0 X5 Y0 Z0\nG2 X5 Y0 I-5 J0 F600\n");
+    let arc = &tp.points[1..];
+    check_arc(
+        arc,
+        v(5.0, 0.0, 0.0),
+        v(5.0, 0.0, 0.0),
+        v(0.0, 0.0, 0.0),
+        5.0,
+        (0, 1),
+    );
+    assert!(
+        (swept(arc, v(5.0, 0.0, 0.0), v(0.0, 0.0, 0.0), (0, 1)) + std::f64::consts::TAU).abs()
+            < 1e-9
+    );
+    // Chord count: the fewest chords with sagitta ≤ 1 µm.
+    let step = 2.0 * (1.0 - MAX_CHORD_ERROR_MM / 5.0f64).acos();
+    assert_eq!(arc.len(), (std::f64::consts::TAU / step).ceil() as usize);
+    // Incremental full circle, and LinuxCNC P turns.
+    let tp = ok("G0 X5 Y0 Z0\nG91 G3 X0 Y0 I-5 J0 P2 F600\n");
+    let arc = &tp.points[1..];
+    assert!(
+        (swept(arc, v(5.0, 0.0, 0.0), v(0.0, 0.0, 0.0), (0, 1)) - 2.0 * std::f64::consts::TAU)
+            .abs()
+            < 1e-9
+    );
+}
+
+#[test]
+fn xz_and_yz_arcs() {
+    use std::f64::consts::FRAC_PI_2;
+    // G18: plane (Z, X); CCW = positive rotation about +Y, which takes +Z towards +X.
+    let tp = ok("G18 G0 X0 Y0 Z10\nG3 X10 Z0 I0 K-10 F600\n");
+    let (s, e, c) = (v(0.0, 0.0, 10.0), v(10.0, 0.0, 0.0), v(0.0, 0.0, 0.0));
+    check_arc(&tp.points[1..], s, e, c, 10.0, (2, 0));
+    assert!((swept(&tp.points[1..], s, c, (2, 0)) - FRAC_PI_2).abs() < 1e-9);
+    let tp = ok("G18 G0 X0 Y0 Z10\nG2 X10 Z0 R-10 F600\n");
+    check_arc(&tp.points[1..], s, e, c, 10.0, (2, 0));
+    assert!((swept(&tp.points[1..], s, c, (2, 0)) + 3.0 * FRAC_PI_2).abs() < 1e-9);
+    let tp = ok("G18 G0 X0 Y0 Z10\nG2 X10 Z0 R10 F600\n");
+    let c2 = v(10.0, 0.0, 10.0);
+    check_arc(&tp.points[1..], s, e, c2, 10.0, (2, 0));
+    assert!(tp.points[1..].iter().all(|p| p.p.y == 0.0));
+    // G19: plane (Y, Z); CCW takes +Y towards +Z.
+    let tp = ok("G19 G0 X0 Y10 Z0\nG3 Y0 Z10 J-10 K0 F600\n");
+    let (s, e) = (v(0.0, 10.0, 0.0), v(0.0, 0.0, 10.0));
+    check_arc(&tp.points[1..], s, e, c, 10.0, (1, 2));
+    assert!((swept(&tp.points[1..], s, c, (1, 2)) - FRAC_PI_2).abs() < 1e-9);
+    let tp = ok("G19 G0 X0 Y10 Z0\nG2 Y0 Z10 R10 F600\n");
+    let c3 = v(0.0, 10.0, 10.0);
+    check_arc(&tp.points[1..], s, e, c3, 10.0, (1, 2));
+    assert!(tp.points[1..].iter().all(|p| p.p.x == 0.0));
+}
+
+#[test]
+fn helical_arc() {
+    // A full turn and a quarter in XY while Z falls 5 mm and C turns 90°.
+    let tp = ok("G0 X10 Y0 Z0 C0\nG3 X0 Y10 Z-5 C90 I-10 J0 P2 F600\n");
+    let arc = &tp.points[1..];
+    check_arc(
+        arc,
+        v(10.0, 0.0, 0.0),
+        v(0.0, 10.0, -5.0),
+        v(0.0, 0.0, 0.0),
+        10.0,
+        (0, 1),
+    );
+    let total = swept(arc, v(10.0, 0.0, 0.0), v(0.0, 0.0, 0.0), (0, 1));
+    assert!((total - 2.5 * std::f64::consts::PI).abs() < 1e-9);
+    // Z and C are linear in the swept angle.
+    let mut so_far = 0.0;
+    let mut prev = v(10.0, 0.0, 0.0);
+    for p in arc {
+        so_far += swept(std::slice::from_ref(p), prev, v(0.0, 0.0, 0.0), (0, 1));
+        prev = p.p;
+        let t = so_far / total;
+        assert!((p.p.z - (-5.0 * t)).abs() < 1e-9);
+        assert!((p.rotary.unwrap()[2] - 90.0 * t).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn g93_arc_splits_block_time_by_chord_length() {
+    let tp = ok("G0 X10 Y0 Z0\nG93 G3 X-10 Y0 I-10 J0 F6\n");
+    let arc = &tp.points[1..];
+    let total: f64 = arc.iter().map(|p| block_time(p.feed)).sum();
+    assert!((total - 10.0).abs() < 1e-12);
+    let mut prev = tp.points[0].p;
+    let mut lengths = Vec::new();
+    for p in arc {
+        lengths.push((p.p - prev).norm());
+        prev = p.p;
+    }
+    let sum: f64 = lengths.iter().sum();
+    for (p, len) in arc.iter().zip(&lengths) {
+        assert!((block_time(p.feed) - 10.0 * len / sum).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn bad_arcs_are_errors() {
+    err("G0 X0 Y0 Z0\nG2 X10 Y0 R4 F100\n", 2, &["radius"]);
+    err("G0 X0 Y0 Z0\nG2 X10 Y0 I5 J0 R5 F100\n", 2, &["R", "I/J/K"]);
+    err("G0 X0 Y0 Z0\nG2 X10 Y0 F100\n", 2, &["centre"]);
+    err(
+        "G0 X0 Y0 Z0\nG2 X10 Y0 I4 J0 F100\n",
+        2,
+        &["not on the circle"],
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rotary words
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn rotary_words_are_never_wrapped() {
+    let tp = ok("G0 X0 Y0 Z0 C350\nG1 C370 F600\nG91 C20\nC-400\nG90 A-30 B720\n");
+    let r: Vec<[f64; 3]> = tp.points.iter().map(|p| p.rotary.unwrap()).collect();
+    assert_eq!(
+        r,
+        vec![
+            [0.0, 0.0, 350.0],
+            [0.0, 0.0, 370.0],
+            [0.0, 0.0, 390.0],
+            [0.0, 0.0, -10.0],
+            [-30.0, 720.0, -10.0],
+        ]
+    );
+}
+
+#[test]
+fn rotary_present_anywhere_gives_every_point_rotary() {
+    // The first rotary word comes late: earlier points get 0 for A B C.
+    let tp = ok("G0 X0 Y0 Z0\nG1 X1 F100\nG0 A10\n");
+    assert_eq!(tp.points[0].rotary, Some([0.0, 0.0, 0.0]));
+    assert_eq!(tp.points[2].rotary, Some([10.0, 0.0, 0.0]));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Words, comments, warnings, errors
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn unknown_word_warns_with_its_line() {
+    let tp = ok("G0 X0 Y0 Z0\nG1 X1 F100 G43.4\nM999\n");
+    assert_eq!(tp.points.len(), 2);
+    assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
+    assert_eq!(tp.warnings[0].line, 2);
+    assert!(
+        tp.warnings[0].message.contains("G43.4"),
+        "{:?}",
+        tp.warnings[0]
+    );
+    assert_eq!(tp.warnings[1].line, 3);
+    assert!(
+        tp.warnings[1].message.contains("M999"),
+        "{:?}",
+        tp.warnings[1]
+    );
+    // Sinumerik: an unknown keyword and an unknown named word.
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G0 X0 Y0 Z0\nFOO G1 X1 F100\nBAR=3 Y1\n",
+    );
+    assert_eq!(tp.points.len(), 3);
+    assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
+    assert!(tp.warnings[0].line == 2 && tp.warnings[0].message.contains("FOO"));
+    assert!(tp.warnings[1].line == 3 && tp.warnings[1].message.contains("BAR"));
+    // U V W are known to LinuxCNC but not modelled: a warning too.
+    let tp = ok("G0 X0 Y0 Z0 U5\n");
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 1 && w.message.contains("U5"))
+    );
+}
+
+#[test]
+fn malformed_numbers_are_errors_naming_the_line() {
+    err("G0 X0 Y0 Z0\nG1 X1.2.3 F100\n", 2, &["1.2.3", "X"]);
+    err("G0 X0 Y0 Z0\n\nG1 Y- F100\n", 3, &["Y"]);
+    err("G0 X0 Y0 Z0\nG1 X1 F\n", 2, &["F"]);
+    err("G0 X0 Y0 Z0\nG1 X+-1 F100\n", 2, &["+-1"]);
+    // No exponents in G-code: `F1E3` is F1 and an E word.
+    assert_eq!(
+        ok("G0 X0 Y0 Z0\nG1 X1 F1E3\n").points[1].feed,
+        Feed::Programmed(1.0 / 60.0)
+    );
+    err_in(
+        Dialect::Sinumerik,
+        "G0 X0 Y0 Z0\nG1 A3=0..5 X1\n",
+        2,
+        &["A3"],
+    );
+    err_in(Dialect::Fanuc, "G0 X0 Y0 Z0\nG1 X-1-2 F100\n", 2, &["X"]);
+}
+
+#[test]
+fn other_errors_name_the_line() {
+    err("G0 X0 Y0 Z0\nG1 X#1 F100\n", 2, &["expressions"]);
+    err("G0 X0 Y0 Z0\no100 sub\n", 2, &["O-word"]);
+    err("G0 X0 Y0 Z0\nG81 X1 Y1 Z-1 R1\n", 2, &["canned"]);
+    err("G0 X0 Y0 Z0\nG1 X1 X2 F100\n", 2, &["twice"]);
+    err("G0 X0 Y0 Z0\nG0 G1 X1\n", 2, &["two motion codes"]);
+    err("X1 Y2\n", 1, &["motion mode"]);
+    err("G0 X0 (unclosed\n", 1, &["unclosed"]);
+    err("G0 X0 Y0 Z0\nG1 X1 F-5\n", 2, &["negative"]);
+    err("(only comments)\n", 1, &["no motion"]);
+}
+
+#[test]
+fn comments_of_both_kinds_and_skipped_lines() {
+    let text = "%\n\
+                (header comment)\n\
+                G0 X1 Y1 Z1 ; a semicolon comment with X99 in it\n\
+                G1 (inline; with a semicolon) X2 F60 (and another)\n\
+                /G1 X50\n\
+                N100 G1 Y2 S1000 M3 T1 M6 ; Z99\n\
+                g1 x  3  (lower case and spaces)\n\
+                %\n";
+    let tp = ok(text);
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(
+        p,
+        vec![
+            v(1.0, 1.0, 1.0),
+            v(2.0, 1.0, 1.0),
+            v(2.0, 2.0, 1.0),
+            v(3.0, 2.0, 1.0)
+        ]
+    );
+    assert_eq!(tp.points[1].line, 4);
+    // The block-delete line is skipped with a warning.
+    assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(tp.warnings[0].line, 5);
+    // Sinumerik: `;` comments only.
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G0 X1 Y1 Z1 ; (not a paren comment) X9\nG1 X2 F60\n",
+    );
+    assert_eq!(tp.points[0].p, v(1.0, 1.0, 1.0));
+    // Fanuc: `( )` comments, `;` ends a block.
+    let tp = ok_in(Dialect::Fanuc, "G0 X1. Y1. Z1. (start);G1 X2. F60.;\n");
+    assert_eq!(tp.points.len(), 2);
+    assert_eq!(tp.points[1].p, v(2.0, 1.0, 1.0));
+}
+
+#[test]
+fn tolerated_codes_do_not_move() {
+    let tp = ok(
+        "G17 G21 G40 G49 G54 G64 G61 G90 G94\nG0 G43 H1 X0 Y0 Z5 M8\nG59.1 G1 X1 F60\n\
+         M5 M9\nM30\nG1 X99\n",
+    );
+    assert_eq!(tp.points.len(), 2, "M30 ends the program");
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+}
+
+#[test]
+fn g53_moves_are_included_with_a_warning() {
+    let tp = ok("G0 X1 Y1 Z1\nG53 G0 Z30\nG53 Y0 B0 C0\n");
+    assert_eq!(tp.points.len(), 3);
+    assert_eq!(tp.points[1].p, v(1.0, 1.0, 30.0));
+    assert_eq!(tp.points[2].p, v(1.0, 0.0, 30.0));
+    let g53: Vec<usize> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("machine-coordinate"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(g53, vec![2, 3]);
+}
+
+#[test]
+fn unknown_start_position_warns_once() {
+    let tp = ok("G0 Z5\nX1 Y2\nZ1\n");
+    assert_eq!(tp.points[0].p, v(0.0, 0.0, 5.0));
+    assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(tp.warnings[0].line, 1);
+    assert!(tp.warnings[0].message.contains("X, Y"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// TCP and tool vectors per dialect
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn tcp_modes_per_dialect() {
+    // LinuxCNC: M428 on; rotary motion without it warns once per stretch.
+    let tp = ok("M428\nG0 X0 Y0 Z0 A10 C20\nM429\nG0 A0\nA5\n");
+    assert_eq!(tp.points[0].rotary, Some([10.0, 0.0, 20.0]));
+    let tcp: Vec<usize> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("TCP"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(tcp, vec![4]);
+    // Fanuc G43.4: rotary words in TCP mode, no warnings.
+    let tp = ok_in(Dialect::Fanuc, "G43.4 H1\nG0 X0. Y0. Z0. A10. C20.\nG49\n");
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    // Fanuc G43.5: I J K on G1 are the tool vector (normalised); rotary stays None.
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "G43.5 H1\nG0 X0. Y0. Z0. I0. J0. K1.\nG1 X1. I1. K1. F600.\nG1 X2.\n",
+    );
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    assert!(tp.points.iter().all(|p| p.rotary.is_none()));
+    assert_eq!(tp.points[0].o, v(0.0, 0.0, 1.0));
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert_close(tp.points[1].o, v(h, 0.0, h), 1e-15);
+    assert_close(tp.points[2].o, v(h, 0.0, h), 1e-15);
+    // Sinumerik TRAORI with A3 B3 C3.
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "TRAORI\nG0 X0 Y0 Z0 A3=0 B3=0 C3=1\nG1 X1 A3=0 B3=1 C3=1 F600\nTRAFOOF\nM30\n",
+    );
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    assert_close(tp.points[1].o, v(0.0, h, h), 1e-15);
+    err_in(
+        Dialect::Sinumerik,
+        "TRAORI\nG0 X0 Y0 Z0 A3=0 B3=0 C3=0\n",
+        2,
+        &["tool vector"],
+    );
+}
+
+#[test]
+fn fanuc_numbers_without_a_decimal_point_are_increments() {
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "G21 G0 X100 Y1. Z-2500 C90000\nG1 X1 F100\n",
+    );
+    assert_close(tp.points[0].p, v(0.1, 1.0, -2.5), 1e-12);
+    assert!((tp.points[0].rotary.unwrap()[2] - 90.0).abs() < 1e-9);
+    // F is not a dimension: F100 is 100 mm/min.
+    assert!((programmed(tp.points[1].feed) - 100.0 / 60.0).abs() < 1e-12);
+}
+
+#[test]
+fn sinumerik_units_radius_and_spaces() {
+    // G71 mm; CR= radius; N numbers; G70 inch geometry leaves F alone, G700 scales it.
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "N10 G71 G17 G0 X10 Y0 Z0\nN20 G3 X0 Y10 CR=10 F600\nN30 G70 G1 X1 F60\nN40 G700 X2 F60\n",
+    );
+    let arc: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 2).collect();
+    for p in &arc {
+        assert!((p.p.x.hypot(p.p.y) - 10.0).abs() < 1e-9);
+    }
+    let n = tp.points.len();
+    assert_close(tp.points[n - 2].p, v(25.4, 10.0, 0.0), 1e-12);
+    assert_eq!(tp.points[n - 2].feed, Feed::Programmed(1.0));
+    assert!((programmed(tp.points[n - 1].feed) - 25.4).abs() < 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The LinuxCNC demo programs (GPL-2.0 test data in ../shared; skipped when absent)
+// ---------------------------------------------------------------------------------------------
+
+fn linuxcnc_dir() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("skipped: {} not present", dir.display());
+        None
+    }
+}
+
+fn read_demo(name: &str) -> Option<(Toolpath, String)> {
+    let path = linuxcnc_dir()?.join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let tp = feedopt::toolpath::gcode::read(&path, Dialect::LinuxCnc)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    // The extension chooses the same reader.
+    assert_eq!(feedopt::toolpath::read(&path).unwrap(), tp);
+    Some((tp, text))
+}
+
+/// Programmed feed time: Σ BlockTime + Σ chord length / programmed feed.
+fn programmed_feed_time(tp: &Toolpath) -> (f64, f64) {
+    let (mut inverse, mut per_minute) = (0.0, 0.0);
+    for w in tp.points.windows(2) {
+        match w[1].feed {
+            Feed::BlockTime(t) => inverse += t,
+            Feed::Programmed(f) => per_minute += (w[1].p - w[0].p).norm() / f,
+            Feed::Rapid => {}
+            Feed::Unspecified => panic!("line {}: feed move without F", w[1].line),
+        }
+    }
+    if let Feed::BlockTime(t) = tp.points[0].feed {
+        inverse += t;
+    }
+    (inverse, per_minute)
+}
+
+/// Motion blocks per kind: lines whose points are rapids, block times or programmed feeds.
+fn blocks_by_feed(tp: &Toolpath) -> BTreeMap<&'static str, usize> {
+    let mut kind_of_line: BTreeMap<usize, &'static str> = BTreeMap::new();
+    for p in &tp.points {
+        let kind = match p.feed {
+            Feed::Rapid => "rapid",
+            Feed::BlockTime(_) => "block time",
+            Feed::Programmed(_) => "programmed",
+            Feed::Unspecified => "unspecified",
+        };
+        let previous = kind_of_line.insert(p.line, kind);
+        assert!(
+            previous.is_none_or(|k| k == kind),
+            "line {} mixes feeds",
+            p.line
+        );
+    }
+    let mut counts = BTreeMap::new();
+    for kind in kind_of_line.values() {
+        *counts.entry(*kind).or_insert(0) += 1;
+    }
+    counts
+}
+
+fn report_warnings(name: &str, tp: &Toolpath) {
+    eprintln!(
+        "{name}: {} points, {} warnings",
+        tp.points.len(),
+        tp.warnings.len()
+    );
+    for w in &tp.warnings {
+        eprintln!("  line {}: {}", w.line, w.message);
+    }
+}
+
+/// Lines of `text` that start with `code` followed by a space (after leading blanks).
+fn lines_starting(text: &str, code: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| l.trim_start().starts_with(&format!("{code} ")))
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
+#[test]
+fn linuxcnc_impeller() {
+    let Some((tp, text)) = read_demo("impeller-7bl-xyzac.ngc") else {
+        return;
+    };
+    report_warnings("impeller-7bl-xyzac", &tp);
+    let counts = blocks_by_feed(&tp);
+    assert_eq!(counts.get("block time"), Some(&4306), "{counts:?}");
+    assert_eq!(counts.get("rapid"), Some(&186), "{counts:?}");
+    assert_eq!(counts.len(), 2, "{counts:?}");
+    // Each motion block is one point on its own line, as the file says.
+    let mut lines: Vec<usize> = tp.points.iter().map(|p| p.line).collect();
+    lines.dedup();
+    assert_eq!(lines.len(), tp.points.len());
+    let mut expected = lines_starting(&text, "G1");
+    expected.extend(lines_starting(&text, "G0"));
+    expected.sort();
+    assert_eq!(lines, expected);
+    let (inverse, per_minute) = programmed_feed_time(&tp);
+    eprintln!("impeller programmed feed time: {inverse:.4} s (G93)");
+    assert_eq!(per_minute, 0.0);
+    assert!((inverse - 1078.68).abs() < 0.01, "{inverse}");
+    // Rotary words as written, never wrapped.
+    let c_min = tp
+        .points
+        .iter()
+        .map(|p| p.rotary.unwrap()[2])
+        .fold(f64::INFINITY, f64::min);
+    assert!((c_min + 399.805).abs() < 1e-9, "{c_min}");
+    assert!(tp.points.iter().all(|p| p.o == v(0.0, 0.0, 1.0)));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+}
+
+#[test]
+fn linuxcnc_boat_xyzac() {
+    let Some((tp, _)) = read_demo("boat-xyzac.ngc") else {
+        return;
+    };
+    report_warnings("boat-xyzac", &tp);
+    let (inverse, per_minute) = programmed_feed_time(&tp);
+    eprintln!(
+        "boat-xyzac programmed feed time: {:.4} s (G93 {inverse:.4} + G94 {per_minute:.4})",
+        inverse + per_minute
+    );
+    assert!((inverse + per_minute - 459.42).abs() < 0.02);
+    assert!((inverse - 293.43).abs() < 0.01, "{inverse}");
+    assert!((per_minute - 165.99).abs() < 0.01, "{per_minute}");
+    let counts = blocks_by_feed(&tp);
+    assert_eq!(counts.get("block time"), Some(&1454), "{counts:?}");
+    assert_eq!(counts.get("programmed"), Some(&(281 + 4)), "{counts:?}");
+    assert_eq!(counts.get("rapid"), Some(&93), "{counts:?}");
+    // The four G2 arcs are several chords each.
+    let arc_lines = [51usize, 53, 262, 264];
+    for line in arc_lines {
+        assert!(tp.points.iter().filter(|p| p.line == line).count() > 10);
+    }
+    assert!(tp.points.iter().all(|p| p.rotary.is_some()));
+    // The only warning: the first move (`Z5`) comes before any X and Y.
+    assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(tp.warnings[0].line, 11);
+}
+
+#[test]
+fn linuxcnc_boat_xyzbc() {
+    let Some((tp, _)) = read_demo("boat-xyzbc.ngc") else {
+        return;
+    };
+    report_warnings("boat-xyzbc", &tp);
+    let (inverse, per_minute) = programmed_feed_time(&tp);
+    eprintln!(
+        "boat-xyzbc programmed feed time: {:.4} s (G93 {inverse:.4} + G94 {per_minute:.4})",
+        inverse + per_minute
+    );
+    assert!((inverse + per_minute - 301.90).abs() < 0.01);
+    let counts = blocks_by_feed(&tp);
+    assert_eq!(counts.get("block time"), Some(&1720), "{counts:?}");
+    assert_eq!(counts.get("rapid"), Some(&101), "{counts:?}");
+    let g53: Vec<usize> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("G53"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(g53, vec![1863, 1864]);
+    // And the first move (line 11) comes before any Z.
+    assert_eq!(tp.warnings.len(), 3, "{:?}", tp.warnings);
+    assert_eq!(tp.warnings[0].line, 11);
+}
