@@ -53,6 +53,18 @@ pub struct SolveArgs {
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     #[arg(long, default_value_t = 0.01, value_name = "DEG")]
     pub tolerance_deg: f64,
+    /// Cap every programmed feed at this multiple of it (a feed override).
+    #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+    pub feed_override: f64,
+    /// Ignore the program's feeds: what do the machine's limits alone allow?
+    #[arg(long)]
+    pub ignore_programmed_feed: bool,
+    /// Input format instead of the file's extension: apt, gcode or csv.
+    #[arg(long, value_enum)]
+    pub format: Option<FormatChoice>,
+    /// G-code dialect: linuxcnc, fanuc or sinumerik.
+    #[arg(long, default_value = "linuxcnc")]
+    pub dialect: crate::toolpath::gcode::Dialect,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -87,6 +99,14 @@ fn parse_period(text: &str) -> std::result::Result<f64, String> {
             "`{text}` is not a positive duration (e.g. 1ms, 500us, 0.002)"
         )),
     }
+}
+
+/// `--format` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FormatChoice {
+    Apt,
+    Gcode,
+    Csv,
 }
 
 /// `--solver` values.
@@ -131,6 +151,14 @@ impl SolveArgs {
                 "--tolerance and --tolerance-deg must be ≥ 0".into(),
             ));
         }
+        if !(self.feed_override.is_finite() && self.feed_override > 0.0) {
+            return Err(Error::Usage(format!(
+                "--feed-override must be a positive factor, got {}",
+                self.feed_override
+            )));
+        }
+        o.geometry.feed_override = self.feed_override;
+        o.geometry.ignore_programmed_feed = self.ignore_programmed_feed;
         o.geometry.tolerance_mm = self.tolerance;
         o.geometry.tolerance_deg = self.tolerance_deg;
         Ok(o)
@@ -141,7 +169,12 @@ impl SolveArgs {
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
-    let input = toolpath::read_input(&args.toolpath)?;
+    let format = args.format.map(|f| match f {
+        FormatChoice::Apt => toolpath::Format::Apt,
+        FormatChoice::Gcode => toolpath::Format::Gcode,
+        FormatChoice::Csv => toolpath::Format::Csv,
+    });
+    let input = toolpath::read_as(&args.toolpath, format, args.dialect)?;
     let solution = optimize::optimize_input(&machine, &input, &options)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;

@@ -207,20 +207,28 @@ pub fn stations(span: &Span, grid: Grid) -> Vec<f64> {
     u
 }
 
-/// Feed cap at each station: the lowest cap of every CL move that the station's neighbouring
-/// intervals overlap, so the feed respects a lower cap ahead before reaching it.
+/// Feed cap at each station: the lower cap of the CL moves that contain its two neighbouring
+/// intervals. Every CL point is a station, so each interval lies within one move, and b linear
+/// between stations keeps that move's cap over the whole interval. (Taking every move that
+/// merely touches the neighbourhood would smear each cap one interval into the next move: an
+/// O(Δu) error at every CL point of a program whose feed changes block by block.)
 fn station_feed_caps(span: &Span, u: &[f64]) -> Vec<f64> {
     let n = u.len() - 1;
-    let seg = |x: f64| span.spline.segment(x);
     let caps = &span.feed_caps;
+    let interval_cap = |k: usize| caps[span.spline.segment(0.5 * (u[k] + u[k + 1]))];
     (0..=n)
         .map(|i| {
-            let a = seg(u[i.saturating_sub(1)]);
-            let b = seg(u[(i + 1).min(n)]).max(a);
-            caps[a..=b.min(caps.len() - 1)]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min)
+            let before = if i > 0 {
+                interval_cap(i - 1)
+            } else {
+                f64::INFINITY
+            };
+            let after = if i < n {
+                interval_cap(i)
+            } else {
+                f64::INFINITY
+            };
+            before.min(after)
         })
         .collect()
 }

@@ -38,6 +38,10 @@ pub struct GeometryOptions {
     pub tolerance_mm: f64,
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     pub tolerance_deg: f64,
+    /// Factor on every programmed feed (a feed override: 1.2 runs the program 20 % faster).
+    pub feed_override: f64,
+    /// Ignore the program's feeds: only the machine's limits (and its maximum feed) apply.
+    pub ignore_programmed_feed: bool,
 }
 
 impl Default for GeometryOptions {
@@ -46,6 +50,8 @@ impl Default for GeometryOptions {
             corner_angle_deg: 10.0,
             tolerance_mm: 0.005,
             tolerance_deg: 0.01,
+            feed_override: 1.0,
+            ignore_programmed_feed: false,
         }
     }
 }
@@ -129,9 +135,11 @@ impl Path {
         // implies the tool-tip speed chord/time.
         let cap = |a: usize, b: usize| -> f64 {
             let m = feed_max.unwrap_or(f64::INFINITY);
+            let k = options.feed_override;
             match pts[b].feed {
-                Feed::Programmed(v) => v.min(m),
-                Feed::BlockTime(t) => ((pts[b].p - pts[a].p).norm() / t).min(m),
+                _ if options.ignore_programmed_feed => m,
+                Feed::Programmed(v) => (k * v).min(m),
+                Feed::BlockTime(t) => (k * (pts[b].p - pts[a].p).norm() / t).min(m),
                 Feed::Rapid | Feed::Unspecified => m,
             }
         };

@@ -70,14 +70,37 @@ pub enum Input {
 /// Reads any input path, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
 /// `.nc`, `.gcode`, `.tap`: G-code in the default dialect, LinuxCNC; `.csv`: joint space).
 pub fn read_input(path: &Path) -> Result<Input> {
-    let is_csv = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    if is_csv {
-        joint_csv::read(path).map(Input::Joint)
-    } else {
-        read(path).map(Input::Cl)
+    read_as(path, None, gcode::Dialect::default())
+}
+
+/// An input format, to override the choice by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Apt,
+    Gcode,
+    Csv,
+}
+
+/// Reads any input path: in `format` if given, else by extension; G-code in `dialect`.
+pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> Result<Input> {
+    let by_ext = || {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "csv" => Some(Format::Csv),
+            "ngc" | "nc" | "gcode" | "tap" => Some(Format::Gcode),
+            "cls" | "apt" | "cl" => Some(Format::Apt),
+            _ => None,
+        }
+    };
+    match format.or_else(by_ext) {
+        Some(Format::Csv) => joint_csv::read(path).map(Input::Joint),
+        Some(Format::Gcode) => gcode::read(path, dialect).map(Input::Cl),
+        Some(Format::Apt) => apt::read(path).map(Input::Cl),
+        None => read(path).map(Input::Cl), // says what is wrong with the extension
     }
 }
 
