@@ -175,11 +175,24 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
         FormatChoice::Csv => toolpath::Format::Csv,
     });
     let input = toolpath::read_as(&args.toolpath, format, args.dialect)?;
+    // What the reader skipped or doubted: one line each on stderr, and in the summary.
+    let warnings: Vec<String> = match &input {
+        toolpath::Input::Cl(t) => t
+            .warnings
+            .iter()
+            .map(|w| format!("{}:{}: {}", args.toolpath.display(), w.line, w.message))
+            .collect(),
+        toolpath::Input::Joint(_) => Vec::new(),
+    };
+    for w in &warnings {
+        eprintln!("feedopt: warning: {w}");
+    }
     let solution = optimize::optimize_input(&machine, &input, &options)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
-    let summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
+    let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
+    summary.warnings = warnings;
     Ok(if args.json {
         let mut s = serde_json::to_string_pretty(&summary)
             .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;

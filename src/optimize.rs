@@ -311,6 +311,29 @@ struct Plan<'a> {
 }
 
 impl Plan<'_> {
+    /// Every axis within its travel at every station, or an error naming where.
+    fn check_travel(&self, si: usize, p: &SpanProblem) -> Result<()> {
+        for (j, axis) in self.machine.axes.iter().enumerate() {
+            let Some((lo, hi)) = axis.travel else {
+                continue;
+            };
+            let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
+            if let Some(i) =
+                (0..p.u.len()).find(|&i| !(lo - tol..=hi + tol).contains(&p.jets[i].q[j]))
+            {
+                return Err(Error::Infeasible(format!(
+                    "span {si}, u = {:.6}, nearest CL line {}: axis {} would be at {:.4}, outside \
+                     its travel [{lo}, {hi}]",
+                    p.u[i],
+                    self.path.spans[si].nearest_line(p.u[i]),
+                    axis.name,
+                    p.jets[i].q[j]
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Re-simulates one level's schedule.
     fn verify(&self, lv: &Level, options: &Options) -> Result<Verification> {
         verify(
@@ -354,6 +377,7 @@ impl Plan<'_> {
             }
             u.push(old.u[old.intervals()]);
             let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
+            self.check_travel(si, &p)?;
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
             let s = self.solve_span(si, &p, options)?;
             lv.iterations += s.iterations;
@@ -423,6 +447,7 @@ impl Plan<'_> {
                 min_parts: parts,
             };
             let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
+            self.check_travel(si, &p)?;
             if si == 0 {
                 p.b_start = end_speed(span, &p, 0, options.start_feed, "start")?;
             }

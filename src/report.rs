@@ -65,6 +65,8 @@ pub struct Summary {
     pub worst_ratio: Vec<(String, WorstRatio)>,
     /// Worst ratio of the tool-tip feed to its cap (0 without a cap).
     pub worst_feed_ratio: f64,
+    /// The reader's warnings (`file:line: message`).
+    pub warnings: Vec<String>,
 }
 
 /// Worst use of one axis's limits in the re-simulation.
@@ -196,6 +198,7 @@ impl Summary {
                 })
                 .collect(),
             worst_feed_ratio: sol.verification.worst_feed,
+            warnings: Vec::new(),
         }
     }
 }
