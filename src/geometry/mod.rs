@@ -12,6 +12,7 @@
 //! (turning angle between successive chords above `corner_angle`) and where the tip starts or
 //! stops moving while the tool turns.
 
+pub mod biarc;
 pub mod spline;
 
 use nalgebra::Vector3;
