@@ -127,6 +127,7 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
         &angles,
         machine.feed_max,
         kin.uses_orientation(),
+        matches!(kin, Kinematics::Dresser(_)),
         &options.geometry,
     )?;
     if path.spans.is_empty() {

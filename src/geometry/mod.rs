@@ -117,11 +117,16 @@ impl Path {
     /// k on one continuous branch; `feed_max` caps every feed, rapids run at it;
     /// `orientation_moves_axes` is false for machines that ignore orientation (a pure
     /// reorientation then takes no time and is dropped).
+    ///
+    /// `profile_normal` (a dresser, seed 001): each moving span's X–Z profile is fitted by
+    /// tangent-continuous lines and arcs within `tolerance_mm` ([`biarc::fit`]) and the rotary
+    /// angle follows the fitted profile's normal, on the side the program points the tool.
     pub fn build(
         toolpath: &Toolpath,
         angles: &[[f64; 2]],
         feed_max: Option<f64>,
         orientation_moves_axes: bool,
+        profile_normal: bool,
         options: &GeometryOptions,
     ) -> Result<Path> {
         let pts = &toolpath.points;
@@ -194,11 +199,19 @@ impl Path {
                     w
                 })
                 .collect();
-            let deviation = smooth_within(
-                &mut values,
-                if moving { options.tolerance_mm } else { 0.0 },
-                options.tolerance_deg.to_radians(),
-            );
+            let mut feed_caps: Vec<f64> = idx.windows(2).map(|w| cap(w[0], w[1])).collect();
+            let mut lines: Vec<usize> = idx.iter().map(|&i| pts[i].line).collect();
+            let deviation = if moving && profile_normal {
+                let fitted = dresser_profile(&values, &feed_caps, &lines, options.tolerance_mm);
+                (values, feed_caps, lines) = (fitted.values, fitted.caps, fitted.lines);
+                fitted.deviation
+            } else {
+                smooth_within(
+                    &mut values,
+                    if moving { options.tolerance_mm } else { 0.0 },
+                    options.tolerance_deg.to_radians(),
+                )
+            };
             // u: the tip's chord length, or on a reorientation the rotary angles' travel.
             let mut u = Vec::with_capacity(idx.len());
             let mut acc = 0.0;
@@ -218,8 +231,8 @@ impl Path {
                     SpanKind::Reorientation
                 },
                 spline: CubicSpline::new(&u, &values),
-                feed_caps: idx.windows(2).map(|w| cap(w[0], w[1])).collect(),
-                lines: idx.iter().map(|&i| pts[i].line).collect(),
+                feed_caps,
+                lines,
             });
         }
         Ok(Path { spans })
@@ -280,6 +293,104 @@ impl Path {
                 lines: jp.lines.clone(),
             }],
         })
+    }
+}
+
+/// A dresser span refitted by biarcs: samples of the fitted profile with θ on its normal.
+struct FittedProfile {
+    values: Vec<[f64; PATH_DIM]>,
+    caps: Vec<f64>,
+    lines: Vec<usize>,
+    deviation: (f64, f64),
+}
+
+/// Fits a dresser span's X–Z profile (w₀, w₂) by tangent-continuous lines and arcs within
+/// `tol_mm`, samples every piece (at most the programmed spacing and 1° of turn apart) and puts
+/// θ (w₃) on the fitted normal — on the side of the programmed tool, unwrapped from the
+/// programmed first angle. Each sample takes the feed cap and line of the programmed point
+/// nearest to it. Deviation: the profile's (mm) and the largest difference between a programmed
+/// angle and the fitted normal at the sample nearest its point (rad).
+fn dresser_profile(
+    values: &[[f64; PATH_DIM]],
+    caps: &[f64],
+    lines: &[usize],
+    tol_mm: f64,
+) -> FittedProfile {
+    let pts: Vec<[f64; 2]> = values.iter().map(|w| [w[0], w[2]]).collect();
+    let pieces = biarc::fit(&pts, tol_mm.max(1e-9));
+    let spacing = pts
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6);
+    let wrap = |a: f64| a - std::f64::consts::TAU * (a / std::f64::consts::TAU).round();
+    // Side: flip the normal if the program points the tool the other way.
+    let flip = pieces.first().map_or(0.0, |p| {
+        if wrap(values[0][3] - p.normal_angle_at_start()).abs() > std::f64::consts::FRAC_PI_2 {
+            std::f64::consts::PI
+        } else {
+            0.0
+        }
+    });
+    let mut samples: Vec<([f64; 2], f64)> = Vec::new();
+    let mut theta_prev = values[0][3];
+    for (k, piece) in pieces.iter().enumerate() {
+        let (a0, a1) = (
+            piece.normal_angle_at_start() + flip,
+            piece.normal_angle_at_end() + flip,
+        );
+        let turn = wrap(a1 - a0);
+        let parts = ((piece.length() / spacing).ceil() as usize)
+            .max((turn.abs() / 1f64.to_radians()).ceil() as usize)
+            .max(1);
+        for i in usize::from(k > 0)..=parts {
+            let t = i as f64 / parts as f64;
+            let theta = theta_prev + wrap(a0 + turn * t - theta_prev);
+            theta_prev = theta;
+            samples.push((piece.point_at(t), theta));
+        }
+    }
+    if samples.len() < 2 {
+        return FittedProfile {
+            values: values.to_vec(),
+            caps: caps.to_vec(),
+            lines: lines.to_vec(),
+            deviation: (0.0, 0.0),
+        };
+    }
+    // The programmed point nearest each sample (both run along the profile: a moving cursor).
+    let mut nearest = Vec::with_capacity(samples.len());
+    let mut c = 0;
+    let d2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    for (p, _) in &samples {
+        while c + 1 < pts.len() && d2(pts[c + 1], *p) <= d2(pts[c], *p) {
+            c += 1;
+        }
+        nearest.push(c);
+    }
+    let mut dev_rad: f64 = 0.0;
+    for (k, (p, theta)) in samples.iter().enumerate() {
+        if d2(pts[nearest[k]], *p) <= (2.0 * tol_mm).powi(2) {
+            dev_rad = dev_rad.max(wrap(theta - values[nearest[k]][3]).abs());
+        }
+    }
+    let out_values = samples
+        .iter()
+        .map(|(p, theta)| {
+            let mut w = [0.0; PATH_DIM];
+            (w[0], w[2], w[3]) = (p[0], p[1], *theta);
+            w
+        })
+        .collect();
+    let seg_cap =
+        |i: usize| caps[i.min(caps.len() - 1)].min(caps[i.saturating_sub(1).min(caps.len() - 1)]);
+    FittedProfile {
+        values: out_values,
+        caps: (0..samples.len() - 1)
+            .map(|k| seg_cap(nearest[k]).min(seg_cap(nearest[k + 1])))
+            .collect(),
+        lines: nearest.iter().map(|&i| lines[i]).collect(),
+        deviation: (biarc::max_deviation(&pts, &pieces), dev_rad),
     }
 }
 
