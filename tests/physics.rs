@@ -1,33 +1,12 @@
 //! Closed-form physics: cases whose time-optimal answer is known exactly.
 
-use std::path::PathBuf;
-
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize};
-use feedopt::toolpath::{ClPoint, Feed, Toolpath};
+use feedopt::toolpath::Toolpath;
 use nalgebra::Vector3;
 
-fn machine(json: &str) -> Machine {
-    Machine::from_json("test.json".as_ref(), json).expect("valid machine")
-}
-
-fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>) -> Toolpath {
-    Toolpath {
-        source: PathBuf::from("test.cls"),
-        points: points
-            .iter()
-            .enumerate()
-            .map(|(k, (p, o))| ClPoint {
-                p: *p,
-                o: o.normalize(),
-                feed: feed_mm_s.map_or(Feed::Unspecified, Feed::Programmed),
-                rotary: None,
-                line: k + 1,
-            })
-            .collect(),
-        warnings: Vec::new(),
-    }
-}
+mod common;
+use common::{UP, machine, toolpath};
 
 fn solve(m: &Machine, t: &Toolpath) -> Solution {
     optimize(m, t, &Options::default()).expect("solves")
@@ -36,8 +15,6 @@ fn solve(m: &Machine, t: &Toolpath) -> Solution {
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
-
-const UP: Vector3<f64> = Vector3::new(0.0, 0.0, 1.0);
 
 /// Tool tip on a circle of radius r, `turns` times round, starting at angle 0.
 fn circle(r: f64, turns: usize, per_turn: usize) -> Vec<(Vector3<f64>, Vector3<f64>)> {

@@ -1,38 +1,17 @@
 //! Re-simulation at the servo period: real schedules pass, tampered or under-resolved ones fail.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use feedopt::geometry::GeometryOptions;
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize};
-use feedopt::toolpath::{self, ClPoint, Feed, Toolpath};
+use feedopt::toolpath::{self, Toolpath};
 use feedopt::verify::{Quantity, Verification, VerifyOptions, verify};
 use nalgebra::Vector3;
 
-fn machine(json: &str) -> Machine {
-    Machine::from_json("test.json".as_ref(), json).expect("valid machine")
-}
-
-fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>) -> Toolpath {
-    Toolpath {
-        source: PathBuf::from("test.cls"),
-        points: points
-            .iter()
-            .enumerate()
-            .map(|(k, (p, o))| ClPoint {
-                p: *p,
-                o: o.normalize(),
-                feed: feed_mm_s.map_or(Feed::Unspecified, Feed::Programmed),
-                rotary: None,
-                line: k + 1,
-            })
-            .collect(),
-        warnings: Vec::new(),
-    }
-}
-
-const UP: Vector3<f64> = Vector3::new(0.0, 0.0, 1.0);
+mod common;
+use common::{UP, machine, toolpath};
 
 const XYZ_2000: &str = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
     "axes": {"X": {"velocity": 10000, "acceleration": 2000},

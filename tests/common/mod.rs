@@ -1,0 +1,35 @@
+//! Helpers shared by the integration tests: in-memory machines and toolpaths.
+#![allow(dead_code)] // each test binary uses its own subset
+
+use std::path::PathBuf;
+
+use feedopt::machine::Machine;
+use feedopt::toolpath::{ClPoint, Feed, Toolpath};
+use nalgebra::Vector3;
+
+/// A machine from JSON text (must be valid).
+pub fn machine(json: &str) -> Machine {
+    Machine::from_json("test.json".as_ref(), json).expect("valid machine")
+}
+
+/// A toolpath through (tip, tool vector) pairs, all at `feed_mm_s` (or unspecified).
+pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>) -> Toolpath {
+    Toolpath {
+        source: PathBuf::from("test.cls"),
+        points: points
+            .iter()
+            .enumerate()
+            .map(|(k, (p, o))| ClPoint {
+                p: *p,
+                o: o.normalize(),
+                feed: feed_mm_s.map_or(Feed::Unspecified, Feed::Programmed),
+                rotary: None,
+                line: k + 1,
+            })
+            .collect(),
+        warnings: Vec::new(),
+    }
+}
+
+/// The tool pointing up.
+pub const UP: Vector3<f64> = Vector3::new(0.0, 0.0, 1.0);
