@@ -92,10 +92,7 @@ fn a_groove_is_fitted_by_biarcs_and_b_follows_the_profile_normal() {
     let s45 = 45f64.to_radians();
     assert!((b_at(5.0 * s45.sin(), -5.0 + 5.0 * s45.cos()) - 45.0).abs() < 1.0);
     assert!((b_at(5.0, -10.0) - 90.0).abs() < 0.1);
-    // Through every rounded point exactly instead. Measured: fitted 2.9277 s, exact 2.8928 s —
-    // the fit is 1.2 % slower here (the tool vectors are exact normals, so the exact path has
-    // little noise to lose); why the biarc path is slower is not yet understood: tracked in the
-    // closing note of issue 4. Both verify; they must stay within 2 %.
+    // Through every rounded point exactly instead (tolerance 0): fitting must not cost time.
     let mut exact = options.clone();
     exact.geometry.tolerance_mm = 0.0;
     exact.geometry.tolerance_deg = 0.0;
@@ -105,6 +102,10 @@ fn a_groove_is_fitted_by_biarcs_and_b_follows_the_profile_normal() {
         "fitted {:.4} s, exact {:.4} s",
         fitted.schedule.cycle_time, raw.schedule.cycle_time
     );
-    let rel = (fitted.schedule.cycle_time - raw.schedule.cycle_time) / raw.schedule.cycle_time;
-    assert!(rel.abs() < 0.02, "fitted vs exact: {rel:+.4}");
+    assert!(
+        fitted.schedule.cycle_time <= raw.schedule.cycle_time * (1.0 + 1e-3),
+        "fitted {} vs exact {}",
+        fitted.schedule.cycle_time,
+        raw.schedule.cycle_time
+    );
 }
