@@ -420,3 +420,14 @@ fn shared_cases_parse() {
             .all(|pt| pt.o == Vector3::new(0.0, 0.0, 1.0))
     );
 }
+
+#[test]
+fn unknown_records_are_skipped_with_a_warning_naming_the_line() {
+    let t = ok(
+        "TOOL PATH/PUBLIC,TOOL,MILL\nTLDATA/MILL,10,0,50,0\nFOOBAR/1,2\nGOTO/0,0,0\nPPRINT hi\nGOTO/1,0,0\nEND-OF-PATH\n",
+    );
+    assert_eq!(t.points.len(), 2);
+    assert_eq!(t.warnings.len(), 1, "{:?}", t.warnings);
+    assert_eq!(t.warnings[0].line, 3);
+    assert!(t.warnings[0].message.contains("FOOBAR"));
+}

@@ -45,9 +45,9 @@
 //!
 //! Records that do not affect the motion are skipped silently; [`NON_MOTION_WORDS`] lists the
 //! known ones (`TOOL PATH`, `TLDATA`, `MSYS`, `LOADTL`, `PPRINT`, `SPINDL`, `COOLNT`,
-//! `END-OF-PATH`, `FINI`, ...). A record with an *unknown* major word is skipped silently as
-//! well: [`Toolpath`] has no channel for warnings yet, and post-processors emit many
-//! vendor-specific words.
+//! `END-OF-PATH`, `FINI`, ...). A record with an *unknown* major word is skipped too, with a
+//! warning naming the word and its line ([`Toolpath::warnings`]): post-processors emit many
+//! vendor-specific words, and none is dropped silently.
 //!
 //! # Records that are rejected
 //!
@@ -174,7 +174,7 @@ pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
     Ok(Toolpath {
         source: source.to_path_buf(),
         points: reader.points,
-        warnings: Vec::new(),
+        warnings: reader.warnings,
     })
 }
 
@@ -206,6 +206,7 @@ struct Reader<'a> {
     feed: Feed,
     rapid_next: bool,
     points: Vec<ClPoint>,
+    warnings: Vec<crate::toolpath::Warning>,
 }
 
 impl<'a> Reader<'a> {
@@ -218,6 +219,7 @@ impl<'a> Reader<'a> {
             feed: Feed::Unspecified,
             rapid_next: false,
             points: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 
@@ -269,7 +271,16 @@ impl<'a> Reader<'a> {
                         ));
                     }
                 }
-                // Known non-motion word (NON_MOTION_WORDS) or an unknown word: skipped.
+                // Known non-motion words are skipped; unknown ones too, with a warning.
+                let known = NON_MOTION_WORDS
+                    .iter()
+                    .any(|w| major == *w || major.starts_with(&format!("{w} ")));
+                if !known {
+                    self.warnings.push(crate::toolpath::Warning {
+                        line,
+                        message: format!("unknown APT record `{}`: skipped", major),
+                    });
+                }
                 Ok(())
             }
         }
