@@ -30,7 +30,16 @@ use feedopt::machine::Machine;
 use feedopt::optimize::{Options, optimize_joint};
 use feedopt::solver::{self, SolverKind};
 use feedopt::toolpath::joint_csv::{self, JointPath};
-use serde_json::{Value, json};
+use serde_json::Value;
+
+#[path = "../tests/common/copp.rs"]
+mod copp_data;
+
+/// The joint-space machine of a COPP path's `limits`.
+fn machine(limits: &Value) -> Machine {
+    let text = copp_data::machine_json(limits);
+    Machine::from_json(FsPath::new("copp_machine.json"), &text).expect("valid machine")
+}
 
 const PATHS: usize = 20;
 
@@ -42,34 +51,6 @@ fn data_dir() -> Option<PathBuf> {
         eprintln!("skipping: {} is absent", dir.display());
         None
     }
-}
-
-/// The joint-space machine of a COPP path's `limits` (axis j named `j`, as the CSV's `q_j`).
-fn machine(limits: &Value) -> Machine {
-    let arr = |key: &str| -> Vec<f64> {
-        limits[key]
-            .as_array()
-            .expect("limits array")
-            .iter()
-            .map(|v| v.as_f64().expect("a number"))
-            .collect()
-    };
-    let (vmin, vmax, amin, amax) = (
-        arr("vel_min"),
-        arr("vel_max"),
-        arr("acc_min"),
-        arr("acc_max"),
-    );
-    let mut axes = serde_json::Map::new();
-    for j in 0..vmax.len() {
-        axes.insert(
-            j.to_string(),
-            json!({"velocity": [vmin[j], vmax[j]], "acceleration": [amin[j], amax[j]]}),
-        );
-    }
-    let text = json!({"name": "COPP random 7-axis", "kinematics": {"type": "joint"}, "axes": axes})
-        .to_string();
-    Machine::from_json(FsPath::new("copp_machine.json"), &text).expect("valid machine")
 }
 
 struct Case {

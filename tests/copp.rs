@@ -19,9 +19,13 @@ use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize_joint};
 use feedopt::solver::{SolverKind, Status};
 use feedopt::toolpath::joint_csv::{self, JointPath};
-use serde_json::{Value, json};
+use serde_json::Value;
 
 /// Number of COPP paths in the shared folder.
+#[path = "common/copp.rs"]
+mod copp_data;
+use copp_data::machine_json;
+
 const PATHS: usize = 20;
 
 /// The shared benchmark folder, or `None` (with a note on stderr) when it is absent.
@@ -46,32 +50,6 @@ struct Case {
     copp2_socp: f64,
     /// `results."TOPP2-RA".traversal_time_s`
     topp2_ra: f64,
-}
-
-/// The machine file (kinematics `joint`) of a COPP path's `limits`.
-fn machine_json(limits: &Value) -> String {
-    let arr = |key: &str| -> Vec<f64> {
-        limits[key]
-            .as_array()
-            .unwrap_or_else(|| panic!("limits.{key} is an array"))
-            .iter()
-            .map(|v| v.as_f64().expect("a number"))
-            .collect()
-    };
-    let (vmin, vmax, amin, amax) = (
-        arr("vel_min"),
-        arr("vel_max"),
-        arr("acc_min"),
-        arr("acc_max"),
-    );
-    let mut axes = serde_json::Map::new();
-    for j in 0..vmax.len() {
-        axes.insert(
-            j.to_string(),
-            json!({"velocity": [vmin[j], vmax[j]], "acceleration": [amin[j], amax[j]]}),
-        );
-    }
-    json!({"name": "COPP random 7-axis", "kinematics": {"type": "joint"}, "axes": axes}).to_string()
 }
 
 fn load(dir: &Path, index: usize) -> Case {

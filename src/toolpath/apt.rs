@@ -64,10 +64,7 @@ use nalgebra::Vector3;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Feed, Toolpath};
-
-/// Millimetres per inch.
-const MM_PER_INCH: f64 = 25.4;
+use crate::toolpath::{ClPoint, Feed, Toolpath, Units};
 
 /// Tool vectors shorter than this are rejected as having no direction.
 const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
@@ -176,22 +173,6 @@ pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
         points: reader.points,
         warnings: reader.warnings,
     })
-}
-
-/// Length unit in force (`UNITS`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Units {
-    Mm,
-    Inch,
-}
-
-impl Units {
-    fn mm_per_unit(self) -> f64 {
-        match self {
-            Units::Mm => 1.0,
-            Units::Inch => MM_PER_INCH,
-        }
-    }
 }
 
 /// `MULTAX` state: `None` until the first `MULTAX` record (behaves as on).

@@ -103,10 +103,8 @@ use std::path::Path;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Feed, Toolpath, Warning};
-
-/// Millimetres per inch.
-const MM_PER_INCH: f64 = 25.4;
+pub use crate::toolpath::Units;
+use crate::toolpath::{ClPoint, Feed, MM_PER_INCH, Toolpath, Warning};
 
 /// Largest distance between an arc and the chords that replace it (the sagitta), mm: 1 µm.
 ///
@@ -279,22 +277,6 @@ impl Plane {
             Plane::Xy => "G17",
             Plane::Zx => "G18",
             Plane::Yz => "G19",
-        }
-    }
-}
-
-/// Length units.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Units {
-    Mm,
-    Inch,
-}
-
-impl Units {
-    fn mm_per_unit(self) -> f64 {
-        match self {
-            Units::Mm => 1.0,
-            Units::Inch => MM_PER_INCH,
         }
     }
 }

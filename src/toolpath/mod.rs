@@ -14,6 +14,26 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Result;
 
+/// Millimetres per inch.
+pub const MM_PER_INCH: f64 = 25.4;
+
+/// Length units of a program (APT `UNITS`, G-code G20/G21).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    Mm,
+    Inch,
+}
+
+impl Units {
+    /// Millimetres per program unit.
+    pub fn mm_per_unit(self) -> f64 {
+        match self {
+            Units::Mm => 1.0,
+            Units::Inch => MM_PER_INCH,
+        }
+    }
+}
+
 /// How fast the move that arrives at a CL point may run, as the program says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Feed {

@@ -1,0 +1,31 @@
+//! The COPP benchmark's limits as a feedopt machine file (shared by tests/copp.rs and
+//! benches/copp.rs; the data stay in ../shared).
+
+use serde_json::{Value, json};
+
+/// The machine file (kinematics `joint`, axis j named `j` as the CSV's `q_j`) of a COPP path's
+/// `limits` (`vel_min`, `vel_max`, `acc_min`, `acc_max` arrays).
+pub fn machine_json(limits: &Value) -> String {
+    let arr = |key: &str| -> Vec<f64> {
+        limits[key]
+            .as_array()
+            .unwrap_or_else(|| panic!("limits.{key} is an array"))
+            .iter()
+            .map(|v| v.as_f64().expect("a number"))
+            .collect()
+    };
+    let (vmin, vmax, amin, amax) = (
+        arr("vel_min"),
+        arr("vel_max"),
+        arr("acc_min"),
+        arr("acc_max"),
+    );
+    let mut axes = serde_json::Map::new();
+    for j in 0..vmax.len() {
+        axes.insert(
+            j.to_string(),
+            json!({"velocity": [vmin[j], vmax[j]], "acceleration": [amin[j], amax[j]]}),
+        );
+    }
+    json!({"name": "COPP random 7-axis", "kinematics": {"type": "joint"}, "axes": axes}).to_string()
+}
