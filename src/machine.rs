@@ -9,7 +9,8 @@
 //! ```
 //!
 //! A limit is a number (symmetric, `> 0`) or `[min, max]` with `min < 0 < max`. Linear axes are
-//! in mm/s and mm/s², rotary axes in °/s and °/s². An axis may also give its travel, `"min"` and
+//! in mm/s and mm/s², rotary axes in °/s and °/s². An optional `"jerk"` (number or `[min, max]`,
+//! mm/s³ or °/s³) makes the schedule jerk-limited. An axis may also give its travel, `"min"` and
 //! `"max"` (mm or degrees, both or neither, `min < max`). `feed.max` (mm/s) caps the tool-tip
 //! feed V; the `feed` section is optional. Unknown fields, missing axes or limits and
 //! non-positive limits are errors that name the field.
@@ -68,6 +69,9 @@ pub struct Axis {
     pub kind: AxisKind,
     pub velocity: Limit,
     pub acceleration: Limit,
+    /// Jerk limit (mm/s³ or °/s³), `None` when the file gives none: the schedule is then
+    /// acceleration-limited (issue 6).
+    pub jerk: Option<Limit>,
     /// Travel `(min, max)` of the axis position (mm or degrees), `None` when the file gives
     /// none.
     pub travel: Option<(f64, f64)>,
@@ -179,6 +183,11 @@ pub struct Machine {
 }
 
 impl Machine {
+    /// Whether any axis has a jerk limit (the schedule is then jerk-limited).
+    pub fn has_jerk(&self) -> bool {
+        self.axes.iter().any(|a| a.jerk.is_some())
+    }
+
     /// Reads and validates a machine file.
     pub fn from_file(path: &Path) -> Result<Machine> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
@@ -490,7 +499,11 @@ impl Parser {
                     )
                 })?;
                 let a = self.object(a, &field)?;
-                self.only_known(a, &field, &["velocity", "acceleration", "min", "max"])?;
+                self.only_known(
+                    a,
+                    &field,
+                    &["velocity", "acceleration", "jerk", "min", "max"],
+                )?;
                 Ok(Axis {
                     name: name.to_string(),
                     kind: if *kin == KinematicsSpec::Joint {
@@ -501,6 +514,10 @@ impl Parser {
                     velocity: self.limit(a.get("velocity"), &format!("{field}.velocity"))?,
                     acceleration: self
                         .limit(a.get("acceleration"), &format!("{field}.acceleration"))?,
+                    jerk: match a.get("jerk") {
+                        None => None,
+                        Some(j) => Some(self.limit(Some(j), &format!("{field}.jerk"))?),
+                    },
                     travel: self.travel(a, &field)?,
                 })
             })

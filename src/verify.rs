@@ -458,6 +458,7 @@ mod tests {
             kind: AxisKind::Linear,
             velocity: Limit::symmetric(v),
             acceleration: Limit::symmetric(a),
+            jerk: None,
             travel: None,
         };
         Machine {

@@ -173,6 +173,7 @@ fn axis(name: &str, travel: Option<(f64, f64)>) -> Axis {
         kind: KinematicsSpec::axis_kind(name),
         velocity: Limit::symmetric(100.0),
         acceleration: Limit::symmetric(1000.0),
+        jerk: None,
         travel,
     }
 }

@@ -846,3 +846,37 @@ fn joint_machines_may_give_travel() {
         "axes": {"J1": {"velocity": 1, "acceleration": 2, "min": -3, "max": 3}}}"#);
     assert_eq!(m.axes[0].travel, Some((-3.0, 3.0)));
 }
+
+#[test]
+fn jerk_limits_are_optional_per_axis() {
+    let m = ok(r#"{"kinematics": {"type": "xyz"}, "axes": {
+        "X": {"velocity": 400, "acceleration": 2000, "jerk": 50000},
+        "Y": {"velocity": 400, "acceleration": 2000, "jerk": [-40000, 60000]},
+        "Z": {"velocity": 300, "acceleration": 1500}}}"#);
+    assert_eq!(m.axes[0].jerk, Some(Limit::symmetric(50000.0)));
+    assert_eq!(
+        m.axes[1].jerk,
+        Some(Limit {
+            min: -40000.0,
+            max: 60000.0
+        })
+    );
+    assert_eq!(m.axes[2].jerk, None);
+    assert!(m.has_jerk());
+    let plain = ok(&format!(
+        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}}}"#
+    ));
+    assert!(!plain.has_jerk());
+}
+
+#[test]
+fn bad_jerk_limit_names_its_field() {
+    field_err(
+        r#"{"kinematics": {"type": "xyz"}, "axes": {
+        "X": {"velocity": 400, "acceleration": 2000, "jerk": -5},
+        "Y": {"velocity": 400, "acceleration": 2000},
+        "Z": {"velocity": 300, "acceleration": 1500}}}"#,
+        "axes.X.jerk",
+        &["positive"],
+    );
+}
