@@ -54,6 +54,7 @@ pub mod error;
 pub mod geometry;
 pub mod kinematics;
 pub mod machine;
+pub mod motion;
 pub mod optimize;
 pub mod report;
 pub mod schedule;

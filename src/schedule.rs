@@ -1,15 +1,19 @@
 //! Schedule: the optimal b = u̇² turned into time (seed 000, eq. 40–43) and into every axis's
 //! motion at every station.
 //!
-//! Between stations b is linear in u, so ü is constant there (the paper's "A constant between
-//! stations"), and eq. 43 integrates in closed form:
+//! Between stations the motion follows the profile's law ([`crate::motion`]): for an
+//! acceleration-limited profile b is linear in u, so ü is constant there (the paper's "A
+//! constant between stations"), and eq. 43 integrates in closed form:
 //!
-//! `t_{k+1} − t_k = ∫ du / √b(u) = 2 Δu_k / (√b_k + √b_{k+1})`.
+//! `t_{k+1} − t_k = ∫ du / √b(u) = 2 Δu_k / (√b_k + √b_{k+1})`;
+//!
+//! for a jerk-limited one ü is continuous and piecewise linear in u (issue 6).
 
 use crate::constraints::SpanProblem;
 use crate::error::{Error, Result};
 use crate::geometry::Span;
 use crate::kinematics::MAX_AXES;
+use crate::motion::Interval;
 use crate::solver::SpanSolution;
 
 /// One station of the schedule.
@@ -47,22 +51,30 @@ pub struct Schedule {
     pub cycle_time: f64,
 }
 
-/// Time taken by each interval of one span (eq. 43 with ü constant per interval).
-pub fn interval_times(problem: &SpanProblem, b: &[f64]) -> Result<Vec<f64>> {
-    b.windows(2)
-        .enumerate()
-        .map(|(k, w)| {
-            let du = problem.du(k);
-            let root = w[0].max(0.0).sqrt() + w[1].max(0.0).sqrt();
-            if root > 0.0 {
-                Ok(2.0 * du / root)
-            } else {
-                Err(Error::Infeasible(format!(
-                    "the feed is zero on a whole interval (station {k}): the path cannot be traversed"
-                )))
-            }
+/// Time taken by each interval of one span (eq. 43 under the profile's law, see
+/// [`crate::motion`]).
+pub fn interval_times(problem: &SpanProblem, sol: &SpanSolution) -> Result<Vec<f64>> {
+    (0..problem.intervals())
+        .map(|k| {
+            Interval::of(&problem.u, &sol.b, sol.a.as_deref(), k)
+                .duration()
+                .map_err(|_| {
+                    Error::Infeasible(format!(
+                        "the feed is zero on a whole interval (station {k}): the path cannot be \
+                         traversed"
+                    ))
+                })
         })
         .collect()
+}
+
+/// ü at station `i` (on the interval that starts there; the last station: the one ending
+/// there), under the profile's law.
+pub fn station_udd(problem: &SpanProblem, sol: &SpanSolution, i: usize) -> f64 {
+    match &sol.a {
+        Some(a) => a[i],
+        None => problem.path_acceleration(&sol.b, i.min(problem.intervals() - 1)),
+    }
 }
 
 impl Schedule {
@@ -78,12 +90,11 @@ impl Schedule {
         let (mut t0, mut s0) = (0.0, 0.0);
         for (si, ((span, p), sol)) in spans.iter().zip(problems).zip(solutions).enumerate() {
             let b = &sol.b;
-            let dt = interval_times(p, b)?;
+            let dt = interval_times(p, sol)?;
             let n = p.intervals();
             let (mut t, mut s) = (t0, s0);
             for i in 0..=n {
-                let k = i.min(n - 1); // interval starting here (the last station: the one ending here)
-                let udd = p.path_acceleration(b, k);
+                let udd = station_udd(p, sol, i);
                 let ud = b[i].sqrt();
                 let jet = &p.jets[i];
                 let w = span.eval(p.u[i]);

@@ -23,8 +23,9 @@
 use crate::constraints::SpanProblem;
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
-use crate::kinematics::{AxisJets, Kinematics};
+use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
+use crate::motion::{Interval, Law, State};
 use crate::schedule::interval_times;
 use crate::solver::SpanSolution;
 
@@ -59,6 +60,8 @@ pub enum Quantity {
     Acceleration,
     /// The tool-tip feed V against the programmed or maximum feed.
     Feed,
+    /// An axis jerk q⃛ (only where the machine file gives jerk limits).
+    Jerk,
 }
 
 /// The worst use of one axis's limits over all samples.
@@ -70,6 +73,8 @@ pub struct AxisWorst {
     pub velocity: f64,
     /// Largest q̈ / limit on its side (≥ 0).
     pub acceleration: f64,
+    /// Largest q⃛ / limit on its side (≥ 0; 0 where the axis has no jerk limit).
+    pub jerk: f64,
 }
 
 /// A limit exceeded by more than the tolerance: the worst excess within one station interval.
@@ -122,7 +127,7 @@ impl Verification {
     pub fn worst_ratio(&self) -> f64 {
         self.worst
             .iter()
-            .flat_map(|w| [w.velocity, w.acceleration])
+            .flat_map(|w| [w.velocity, w.acceleration, w.jerk])
             .fold(self.worst_feed, f64::max)
     }
 }
@@ -164,15 +169,16 @@ pub fn verify(
         )));
     }
     let na = kin.n_axes().min(machine.axes.len());
+    let jerk = machine.axes.iter().take(na).any(|a| a.jerk.is_some());
     let mut acc = Accumulator {
         limits: machine
             .axes
             .iter()
             .take(na)
-            .map(|a| (a.velocity, a.acceleration))
+            .map(|a| (a.velocity, a.acceleration, a.jerk))
             .collect(),
         threshold: 1.0 + options.tolerance,
-        worst: vec![[0.0; 2]; na],
+        worst: vec![[0.0; 3]; na],
         worst_feed: 0.0,
         current: None,
         violations: Vec::new(),
@@ -188,7 +194,7 @@ pub fn verify(
                 b.len()
             )));
         }
-        let dt = interval_times(p, b)?;
+        let dt = interval_times(p, sol)?;
         let knots = span.spline.knots();
         let last_seg = knots.len() - 2;
         let moving = span.kind == SpanKind::Moving;
@@ -201,14 +207,14 @@ pub fn verify(
         while seg < last_seg && knots[seg + 1] <= p.u[0] {
             seg += 1;
         }
-        let mut at_start = Point::new(span, kin, seg, p.u[0], moving);
+        let mut at_start = Point::new(span, kin, seg, p.u[0], moving, jerk);
         let n = p.intervals();
+        // ü just before the current station (at rest before a span that starts at rest).
+        let mut udd_before = 0.0;
         for i in 0..n {
             let (ua, ub) = (p.u[i], p.u[i + 1]);
-            let (ba, bb) = (b[i].max(0.0), b[i + 1].max(0.0));
-            let (ra, rb) = (ba.sqrt(), bb.sqrt());
-            // ü of the clamped profile: ü Δt = √b_{i+1} − √b_i exactly (eq. 43).
-            let udd = (bb - ba) / (2.0 * (ub - ua));
+            let iv = Interval::of(&p.u, b, sol.a.as_deref(), i);
+            let (s0, s1) = iv.ends();
             let tb = ta + dt[i];
             // The segment of the spline this interval starts in (a station at a knot starts
             // the next segment: its feed cap applies from there on).
@@ -216,18 +222,13 @@ pub fn verify(
                 seg += 1;
             }
             let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-            acc.check(
-                &at_start.jets,
-                at_start.speed,
-                ra,
-                ba,
-                udd,
-                cap,
-                ua,
-                ta,
-                si,
-                i,
-            );
+            acc.check(&at_start, &s0, cap, ua, ta, si, i);
+            if jerk && iv.law == Law::Linear && (i > 0 || s0.b == 0.0) {
+                // ü jumps at the station: a controller sampling at the period sees the step
+                // of q̈ within one period.
+                acc.check_step(&at_start, (s0.udd - udd_before) / period, ua, ta, si, i);
+            }
+            udd_before = s1.udd;
             station_checks += 1;
             // Servo instants strictly inside the interval (and at its start).
             loop {
@@ -235,14 +236,15 @@ pub fn verify(
                 if t >= tb {
                     break;
                 }
-                let (r, u) = state(ra, rb, udd, ua, ub, t - ta, dt[i]);
+                let st = iv.at(t - ta, dt[i]);
+                let u = (ua + st.x).min(ub);
                 // Stay in the left segment at a knot: the interval's own side.
                 while seg < last_seg && knots[seg + 1] < u {
                     seg += 1;
                 }
                 let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-                let pt = Point::new(span, kin, seg, u, moving);
-                acc.check(&pt.jets, pt.speed, r, r * r, udd, cap, u, t, si, i);
+                let pt = Point::new(span, kin, seg, u, moving, jerk);
+                acc.check(&pt, &st, cap, u, t, si, i);
                 samples += 1;
                 j += 1;
             }
@@ -251,8 +253,8 @@ pub fn verify(
                 seg += 1;
             }
             let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-            let at_end = Point::new(span, kin, seg, ub, moving);
-            acc.check(&at_end.jets, at_end.speed, rb, bb, udd, cap, ub, tb, si, i);
+            let at_end = Point::new(span, kin, seg, ub, moving, jerk);
+            acc.check(&at_end, &s1, cap, ub, tb, si, i);
             station_checks += 1;
             acc.close_interval();
             at_start = at_end;
@@ -278,6 +280,7 @@ pub fn verify(
                 name: a.name.clone(),
                 velocity: w[0],
                 acceleration: w[1],
+                jerk: w[2],
             })
             .collect(),
         worst_feed: acc.worst_feed,
@@ -286,25 +289,19 @@ pub fn verify(
     })
 }
 
-/// √b and u at local time `tau` into an interval with constant ü (eq. 43 integrated exactly),
-/// clamped to the interval so rounding never leaves it.
-fn state(ra: f64, rb: f64, udd: f64, ua: f64, ub: f64, tau: f64, dt: f64) -> (f64, f64) {
-    let tau = tau.clamp(0.0, dt);
-    let r = (ra + udd * tau).clamp(ra.min(rb), ra.max(rb));
-    let u = (ua + 0.5 * tau * (ra + r)).clamp(ua, ub);
-    (r, u)
-}
-
 /// The path geometry at one sample: every axis's u-derivatives and |P'|.
 struct Point {
     jets: AxisJets,
     /// |P'(u)| on a moving span, 0 on a reorientation.
     speed: f64,
+    /// Every axis's q''' (on the segment's side of a knot), when jerk is checked.
+    dddq: Option<[f64; MAX_AXES]>,
 }
 
 impl Point {
-    fn new(span: &Span, kin: &Kinematics, seg: usize, u: f64, moving: bool) -> Point {
+    fn new(span: &Span, kin: &Kinematics, seg: usize, u: f64, moving: bool, jerk: bool) -> Point {
         let w = span.spline.eval_in(seg, u);
+        let dddq = jerk.then(|| kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, u)));
         let speed = if moving {
             (w.d1[0] * w.d1[0] + w.d1[1] * w.d1[1] + w.d1[2] * w.d1[2]).sqrt()
         } else {
@@ -313,17 +310,18 @@ impl Point {
         Point {
             jets: kin.axis_jets(&w),
             speed,
+            dddq,
         }
     }
 }
 
 /// Worst ratios so far and the violations found.
 struct Accumulator {
-    /// (velocity, acceleration) limits per axis.
-    limits: Vec<(Limit, Limit)>,
+    /// (velocity, acceleration, jerk) limits per axis.
+    limits: Vec<(Limit, Limit, Option<Limit>)>,
     threshold: f64,
-    /// [velocity, acceleration] worst ratio per axis.
-    worst: Vec<[f64; 2]>,
+    /// [velocity, acceleration, jerk] worst ratio per axis.
+    worst: Vec<[f64; 3]>,
     worst_feed: f64,
     /// The worst violation of the interval being checked.
     current: Option<Violation>,
@@ -337,50 +335,28 @@ fn ratio(limit: f64, value: f64) -> f64 {
 }
 
 impl Accumulator {
-    /// Checks every limit at one sample: √b = `r`, b, ü, feed cap `cap`.
+    /// Checks every limit at one sample: the geometry `pt`, the motion `st`, feed cap `cap`.
     #[allow(clippy::too_many_arguments)]
     fn check(
         &mut self,
-        jets: &AxisJets,
-        speed: f64,
-        r: f64,
-        b: f64,
-        udd: f64,
+        pt: &Point,
+        st: &State,
         cap: f64,
         u: f64,
         t: f64,
         span: usize,
         interval: usize,
     ) {
-        for (j, (vl, al)) in self.limits.iter().enumerate() {
+        let (jets, speed, r) = (&pt.jets, pt.speed, st.ud);
+        for j in 0..self.limits.len() {
             let qd = jets.dq[j] * r;
-            let qdd = jets.ddq[j] * b + jets.dq[j] * udd;
-            for (k, (value, lim, kind)) in [
-                (qd, vl, Quantity::Velocity),
-                (qdd, al, Quantity::Acceleration),
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                let limit = if value >= 0.0 { lim.max } else { lim.min };
-                let x = ratio(limit, value);
-                if x > self.worst[j][k] {
-                    self.worst[j][k] = x;
-                }
-                if x > self.threshold {
-                    record(
-                        &mut self.current,
-                        span,
-                        interval,
-                        u,
-                        t,
-                        Some(j),
-                        kind,
-                        value,
-                        limit,
-                        x,
-                    );
-                }
+            let qdd = jets.ddq[j] * st.b + jets.dq[j] * st.udd;
+            self.compare(j, 0, Quantity::Velocity, qd, (span, interval, u, t));
+            self.compare(j, 1, Quantity::Acceleration, qdd, (span, interval, u, t));
+            if let Some(d3) = &pt.dddq {
+                // q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛.
+                let q3 = d3[j] * r * st.b + 3.0 * jets.ddq[j] * r * st.udd + jets.dq[j] * st.uddd;
+                self.compare(j, 2, Quantity::Jerk, q3, (span, interval, u, t));
             }
         }
         if cap.is_finite() && speed > 0.0 {
@@ -403,6 +379,60 @@ impl Accumulator {
                     x,
                 );
             }
+        }
+    }
+
+    /// A step of ü at a station (`rate` = Δü / period): the jerk a controller sees there.
+    fn check_step(&mut self, pt: &Point, rate: f64, u: f64, t: f64, span: usize, interval: usize) {
+        for j in 0..self.limits.len() {
+            self.compare(
+                j,
+                2,
+                Quantity::Jerk,
+                pt.jets.dq[j] * rate,
+                (span, interval, u, t),
+            );
+        }
+    }
+
+    /// One value of axis `j`'s quantity `k` (0 velocity, 1 acceleration, 2 jerk) against its
+    /// limit; `at` = (span, interval, u, t).
+    fn compare(
+        &mut self,
+        j: usize,
+        k: usize,
+        kind: Quantity,
+        value: f64,
+        at: (usize, usize, f64, f64),
+    ) {
+        let (vl, al, jl) = &self.limits[j];
+        let lim = match k {
+            0 => vl,
+            1 => al,
+            _ => match jl {
+                Some(l) => l,
+                None => return,
+            },
+        };
+        let (span, interval, u, t) = at;
+        let limit = if value >= 0.0 { lim.max } else { lim.min };
+        let x = ratio(limit, value);
+        if x > self.worst[j][k] {
+            self.worst[j][k] = x;
+        }
+        if x > self.threshold {
+            record(
+                &mut self.current,
+                span,
+                interval,
+                u,
+                t,
+                Some(j),
+                kind,
+                value,
+                limit,
+                x,
+            );
         }
     }
 
@@ -484,6 +514,7 @@ mod tests {
 
     fn solution(b: Vec<f64>) -> SpanSolution {
         SpanSolution {
+            a: None,
             b,
             status: Status::Optimal,
             iterations: 0,
@@ -493,15 +524,21 @@ mod tests {
 
     #[test]
     fn exact_integration_with_constant_path_acceleration() {
-        // From rest with ü = 3: √b = 3τ, u = 1.5 τ².
-        let (r, u) = state(0.0, 6.0, 3.0, 0.0, 6.0, 1.5, 2.0);
-        assert!((r - 4.5).abs() < 1e-15 && (u - 1.5 * 2.25).abs() < 1e-15);
+        let lin = |ua: f64, ub: f64, ba: f64, bb: f64| {
+            Interval::of(&[ua, ub], &[ba * ba, bb * bb], None, 0)
+        };
+        // From rest with ü = 3 (√b 0 → 6 over u 0 → 6, 2 s): √b = 3τ, u = 1.5 τ².
+        let iv = lin(0.0, 6.0, 0.0, 6.0);
+        let st = iv.at(1.5, iv.duration().unwrap());
+        assert!((st.ud - 4.5).abs() < 1e-15 && (st.x - 1.5 * 2.25).abs() < 1e-15);
         // ü = 0: uniform motion, no division anywhere.
-        let (r, u) = state(2.0, 2.0, 0.0, 1.0, 5.0, 0.5, 2.0);
-        assert_eq!((r, u), (2.0, 2.0));
+        let iv = lin(1.0, 5.0, 2.0, 2.0);
+        let st = iv.at(0.5, 2.0);
+        assert_eq!((st.ud, st.x + 1.0), (2.0, 2.0));
         // Braking to rest ends exactly at the interval's end.
-        let (r, u) = state(4.0, 0.0, -2.0, 0.0, 4.0, 2.0, 2.0);
-        assert_eq!((r, u), (0.0, 4.0));
+        let iv = lin(0.0, 4.0, 4.0, 0.0);
+        let st = iv.at(2.0, iv.duration().unwrap());
+        assert_eq!((st.ud, st.x), (0.0, 4.0));
     }
 
     #[test]

@@ -145,6 +145,18 @@ impl<const D: usize> CubicSpline<D> {
     }
 }
 
+impl<const D: usize> CubicSpline<D> {
+    /// Third derivative of every coordinate at `u` on segment `k` (constant on a cubic
+    /// segment; it jumps at knots, so the segment says which side): what jerk limits need.
+    pub fn d3_in(&self, k: usize, u: f64) -> [f64; D] {
+        let h = u - self.knots[k];
+        std::array::from_fn(|j| {
+            let [_, _, _, d, e, f] = self.coef[k][j];
+            6.0 * d + h * (24.0 * e + h * 60.0 * f)
+        })
+    }
+}
+
 /// Three points: the one parabola through them (not-a-knot degenerates to it).
 fn parabola_slopes<const D: usize>(dx: &[f64], slope: &[[f64; D]]) -> Vec<[f64; D]> {
     let mut s = vec![[0.0; D]; 3];

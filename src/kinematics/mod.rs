@@ -46,7 +46,7 @@ use crate::geometry::spline::Jet;
 use crate::machine::{Axis, KinematicsSpec, Machine, TrunnionTilt};
 use crate::toolpath::ClPoint;
 use branch::{Layout, Target};
-use dual::{Dual2, Real};
+use dual::{Dual2, Dual3, Real};
 
 /// Largest number of machine axes.
 pub const MAX_AXES: usize = 8;
@@ -287,6 +287,17 @@ impl Kinematics {
             out.ddq[i] = q[i].dd;
         }
         out
+    }
+
+    /// Every axis's d³q/du³ (generic route: third-order dual numbers through
+    /// [`Kinematics::axis_positions`]), given the path's jet `w` and its third derivative `d3`.
+    /// Axis jerk is q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛ (issue 6).
+    pub fn axis_third_derivatives(&self, w: &PathJet, d3: &[f64; PATH_DIM]) -> [f64; MAX_AXES] {
+        let wd: [Dual3; PATH_DIM] =
+            std::array::from_fn(|i| Dual3::new(w.value[i], w.d1[i], w.d2[i], d3[i]));
+        let mut q = [Dual3::cst(0.0); MAX_AXES];
+        self.axis_positions(wd, &mut q);
+        std::array::from_fn(|i| if i < self.n_axes() { q[i].ddd } else { 0.0 })
     }
 
     /// Every axis's q, dq/du, d²q/du²: the closed forms of seed 000 (eq. 31–39) where the tool

@@ -246,6 +246,7 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
     }
     b.push(p.b_end);
     Ok(SpanSolution {
+        a: None,
         b,
         status,
         iterations: sol.iterations,
@@ -353,6 +354,7 @@ pub fn solve_windowed(
         b.extend_from_slice(if i == 0 { &s.b[..] } else { &s.b[1..] });
     }
     Ok(SpanSolution {
+        a: None,
         b,
         status,
         iterations,

@@ -83,6 +83,10 @@ impl Default for SolverSettings {
 pub struct SpanSolution {
     /// b = u̇² at every station.
     pub b: Vec<f64>,
+    /// ü at every station for a jerk-limited profile (ü continuous, b quadratic in u between
+    /// stations; see [`crate::motion`]); `None`: b linear in u between stations, ü constant
+    /// per interval.
+    pub a: Option<Vec<f64>>,
     pub status: Status,
     pub iterations: u32,
     /// Wall time of the solver proper (s), excluding problem build.

@@ -267,6 +267,7 @@ pub fn solve(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
         b.push(rows.y_max(b[k]).clamp(next.lo, next.hi));
     }
     Ok(SpanSolution {
+        a: None,
         b,
         status: Status::Greedy,
         iterations: 0,
