@@ -183,6 +183,15 @@ pub struct Machine {
 }
 
 impl Machine {
+    /// The same machine without jerk limits (for an acceleration-limited schedule).
+    pub fn without_jerk(&self) -> Machine {
+        let mut m = self.clone();
+        for a in &mut m.axes {
+            a.jerk = None;
+        }
+        m
+    }
+
     /// Whether any axis has a jerk limit (the schedule is then jerk-limited).
     pub fn has_jerk(&self) -> bool {
         self.axes.iter().any(|a| a.jerk.is_some())

@@ -21,6 +21,7 @@ use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
 use crate::machine::{KinematicsSpec, Machine};
 use crate::schedule::Schedule;
+use crate::solver::jerk::{JerkData, JerkOptions};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
@@ -55,6 +56,11 @@ pub struct Options {
     /// first converged (or the fixed) grid is returned as it is, with its verification: for
     /// like-for-like comparisons with other solvers on their grid. The CLI always refines.
     pub refine_until_verified: bool,
+    /// Honour the machine's jerk limits (when it has any; issue 6). When false, the jerk limits
+    /// are dropped from the machine for the whole solve (an acceleration-limited schedule).
+    pub jerk_limited: bool,
+    /// The sequential convex programme of a jerk-limited solve.
+    pub jerk: JerkOptions,
 }
 
 impl Default for Options {
@@ -71,6 +77,8 @@ impl Default for Options {
             max_stations: 4_000_000,
             verify: VerifyOptions::default(),
             refine_until_verified: true,
+            jerk_limited: true,
+            jerk: JerkOptions::default(),
         }
     }
 }
@@ -162,6 +170,13 @@ pub fn optimize_input(machine: &Machine, input: &Input, options: &Options) -> Re
 
 /// The refinement loop over a built path.
 fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Solution> {
+    let unlimited;
+    let machine = if options.jerk_limited || !machine.has_jerk() {
+        machine
+    } else {
+        unlimited = machine.without_jerk();
+        &unlimited
+    };
     let plan = Plan {
         machine,
         weights: span_weights(&path),
@@ -397,6 +412,17 @@ impl Plan<'_> {
         // The O(N) pass runs first whatever the solver: it finds an impossible request and
         // says where, which a convex solver's infeasibility certificate cannot.
         let greedy = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
+        if self.machine.has_jerk() {
+            if options.solver_kind == SolverKind::Reach {
+                return Err(Error::Usage(
+                    "the machine has jerk limits: only the clarabel solver honours them (or \
+                     drop them with --no-jerk)"
+                        .into(),
+                ));
+            }
+            let jd = JerkData::new(&self.path.spans[si], &self.kin, self.machine, p);
+            return solver::jerk::solve(p, &jd, &greedy, &options.solver, &options.jerk);
+        }
         Ok(match options.solver_kind {
             SolverKind::Reach => greedy,
             SolverKind::Clarabel => {

@@ -7,6 +7,7 @@
 //! cross-check, and the source of precise infeasibility errors.
 
 pub mod clarabel;
+pub mod jerk;
 pub mod reach;
 
 /// Which solver computes the profile.

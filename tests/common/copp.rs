@@ -6,6 +6,16 @@ use serde_json::{Value, json};
 /// The machine file (kinematics `joint`, axis j named `j` as the CSV's `q_j`) of a COPP path's
 /// `limits` (`vel_min`, `vel_max`, `acc_min`, `acc_max` arrays).
 pub fn machine_json(limits: &Value) -> String {
+    machine_json_with(limits, false)
+}
+
+/// The same with the jerk limits (`jerk_min`, `jerk_max`) too.
+#[allow(dead_code)]
+pub fn machine_json_jerk(limits: &Value) -> String {
+    machine_json_with(limits, true)
+}
+
+fn machine_json_with(limits: &Value, jerk: bool) -> String {
     let arr = |key: &str| -> Vec<f64> {
         limits[key]
             .as_array()
@@ -22,10 +32,11 @@ pub fn machine_json(limits: &Value) -> String {
     );
     let mut axes = serde_json::Map::new();
     for j in 0..vmax.len() {
-        axes.insert(
-            j.to_string(),
-            json!({"velocity": [vmin[j], vmax[j]], "acceleration": [amin[j], amax[j]]}),
-        );
+        let mut axis = json!({"velocity": [vmin[j], vmax[j]], "acceleration": [amin[j], amax[j]]});
+        if jerk {
+            axis["jerk"] = json!([arr("jerk_min")[j], arr("jerk_max")[j]]);
+        }
+        axes.insert(j.to_string(), axis);
     }
     json!({"name": "COPP random 7-axis", "kinematics": {"type": "joint"}, "axes": axes}).to_string()
 }
