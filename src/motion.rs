@@ -234,6 +234,30 @@ impl Interval {
         }
     }
 
+    /// b and ü where u − u_0 = `x` (0 ≤ x ≤ Δu): the profile as a function of u.
+    pub fn at_x(&self, x: f64) -> (f64, f64) {
+        let x = x.clamp(0.0, self.du);
+        match self.law {
+            Law::Linear => {
+                let f = x / self.du;
+                (self.b0 + f * (self.b1 - self.b0), self.a0)
+            }
+            Law::Quadratic => {
+                let alpha = (self.a1 - self.a0) / self.du;
+                (self.b_at(x).max(0.0), self.a0 + alpha * x)
+            }
+            // x = Δu s³ from the rest end: u̇ = s² √b_far, ü = ±(2/3) s b_far/Δu.
+            Law::RestStart => {
+                let s = (x / self.du).cbrt();
+                (self.b1 * s.powi(4), 2.0 * s * self.b1 / (3.0 * self.du))
+            }
+            Law::RestEnd => {
+                let s = ((self.du - x) / self.du).cbrt();
+                (self.b0 * s.powi(4), -2.0 * s * self.b0 / (3.0 * self.du))
+            }
+        }
+    }
+
     /// The motion at the interval's start (τ = 0) and end (τ = duration), exactly.
     pub fn ends(&self) -> (State, State) {
         let alpha = if self.law == Law::Quadratic {
@@ -373,6 +397,10 @@ mod tests {
         assert!((end.udd - iv.a1).abs() < 1e-12);
         let (s0, s1) = iv.ends();
         assert_eq!((s0.ud, s0.udd), (0.0, 0.0));
+        // As a function of u: at the sampled instant's x, the same b and ü.
+        let mid = iv.at(0.4 * dur, dur);
+        let (b, a) = iv.at_x(mid.x);
+        assert!((b - mid.b).abs() < 1e-12 && (a - mid.udd).abs() < 1e-12);
         assert!((s1.uddd - end.uddd).abs() < 1e-12 && (s0.uddd - end.uddd).abs() < 1e-12);
         // The mirror image ends at rest.
         let back = Interval {

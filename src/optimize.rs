@@ -21,7 +21,7 @@ use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
 use crate::machine::{KinematicsSpec, Machine};
 use crate::schedule::Schedule;
-use crate::solver::jerk::{JerkData, JerkOptions};
+use crate::solver::jerk::{JerkData, JerkOptions, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
@@ -187,8 +187,9 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
     let mut refinement = Vec::new();
     let total = options.stations.unwrap_or(options.initial_stations);
     let mut last_time: Option<f64> = None;
+    let mut previous: Option<Level> = None;
     for level in 0.. {
-        let mut lv = plan.solve_at(total, level, options)?;
+        let mut lv = plan.solve_at(total, level, options, previous.as_ref())?;
         let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
         refinement.push(Refinement {
             stations,
@@ -237,6 +238,7 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
             )));
         }
         last_time = Some(time);
+        previous = Some(lv);
     }
     unreachable!("the refinement loop returns")
 }
@@ -395,7 +397,7 @@ impl Plan<'_> {
             let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
             self.check_travel(si, &p)?;
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
-            let s = self.solve_span(si, &p, options)?;
+            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])))?;
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
@@ -408,7 +410,13 @@ impl Plan<'_> {
 
     /// Solves one span's problem with the chosen solver, after the reach pass has checked that a
     /// schedule exists (and said where not).
-    fn solve_span(&self, si: usize, p: &SpanProblem, options: &Options) -> Result<SpanSolution> {
+    fn solve_span(
+        &self,
+        si: usize,
+        p: &SpanProblem,
+        options: &Options,
+        previous: Option<(&SpanProblem, &SpanSolution)>,
+    ) -> Result<SpanSolution> {
         // The O(N) pass runs first whatever the solver: it finds an impossible request and
         // says where, which a convex solver's infeasibility certificate cannot.
         let greedy = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
@@ -421,7 +429,8 @@ impl Plan<'_> {
                 ));
             }
             let jd = JerkData::new(&self.path.spans[si], &self.kin, self.machine, p);
-            return solver::jerk::solve(p, &jd, &greedy, &options.solver, &options.jerk);
+            let warm = previous.and_then(|(op, os)| Warm::resample(op, os, p));
+            return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk);
         }
         Ok(match options.solver_kind {
             SolverKind::Reach => greedy,
@@ -460,7 +469,14 @@ impl Plan<'_> {
     }
 
     /// Solves every span with about `total` stations at refinement `level`.
-    fn solve_at(&self, total: usize, level: u32, options: &Options) -> Result<Level> {
+    /// `previous`: the level before, whose profiles start the jerk-limited solves.
+    fn solve_at(
+        &self,
+        total: usize,
+        level: u32,
+        options: &Options,
+        previous: Option<&Level>,
+    ) -> Result<Level> {
         let spans = &self.path.spans;
         let mut problems = Vec::with_capacity(spans.len());
         let mut solutions = Vec::with_capacity(spans.len());
@@ -481,7 +497,8 @@ impl Plan<'_> {
             if si + 1 == spans.len() {
                 p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
             }
-            let s = self.solve_span(si, &p, options)?;
+            let warm = previous.map(|lv| (&lv.problems[si], &lv.solutions[si]));
+            let s = self.solve_span(si, &p, options, warm)?;
             status = status.worst(s.status);
             iterations += s.iterations;
             solve_time += s.solve_time;
