@@ -55,7 +55,7 @@ fn explore_copp_jerk() {
             .as_f64()
             .unwrap();
         eprintln!(
-            "path {idx}: T = {:.6} s vs TOPP3-SOCP {topp3:.6} ({:+.4} %), iterations {}, solve {:.1} ms, wall {:.1} ms, stations {}, verified {}, worst {:.5}",
+            "path {idx}: T = {:.6} s vs TOPP3-SOCP {topp3:.6} ({:+.4} %), iterations {}, solve {:.1} ms, wall {:.1} ms, stations {}, verified {}, worst {:.5}, violating {}",
             sol.schedule.cycle_time,
             100.0 * (sol.schedule.cycle_time / topp3 - 1.0),
             sol.iterations,
@@ -63,7 +63,8 @@ fn explore_copp_jerk() {
             t0.elapsed().as_secs_f64() * 1e3,
             sol.stations(),
             sol.verification.verified,
-            sol.verification.worst_ratio()
+            sol.verification.worst_ratio(),
+            sol.verification.violating_intervals
         );
         if list.len() == 1 {
             for w in &sol.verification.worst {

@@ -107,14 +107,20 @@ pub struct JerkData {
     /// Largest b at station 1 (N−1) for the first (last) interval's constant jerk to stay
     /// within every limit; infinite where the span does not start (end) at rest.
     pub rest_bound: (f64, f64),
-    /// The midpoint of every interval (collocation: b is quadratic between stations and may
-    /// bulge above both ends).
+    /// The [`COLLOCATION`] points of every interval, interval by interval.
     pub mid: Vec<Midpoint>,
 }
 
-/// The geometry at an interval's midpoint.
+/// Where inside each interval velocity, acceleration and jerk are also bounded (as fractions
+/// of the interval): b is quadratic between stations and may bulge above both ends, and the
+/// geometry's curvature varies in between.
+pub const COLLOCATION: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// The geometry at a collocation point inside an interval.
 #[derive(Debug, Clone)]
 pub struct Midpoint {
+    /// Its place in the interval, 0 < θ < 1.
+    pub theta: f64,
     pub jets: AxisJets,
     pub d3: [f64; MAX_AXES],
     /// The velocity bound on b there (axes and feed cap, and the acceleration polygon's b*).
@@ -166,8 +172,9 @@ impl JerkData {
         }
         let moving = span.kind == SpanKind::Moving;
         let mid = (0..n)
-            .map(|k| {
-                let um = 0.5 * (p.u[k] + p.u[k + 1]);
+            .flat_map(|k| COLLOCATION.iter().map(move |&th| (k, th)))
+            .map(|(k, th)| {
+                let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
                 let seg = span.spline.segment(um);
                 let w = span.spline.eval_in(seg, um);
                 let jets = kin.axis_jets(&w);
@@ -192,6 +199,7 @@ impl JerkData {
                 }
                 let (essential, b_star, _) = essential_rows(&jets, &p.acceleration, b_max);
                 Midpoint {
+                    theta: th,
                     d3: kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, um)),
                     jets,
                     b_max: b_max.min(b_star),
@@ -667,35 +675,34 @@ fn subproblem(
                 Some((d3, &slope, be)),
             );
         }
-        // At the midpoint (collocation): b_m = (b_k + b_{k+1})/2 + Δu (a_k − a_{k+1})/4,
-        // a_m = (a_k + a_{k+1})/2 — velocity, acceleration and jerk.
-        let m = &jd.mid[k];
-        let xm = sum(&[
-            (&x(k), 0.5),
-            (&x(k + 1), 0.5),
-            (&y(k), du / 4.0),
-            (&y(k + 1), -du / 4.0),
-        ]);
-        let ym = sum(&[(&y(k), 0.5), (&y(k + 1), 0.5)]);
-        if m.b_max.is_finite() {
-            le(&mut lin, &xm, m.b_max / scale);
+        // At the collocation points x = θΔu: b(x) = b_k + (2x − x²/Δu) a_k + (x²/Δu) a_{k+1},
+        // a(x) = (1 − θ) a_k + θ a_{k+1} — velocity, acceleration and jerk.
+        let nc = COLLOCATION.len();
+        for m in &jd.mid[nc * k..nc * (k + 1)] {
+            let (th, xx) = (m.theta, m.theta * du);
+            let (wa, wb) = (2.0 * xx - xx * xx / du, xx * xx / du);
+            let xm = sum(&[(&x(k), 1.0), (&y(k), wa), (&y(k + 1), wb)]);
+            let ym = sum(&[(&y(k), 1.0 - th), (&y(k + 1), th)]);
+            if m.b_max.is_finite() {
+                le(&mut lin, &xm, m.b_max / scale);
+            }
+            let bbar_m = match abar {
+                Some(a) => bbar[k] + wa * a[k] + wb * a[k + 1],
+                None => (1.0 - th) * bbar[k] + th * bbar[k + 1],
+            };
+            point_rows(
+                &mut lin,
+                &mut cand,
+                p,
+                jd,
+                scale,
+                &m.jets,
+                m.essential,
+                &xm,
+                &ym,
+                Some((&m.d3, &slope, bbar_m)),
+            );
         }
-        let bbar_m = match abar {
-            Some(a) => 0.5 * (bbar[k] + bbar[k + 1]) + du * (a[k] - a[k + 1]) / 4.0,
-            None => 0.5 * (bbar[k] + bbar[k + 1]),
-        };
-        point_rows(
-            &mut lin,
-            &mut cand,
-            p,
-            jd,
-            scale,
-            &m.jets,
-            m.essential,
-            &xm,
-            &ym,
-            Some((&m.d3, &slope, bbar_m)),
-        );
     }
     let n_eq = eq.h.len();
     let n_lin = lin.h.len();
