@@ -57,8 +57,11 @@
 //! the rule of [`crate::geometry::biarc::limit_rotation`]: into 2ᵏ pieces of equal parameter
 //! length, k the fewest halvings that bring every piece's turn to at most Δθ (at most 2²⁰).
 //! The new points lie on the path the schedule follows (the span's curve: on a dresser's
-//! fitted profile, points of the fitted arc, as `limit_rotation` places them) and their times
-//! are the schedule's. It applies to every kinematics with rotary axes; seed 001's dresser is
+//! fitted profile, points of the fitted arc, as `limit_rotation` places them), shifted
+//! linearly along the block so that the block still starts and ends at the programmed points
+//! (which lie within the fitting tolerance of the curve; on a dresser span fitted by a line the
+//! fitted normal is constant, and the shift turns B evenly from one programmed angle to the
+//! next); their times are the schedule's at the same u. It applies to every kinematics with rotary axes; seed 001's dresser is
 //! the machine that needs it. A pure rotation on the spot is already a block of its own (a
 //! reorientation span), split the same way.
 //!
@@ -223,10 +226,29 @@ fn nodes(
         for k in 1..idx.len() {
             let (ua, ub) = (us[k - 1], us[k]);
             if let Some(step) = max_rotation_rad {
-                let parts = halvings(span, ua, ub, step);
+                // The span's curve between the block's ends, shifted linearly so that it meets
+                // the programmed points there (they differ by at most the fitting tolerance).
+                let prog = |k: usize| {
+                    let (p, a) = (pts[idx[k]].p, angles[idx[k]]);
+                    [p.x, p.y, p.z, a[0], a[1]]
+                };
+                let curve = |u: f64| {
+                    let w = span.eval(u).value;
+                    [w[0], w[1], w[2], w[3], w[4]]
+                };
+                let (ca, cb) = (curve(ua), curve(ub));
+                let (pa, pb) = (prog(k - 1), prog(k));
+                let at = |u: f64| -> [f64; 5] {
+                    let l = if ub > ua { (u - ua) / (ub - ua) } else { 0.0 };
+                    let c = curve(u);
+                    std::array::from_fn(|j| {
+                        c[j] + (1.0 - l) * (pa[j] - ca[j]) + l * (pb[j] - cb[j])
+                    })
+                };
+                let parts = halvings(&at, ua, ub, step);
                 for j in 1..parts {
                     let u = ua + (ub - ua) * j as f64 / parts as f64;
-                    let w = span.eval(u).value;
+                    let w = at(u);
                     out.push(Node {
                         p: [w[0], w[1], w[2]],
                         angles: [w[3], w[4]],
@@ -242,19 +264,16 @@ fn nodes(
     Ok((out, split))
 }
 
-/// The number of equal pieces (2ᵏ, k fewest) that keep every piece's turn within `step` rad.
-fn halvings(span: &Span, ua: f64, ub: f64, step: f64) -> usize {
-    let theta = |u: f64| {
-        let w = span.eval(u).value;
-        [w[3], w[4]]
-    };
-    let turn = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs());
+/// The number of equal pieces (2ᵏ, k fewest) of [ua, ub] that keep every piece's turn of both
+/// path angles (`at(u)[3..5]`) within `step` rad.
+fn halvings(at: &dyn Fn(f64) -> [f64; 5], ua: f64, ub: f64, step: f64) -> usize {
+    let turn = |a: [f64; 5], b: [f64; 5]| (a[3] - b[3]).abs().max((a[4] - b[4]).abs());
     for k in 0..=MAX_HALVINGS {
         let m = 1usize << k;
-        let th: Vec<[f64; 2]> = (0..=m)
-            .map(|j| theta(ua + (ub - ua) * j as f64 / m as f64))
+        let w: Vec<[f64; 5]> = (0..=m)
+            .map(|j| at(ua + (ub - ua) * j as f64 / m as f64))
             .collect();
-        if th.windows(2).all(|w| turn(w[0], w[1]) <= step) {
+        if w.windows(2).all(|p| turn(p[0], p[1]) <= step) {
             return m;
         }
     }
