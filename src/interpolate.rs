@@ -142,7 +142,10 @@ impl SpanTimeline {
     /// The interval containing `u` (the last one at the span's end).
     pub fn interval_of(&self, u: f64) -> usize {
         let n = self.u.len() - 1;
-        self.u.partition_point(|&x| x <= u).saturating_sub(1).min(n - 1)
+        self.u
+            .partition_point(|&x| x <= u)
+            .saturating_sub(1)
+            .min(n - 1)
     }
 
     /// The time (s, global clock) at which the motion passes `u` on this span.
@@ -265,7 +268,12 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
         )));
     }
     Ok(Setpoints {
-        axes: machine.axes.iter().take(na).map(|a| a.name.clone()).collect(),
+        axes: machine
+            .axes
+            .iter()
+            .take(na)
+            .map(|a| a.name.clone())
+            .collect(),
         kinds: machine.axes.iter().take(na).map(|a| a.kind).collect(),
         joint: spans.iter().any(|s| s.kind == SpanKind::Joint),
         period,
@@ -403,7 +411,9 @@ pub fn read_setpoints_bin(source: &Path, bytes: &[u8]) -> Result<Setpoints> {
     let f64_of = |b: &[u8]| f64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
     let version = u32_of(take(4)?);
     if version != VERSION {
-        return Err(bad(&format!("setpoint file version {version} (expected 1)")));
+        return Err(bad(&format!(
+            "setpoint file version {version} (expected 1)"
+        )));
     }
     let joint = u32_of(take(4)?) & 1 == 1;
     let na = u32_of(take(4)?) as usize;

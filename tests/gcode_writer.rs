@@ -72,7 +72,11 @@ fn round_trip(
         "{dialect}: programmed {time} s vs schedule {cycle} s"
     );
     // The writer's own sum agrees with the reader's to rounding.
-    assert!((prog.time - time).abs() <= 1e-6 * cycle, "{} vs {time}", prog.time);
+    assert!(
+        (prog.time - time).abs() <= 1e-6 * cycle,
+        "{} vs {time}",
+        prog.time
+    );
     assert_eq!(back.points.len(), prog.blocks + 1);
 
     let kin = Kinematics::new(m);
@@ -112,7 +116,11 @@ fn round_trip(
         }
         c += 1;
     }
-    assert_eq!(c, input.points.len(), "{dialect}: the last input point is written last");
+    assert_eq!(
+        c,
+        input.points.len(),
+        "{dialect}: the last input point is written last"
+    );
     (prog, time)
 }
 
@@ -148,7 +156,12 @@ fn a_three_axis_pocket_is_written_with_g94_feeds_only() {
     let sol = optimize(&m, &t, &options).unwrap();
     let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
     assert_eq!(prog.inverse_time_blocks, 0);
-    assert!(!prog.text.lines().any(|l| l.starts_with("G93") || l.starts_with("M428")));
+    assert!(
+        !prog
+            .text
+            .lines()
+            .any(|l| l.starts_with("G93") || l.starts_with("M428"))
+    );
     assert!(!prog.text.contains(" A") && !prog.text.contains(" C"));
     // Each block's G94 F is its chord over the schedule's time between its CL points: the
     // first block from rest cannot run at the full feed of the middle.
@@ -160,7 +173,10 @@ fn a_three_axis_pocket_is_written_with_g94_feeds_only() {
         .map(|f| f.parse().unwrap())
         .collect();
     let fmax = m.feed_max.unwrap() * 60.0;
-    assert!(feeds.iter().all(|&f| f > 0.0 && f <= fmax * (1.0 + 1e-6)), "{fmax}");
+    assert!(
+        feeds.iter().all(|&f| f > 0.0 && f <= fmax * (1.0 + 1e-6)),
+        "{fmax}"
+    );
     assert!(feeds[0] < 0.5 * feeds.iter().cloned().fold(0.0, f64::max));
 }
 
@@ -235,8 +251,8 @@ fn the_rotary_step_rule_splits_dresser_blocks_and_keeps_the_time() {
     };
     let prog = program(&m, &t, &sol, &options.geometry, &o).unwrap();
     assert_eq!((prog.blocks, prog.split), (36, 27));
-    let back = toolpath::gcode::parse(Path::new("split.ngc"), &prog.text, Dialect::LinuxCnc)
-        .unwrap();
+    let back =
+        toolpath::gcode::parse(Path::new("split.ngc"), &prog.text, Dialect::LinuxCnc).unwrap();
     assert!(back.warnings.is_empty(), "{:?}", back.warnings);
     let b: Vec<f64> = back.points.iter().map(|p| p.rotary.unwrap()[1]).collect();
     assert!(b.windows(2).all(|w| (w[1] - w[0]).abs() <= 3.0 + 1e-9));

@@ -34,7 +34,10 @@ fn finite_differences_of_the_setpoints_stay_within_every_axis_limit() {
     // t = kT up to the cycle time, and the final instant itself.
     assert_eq!(s.len(), (cycle / period).ceil() as usize + 1);
     assert_eq!(s.last().unwrap().t, cycle);
-    assert!(s.windows(2).all(|w| w[1].t > w[0].t && w[1].t - w[0].t <= period * (1.0 + 1e-9)));
+    assert!(
+        s.windows(2)
+            .all(|w| w[1].t > w[0].t && w[1].t - w[0].t <= period * (1.0 + 1e-9))
+    );
     let tol = 1.001;
     let (mut worst_v, mut worst_a) = (0.0f64, 0.0f64);
     for (j, axis) in m.axes.iter().enumerate() {
@@ -48,8 +51,7 @@ fn finite_differences_of_the_setpoints_stay_within_every_axis_limit() {
             if k > 0 {
                 // Second difference on a possibly uneven last step.
                 let h0 = s[k].t - s[k - 1].t;
-                let a = 2.0
-                    * ((s[k + 1].q[j] - s[k].q[j]) / h - (s[k].q[j] - s[k - 1].q[j]) / h0)
+                let a = 2.0 * ((s[k + 1].q[j] - s[k].q[j]) / h - (s[k].q[j] - s[k - 1].q[j]) / h0)
                     / (h + h0);
                 assert!(!a.is_nan());
                 let r = axis.acceleration.ratio(a);
@@ -67,7 +69,10 @@ fn finite_differences_of_the_setpoints_stay_within_every_axis_limit() {
     // s never decreases, never outruns the maximum feed, and ends at the schedule's length.
     for w in s.windows(2) {
         let ds = w[1].s - w[0].s;
-        assert!(ds >= -1e-12 && ds <= fmax * tol * (w[1].t - w[0].t), "Δs {ds}");
+        assert!(
+            ds >= -1e-12 && ds <= fmax * tol * (w[1].t - w[0].t),
+            "Δs {ds}"
+        );
     }
     assert!((s.last().unwrap().s - length).abs() < 1e-9 * length);
 }
@@ -120,11 +125,24 @@ fn a_straight_line_follows_the_trapezoid_and_the_triangle() {
         let (sp, cycle) = line(len, v, a, 1e-3);
         let vp = v.min((a * len).sqrt());
         let expect = 2.0 * vp / a + (len - vp * vp / a) / vp;
-        assert!((cycle - expect).abs() < 1e-9 * expect, "T {cycle} vs {expect}");
+        assert!(
+            (cycle - expect).abs() < 1e-9 * expect,
+            "T {cycle} vs {expect}"
+        );
         for s in &sp.samples {
             let (x, feed) = trapezoid(len, v, a, s.t);
-            assert!((s.q[0] - x).abs() < 1e-9 * len, "t {}: x {} vs {x}", s.t, s.q[0]);
-            assert!((s.feed - feed).abs() < 1e-9 * v, "t {}: feed {} vs {feed}", s.t, s.feed);
+            assert!(
+                (s.q[0] - x).abs() < 1e-9 * len,
+                "t {}: x {} vs {x}",
+                s.t,
+                s.q[0]
+            );
+            assert!(
+                (s.feed - feed).abs() < 1e-9 * v,
+                "t {}: feed {} vs {feed}",
+                s.t,
+                s.feed
+            );
             assert!((s.s - x).abs() < 1e-9 * len);
             assert!((s.qd[0] - feed).abs() < 1e-9 * v);
             assert_eq!((s.q[1], s.q[2]), (0.0, 0.0));
@@ -140,7 +158,10 @@ fn the_binary_file_reads_back_and_the_csv_names_its_units() {
     let bytes = setpoints_bin(&sp).unwrap();
     let src = Path::new("line.bin");
     let back = read_setpoints_bin(src, &bytes).unwrap();
-    assert_eq!((back.axes.clone(), back.kinds.clone()), (sp.axes.clone(), sp.kinds.clone()));
+    assert_eq!(
+        (back.axes.clone(), back.kinds.clone()),
+        (sp.axes.clone(), sp.kinds.clone())
+    );
     assert_eq!((back.period, back.joint), (sp.period, sp.joint));
     assert_eq!(back.samples.len(), sp.samples.len());
     for (a, b) in back.samples.iter().zip(&sp.samples) {

@@ -150,7 +150,12 @@ impl Path {
                 Feed::Rapid | Feed::Unspecified => m,
             }
         };
-        let plan = span_points(toolpath, angles, orientation_moves_axes, options.corner_angle_deg);
+        let plan = span_points(
+            toolpath,
+            angles,
+            orientation_moves_axes,
+            options.corner_angle_deg,
+        );
         let mut spans = Vec::with_capacity(plan.len());
         for idx in &plan {
             let idx = idx.as_slice();

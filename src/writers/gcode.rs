@@ -163,7 +163,10 @@ fn words(dialect: Dialect) -> Words {
 /// A coordinate: 6 decimals, never `-0.000000`.
 fn coord(x: f64) -> String {
     let s = format!("{x:.6}");
-    if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
         "0.000000".to_string()
     } else {
         s
@@ -364,7 +367,11 @@ pub fn program(
     let mut rotary: Vec<(String, usize)> = Vec::new();
     for (a, axis) in kin.rotary_axes().iter().enumerate() {
         if let Some(j) = *axis {
-            let name = machine.axes.get(j).map(|x| x.name.clone()).unwrap_or_default();
+            let name = machine
+                .axes
+                .get(j)
+                .map(|x| x.name.clone())
+                .unwrap_or_default();
             if !matches!(name.as_str(), "A" | "B" | "C") {
                 return Err(Error::Usage(format!(
                     "rotary axis `{name}` cannot be written as a G-code word (A, B or C)"
@@ -463,10 +470,9 @@ pub fn program(
             )));
         }
         let turns = r.iter().zip(&prev_r).any(|(a, b)| a != b);
-        let chord = ((p[0] - prev_p[0]).powi(2)
-            + (p[1] - prev_p[1]).powi(2)
-            + (p[2] - prev_p[2]).powi(2))
-        .sqrt();
+        let chord =
+            ((p[0] - prev_p[0]).powi(2) + (p[1] - prev_p[1]).powi(2) + (p[2] - prev_p[2]).powi(2))
+                .sqrt();
         let (mode, f) = if turns || chord == 0.0 {
             inverse_blocks += 1;
             let m = if inverse_mode { "" } else { "G93 " };
