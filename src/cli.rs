@@ -23,6 +23,10 @@ pub struct Cli {
 pub enum Command {
     /// Compute the time-optimal feed profile of a toolpath on a machine.
     Solve(SolveArgs),
+    /// Solve, then write the toolpath back as G-code with the optimised feed per block.
+    Gcode(GcodeArgs),
+    /// Solve, then sample every axis's setpoint at a fixed interpolation period.
+    Interpolate(InterpolateArgs),
 }
 
 #[derive(Debug, Args)]
@@ -207,5 +211,196 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
 pub fn run(cli: &Cli) -> Result<String> {
     match &cli.command {
         Command::Solve(args) => solve(args),
+        Command::Gcode(args) => gcode(args),
+        Command::Interpolate(args) => interpolate(args),
     }
+}
+
+/// The solve options of `feedopt gcode` and `feedopt interpolate` (as `feedopt solve`'s).
+#[derive(Debug, Clone, Args)]
+pub struct PlanArgs {
+    /// Machine file (JSON: kinematics, axis limits, maximum feed).
+    #[arg(long, short)]
+    pub machine: PathBuf,
+    /// Toolpath file (APT CL: .cls, .apt; G-code: .ngc, .nc, .gcode, .tap).
+    pub toolpath: PathBuf,
+    /// Total station count (default: refined automatically).
+    #[arg(long)]
+    pub stations: Option<usize>,
+    /// Turning angle between CL moves (degrees) above which the path stops exactly.
+    #[arg(long, default_value_t = 10.0)]
+    pub corner_angle: f64,
+    /// How far the fitted path may stray from the programmed tool-tip positions, mm.
+    #[arg(long, default_value_t = 0.005, value_name = "MM")]
+    pub tolerance: f64,
+    /// How far the fitted rotary angles may stray from the programmed ones, degrees.
+    #[arg(long, default_value_t = 0.01, value_name = "DEG")]
+    pub tolerance_deg: f64,
+    /// Cap every programmed feed at this multiple of it (a feed override).
+    #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+    pub feed_override: f64,
+    /// Ignore the program's feeds: only the machine's limits apply.
+    #[arg(long)]
+    pub ignore_programmed_feed: bool,
+    /// Input format instead of the file's extension: apt, gcode or csv.
+    #[arg(long, value_enum)]
+    pub format: Option<FormatChoice>,
+    /// Solver: `clarabel` or `reach`.
+    #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
+    pub solver: SolverChoice,
+    /// Tool-tip feed at the start of the path, mm/s (default: at rest).
+    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
+    pub start_feed: f64,
+    /// Tool-tip feed at the end of the path, mm/s (default: at rest).
+    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
+    pub end_feed: f64,
+}
+
+impl PlanArgs {
+    /// The same solve as `feedopt solve` with these options (G-code input in `dialect`).
+    fn solve_args(&self, dialect: crate::toolpath::gcode::Dialect, period: f64) -> SolveArgs {
+        SolveArgs {
+            machine: self.machine.clone(),
+            toolpath: self.toolpath.clone(),
+            json: false,
+            output: None,
+            stations: self.stations,
+            corner_angle: self.corner_angle,
+            tolerance: self.tolerance,
+            tolerance_deg: self.tolerance_deg,
+            feed_override: self.feed_override,
+            ignore_programmed_feed: self.ignore_programmed_feed,
+            format: self.format,
+            dialect,
+            solver: self.solver,
+            start_feed: self.start_feed,
+            end_feed: self.end_feed,
+            period,
+        }
+    }
+}
+
+/// Reads, solves; reader warnings go to stderr.
+fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
+    let options = args.options()?;
+    let machine = Machine::from_file(&args.machine)?;
+    let format = args.format.map(|f| match f {
+        FormatChoice::Apt => toolpath::Format::Apt,
+        FormatChoice::Gcode => toolpath::Format::Gcode,
+        FormatChoice::Csv => toolpath::Format::Csv,
+    });
+    let input = toolpath::read_as(&args.toolpath, format, args.dialect)?;
+    if let toolpath::Input::Cl(t) = &input {
+        for w in &t.warnings {
+            eprintln!(
+                "feedopt: warning: {}:{}: {}",
+                args.toolpath.display(),
+                w.line,
+                w.message
+            );
+        }
+    }
+    let solution = optimize::optimize_input(&machine, &input, &options)?;
+    Ok((machine, input, options, solution))
+}
+
+#[derive(Debug, Args)]
+pub struct GcodeArgs {
+    #[command(flatten)]
+    pub plan: PlanArgs,
+    /// The G-code program to write (.ngc, .nc, …).
+    #[arg(long, short, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Dialect of the written program (and of a G-code input unless --input-dialect):
+    /// linuxcnc, fanuc or sinumerik.
+    #[arg(long, default_value = "linuxcnc")]
+    pub dialect: crate::toolpath::gcode::Dialect,
+    /// Dialect of a G-code input, when it differs from the output's.
+    #[arg(long)]
+    pub input_dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// Largest turn of a rotary axis within one block (Δθ, degrees, seed 001): longer turns are
+    /// split by bisection (default: no limit).
+    #[arg(long, value_name = "DEG")]
+    pub max_rotation_deg: Option<f64>,
+}
+
+/// `feedopt gcode`: returns what to print on stdout.
+pub fn gcode(args: &GcodeArgs) -> Result<String> {
+    let dir = match args.output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: the directory {} does not exist",
+            args.output.display(),
+            dir.display()
+        )));
+    }
+    let solve_args = args.plan.solve_args(
+        args.input_dialect.unwrap_or(args.dialect),
+        crate::verify::VerifyOptions::default().period,
+    );
+    let (machine, input, options, solution) = plan(&solve_args)?;
+    let toolpath::Input::Cl(path) = &input else {
+        return Err(Error::Usage(format!(
+            "{}: a joint-space path has no tool tip to write as G-code",
+            args.plan.toolpath.display()
+        )));
+    };
+    let prog = writers::gcode::write_gcode(
+        &args.output,
+        &machine,
+        path,
+        &solution,
+        &options.geometry,
+        &writers::gcode::GcodeOptions {
+            dialect: args.dialect,
+            max_rotation_deg: args.max_rotation_deg,
+        },
+    )?;
+    Ok(format!(
+        "wrote {} ({} dialect): {} blocks ({} under G93), {} merged, {} added by Δθ\n\
+         schedule cycle time {:.4} s, program time {:.4} s\n",
+        args.output.display(),
+        args.dialect,
+        prog.blocks,
+        prog.inverse_time_blocks,
+        prog.merged,
+        prog.split,
+        solution.schedule.cycle_time,
+        prog.time
+    ))
+}
+
+#[derive(Debug, Args)]
+pub struct InterpolateArgs {
+    #[command(flatten)]
+    pub plan: PlanArgs,
+    /// Interpolation period: `1ms`, `500us`, `0.002` (seconds). Also the servo period of the
+    /// schedule's verification.
+    #[arg(long, default_value = "1ms", value_parser = parse_period)]
+    pub period: f64,
+    /// The setpoints to write: FILE.csv or FILE.bin (layout in `feedopt::interpolate`).
+    #[arg(long, short, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Dialect of a G-code input.
+    #[arg(long, default_value = "linuxcnc")]
+    pub dialect: crate::toolpath::gcode::Dialect,
+}
+
+/// `feedopt interpolate`: returns what to print on stdout.
+pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
+    crate::interpolate::setpoint_format(&args.output)?;
+    let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, args.period))?;
+    let sp = crate::interpolate::sample(&machine, &solution, args.period)?;
+    crate::interpolate::write_setpoints(&args.output, &sp)?;
+    Ok(format!(
+        "wrote {}: {} setpoints every {} s over {:.4} s, axes {}\n",
+        args.output.display(),
+        sp.samples.len(),
+        args.period,
+        solution.schedule.cycle_time,
+        sp.axes.join(" ")
+    ))
 }

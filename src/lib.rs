@@ -52,6 +52,7 @@ pub mod cli;
 pub mod constraints;
 pub mod error;
 pub mod geometry;
+pub mod interpolate;
 pub mod kinematics;
 pub mod machine;
 pub mod motion;

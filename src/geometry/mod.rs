@@ -150,46 +150,16 @@ impl Path {
                 Feed::Rapid | Feed::Unspecified => m,
             }
         };
-        // Keep the points that move the tip, or turn the tool on a machine where that matters.
-        let mut keep: Vec<usize> = vec![0];
-        for k in 1..pts.len() {
-            let last = &pts[*keep.last().unwrap_or(&0)];
-            let moved = (pts[k].p - last.p).norm() > SAME_POSITION_MM;
-            let last_k = *keep.last().unwrap_or(&0);
-            let turned = orientation_moves_axes
-                && (angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD
-                    || (0..2)
-                        .any(|j| (angles[k][j] - angles[last_k][j]).abs() > SAME_ORIENTATION_RAD));
-            if moved || turned {
-                keep.push(k);
-            }
-        }
-        // Segment kinds and corners.
-        let seg_moving: Vec<bool> = keep
-            .windows(2)
-            .map(|w| (pts[w[1]].p - pts[w[0]].p).norm() > SAME_POSITION_MM)
-            .collect();
-        let corner_cos = options.corner_angle_deg.to_radians().cos();
-        let mut cuts = vec![0usize];
-        for k in 1..seg_moving.len() {
-            let split = if seg_moving[k - 1] != seg_moving[k] {
-                true
-            } else if seg_moving[k] {
-                let a = pts[keep[k]].p - pts[keep[k - 1]].p;
-                let b = pts[keep[k + 1]].p - pts[keep[k]].p;
-                a.dot(&b) / (a.norm() * b.norm()) < corner_cos
-            } else {
-                false
-            };
-            if split {
-                cuts.push(k);
-            }
-        }
-        cuts.push(seg_moving.len());
-        let mut spans = Vec::with_capacity(cuts.len() - 1);
-        for c in cuts.windows(2) {
-            let idx = &keep[c[0]..=c[1]];
-            let moving = seg_moving[c[0]];
+        let plan = span_points(
+            toolpath,
+            angles,
+            orientation_moves_axes,
+            options.corner_angle_deg,
+        );
+        let mut spans = Vec::with_capacity(plan.len());
+        for idx in &plan {
+            let idx = idx.as_slice();
+            let moving = (pts[idx[1]].p - pts[idx[0]].p).norm() > SAME_POSITION_MM;
             let p0: Vector3<f64> = pts[idx[0]].p;
             let mut values: Vec<[f64; PATH_DIM]> = idx
                 .iter()
@@ -238,6 +208,63 @@ impl Path {
         }
         Ok(Path { spans })
     }
+}
+
+/// The CL points (indices into `toolpath.points`) at the knots of each span [`Path::build`]
+/// makes, before any dresser refit: points that neither move the tip (by more than
+/// [`SAME_POSITION_MM`]) nor, when `orientation_moves_axes`, turn the tool are dropped; the
+/// rest is cut into rest-to-rest spans where the tip starts or stops moving and at corners
+/// sharper than `corner_angle_deg`. Consecutive spans share their boundary point. Empty when
+/// fewer than two points remain.
+pub fn span_points(
+    toolpath: &Toolpath,
+    angles: &[[f64; 2]],
+    orientation_moves_axes: bool,
+    corner_angle_deg: f64,
+) -> Vec<Vec<usize>> {
+    let pts = &toolpath.points;
+    if pts.is_empty() {
+        return Vec::new();
+    }
+    // Keep the points that move the tip, or turn the tool on a machine where that matters.
+    let mut keep: Vec<usize> = vec![0];
+    for k in 1..pts.len() {
+        let last = &pts[*keep.last().unwrap_or(&0)];
+        let moved = (pts[k].p - last.p).norm() > SAME_POSITION_MM;
+        let last_k = *keep.last().unwrap_or(&0);
+        let turned = orientation_moves_axes
+            && (angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD
+                || (0..2).any(|j| (angles[k][j] - angles[last_k][j]).abs() > SAME_ORIENTATION_RAD));
+        if moved || turned {
+            keep.push(k);
+        }
+    }
+    // Segment kinds and corners.
+    let seg_moving: Vec<bool> = keep
+        .windows(2)
+        .map(|w| (pts[w[1]].p - pts[w[0]].p).norm() > SAME_POSITION_MM)
+        .collect();
+    let corner_cos = corner_angle_deg.to_radians().cos();
+    let mut cuts = vec![0usize];
+    for k in 1..seg_moving.len() {
+        let split = if seg_moving[k - 1] != seg_moving[k] {
+            true
+        } else if seg_moving[k] {
+            let a = pts[keep[k]].p - pts[keep[k - 1]].p;
+            let b = pts[keep[k + 1]].p - pts[keep[k]].p;
+            a.dot(&b) / (a.norm() * b.norm()) < corner_cos
+        } else {
+            false
+        };
+        if split {
+            cuts.push(k);
+        }
+    }
+    cuts.push(seg_moving.len());
+    cuts.windows(2)
+        .filter(|c| c[1] > c[0])
+        .map(|c| keep[c[0]..=c[1]].to_vec())
+        .collect()
 }
 
 impl Path {

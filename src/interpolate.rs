@@ -1,0 +1,535 @@
+//! Data-sampling interpolation (seed 004): the schedule turned into every axis's setpoint at a
+//! fixed interpolation period T, what a controller's servo loops consume.
+//!
+//! # Motion between stations
+//!
+//! The schedule fixes b = u̇² at its stations and takes b linear in u between them, so ü is
+//! constant on each interval (eq. 40–43). [`Interval::state_at`] is that law, the **one**
+//! place where it is written for sampling (and its inverse, [`Interval::time_to`], for the
+//! G-code writer): with r = √b,
+//!
+//! ```text
+//! ü = (b₁ − b₀) / (2 Δu),   r(τ) = r₀ + ü τ,   u(τ) = u₀ + τ (r₀ + r(τ)) / 2,
+//! Δt = 2 Δu / (r₀ + r₁)                                  (eq. 43, closed form)
+//! ```
+//!
+//! exactly the motion [`crate::verify`] re-simulates. A jerk-limited model (b quadratic in u
+//! per interval) only has to change [`Interval`]'s methods.
+//!
+//! # Samples
+//!
+//! [`sample`] gives one [`Sample`] at every t = kT from 0 while kT is before the cycle time,
+//! and one at the cycle time itself (so the last period may be shorter). At each sample the
+//! path is evaluated from the span's spline at u(t) and pushed through the kinematics — never
+//! interpolated between stations: q, and the analytic q̇ = q′ u̇, q̈ = q″ b + q′ ü. The arc length
+//! s is the interval's start station's s plus Simpson's rule on |P′| over [u_i, u]; the feed
+//! is |P′| u̇ (on a joint-space path u is s itself: s = u, feed = u̇).
+//!
+//! # Files
+//!
+//! **CSV** ([`setpoints_csv`]): a header naming each column with its unit,
+//! `t_s,s_mm,feed_mm_s,X_mm,Y_mm,Z_mm,C_deg,A_deg` (a joint-space path: `t_s,s,feed,<axis>_mm|
+//! _deg…`, s in the file's own unit), then one row per sample.
+//!
+//! **Binary** ([`setpoints_bin`], read back by [`read_setpoints_bin`]), all little-endian:
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `FOSETPT\0` |
+//! | 4 | u32 version = 1 |
+//! | 4 | u32 flags: bit 0 set = joint-space path (s and feed in the path's own units) |
+//! | 4 | u32 axis count n |
+//! | 8 | f64 period T, s |
+//! | 8 | u64 sample count m |
+//! | per axis | u8 name length, the name (UTF-8), u8 unit: 0 = mm, 1 = degrees |
+//! | m × (3 + n) × 8 | records of f64: t (s), s (mm), feed (mm/s), q₁ … qₙ (mm or °) |
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::geometry::{Span, SpanKind};
+use crate::kinematics::{Kinematics, MAX_AXES};
+use crate::machine::{AxisKind, Machine};
+use crate::optimize::Solution;
+use crate::schedule::interval_times;
+
+/// One interval of the schedule between two stations: u and b = u̇² at both ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    pub u0: f64,
+    pub u1: f64,
+    pub b0: f64,
+    pub b1: f64,
+}
+
+/// Where the motion is along the path at one instant: u, u̇, ü.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathState {
+    pub u: f64,
+    pub ud: f64,
+    pub udd: f64,
+}
+
+impl Interval {
+    /// ü on the interval: b linear in u makes it constant, (b₁ − b₀) / (2Δu).
+    fn udd(&self) -> f64 {
+        (self.b1.max(0.0) - self.b0.max(0.0)) / (2.0 * (self.u1 - self.u0))
+    }
+
+    /// The interval's duration, eq. 43: 2Δu / (√b₀ + √b₁) (infinite when b is 0 at both ends).
+    pub fn duration(&self) -> f64 {
+        2.0 * (self.u1 - self.u0) / (self.b0.max(0.0).sqrt() + self.b1.max(0.0).sqrt())
+    }
+
+    /// The motion law: the state `tau` seconds after the interval's start (clamped to the
+    /// interval, so rounding never leaves it). √b(τ) = √b₀ + ü τ, u(τ) = u₀ + τ (√b₀ + √b(τ))/2.
+    pub fn state_at(&self, tau: f64) -> PathState {
+        let (r0, r1) = (self.b0.max(0.0).sqrt(), self.b1.max(0.0).sqrt());
+        let udd = self.udd();
+        let tau = tau.clamp(0.0, self.duration());
+        let r = (r0 + udd * tau).clamp(r0.min(r1), r0.max(r1));
+        let u = (self.u0 + 0.5 * tau * (r0 + r)).clamp(self.u0, self.u1);
+        PathState { u, ud: r, udd }
+    }
+
+    /// The inverse of [`Interval::state_at`]: the time from the interval's start to reach `u`
+    /// (clamped to the interval): b(u) is linear, so τ = 2 (u − u₀) / (√b₀ + √b(u)).
+    pub fn time_to(&self, u: f64) -> f64 {
+        let u = u.clamp(self.u0, self.u1);
+        if u <= self.u0 {
+            return 0.0;
+        }
+        if u >= self.u1 {
+            return self.duration();
+        }
+        let (b0, b1) = (self.b0.max(0.0), self.b1.max(0.0));
+        let b = b0 + (b1 - b0) * (u - self.u0) / (self.u1 - self.u0);
+        2.0 * (u - self.u0) / (b0.sqrt() + b.max(0.0).sqrt())
+    }
+}
+
+/// The schedule's motion as intervals, span by span, with each interval's start time and the
+/// station's arc length there: what the sampler and the G-code writer walk along.
+#[derive(Debug, Clone)]
+pub struct Timeline {
+    /// Per span: its stations' u, start times t (s) and arc lengths s, and b.
+    pub spans: Vec<SpanTimeline>,
+    pub cycle_time: f64,
+}
+
+/// One span's stations on the global clock.
+#[derive(Debug, Clone)]
+pub struct SpanTimeline {
+    pub u: Vec<f64>,
+    pub b: Vec<f64>,
+    /// Time at each station, s (the schedule's).
+    pub t: Vec<f64>,
+    /// Arc length at each station, mm (the schedule's).
+    pub s: Vec<f64>,
+}
+
+impl SpanTimeline {
+    /// Interval `i` (stations i, i + 1).
+    pub fn interval(&self, i: usize) -> Interval {
+        Interval {
+            u0: self.u[i],
+            u1: self.u[i + 1],
+            b0: self.b[i],
+            b1: self.b[i + 1],
+        }
+    }
+
+    /// The interval containing `u` (the last one at the span's end).
+    pub fn interval_of(&self, u: f64) -> usize {
+        let n = self.u.len() - 1;
+        self.u
+            .partition_point(|&x| x <= u)
+            .saturating_sub(1)
+            .min(n - 1)
+    }
+
+    /// The time (s, global clock) at which the motion passes `u` on this span.
+    pub fn time_at(&self, u: f64) -> f64 {
+        let i = self.interval_of(u);
+        self.t[i] + self.interval(i).time_to(u)
+    }
+}
+
+impl Timeline {
+    /// The timeline of a solution's schedule. Station times are the schedule's own.
+    pub fn new(solution: &Solution) -> Result<Timeline> {
+        let stations = &solution.schedule.stations;
+        let mut spans = Vec::with_capacity(solution.problems.len());
+        let mut offset = 0;
+        for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
+            let n = p.u.len();
+            if sol.b.len() != n || offset + n > stations.len() || n < 2 {
+                return Err(Error::Solver(format!(
+                    "the schedule does not match its span problems ({} stations, span of {n})",
+                    stations.len()
+                )));
+            }
+            // Checks that the schedule's intervals are traversable (never zero speed).
+            interval_times(p, &sol.b)?;
+            let st = &stations[offset..offset + n];
+            spans.push(SpanTimeline {
+                u: p.u.clone(),
+                b: sol.b.clone(),
+                t: st.iter().map(|s| s.t).collect(),
+                s: st.iter().map(|s| s.s).collect(),
+            });
+            offset += n;
+        }
+        Ok(Timeline {
+            spans,
+            cycle_time: solution.schedule.cycle_time,
+        })
+    }
+}
+
+/// One setpoint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub t: f64,
+    /// Tool-tip arc length from the start, mm (joint-space path: its parameter s).
+    pub s: f64,
+    /// Tool-tip feed, mm/s (joint-space path: ds/dt).
+    pub feed: f64,
+    /// Axis positions, mm or degrees (the machine's axis order; unused entries 0).
+    pub q: [f64; MAX_AXES],
+    /// Axis velocities q̇ = q′ u̇ (analytic; not written to the files).
+    pub qd: [f64; MAX_AXES],
+    /// Axis accelerations q̈ = q″ b + q′ ü (analytic; not written to the files).
+    pub qdd: [f64; MAX_AXES],
+}
+
+/// Setpoints at a fixed period.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setpoints {
+    /// Axis names in the order of [`Sample::q`].
+    pub axes: Vec<String>,
+    /// Unit of each axis: linear (mm) or rotary (degrees).
+    pub kinds: Vec<AxisKind>,
+    /// A joint-space path: s and feed are in the path's own units.
+    pub joint: bool,
+    /// Interpolation period T, s.
+    pub period: f64,
+    pub samples: Vec<Sample>,
+}
+
+/// Samples the solution's motion at period `period` (s): see the module doc.
+pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
+    if !(period.is_finite() && period > 0.0) {
+        return Err(Error::Usage(format!(
+            "the interpolation period must be a positive number of seconds, got {period}"
+        )));
+    }
+    let timeline = Timeline::new(solution)?;
+    let cycle = timeline.cycle_time;
+    let count = (cycle / period).ceil();
+    if !(count.is_finite() && count < 5e8) {
+        return Err(Error::Usage(format!(
+            "{cycle} s at a period of {period} s is too many samples"
+        )));
+    }
+    let kin = &solution.kinematics;
+    let na = kin.n_axes().min(machine.axes.len());
+    let spans = &solution.path.spans;
+    let mut samples = Vec::with_capacity(count as usize + 2);
+    let mut k: u64 = 0;
+    for (span, tl) in spans.iter().zip(&timeline.spans) {
+        for i in 0..tl.u.len() - 1 {
+            let iv = tl.interval(i);
+            let t_end = tl.t[i + 1];
+            loop {
+                let t = k as f64 * period;
+                if t >= t_end {
+                    break;
+                }
+                samples.push(point(span, kin, na, tl, i, iv.state_at(t - tl.t[i]), t));
+                k += 1;
+            }
+        }
+    }
+    // The final instant: the end of the last span.
+    if let (Some(span), Some(tl)) = (spans.last(), timeline.spans.last()) {
+        let i = tl.u.len() - 2;
+        let st = tl.interval(i).state_at(f64::INFINITY);
+        samples.push(point(span, kin, na, tl, i, st, cycle));
+    }
+    if let Some(bad) = samples.iter().find(|s| {
+        !(s.t.is_finite() && s.s.is_finite() && s.feed.is_finite())
+            || s.q[..na].iter().any(|x| !x.is_finite())
+    }) {
+        return Err(Error::Solver(format!(
+            "the setpoint at t = {} s is not finite",
+            bad.t
+        )));
+    }
+    Ok(Setpoints {
+        axes: machine
+            .axes
+            .iter()
+            .take(na)
+            .map(|a| a.name.clone())
+            .collect(),
+        kinds: machine.axes.iter().take(na).map(|a| a.kind).collect(),
+        joint: spans.iter().any(|s| s.kind == SpanKind::Joint),
+        period,
+        samples,
+    })
+}
+
+/// The setpoint at state `st` within interval `i` of a span.
+fn point(
+    span: &Span,
+    kin: &Kinematics,
+    na: usize,
+    tl: &SpanTimeline,
+    i: usize,
+    st: PathState,
+    t: f64,
+) -> Sample {
+    let w = span.eval(st.u);
+    let jets = kin.axis_jets(&w);
+    let tip = |u: f64| {
+        let d = span.eval(u).d1;
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    };
+    let (s, feed) = match span.kind {
+        SpanKind::Joint => (tl.s[i] + (st.u - tl.u[i]), st.ud),
+        SpanKind::Reorientation => (tl.s[i], 0.0),
+        SpanKind::Moving => {
+            let (ua, du) = (tl.u[i], st.u - tl.u[i]);
+            let s = if du > 0.0 {
+                du / 6.0 * (tip(ua) + 4.0 * tip(ua + 0.5 * du) + tip(st.u))
+            } else {
+                0.0
+            };
+            (tl.s[i] + s, tip(st.u) * st.ud)
+        }
+    };
+    let mut out = Sample {
+        t,
+        s,
+        feed,
+        q: [0.0; MAX_AXES],
+        qd: [0.0; MAX_AXES],
+        qdd: [0.0; MAX_AXES],
+    };
+    for j in 0..na {
+        out.q[j] = jets.q[j];
+        out.qd[j] = jets.dq[j] * st.ud;
+        out.qdd[j] = jets.ddq[j] * st.ud * st.ud + jets.dq[j] * st.udd;
+    }
+    out
+}
+
+fn unit_name(kind: AxisKind) -> &'static str {
+    match kind {
+        AxisKind::Linear => "mm",
+        AxisKind::Rotary => "deg",
+    }
+}
+
+/// The setpoints as CSV: header `t_s,s_mm,feed_mm_s,<axis>_<unit>…`, one row per sample.
+pub fn setpoints_csv(sp: &Setpoints) -> String {
+    use std::fmt::Write as _;
+    let na = sp.axes.len();
+    let mut out = String::with_capacity(sp.samples.len() * (24 * (3 + na)));
+    out.push_str(if sp.joint {
+        "t_s,s,feed"
+    } else {
+        "t_s,s_mm,feed_mm_s"
+    });
+    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
+        let _ = write!(out, ",{name}_{}", unit_name(*kind));
+    }
+    out.push('\n');
+    for s in &sp.samples {
+        let _ = write!(out, "{},{},{}", s.t, s.s, s.feed);
+        for q in &s.q[..na] {
+            let _ = write!(out, ",{q}");
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Magic bytes of the binary setpoint file.
+pub const MAGIC: &[u8; 8] = b"FOSETPT\0";
+/// Version of the binary layout.
+pub const VERSION: u32 = 1;
+
+/// The setpoints in the binary layout of the module doc.
+pub fn setpoints_bin(sp: &Setpoints) -> Result<Vec<u8>> {
+    let na = sp.axes.len();
+    let mut out = Vec::with_capacity(64 + sp.samples.len() * 8 * (3 + na));
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&u32::from(sp.joint).to_le_bytes());
+    out.extend_from_slice(&(na as u32).to_le_bytes());
+    out.extend_from_slice(&sp.period.to_le_bytes());
+    out.extend_from_slice(&(sp.samples.len() as u64).to_le_bytes());
+    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
+        let len = u8::try_from(name.len())
+            .map_err(|_| Error::Usage(format!("axis name `{name}` is too long")))?;
+        out.push(len);
+        out.extend_from_slice(name.as_bytes());
+        out.push(u8::from(*kind == AxisKind::Rotary));
+    }
+    for s in &sp.samples {
+        for x in [s.t, s.s, s.feed].iter().chain(&s.q[..na]) {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    Ok(out)
+}
+
+/// Reads the binary layout back (positions only: [`Sample::qd`], [`Sample::qdd`] are 0).
+/// `source` names the file in errors.
+pub fn read_setpoints_bin(source: &Path, bytes: &[u8]) -> Result<Setpoints> {
+    let bad = |what: &str| {
+        Error::io(
+            source,
+            std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string()),
+        )
+    };
+    let mut at = 0usize;
+    let mut take = |n: usize| -> Result<&[u8]> {
+        let slice = bytes
+            .get(at..at + n)
+            .ok_or_else(|| bad("truncated setpoint file"))?;
+        at += n;
+        Ok(slice)
+    };
+    if take(8)? != MAGIC {
+        return Err(bad("not a feedopt setpoint file (bad magic bytes)"));
+    }
+    let u32_of = |b: &[u8]| u32::from_le_bytes(b.try_into().unwrap_or([0; 4]));
+    let f64_of = |b: &[u8]| f64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
+    let version = u32_of(take(4)?);
+    if version != VERSION {
+        return Err(bad(&format!(
+            "setpoint file version {version} (expected 1)"
+        )));
+    }
+    let joint = u32_of(take(4)?) & 1 == 1;
+    let na = u32_of(take(4)?) as usize;
+    if na > MAX_AXES {
+        return Err(bad(&format!("{na} axes (at most {MAX_AXES})")));
+    }
+    let period = f64_of(take(8)?);
+    let m = u64::from_le_bytes(take(8)?.try_into().unwrap_or([0; 8]));
+    let mut axes = Vec::with_capacity(na);
+    let mut kinds = Vec::with_capacity(na);
+    for _ in 0..na {
+        let len = take(1)?[0] as usize;
+        let name = std::str::from_utf8(take(len)?).map_err(|_| bad("axis name is not UTF-8"))?;
+        axes.push(name.to_string());
+        kinds.push(match take(1)?[0] {
+            0 => AxisKind::Linear,
+            1 => AxisKind::Rotary,
+            u => return Err(bad(&format!("unknown axis unit code {u}"))),
+        });
+    }
+    let record = 8 * (3 + na);
+    let rest = bytes.len() - at;
+    if (rest as u64) != m.saturating_mul(record as u64) {
+        return Err(bad(&format!(
+            "{m} records of {record} bytes announced, {rest} bytes present"
+        )));
+    }
+    let samples = bytes[at..]
+        .chunks_exact(record)
+        .map(|r| {
+            let x = |k: usize| f64_of(&r[8 * k..8 * k + 8]);
+            let mut q = [0.0; MAX_AXES];
+            for (j, qj) in q.iter_mut().enumerate().take(na) {
+                *qj = x(3 + j);
+            }
+            Sample {
+                t: x(0),
+                s: x(1),
+                feed: x(2),
+                q,
+                qd: [0.0; MAX_AXES],
+                qdd: [0.0; MAX_AXES],
+            }
+        })
+        .collect();
+    Ok(Setpoints {
+        axes,
+        kinds,
+        joint,
+        period,
+        samples,
+    })
+}
+
+/// Output formats of the setpoints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SetpointFormat {
+    Csv,
+    Bin,
+}
+
+/// The format of an output path by its extension (`.csv` or `.bin`).
+pub fn setpoint_format(path: &Path) -> Result<SetpointFormat> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("csv") => Ok(SetpointFormat::Csv),
+        Some("bin") => Ok(SetpointFormat::Bin),
+        _ => Err(Error::Usage(format!(
+            "{}: unknown setpoint format (use .csv or .bin)",
+            path.display()
+        ))),
+    }
+}
+
+/// Writes the setpoints to `path` (format by extension), atomically.
+pub fn write_setpoints(path: &Path, sp: &Setpoints) -> Result<()> {
+    let bytes = match setpoint_format(path)? {
+        SetpointFormat::Csv => setpoints_csv(sp).into_bytes(),
+        SetpointFormat::Bin => setpoints_bin(sp)?,
+    };
+    crate::writers::write_atomically(path, &bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_law_and_its_inverse_agree() {
+        let iv = Interval {
+            u0: 1.0,
+            u1: 3.0,
+            b0: 4.0,
+            b1: 9.0,
+        };
+        // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
+        assert!((iv.duration() - 0.8).abs() < 1e-15);
+        for k in 0..=8 {
+            let tau = 0.1 * k as f64;
+            let st = iv.state_at(tau);
+            assert!((st.ud - (2.0 + 1.25 * tau).min(3.0)).abs() < 1e-12);
+            assert!((iv.time_to(st.u) - tau).abs() < 1e-12, "{tau}");
+        }
+        // From rest: u = ½ ü τ².
+        let rest = Interval {
+            u0: 0.0,
+            u1: 2.0,
+            b0: 0.0,
+            b1: 16.0,
+        };
+        let st = rest.state_at(0.5);
+        assert!((st.udd - 4.0).abs() < 1e-15 && (st.u - 0.5).abs() < 1e-15);
+        assert!((rest.time_to(0.5) - 0.5).abs() < 1e-15);
+    }
+}

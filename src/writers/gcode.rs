@@ -1,0 +1,550 @@
+//! G-code writer: the toolpath written back as a program whose every block carries the
+//! optimised feed, so a controller that follows the program's feeds runs the schedule's time.
+//!
+//! # Blocks and their time
+//!
+//! Every CL point that [`crate::geometry`] keeps (see [`span_points`]) is a knot of its span,
+//! hence a station of the schedule; the block that ends at it takes the schedule's time between
+//! the stations at the block's two CL points. (A dresser span refitted by biarcs has sample
+//! knots instead: each programmed point is then projected onto the fitted profile and its time
+//! taken there, by the inverse of the motion law, [`crate::interpolate::Interval::time_to`].)
+//! Points the geometry drops (the same position, and on a machine that uses it the same
+//! orientation, as the point before) are not written. Consecutive spans share their boundary
+//! point, written once; a rest-to-rest stop and a pure reorientation (the tip stands, the tool
+//! turns) are ordinary blocks whose time is the schedule's.
+//!
+//! # Feed words
+//!
+//! * A block that moves a rotary axis is written under **G93** (inverse time): F = 1 / block
+//!   time in minutes = 60 / Δt.
+//! * A block where only X, Y, Z move is written under **G94**: F = chord / Δt in mm/min, the
+//!   chord measured between the coordinates as written.
+//!
+//! F is written with 7 significant digits (always with a decimal point): each block's time is
+//! then exact to 5e-7, so the file's total time matches the schedule's far within 0.1 %.
+//! **Tiny blocks**: a block shorter than [`MIN_BLOCK_TIME_S`] (10 µs, F = 6,000,000 under G93)
+//! is merged with the next one — its end point is not written (the last block merges with the
+//! one before instead). Because every feed is capped, such a point lies within 10 µs of travel
+//! of its neighbour (0.35 µm at 35 mm/s). No F is therefore absurd, and no time is lost: the
+//! merged block takes both blocks' time.
+//!
+//! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
+//! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
+//! the schedule's. Only the first point is reached by a G0, as every program starts: that move
+//! comes before the schedule's t = 0 and is not part of its time.
+//!
+//! # Dialect
+//!
+//! The header, the tool-tip (TCP) switch, the feed-mode words and the comment syntax come from
+//! the dialect, as the reader's tables in [`crate::toolpath::gcode`] define them (round-trip
+//! tests read every written program back through those tables and require no warning):
+//!
+//! | dialect | units, plane | TCP on / off | comments | end |
+//! |---|---|---|---|---|
+//! | linuxcnc | `G21 G90 G17` | `M428` / `M429` (the trt sims' remaps) | `( … )` | `M30` |
+//! | fanuc | `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
+//! | sinumerik | `G710 G90 G17` | `TRAORI` / `TRAFOOF` | `; …` | `M30` |
+//!
+//! TCP is switched on only on machines with rotary axes; X Y Z are then the tool tip and the
+//! rotary words (named as the machine's axes: C and A on the head_head, A/B and C on trunnions,
+//! B on the dresser) the machine's rotary positions in degrees, unwrapped as the schedule
+//! follows them. Coordinates carry 6 decimals (1 nm, 1 µ°), always with a decimal point (a
+//! Fanuc number without one counts increments of 0.001).
+//!
+//! # Rotary step Δθ (seed 001)
+//!
+//! With `max_rotation_deg` = Δθ, a block whose rotary axes turn by more than Δθ is split by
+//! the rule of [`crate::geometry::biarc::limit_rotation`]: into 2ᵏ pieces of equal parameter
+//! length, k the fewest halvings that bring every piece's turn to at most Δθ (at most 2²⁰).
+//! The new points lie on the path the schedule follows (the span's curve: on a dresser's
+//! fitted profile, points of the fitted arc, as `limit_rotation` places them), shifted
+//! linearly along the block so that the block still starts and ends at the programmed points
+//! (which lie within the fitting tolerance of the curve; on a dresser span fitted by a line the
+//! fitted normal is constant, and the shift turns B evenly from one programmed angle to the
+//! next); their times are the schedule's at the same u. It applies to every kinematics with rotary axes; seed 001's dresser is
+//! the machine that needs it. A pure rotation on the spot is already a block of its own (a
+//! reorientation span), split the same way.
+//!
+//! Joint-space input (a CSV of axis positions) has no tool tip to write: it is rejected.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::geometry::{GeometryOptions, Span, span_points};
+use crate::interpolate::Timeline;
+use crate::kinematics::Kinematics;
+use crate::machine::Machine;
+use crate::optimize::Solution;
+use crate::toolpath::gcode::Dialect;
+use crate::toolpath::{Feed, Toolpath};
+
+/// Blocks shorter than this (s) are merged with the next one.
+pub const MIN_BLOCK_TIME_S: f64 = 1e-5;
+
+/// Most halvings of one block under the Δθ rule (as `limit_rotation`).
+const MAX_HALVINGS: u32 = 20;
+
+/// Significant digits of F.
+const F_DIGITS: i32 = 7;
+
+/// Options of the writer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GcodeOptions {
+    pub dialect: Dialect,
+    /// Δθ: the largest turn of any rotary axis within one block, degrees (`None`: no limit).
+    pub max_rotation_deg: Option<f64>,
+}
+
+/// A written program and what it contains.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Program {
+    pub text: String,
+    /// Motion blocks after the first point (each with its F).
+    pub blocks: usize,
+    /// Of those, blocks under G93.
+    pub inverse_time_blocks: usize,
+    /// Sum of the written block times, s.
+    pub time: f64,
+    /// Blocks merged away because they were shorter than [`MIN_BLOCK_TIME_S`].
+    pub merged: usize,
+    /// Blocks added by the Δθ rule.
+    pub split: usize,
+}
+
+/// One point to write: where, and when the schedule passes it.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    /// Tool tip, mm.
+    p: [f64; 3],
+    /// Path angles, radians.
+    angles: [f64; 2],
+    /// Time, s.
+    t: f64,
+    /// Source line of the CL point (0 for a point added by the Δθ rule).
+    line: usize,
+}
+
+/// The words of one dialect.
+struct Words {
+    header: &'static [&'static str],
+    tcp_on: &'static str,
+    tcp_off: &'static str,
+    footer: &'static [&'static str],
+    comment: fn(&str) -> String,
+}
+
+fn words(dialect: Dialect) -> Words {
+    match dialect {
+        Dialect::LinuxCnc => Words {
+            header: &["G21 G90 G17"],
+            tcp_on: "M428",
+            tcp_off: "M429",
+            footer: &["M30"],
+            comment: |c| format!("({})", c.replace(['(', ')'], "")),
+        },
+        Dialect::Fanuc => Words {
+            header: &["G21 G90 G17"],
+            tcp_on: "G43.4 H1",
+            tcp_off: "G49",
+            footer: &["M30", "%"],
+            comment: |c| format!("({})", c.replace(['(', ')', ';'], "")),
+        },
+        Dialect::Sinumerik => Words {
+            header: &["G710 G90 G17"],
+            tcp_on: "TRAORI",
+            tcp_off: "TRAFOOF",
+            footer: &["M30"],
+            comment: |c| format!("; {c}"),
+        },
+    }
+}
+
+/// A coordinate: 6 decimals, never `-0.000000`.
+fn coord(x: f64) -> String {
+    let s = format!("{x:.6}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        "0.000000".to_string()
+    } else {
+        s
+    }
+}
+
+/// The value a written coordinate reads back as.
+fn rounded(x: f64) -> f64 {
+    coord(x).parse().unwrap_or(x)
+}
+
+/// A feed word's number: `F_DIGITS` significant digits, at least one decimal.
+fn feed_number(f: f64) -> String {
+    let mag = f.abs().log10().floor() as i32;
+    let decimals = (F_DIGITS - 1 - mag).clamp(1, 12) as usize;
+    format!("{f:.decimals$}")
+}
+
+/// The schedule's time at every CL point of the program and the points the Δθ rule adds, in
+/// program order (each span's boundary point once).
+fn nodes(
+    machine: &Machine,
+    toolpath: &Toolpath,
+    solution: &Solution,
+    geometry: &GeometryOptions,
+    max_rotation_rad: Option<f64>,
+) -> Result<(Vec<Node>, usize)> {
+    let kin = &solution.kinematics;
+    let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
+    let plan = span_points(
+        toolpath,
+        &angles,
+        kin.uses_orientation(),
+        geometry.corner_angle_deg,
+    );
+    let spans = &solution.path.spans;
+    let timeline = Timeline::new(solution)?;
+    if plan.len() != spans.len() {
+        return Err(Error::Usage(format!(
+            "{}: the solution has {} spans, the toolpath {}: was it solved with other options?",
+            toolpath.source.display(),
+            spans.len(),
+            plan.len()
+        )));
+    }
+    let pts = &toolpath.points;
+    let mut out: Vec<Node> = Vec::new();
+    let mut split = 0usize;
+    for (si, ((idx, span), tl)) in plan.iter().zip(spans).zip(&timeline.spans).enumerate() {
+        let us = point_parameters(toolpath, idx, span)?;
+        let node = |k: usize, u: f64| Node {
+            p: [pts[idx[k]].p.x, pts[idx[k]].p.y, pts[idx[k]].p.z],
+            angles: angles[idx[k]],
+            t: tl.time_at(u),
+            line: pts[idx[k]].line,
+        };
+        if si == 0 {
+            out.push(node(0, us[0]));
+        }
+        for k in 1..idx.len() {
+            let (ua, ub) = (us[k - 1], us[k]);
+            if let Some(step) = max_rotation_rad {
+                // The span's curve between the block's ends, shifted linearly so that it meets
+                // the programmed points there (they differ by at most the fitting tolerance).
+                let prog = |k: usize| {
+                    let (p, a) = (pts[idx[k]].p, angles[idx[k]]);
+                    [p.x, p.y, p.z, a[0], a[1]]
+                };
+                let curve = |u: f64| {
+                    let w = span.eval(u).value;
+                    [w[0], w[1], w[2], w[3], w[4]]
+                };
+                let (ca, cb) = (curve(ua), curve(ub));
+                let (pa, pb) = (prog(k - 1), prog(k));
+                let at = |u: f64| -> [f64; 5] {
+                    let l = if ub > ua { (u - ua) / (ub - ua) } else { 0.0 };
+                    let c = curve(u);
+                    std::array::from_fn(|j| {
+                        c[j] + (1.0 - l) * (pa[j] - ca[j]) + l * (pb[j] - cb[j])
+                    })
+                };
+                let parts = halvings(&at, ua, ub, step);
+                for j in 1..parts {
+                    let u = ua + (ub - ua) * j as f64 / parts as f64;
+                    let w = at(u);
+                    out.push(Node {
+                        p: [w[0], w[1], w[2]],
+                        angles: [w[3], w[4]],
+                        t: tl.time_at(u),
+                        line: 0,
+                    });
+                    split += 1;
+                }
+            }
+            out.push(node(k, ub));
+        }
+    }
+    Ok((out, split))
+}
+
+/// The number of equal pieces (2ᵏ, k fewest) of [ua, ub] that keep every piece's turn of both
+/// path angles (`at(u)[3..5]`) within `step` rad.
+fn halvings(at: &dyn Fn(f64) -> [f64; 5], ua: f64, ub: f64, step: f64) -> usize {
+    let turn = |a: [f64; 5], b: [f64; 5]| (a[3] - b[3]).abs().max((a[4] - b[4]).abs());
+    for k in 0..=MAX_HALVINGS {
+        let m = 1usize << k;
+        let w: Vec<[f64; 5]> = (0..=m)
+            .map(|j| at(ua + (ub - ua) * j as f64 / m as f64))
+            .collect();
+        if w.windows(2).all(|p| turn(p[0], p[1]) <= step) {
+            return m;
+        }
+    }
+    1 << MAX_HALVINGS
+}
+
+/// The span parameter u of each of the span's CL points: its knot, or on a dresser span
+/// refitted by biarcs (knots ≠ CL points) the nearest point of the fitted profile.
+fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<Vec<f64>> {
+    let knots = span.spline.knots();
+    let pts = &toolpath.points;
+    if knots.len() == idx.len() {
+        if let Some(k) = (0..idx.len()).find(|&k| span.lines[k] != pts[idx[k]].line) {
+            return Err(Error::parse(
+                &toolpath.source,
+                pts[idx[k]].line,
+                format!(
+                    "internal: the span's knot {k} comes from line {}, not from this CL point",
+                    span.lines[k]
+                ),
+            ));
+        }
+        return Ok(knots.to_vec());
+    }
+    // Dresser refit: project on the fitted X–Z profile (a cursor moving forward along it).
+    let d2 = |u: f64, k: usize| {
+        let w = span.eval(u).value;
+        let p = pts[idx[k]].p;
+        (w[0] - p.x).powi(2) + (w[2] - p.z).powi(2)
+    };
+    let mut us = Vec::with_capacity(idx.len());
+    let mut c = 0usize;
+    let last = knots.len() - 1;
+    for k in 0..idx.len() {
+        if k == 0 {
+            us.push(0.0);
+            continue;
+        }
+        if k == idx.len() - 1 {
+            us.push(knots[last]);
+            continue;
+        }
+        while c < last && d2(knots[c + 1], k) <= d2(knots[c], k) {
+            c += 1;
+        }
+        // Golden-section search on the two knot segments around the nearest knot.
+        let (mut a, mut b) = (knots[c.saturating_sub(1)], knots[(c + 1).min(last)]);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..60 {
+            let (x1, x2) = (b - g * (b - a), a + g * (b - a));
+            if d2(x1, k) <= d2(x2, k) {
+                b = x2;
+            } else {
+                a = x1;
+            }
+        }
+        let u = (0.5 * (a + b)).max(*us.last().unwrap_or(&0.0));
+        us.push(u);
+    }
+    Ok(us)
+}
+
+/// Writes the toolpath back as G-code with the schedule's feed per block (see the module doc).
+/// `geometry` must be the options the solution was computed with.
+pub fn program(
+    machine: &Machine,
+    toolpath: &Toolpath,
+    solution: &Solution,
+    geometry: &GeometryOptions,
+    options: &GcodeOptions,
+) -> Result<Program> {
+    let kin = &solution.kinematics;
+    if matches!(kin, Kinematics::Joint { .. }) {
+        return Err(Error::Usage(
+            "a joint-space path has no tool tip to write as G-code".into(),
+        ));
+    }
+    let step = match options.max_rotation_deg {
+        None => None,
+        Some(d) if d.is_finite() && d > 0.0 => Some(d.to_radians()),
+        Some(d) => {
+            return Err(Error::Usage(format!(
+                "the largest rotation per block must be a positive number of degrees, got {d}"
+            )));
+        }
+    };
+    // Rotary words: (letter, path angle index) in the machine's axis order.
+    let mut rotary: Vec<(String, usize)> = Vec::new();
+    for (a, axis) in kin.rotary_axes().iter().enumerate() {
+        if let Some(j) = *axis {
+            let name = machine
+                .axes
+                .get(j)
+                .map(|x| x.name.clone())
+                .unwrap_or_default();
+            if !matches!(name.as_str(), "A" | "B" | "C") {
+                return Err(Error::Usage(format!(
+                    "rotary axis `{name}` cannot be written as a G-code word (A, B or C)"
+                )));
+            }
+            rotary.push((name, a));
+        }
+    }
+    rotary.sort_by_key(|(n, _)| n.clone());
+    let (nodes, split) = nodes(machine, toolpath, solution, geometry, step)?;
+    // Written words of each node, and the merge of tiny blocks.
+    let written = |n: &Node| -> (Vec<String>, [f64; 3], Vec<f64>) {
+        let p = n.p.map(rounded);
+        let r: Vec<f64> = rotary
+            .iter()
+            .map(|(_, a)| rounded(n.angles[*a].to_degrees()))
+            .collect();
+        let mut w = vec![
+            format!("X{}", coord(p[0])),
+            format!("Y{}", coord(p[1])),
+            format!("Z{}", coord(p[2])),
+        ];
+        for ((name, _), v) in rotary.iter().zip(&r) {
+            w.push(format!("{name}{}", coord(*v)));
+        }
+        (w, p, r)
+    };
+    let mut keep: Vec<usize> = vec![0];
+    let mut merged = 0usize;
+    for i in 1..nodes.len() {
+        let last = *keep.last().unwrap_or(&0);
+        let same = written(&nodes[i]).0 == written(&nodes[last]).0;
+        let tiny = nodes[i].t - nodes[last].t < MIN_BLOCK_TIME_S;
+        if i == nodes.len() - 1 {
+            if same || (tiny && keep.len() > 1) {
+                // The last block merges with the one before (its end point is the program's).
+                if keep.len() > 1 {
+                    keep.pop();
+                    merged += 1;
+                } else if same {
+                    merged += 1;
+                    continue;
+                }
+            }
+            keep.push(i);
+        } else if same || tiny {
+            merged += 1;
+        } else {
+            keep.push(i);
+        }
+    }
+
+    let w = words(options.dialect);
+    let mut text = String::new();
+    let comment = |s: &str| (w.comment)(s);
+    let _ = writeln!(
+        text,
+        "{}",
+        comment(&format!(
+            "feedopt: {} on {}, optimised feed per block",
+            toolpath.source.display(),
+            machine.name
+        ))
+    );
+    let _ = writeln!(
+        text,
+        "{}",
+        comment(&format!(
+            "schedule cycle time {:.6} s; G93 F = 60 / block time s, G94 F in mm/min",
+            solution.schedule.cycle_time
+        ))
+    );
+    if options.dialect == Dialect::Fanuc {
+        text.insert_str(0, "%\n");
+    }
+    for h in w.header {
+        let _ = writeln!(text, "{h}");
+    }
+    if !rotary.is_empty() {
+        let _ = writeln!(text, "{}", w.tcp_on);
+    }
+    let first = &nodes[keep[0]];
+    let (words0, mut prev_p, mut prev_r) = written(first);
+    let _ = writeln!(text, "G0 {}", words0.join(" "));
+    let mut inverse_mode = false;
+    let (mut blocks, mut inverse_blocks, mut total) = (0usize, 0usize, 0.0f64);
+    let mut prev_t = first.t;
+    for &i in &keep[1..] {
+        let n = &nodes[i];
+        let (ws, p, r) = written(n);
+        let dt = n.t - prev_t;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::Solver(format!(
+                "block to line {} has no positive time ({dt} s)",
+                n.line
+            )));
+        }
+        let turns = r.iter().zip(&prev_r).any(|(a, b)| a != b);
+        let chord =
+            ((p[0] - prev_p[0]).powi(2) + (p[1] - prev_p[1]).powi(2) + (p[2] - prev_p[2]).powi(2))
+                .sqrt();
+        let (mode, f) = if turns || chord == 0.0 {
+            inverse_blocks += 1;
+            let m = if inverse_mode { "" } else { "G93 " };
+            inverse_mode = true;
+            (m, 60.0 / dt)
+        } else {
+            let m = if inverse_mode { "G94 " } else { "" };
+            inverse_mode = false;
+            (m, chord * 60.0 / dt)
+        };
+        let fw = feed_number(f);
+        let fv: f64 = fw.parse().unwrap_or(f);
+        total += if turns || chord == 0.0 {
+            60.0 / fv
+        } else {
+            chord * 60.0 / fv
+        };
+        let _ = writeln!(text, "{mode}G1 {} F{fw}", ws.join(" "));
+        blocks += 1;
+        (prev_p, prev_r, prev_t) = (p, r, n.t);
+    }
+    if inverse_mode {
+        let _ = writeln!(text, "G94");
+    }
+    if !rotary.is_empty() {
+        let _ = writeln!(text, "{}", w.tcp_off);
+    }
+    for f in w.footer {
+        let _ = writeln!(text, "{f}");
+    }
+    Ok(Program {
+        text,
+        blocks,
+        inverse_time_blocks: inverse_blocks,
+        time: total,
+        merged,
+        split,
+    })
+}
+
+/// Writes [`program`] to `path` atomically; returns the program.
+pub fn write_gcode(
+    path: &Path,
+    machine: &Machine,
+    toolpath: &Toolpath,
+    solution: &Solution,
+    geometry: &GeometryOptions,
+    options: &GcodeOptions,
+) -> Result<Program> {
+    let prog = program(machine, toolpath, solution, geometry, options)?;
+    super::write_atomically(path, prog.text.as_bytes())?;
+    Ok(prog)
+}
+
+/// The time a program's feeds imply, as the reader records them: the sum over every point
+/// after the first of its [`Feed::BlockTime`], or chord / feed for [`Feed::Programmed`]. A
+/// rapid or a move without a feed has no programmed time: an error naming its line.
+pub fn programmed_time(toolpath: &Toolpath) -> Result<f64> {
+    let pts = &toolpath.points;
+    let mut total = 0.0;
+    for k in 1..pts.len() {
+        total += match pts[k].feed {
+            Feed::BlockTime(t) => t,
+            Feed::Programmed(v) => (pts[k].p - pts[k - 1].p).norm() / v,
+            Feed::Rapid | Feed::Unspecified => {
+                return Err(Error::parse(
+                    &toolpath.source,
+                    pts[k].line,
+                    "a rapid or a move without feed has no programmed time",
+                ));
+            }
+        };
+    }
+    Ok(total)
+}

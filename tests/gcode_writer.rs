@@ -1,0 +1,350 @@
+//! `feedopt gcode`: the toolpath written back as G-code with the optimised feed per block, read
+//! back by the project's own G-code reader. The program's feeds must imply the schedule's
+//! cycle time (the reader's block times: G93 60/F, G94 chord/F) and its points must be the
+//! input's.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use feedopt::geometry::GeometryOptions;
+use feedopt::kinematics::Kinematics;
+use feedopt::machine::Machine;
+use feedopt::optimize::{Options, Solution, optimize};
+use feedopt::solver::SolverKind;
+use feedopt::toolpath::{self, ClPoint, Feed, Toolpath, gcode::Dialect};
+use feedopt::writers::gcode::{GcodeOptions, Program, program, programmed_time, write_gcode};
+use nalgebra::Vector3;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn reach() -> Options {
+    Options {
+        solver_kind: SolverKind::Reach,
+        ..Options::default()
+    }
+}
+
+/// The CL points of `t` with their path angles (degrees) on `kin`.
+fn angles_deg(m: &Machine, t: &Toolpath) -> Vec<[f64; 2]> {
+    let kin = Kinematics::new(m);
+    kin.rotary_angles(&t.points, &m.axes)
+        .unwrap()
+        .iter()
+        .map(|a| a.map(f64::to_degrees))
+        .collect()
+}
+
+/// Writes, reads back and checks: no reader warning, programmed time = cycle time within
+/// 0.5 %, every written point an input point within 1e-4 mm / 1e-4° (in order; the input
+/// points skipped are repeats of the point before, which the writer leaves out). Returns the
+/// program and its read-back time.
+fn round_trip(
+    m: &Machine,
+    input: &Toolpath,
+    sol: &Solution,
+    geometry: &GeometryOptions,
+    dialect: Dialect,
+) -> (Program, f64) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.ngc");
+    let options = GcodeOptions {
+        dialect,
+        max_rotation_deg: None,
+    };
+    let prog = write_gcode(&out, m, input, sol, geometry, &options).unwrap();
+    let back = match toolpath::read_as(&out, Some(toolpath::Format::Gcode), dialect).unwrap() {
+        toolpath::Input::Cl(t) => t,
+        toolpath::Input::Joint(_) => unreachable!(),
+    };
+    assert!(
+        back.warnings.is_empty(),
+        "{dialect}: reader warnings {:?}",
+        &back.warnings[..back.warnings.len().min(3)]
+    );
+    // Every block after the first carries a time (no rapid, no missing F).
+    let time = programmed_time(&back).unwrap();
+    let cycle = sol.schedule.cycle_time;
+    assert!(
+        (time - cycle).abs() <= 5e-3 * cycle,
+        "{dialect}: programmed {time} s vs schedule {cycle} s"
+    );
+    // The writer's own sum agrees with the reader's to rounding.
+    assert!(
+        (prog.time - time).abs() <= 1e-6 * cycle,
+        "{} vs {time}",
+        prog.time
+    );
+    assert_eq!(back.points.len(), prog.blocks + 1);
+
+    let kin = Kinematics::new(m);
+    let want = angles_deg(m, input);
+    let rotary = kin.rotary_axes();
+    let got_angles: Vec<[f64; 2]> = back
+        .points
+        .iter()
+        .map(|p| {
+            let a = p.rotary.map_or([0.0; 2], |r| kin.angles_from_rotary(r));
+            a.map(f64::to_degrees)
+        })
+        .collect();
+    let close = |a: &ClPoint, ai: &[f64; 2], b: &ClPoint, bi: &[f64; 2]| {
+        (a.p - b.p).amax() <= 1e-4
+            && (0..2).all(|j| rotary[j].is_none() || (ai[j] - bi[j]).abs() <= 1e-4)
+    };
+    let mut c = 0usize;
+    for (k, p) in back.points.iter().enumerate() {
+        let start = c;
+        while c < input.points.len() && !close(p, &got_angles[k], &input.points[c], &want[c]) {
+            c += 1;
+        }
+        assert!(
+            c < input.points.len(),
+            "{dialect}: written point {k} at line {} ({:?}) is no input point after input {start}",
+            p.line,
+            p.p
+        );
+        // Skipped input points repeat the point before them.
+        for s in start.max(1)..c {
+            assert!(
+                (input.points[s].p - input.points[s - 1].p).norm() <= 1e-6,
+                "{dialect}: input point {s} (line {}) was left out",
+                input.points[s].line
+            );
+        }
+        c += 1;
+    }
+    assert_eq!(
+        c,
+        input.points.len(),
+        "{dialect}: the last input point is written last"
+    );
+    (prog, time)
+}
+
+fn bundled(dir: &str, file: &str) -> (Machine, Toolpath) {
+    let m = Machine::from_file(&root().join(format!("problems/{dir}/machine.json"))).unwrap();
+    let t = toolpath::read(&root().join(format!("problems/{dir}/{file}"))).unwrap();
+    (m, t)
+}
+
+#[test]
+fn the_seed_head_head_blade_round_trips_in_every_dialect() {
+    // APT CL with tool vectors → tool-tip X Y Z and the head's C and A words under TCP.
+    let (m, t) = bundled("seed_head_head", "impeller_blade.cls");
+    let options = Options::default();
+    let sol = optimize(&m, &t, &options).unwrap();
+    for dialect in Dialect::ALL {
+        let (prog, time) = round_trip(&m, &t, &sol, &options.geometry, dialect);
+        // The blade's moves turn the head: those blocks are G93; the straight approach and
+        // retract move X Y Z only: G94.
+        assert!(prog.inverse_time_blocks > 0 && prog.inverse_time_blocks < prog.blocks);
+        assert_eq!(prog.merged, 0);
+        eprintln!(
+            "{dialect}: {} blocks ({} G93), {time:.6} s vs {:.6} s",
+            prog.blocks, prog.inverse_time_blocks, sol.schedule.cycle_time
+        );
+    }
+}
+
+#[test]
+fn a_three_axis_pocket_is_written_with_g94_feeds_only() {
+    let (m, t) = bundled("xyz_pocket", "pocket_contour.cls");
+    let options = reach();
+    let sol = optimize(&m, &t, &options).unwrap();
+    let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
+    assert_eq!(prog.inverse_time_blocks, 0);
+    assert!(
+        !prog
+            .text
+            .lines()
+            .any(|l| l.starts_with("G93") || l.starts_with("M428"))
+    );
+    assert!(!prog.text.contains(" A") && !prog.text.contains(" C"));
+    // Each block's G94 F is its chord over the schedule's time between its CL points: the
+    // first block from rest cannot run at the full feed of the middle.
+    let feeds: Vec<f64> = prog
+        .text
+        .lines()
+        .filter(|l| l.starts_with("G1"))
+        .filter_map(|l| l.split(" F").nth(1))
+        .map(|f| f.parse().unwrap())
+        .collect();
+    let fmax = m.feed_max.unwrap() * 60.0;
+    assert!(
+        feeds.iter().all(|&f| f > 0.0 && f <= fmax * (1.0 + 1e-6)),
+        "{fmax}"
+    );
+    assert!(feeds[0] < 0.5 * feeds.iter().cloned().fold(0.0, f64::max));
+}
+
+fn linuxcnc_dir() -> Option<PathBuf> {
+    let d = root().join("../shared/realworld/linuxcnc");
+    d.join("impeller-7bl-xyzac.ngc").exists().then_some(d)
+}
+
+#[test]
+fn the_linuxcnc_impeller_is_written_back_at_the_schedules_time() {
+    let Some(dir) = linuxcnc_dir() else {
+        eprintln!("../shared/realworld/linuxcnc not present: skipped");
+        return;
+    };
+    let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
+    let t = toolpath::read(&dir.join("impeller-7bl-xyzac.ngc")).unwrap();
+    let options = reach();
+    let sol = optimize(&m, &t, &options).unwrap();
+    let (prog, time) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
+    eprintln!(
+        "impeller: {} blocks ({} G93, {} merged), program {time:.4} s, schedule {:.4} s",
+        prog.blocks, prog.inverse_time_blocks, prog.merged, sol.schedule.cycle_time
+    );
+    // The program's own feeds imply a different time: the written ones are the schedule's.
+    let original = programmed_time(&t);
+    assert!(original.is_err(), "the original has rapids without a time");
+}
+
+/// A dresser dressing a 90° arc of radius 5 (tool on the normal): B turns 90°.
+fn dresser_arc() -> (Machine, Toolpath) {
+    let m = common::machine(
+        r#"{"name": "dresser", "kinematics": {"type": "dresser", "tool_length": 10},
+            "axes": {"X": {"velocity": 50, "acceleration": 500},
+                     "Z": {"velocity": 50, "acceleration": 500},
+                     "B": {"velocity": 60, "acceleration": 300}},
+            "feed": {"max": 50}}"#,
+    );
+    let pts: Vec<ClPoint> = (0..=9)
+        .map(|k| {
+            let phi = (10.0 * k as f64).to_radians();
+            ClPoint {
+                p: Vector3::new(5.0 * phi.sin(), 0.0, -5.0 + 5.0 * phi.cos()),
+                o: Vector3::new(phi.sin(), 0.0, phi.cos()),
+                feed: Feed::Programmed(20.0),
+                rotary: None,
+                line: k + 1,
+            }
+        })
+        .collect();
+    let t = Toolpath {
+        source: PathBuf::from("arc.cls"),
+        points: pts,
+        warnings: Vec::new(),
+    };
+    (m, t)
+}
+
+#[test]
+fn the_rotary_step_rule_splits_dresser_blocks_and_keeps_the_time() {
+    let (m, t) = dresser_arc();
+    let mut options = reach();
+    // The arc turns 10° per CL move: one span, not a corner at every point.
+    options.geometry.corner_angle_deg = 30.0;
+    let sol = optimize(&m, &t, &options).unwrap();
+    // Without Δθ: the programmed points, 10° of B per block.
+    let (plain, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
+    assert_eq!((plain.blocks, plain.split), (9, 0));
+    // Δθ = 3°: each 10° block is bisected twice (2.5° pieces).
+    let o = GcodeOptions {
+        dialect: Dialect::LinuxCnc,
+        max_rotation_deg: Some(3.0),
+    };
+    let prog = program(&m, &t, &sol, &options.geometry, &o).unwrap();
+    assert_eq!((prog.blocks, prog.split), (36, 27));
+    let back =
+        toolpath::gcode::parse(Path::new("split.ngc"), &prog.text, Dialect::LinuxCnc).unwrap();
+    assert!(back.warnings.is_empty(), "{:?}", back.warnings);
+    let b: Vec<f64> = back.points.iter().map(|p| p.rotary.unwrap()[1]).collect();
+    assert!(b.windows(2).all(|w| (w[1] - w[0]).abs() <= 3.0 + 1e-9));
+    assert!((b[36] - 90.0).abs() < 1e-6, "B ends at {}", b[36]);
+    // The added points lie on the path (the circle of radius 5) and the time is kept.
+    for p in &back.points {
+        let r = (p.p.x.powi(2) + (p.p.z + 5.0).powi(2)).sqrt();
+        assert!((r - 5.0).abs() < 1e-3, "r = {r}");
+    }
+    let time = programmed_time(&back).unwrap();
+    let cycle = sol.schedule.cycle_time;
+    assert!((time - cycle).abs() <= 1e-5 * cycle, "{time} vs {cycle}");
+    // A bad Δθ is an error, not a panic.
+    let bad = GcodeOptions {
+        max_rotation_deg: Some(0.0),
+        ..o
+    };
+    assert!(program(&m, &t, &sol, &options.geometry, &bad).is_err());
+}
+
+#[test]
+fn repeated_points_and_pure_reorientations_are_blocks_of_their_own_time() {
+    // A head-head path: move, turn the tool on the spot, repeat a point, move on.
+    let m = Machine::from_file(&root().join("problems/seed_head_head/machine.json")).unwrap();
+    let up = common::UP;
+    let tilted = Vector3::new(0.0, -0.2, 1.0).normalize();
+    let pts = [
+        (Vector3::new(0.0, 0.0, 50.0), up),
+        (Vector3::new(10.0, 0.0, 50.0), up),
+        (Vector3::new(10.0, 0.0, 50.0), tilted),
+        (Vector3::new(10.0, 0.0, 50.0), tilted),
+        (Vector3::new(20.0, 0.0, 50.0), tilted),
+    ];
+    let t = common::toolpath(&pts, Some(20.0));
+    let options = reach();
+    let sol = optimize(&m, &t, &options).unwrap();
+    assert_eq!(sol.path.spans.len(), 3, "move, reorientation, move");
+    let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::Sinumerik);
+    assert_eq!(prog.blocks, 3, "the repeated point is not written");
+    // The reorientation block is G93: its time is the schedule's time of the turn.
+    assert!(prog.text.contains("G93"));
+}
+
+#[test]
+fn the_cli_writes_a_program_and_rejects_joint_space_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pocket.ngc");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .args(args)
+            .current_dir(root())
+            .output()
+            .unwrap()
+    };
+    let o = run(&[
+        "gcode",
+        "--solver",
+        "reach",
+        "--dialect",
+        "fanuc",
+        "--machine",
+        "problems/xyz_pocket/machine.json",
+        "problems/xyz_pocket/pocket_contour.cls",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("%\n") && text.trim_end().ends_with('%'));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("program time"));
+    // Joint-space input: a clear error, nothing written.
+    let csv = dir.path().join("joint.csv");
+    std::fs::write(&csv, "s,q_0\n0,0\n1,1\n2,3\n").unwrap();
+    let mj = dir.path().join("joint.json");
+    std::fs::write(
+        &mj,
+        r#"{"name": "j", "kinematics": {"type": "joint"},
+            "axes": {"0": {"velocity": 10, "acceleration": 100}}}"#,
+    )
+    .unwrap();
+    let out2 = dir.path().join("joint.ngc");
+    let o = run(&[
+        "gcode",
+        "--solver",
+        "reach",
+        "--machine",
+        mj.to_str().unwrap(),
+        csv.to_str().unwrap(),
+        "-o",
+        out2.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("joint-space"));
+    assert!(!out2.exists());
+}

@@ -1,0 +1,227 @@
+//! `feedopt interpolate`: setpoints at a fixed period follow the schedule's motion, stay within
+//! every axis limit when differentiated numerically, match the closed-form trapezoid and
+//! triangle profiles of a straight line, and survive the binary file round trip.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use feedopt::interpolate::{Setpoints, read_setpoints_bin, sample, setpoints_bin, setpoints_csv};
+use feedopt::machine::Machine;
+use feedopt::optimize::{Options, optimize};
+use feedopt::solver::SolverKind;
+use feedopt::toolpath;
+use nalgebra::Vector3;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn seed_setpoints(period: f64) -> (Machine, Setpoints, f64, f64) {
+    let m = Machine::from_file(&root().join("problems/seed_head_head/machine.json")).unwrap();
+    let t = toolpath::read(&root().join("problems/seed_head_head/impeller_blade.cls")).unwrap();
+    let sol = optimize(&m, &t, &Options::default()).unwrap();
+    let sp = sample(&m, &sol, period).unwrap();
+    let length = sol.schedule.stations.last().unwrap().s;
+    (m, sp, sol.schedule.cycle_time, length)
+}
+
+#[test]
+fn finite_differences_of_the_setpoints_stay_within_every_axis_limit() {
+    let period = 1e-3;
+    let (m, sp, cycle, length) = seed_setpoints(period);
+    let s = &sp.samples;
+    // t = kT up to the cycle time, and the final instant itself.
+    assert_eq!(s.len(), (cycle / period).ceil() as usize + 1);
+    assert_eq!(s.last().unwrap().t, cycle);
+    assert!(
+        s.windows(2)
+            .all(|w| w[1].t > w[0].t && w[1].t - w[0].t <= period * (1.0 + 1e-9))
+    );
+    let tol = 1.001;
+    let (mut worst_v, mut worst_a) = (0.0f64, 0.0f64);
+    for (j, axis) in m.axes.iter().enumerate() {
+        for k in 0..s.len() - 1 {
+            let h = s[k + 1].t - s[k].t;
+            let v = (s[k + 1].q[j] - s[k].q[j]) / h;
+            assert!(!v.is_nan());
+            let r = axis.velocity.ratio(v);
+            worst_v = worst_v.max(r);
+            assert!(r <= tol, "{} velocity {v} at t = {}", axis.name, s[k].t);
+            if k > 0 {
+                // Second difference on a possibly uneven last step.
+                let h0 = s[k].t - s[k - 1].t;
+                let a = 2.0 * ((s[k + 1].q[j] - s[k].q[j]) / h - (s[k].q[j] - s[k - 1].q[j]) / h0)
+                    / (h + h0);
+                assert!(!a.is_nan());
+                let r = axis.acceleration.ratio(a);
+                worst_a = worst_a.max(r);
+                assert!(r <= tol, "{} acceleration {a} at t = {}", axis.name, s[k].t);
+            }
+        }
+    }
+    // The schedule is time-optimal: some axis runs at its acceleration limit.
+    assert!(worst_a > 0.9, "worst acceleration ratio {worst_a}");
+    eprintln!("worst ratios: velocity {worst_v:.5}, acceleration {worst_a:.5}");
+    // The feed never exceeds the machine's maximum (the programmed feeds are lower still).
+    let fmax = m.feed_max.unwrap();
+    assert!(s.iter().all(|x| x.feed.is_finite() && x.feed <= fmax * tol));
+    // s never decreases, never outruns the maximum feed, and ends at the schedule's length.
+    for w in s.windows(2) {
+        let ds = w[1].s - w[0].s;
+        assert!(
+            ds >= -1e-12 && ds <= fmax * tol * (w[1].t - w[0].t),
+            "Δs {ds}"
+        );
+    }
+    assert!((s.last().unwrap().s - length).abs() < 1e-9 * length);
+}
+
+/// Setpoints of a straight line of length `len` along X on an xyz machine with velocity and
+/// acceleration limits `v`, `a`, rest to rest, on 1,000 stations (the profile's kinks at
+/// u = v²/2a and len − v²/2a fall on stations for the values used).
+fn line(len: f64, v: f64, a: f64, period: f64) -> (Setpoints, f64) {
+    let m = common::machine(&format!(
+        r#"{{"name": "line", "kinematics": {{"type": "xyz"}},
+            "axes": {{"X": {{"velocity": {v}, "acceleration": {a}}},
+                     "Y": {{"velocity": {v}, "acceleration": {a}}},
+                     "Z": {{"velocity": {v}, "acceleration": {a}}}}}}}"#
+    ));
+    let t = common::toolpath(
+        &[
+            (Vector3::new(0.0, 0.0, 0.0), common::UP),
+            (Vector3::new(len, 0.0, 0.0), common::UP),
+        ],
+        None,
+    );
+    let options = Options {
+        solver_kind: SolverKind::Reach,
+        stations: Some(1000),
+        ..Options::default()
+    };
+    let sol = optimize(&m, &t, &options).unwrap();
+    (sample(&m, &sol, period).unwrap(), sol.schedule.cycle_time)
+}
+
+/// Position of the trapezoid (or triangle) profile at t: accelerate at a to v_peak, cruise,
+/// brake at a.
+fn trapezoid(len: f64, v: f64, a: f64, t: f64) -> (f64, f64) {
+    let vp = v.min((a * len).sqrt());
+    let ta = vp / a;
+    let total = 2.0 * ta + (len - vp * ta) / vp;
+    if t <= ta {
+        (0.5 * a * t * t, a * t)
+    } else if t <= total - ta {
+        (0.5 * vp * ta + vp * (t - ta), vp)
+    } else {
+        let r = total - t;
+        (len - 0.5 * a * r * r, a * r)
+    }
+}
+
+#[test]
+fn a_straight_line_follows_the_trapezoid_and_the_triangle() {
+    for (len, v, a) in [(100.0, 100.0, 1000.0), (4.0, 1000.0, 1000.0)] {
+        let (sp, cycle) = line(len, v, a, 1e-3);
+        let vp = v.min((a * len).sqrt());
+        let expect = 2.0 * vp / a + (len - vp * vp / a) / vp;
+        assert!(
+            (cycle - expect).abs() < 1e-9 * expect,
+            "T {cycle} vs {expect}"
+        );
+        for s in &sp.samples {
+            let (x, feed) = trapezoid(len, v, a, s.t);
+            assert!(
+                (s.q[0] - x).abs() < 1e-9 * len,
+                "t {}: x {} vs {x}",
+                s.t,
+                s.q[0]
+            );
+            assert!(
+                (s.feed - feed).abs() < 1e-9 * v,
+                "t {}: feed {} vs {feed}",
+                s.t,
+                s.feed
+            );
+            assert!((s.s - x).abs() < 1e-9 * len);
+            assert!((s.qd[0] - feed).abs() < 1e-9 * v);
+            assert_eq!((s.q[1], s.q[2]), (0.0, 0.0));
+        }
+        let last = sp.samples.last().unwrap();
+        assert_eq!((last.t, last.q[0]), (cycle, len));
+    }
+}
+
+#[test]
+fn the_binary_file_reads_back_and_the_csv_names_its_units() {
+    let (sp, _) = line(4.0, 1000.0, 1000.0, 5e-4);
+    let bytes = setpoints_bin(&sp).unwrap();
+    let src = Path::new("line.bin");
+    let back = read_setpoints_bin(src, &bytes).unwrap();
+    assert_eq!(
+        (back.axes.clone(), back.kinds.clone()),
+        (sp.axes.clone(), sp.kinds.clone())
+    );
+    assert_eq!((back.period, back.joint), (sp.period, sp.joint));
+    assert_eq!(back.samples.len(), sp.samples.len());
+    for (a, b) in back.samples.iter().zip(&sp.samples) {
+        assert_eq!((a.t, a.s, a.feed, a.q), (b.t, b.s, b.feed, b.q));
+    }
+    // Header 8 + 4·3 + 8 + 8, axes 3 × (1 + 1 + 1), records (3 + 3) f64.
+    assert_eq!(bytes.len(), 36 + 9 + sp.samples.len() * 48);
+    // Damaged files are errors, never panics.
+    assert!(read_setpoints_bin(src, &bytes[..bytes.len() - 3]).is_err());
+    assert!(read_setpoints_bin(src, &bytes[..20]).is_err());
+    let mut bad = bytes.clone();
+    bad[0] = b'X';
+    assert!(read_setpoints_bin(src, &bad).is_err());
+    let csv = setpoints_csv(&sp);
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("t_s,s_mm,feed_mm_s,X_mm,Y_mm,Z_mm"));
+    assert_eq!(lines.count(), sp.samples.len());
+}
+
+#[test]
+fn the_cli_writes_csv_and_binary_setpoints() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["pocket.csv", "pocket.bin"] {
+        let out = dir.path().join(name);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .args([
+                "interpolate",
+                "--solver",
+                "reach",
+                "--period",
+                "2ms",
+                "--machine",
+                "problems/xyz_pocket/machine.json",
+                "problems/xyz_pocket/pocket_contour.cls",
+                "-o",
+                out.to_str().unwrap(),
+            ])
+            .current_dir(root())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(out.exists());
+    }
+    let bytes = std::fs::read(dir.path().join("pocket.bin")).unwrap();
+    let sp = read_setpoints_bin(Path::new("pocket.bin"), &bytes).unwrap();
+    assert_eq!(sp.period, 2e-3);
+    let csv = std::fs::read_to_string(dir.path().join("pocket.csv")).unwrap();
+    assert_eq!(csv.lines().count(), sp.samples.len() + 1);
+    // An unknown extension is refused before any work.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+        .args([
+            "interpolate",
+            "--machine",
+            "problems/xyz_pocket/machine.json",
+            "problems/xyz_pocket/pocket_contour.cls",
+            "-o",
+            dir.path().join("x.txt").to_str().unwrap(),
+        ])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
