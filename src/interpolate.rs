@@ -3,18 +3,11 @@
 //!
 //! # Motion between stations
 //!
-//! The schedule fixes b = u̇² at its stations and takes b linear in u between them, so ü is
-//! constant on each interval (eq. 40–43). [`Interval::state_at`] is that law, the **one**
-//! place where it is written for sampling (and its inverse, [`Interval::time_to`], for the
-//! G-code writer): with r = √b,
-//!
-//! ```text
-//! ü = (b₁ − b₀) / (2 Δu),   r(τ) = r₀ + ü τ,   u(τ) = u₀ + τ (r₀ + r(τ)) / 2,
-//! Δt = 2 Δu / (r₀ + r₁)                                  (eq. 43, closed form)
-//! ```
-//!
-//! exactly the motion [`crate::verify`] re-simulates. A jerk-limited model (b quadratic in u
-//! per interval) only has to change [`Interval`]'s methods.
+//! The schedule fixes b = u̇² at its stations (and ü, for a jerk-limited profile); between
+//! them the motion follows the laws of [`crate::motion`] — for an acceleration-limited profile
+//! b linear in u, ü constant (eq. 40–43) — through [`Interval::at`] (and its inverse,
+//! [`Interval::time_to_x`], for the G-code writer): exactly the motion [`crate::verify`]
+//! re-simulates.
 //!
 //! # Samples
 //!
@@ -50,63 +43,9 @@ use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{Kinematics, MAX_AXES};
 use crate::machine::{AxisKind, Machine};
+use crate::motion::{Interval, State};
 use crate::optimize::Solution;
 use crate::schedule::interval_times;
-
-/// One interval of the schedule between two stations: u and b = u̇² at both ends.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Interval {
-    pub u0: f64,
-    pub u1: f64,
-    pub b0: f64,
-    pub b1: f64,
-}
-
-/// Where the motion is along the path at one instant: u, u̇, ü.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PathState {
-    pub u: f64,
-    pub ud: f64,
-    pub udd: f64,
-}
-
-impl Interval {
-    /// ü on the interval: b linear in u makes it constant, (b₁ − b₀) / (2Δu).
-    fn udd(&self) -> f64 {
-        (self.b1.max(0.0) - self.b0.max(0.0)) / (2.0 * (self.u1 - self.u0))
-    }
-
-    /// The interval's duration, eq. 43: 2Δu / (√b₀ + √b₁) (infinite when b is 0 at both ends).
-    pub fn duration(&self) -> f64 {
-        2.0 * (self.u1 - self.u0) / (self.b0.max(0.0).sqrt() + self.b1.max(0.0).sqrt())
-    }
-
-    /// The motion law: the state `tau` seconds after the interval's start (clamped to the
-    /// interval, so rounding never leaves it). √b(τ) = √b₀ + ü τ, u(τ) = u₀ + τ (√b₀ + √b(τ))/2.
-    pub fn state_at(&self, tau: f64) -> PathState {
-        let (r0, r1) = (self.b0.max(0.0).sqrt(), self.b1.max(0.0).sqrt());
-        let udd = self.udd();
-        let tau = tau.clamp(0.0, self.duration());
-        let r = (r0 + udd * tau).clamp(r0.min(r1), r0.max(r1));
-        let u = (self.u0 + 0.5 * tau * (r0 + r)).clamp(self.u0, self.u1);
-        PathState { u, ud: r, udd }
-    }
-
-    /// The inverse of [`Interval::state_at`]: the time from the interval's start to reach `u`
-    /// (clamped to the interval): b(u) is linear, so τ = 2 (u − u₀) / (√b₀ + √b(u)).
-    pub fn time_to(&self, u: f64) -> f64 {
-        let u = u.clamp(self.u0, self.u1);
-        if u <= self.u0 {
-            return 0.0;
-        }
-        if u >= self.u1 {
-            return self.duration();
-        }
-        let (b0, b1) = (self.b0.max(0.0), self.b1.max(0.0));
-        let b = b0 + (b1 - b0) * (u - self.u0) / (self.u1 - self.u0);
-        2.0 * (u - self.u0) / (b0.sqrt() + b.max(0.0).sqrt())
-    }
-}
 
 /// The schedule's motion as intervals, span by span, with each interval's start time and the
 /// station's arc length there: what the sampler and the G-code writer walk along.
@@ -122,6 +61,8 @@ pub struct Timeline {
 pub struct SpanTimeline {
     pub u: Vec<f64>,
     pub b: Vec<f64>,
+    /// ü at the stations of a jerk-limited profile.
+    pub a: Option<Vec<f64>>,
     /// Time at each station, s (the schedule's).
     pub t: Vec<f64>,
     /// Arc length at each station, mm (the schedule's).
@@ -131,12 +72,7 @@ pub struct SpanTimeline {
 impl SpanTimeline {
     /// Interval `i` (stations i, i + 1).
     pub fn interval(&self, i: usize) -> Interval {
-        Interval {
-            u0: self.u[i],
-            u1: self.u[i + 1],
-            b0: self.b[i],
-            b1: self.b[i + 1],
-        }
+        Interval::of(&self.u, &self.b, self.a.as_deref(), i)
     }
 
     /// The interval containing `u` (the last one at the span's end).
@@ -151,7 +87,13 @@ impl SpanTimeline {
     /// The time (s, global clock) at which the motion passes `u` on this span.
     pub fn time_at(&self, u: f64) -> f64 {
         let i = self.interval_of(u);
-        self.t[i] + self.interval(i).time_to(u)
+        let dt = self.t[i + 1] - self.t[i];
+        self.t[i]
+            + self
+                .interval(i)
+                .time_to_x(u - self.u[i])
+                .unwrap_or(dt)
+                .min(dt)
     }
 }
 
@@ -170,11 +112,12 @@ impl Timeline {
                 )));
             }
             // Checks that the schedule's intervals are traversable (never zero speed).
-            interval_times(p, &sol.b)?;
+            interval_times(p, sol)?;
             let st = &stations[offset..offset + n];
             spans.push(SpanTimeline {
                 u: p.u.clone(),
                 b: sol.b.clone(),
+                a: sol.a.clone(),
                 t: st.iter().map(|s| s.t).collect(),
                 s: st.iter().map(|s| s.s).collect(),
             });
@@ -242,12 +185,13 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
         for i in 0..tl.u.len() - 1 {
             let iv = tl.interval(i);
             let t_end = tl.t[i + 1];
+            let dur = t_end - tl.t[i];
             loop {
                 let t = k as f64 * period;
                 if t >= t_end {
                     break;
                 }
-                samples.push(point(span, kin, na, tl, i, iv.state_at(t - tl.t[i]), t));
+                samples.push(point(span, kin, na, tl, i, iv.at(t - tl.t[i], dur), t));
                 k += 1;
             }
         }
@@ -255,7 +199,7 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
     // The final instant: the end of the last span.
     if let (Some(span), Some(tl)) = (spans.last(), timeline.spans.last()) {
         let i = tl.u.len() - 2;
-        let st = tl.interval(i).state_at(f64::INFINITY);
+        let st = tl.interval(i).ends().1;
         samples.push(point(span, kin, na, tl, i, st, cycle));
     }
     if let Some(bad) = samples.iter().find(|s| {
@@ -288,26 +232,27 @@ fn point(
     na: usize,
     tl: &SpanTimeline,
     i: usize,
-    st: PathState,
+    st: State,
     t: f64,
 ) -> Sample {
-    let w = span.eval(st.u);
+    let u = (tl.u[i] + st.x).min(tl.u[i + 1]);
+    let w = span.eval(u);
     let jets = kin.axis_jets(&w);
     let tip = |u: f64| {
         let d = span.eval(u).d1;
         (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
     };
     let (s, feed) = match span.kind {
-        SpanKind::Joint => (tl.s[i] + (st.u - tl.u[i]), st.ud),
+        SpanKind::Joint => (tl.s[i] + (u - tl.u[i]), st.ud),
         SpanKind::Reorientation => (tl.s[i], 0.0),
         SpanKind::Moving => {
-            let (ua, du) = (tl.u[i], st.u - tl.u[i]);
+            let (ua, du) = (tl.u[i], u - tl.u[i]);
             let s = if du > 0.0 {
-                du / 6.0 * (tip(ua) + 4.0 * tip(ua + 0.5 * du) + tip(st.u))
+                du / 6.0 * (tip(ua) + 4.0 * tip(ua + 0.5 * du) + tip(u))
             } else {
                 0.0
             };
-            (tl.s[i] + s, tip(st.u) * st.ud)
+            (tl.s[i] + s, tip(u) * st.ud)
         }
     };
     let mut out = Sample {
@@ -507,29 +452,20 @@ mod tests {
 
     #[test]
     fn the_law_and_its_inverse_agree() {
-        let iv = Interval {
-            u0: 1.0,
-            u1: 3.0,
-            b0: 4.0,
-            b1: 9.0,
-        };
+        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, 0);
         // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
-        assert!((iv.duration() - 0.8).abs() < 1e-15);
+        let dur = iv.duration().unwrap();
+        assert!((dur - 0.8).abs() < 1e-15);
         for k in 0..=8 {
             let tau = 0.1 * k as f64;
-            let st = iv.state_at(tau);
+            let st = iv.at(tau, dur);
             assert!((st.ud - (2.0 + 1.25 * tau).min(3.0)).abs() < 1e-12);
-            assert!((iv.time_to(st.u) - tau).abs() < 1e-12, "{tau}");
+            assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
         }
         // From rest: u = ½ ü τ².
-        let rest = Interval {
-            u0: 0.0,
-            u1: 2.0,
-            b0: 0.0,
-            b1: 16.0,
-        };
-        let st = rest.state_at(0.5);
-        assert!((st.udd - 4.0).abs() < 1e-15 && (st.u - 0.5).abs() < 1e-15);
-        assert!((rest.time_to(0.5) - 0.5).abs() < 1e-15);
+        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, 0);
+        let st = rest.at(0.5, rest.duration().unwrap());
+        assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
+        assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);
     }
 }

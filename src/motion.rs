@@ -258,6 +258,25 @@ impl Interval {
         }
     }
 
+    /// The time from the interval's start to reach u − u_0 = `x` (clamped to the interval): the
+    /// inverse of [`Interval::at`].
+    pub fn time_to_x(&self, x: f64) -> Result<f64> {
+        let x = x.clamp(0.0, self.du);
+        if x <= 0.0 {
+            return Ok(0.0);
+        }
+        let dur = self.duration()?;
+        Ok(match self.law {
+            Law::Linear => {
+                let b = self.b0 + (self.b1 - self.b0) * x / self.du;
+                2.0 * x / (self.b0.sqrt() + b.max(0.0).sqrt())
+            }
+            Law::Quadratic => self.time_to(x).min(dur),
+            Law::RestStart => dur * (x / self.du).cbrt(),
+            Law::RestEnd => dur * (1.0 - ((self.du - x) / self.du).cbrt()),
+        })
+    }
+
     /// The motion at the interval's start (τ = 0) and end (τ = duration), exactly.
     pub fn ends(&self) -> (State, State) {
         let alpha = if self.law == Law::Quadratic {
@@ -368,6 +387,7 @@ mod tests {
             let tau = dur * k as f64 / 10.0;
             let s = iv.at(tau, dur);
             assert!((iv.time_to(s.x) - tau).abs() < 1e-12);
+            assert!((iv.time_to_x(s.x).unwrap() - tau).abs() < 1e-12);
             let (sp, sm) = (iv.at(tau + h, dur), iv.at(tau - h, dur));
             assert!(((sp.x - sm.x) / (2.0 * h) - s.ud).abs() < 1e-7);
             assert!(((sp.ud - sm.ud) / (2.0 * h) - s.udd).abs() < 1e-6);
@@ -401,6 +421,7 @@ mod tests {
         let mid = iv.at(0.4 * dur, dur);
         let (b, a) = iv.at_x(mid.x);
         assert!((b - mid.b).abs() < 1e-12 && (a - mid.udd).abs() < 1e-12);
+        assert!((iv.time_to_x(mid.x).unwrap() - 0.4 * dur).abs() < 1e-12);
         assert!((s1.uddd - end.uddd).abs() < 1e-12 && (s0.uddd - end.uddd).abs() < 1e-12);
         // The mirror image ends at rest.
         let back = Interval {

@@ -32,7 +32,7 @@ fn explore_copp_jerk() {
         vec![which.parse().unwrap_or(0)]
     };
     let (mut sum_t, mut sum_ref, mut sum_solve) = (0.0, 0.0, 0.0);
-    for idx in list.iter().copied() {
+    for &idx in &list {
         let v: Value = serde_json::from_str(
             &std::fs::read_to_string(dir.join(format!("path_{idx:03}.json"))).unwrap(),
         )

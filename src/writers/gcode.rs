@@ -7,7 +7,7 @@
 //! hence a station of the schedule; the block that ends at it takes the schedule's time between
 //! the stations at the block's two CL points. (A dresser span refitted by biarcs has sample
 //! knots instead: each programmed point is then projected onto the fitted profile and its time
-//! taken there, by the inverse of the motion law, [`crate::interpolate::Interval::time_to`].)
+//! taken there, by the inverse of the motion law, [`crate::motion::Interval::time_to_x`].)
 //! Points the geometry drops (the same position, and on a machine that uses it the same
 //! orientation, as the point before) are not written. Consecutive spans share their boundary
 //! point, written once; a rest-to-rest stop and a pure reorientation (the tip stands, the tool

@@ -5,6 +5,7 @@ use serde_json::{Value, json};
 
 /// The machine file (kinematics `joint`, axis j named `j` as the CSV's `q_j`) of a COPP path's
 /// `limits` (`vel_min`, `vel_max`, `acc_min`, `acc_max` arrays).
+#[allow(dead_code)]
 pub fn machine_json(limits: &Value) -> String {
     machine_json_with(limits, false)
 }
