@@ -29,9 +29,56 @@ pub enum Bound {
     AxisAcceleration(usize),
     /// The programmed feed or the machine's maximum feed.
     Feed,
+    /// The chord error of one interpolation period (seed 004).
+    Chord,
     /// Nothing binds (no finite bound).
     #[default]
     None,
+}
+
+/// The chord-error bound of data-sampling interpolation (seed 004): a controller moves on
+/// straight chords between setpoints one period T apart; on a tool-tip path of curvature κ at
+/// feed V a chord of length V T strays from the curve by about κ (V T)²/8. Keeping that below δ
+/// bounds the feed: `V² ≤ 8δ/(κ T²)`, i.e. `b ≤ 8δ / (κ T² |P'|²)` — one more velocity bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chord {
+    /// δ, mm.
+    pub tolerance: f64,
+    /// T, s.
+    pub period: f64,
+}
+
+impl Chord {
+    /// κ |P'|² at a path point: `|P' × P''| / |P'|` (the tool tip's curvature times the squared
+    /// speed of u); 0 on a straight piece or where the tip stands still.
+    pub fn curvature_term(w: &crate::kinematics::PathJet) -> f64 {
+        let (d1, d2) = (&w.d1, &w.d2);
+        let speed = (d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]).sqrt();
+        if speed <= 0.0 {
+            return 0.0;
+        }
+        let c = [
+            d1[1] * d2[2] - d1[2] * d2[1],
+            d1[2] * d2[0] - d1[0] * d2[2],
+            d1[0] * d2[1] - d1[1] * d2[0],
+        ];
+        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() / speed
+    }
+
+    /// The bound on b at a path point (infinite where the path is straight).
+    pub fn b_max(&self, w: &crate::kinematics::PathJet) -> f64 {
+        let k = Self::curvature_term(w);
+        if k > 0.0 {
+            8.0 * self.tolerance / (k * self.period * self.period)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The chord error (mm) of one period at b there.
+    pub fn error(&self, w: &crate::kinematics::PathJet, b: f64) -> f64 {
+        Self::curvature_term(w) * b * self.period * self.period / 8.0
+    }
 }
 
 /// The discretised problem of one span, ready for a solver.
@@ -132,6 +179,21 @@ impl SpanProblem {
             essential,
             b_start: 0.0,
             b_end: 0.0,
+        }
+    }
+
+    /// Tightens the velocity bounds of a moving span by the chord error of `chord` (seed 004).
+    /// The acceleration row masks stay valid: a lower bound on b only adds implied rows.
+    pub fn apply_chord(&mut self, span: &Span, chord: &Chord) {
+        if span.kind != SpanKind::Moving {
+            return;
+        }
+        for (i, &u) in self.u.iter().enumerate() {
+            let b = chord.b_max(&span.eval(u));
+            if b < self.b_max[i] {
+                self.b_max[i] = b;
+                self.b_max_by[i] = Bound::Chord;
+            }
         }
     }
 

@@ -395,6 +395,9 @@ impl Plan<'_> {
             }
             u.push(old.u[old.intervals()]);
             let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
+            if let Some(c) = &options.verify.chord {
+                p.apply_chord(&self.path.spans[si], c);
+            }
             self.check_travel(si, &p)?;
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
             let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])))?;
@@ -428,7 +431,13 @@ impl Plan<'_> {
                         .into(),
                 ));
             }
-            let jd = JerkData::new(&self.path.spans[si], &self.kin, self.machine, p);
+            let jd = JerkData::new(
+                &self.path.spans[si],
+                &self.kin,
+                self.machine,
+                p,
+                options.verify.chord.as_ref(),
+            );
             let warm = previous.and_then(|(op, os)| Warm::resample(op, os, p));
             return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk);
         }
@@ -451,6 +460,7 @@ impl Plan<'_> {
                 Bound::AxisVelocity(j) => Some(format!("{} velocity", self.axes[j])),
                 Bound::AxisAcceleration(j) => Some(format!("{} acceleration", self.axes[j])),
                 Bound::Feed => Some("the feed cap".to_string()),
+                Bound::Chord => Some("the chord tolerance".to_string()),
                 Bound::None => None,
             })
             .collect();
@@ -490,6 +500,9 @@ impl Plan<'_> {
                 min_parts: parts,
             };
             let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
+            if let Some(c) = &options.verify.chord {
+                p.apply_chord(span, c);
+            }
             self.check_travel(si, &p)?;
             if si == 0 {
                 p.b_start = end_speed(span, &p, 0, options.start_feed, "start")?;

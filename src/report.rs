@@ -132,6 +132,7 @@ impl Summary {
             Bound::AxisVelocity(j) => format!("{} velocity", names[j]),
             Bound::AxisAcceleration(j) => format!("{} acceleration", names[j]),
             Bound::Feed => "feed".to_string(),
+            Bound::Chord => "chord error".to_string(),
             Bound::None => "none".to_string(),
         };
         let mut binding: Vec<BindingShare> = by_bound

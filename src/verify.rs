@@ -20,7 +20,7 @@
 //! of every station interval are checked with that interval's own ü (q̈ jumps at stations), so
 //! the check is at least as strict as the solver's own rows.
 
-use crate::constraints::SpanProblem;
+use crate::constraints::{Chord, SpanProblem};
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
@@ -39,6 +39,9 @@ pub struct VerifyOptions {
     pub period: f64,
     /// Allowed relative excess over a limit: a ratio above `1 + tolerance` is a violation.
     pub tolerance: f64,
+    /// The chord error of each interpolation period to check (and, in the pipeline, to bound:
+    /// [`crate::constraints::Chord`]); `None`: not checked.
+    pub chord: Option<Chord>,
 }
 
 impl Default for VerifyOptions {
@@ -46,6 +49,7 @@ impl Default for VerifyOptions {
         VerifyOptions {
             period: 1e-3,
             tolerance: 1e-3,
+            chord: None,
         }
     }
 }
@@ -62,6 +66,8 @@ pub enum Quantity {
     Feed,
     /// An axis jerk q⃛ (only where the machine file gives jerk limits).
     Jerk,
+    /// The chord error of one interpolation period (only with a chord tolerance).
+    Chord,
 }
 
 /// The worst use of one axis's limits over all samples.
@@ -115,6 +121,8 @@ pub struct Verification {
     pub worst: Vec<AxisWorst>,
     /// Largest V / feed cap (0 where no cap applies).
     pub worst_feed: f64,
+    /// Largest chord error / chord tolerance (0 without a chord tolerance).
+    pub worst_chord: f64,
     /// Station intervals with a violation, before [`MAX_VIOLATIONS`] truncation.
     pub violating_intervals: usize,
     /// The worst violation of each offending (span, interval), worst first, at most
@@ -128,7 +136,7 @@ impl Verification {
         self.worst
             .iter()
             .flat_map(|w| [w.velocity, w.acceleration, w.jerk])
-            .fold(self.worst_feed, f64::max)
+            .fold(self.worst_feed.max(self.worst_chord), f64::max)
     }
 }
 
@@ -180,6 +188,8 @@ pub fn verify(
         threshold: 1.0 + options.tolerance,
         worst: vec![[0.0; 3]; na],
         worst_feed: 0.0,
+        worst_chord: 0.0,
+        chord: options.chord,
         current: None,
         violations: Vec::new(),
     };
@@ -284,6 +294,7 @@ pub fn verify(
             })
             .collect(),
         worst_feed: acc.worst_feed,
+        worst_chord: acc.worst_chord,
         violating_intervals,
         violations,
     })
@@ -296,6 +307,8 @@ struct Point {
     speed: f64,
     /// Every axis's q''' (on the segment's side of a knot), when jerk is checked.
     dddq: Option<[f64; MAX_AXES]>,
+    /// κ |P'|² of the tool tip on a moving span ([`Chord::curvature_term`]), else 0.
+    bend: f64,
 }
 
 impl Point {
@@ -311,6 +324,11 @@ impl Point {
             jets: kin.axis_jets(&w),
             speed,
             dddq,
+            bend: if moving {
+                Chord::curvature_term(&w)
+            } else {
+                0.0
+            },
         }
     }
 }
@@ -323,6 +341,8 @@ struct Accumulator {
     /// [velocity, acceleration, jerk] worst ratio per axis.
     worst: Vec<[f64; 3]>,
     worst_feed: f64,
+    worst_chord: f64,
+    chord: Option<Chord>,
     /// The worst violation of the interval being checked.
     current: Option<Violation>,
     violations: Vec<Violation>,
@@ -357,6 +377,27 @@ impl Accumulator {
                 // q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛.
                 let q3 = d3[j] * r * st.b + 3.0 * jets.ddq[j] * r * st.udd + jets.dq[j] * st.uddd;
                 self.compare(j, 2, Quantity::Jerk, q3, (span, interval, u, t));
+            }
+        }
+        if let Some(c) = self.chord.filter(|_| pt.bend > 0.0) {
+            let e = pt.bend * st.b * c.period * c.period / 8.0;
+            let x = ratio(c.tolerance, e);
+            if x > self.worst_chord {
+                self.worst_chord = x;
+            }
+            if x > self.threshold {
+                record(
+                    &mut self.current,
+                    span,
+                    interval,
+                    u,
+                    t,
+                    None,
+                    Quantity::Chord,
+                    e,
+                    c.tolerance,
+                    x,
+                );
             }
         }
         if cap.is_finite() && speed > 0.0 {

@@ -49,7 +49,7 @@ use clarabel::solver::{
 };
 
 use super::{SolverSettings, SpanSolution, Status};
-use crate::constraints::{SpanProblem, essential_rows};
+use crate::constraints::{Chord, SpanProblem, essential_rows};
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
@@ -135,7 +135,13 @@ const REST_SAMPLES: usize = 8;
 
 impl JerkData {
     /// Evaluates q''' at the stations of `p` and the end-interval bounds.
-    pub fn new(span: &Span, kin: &Kinematics, machine: &Machine, p: &SpanProblem) -> JerkData {
+    pub fn new(
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        p: &SpanProblem,
+        chord: Option<&Chord>,
+    ) -> JerkData {
         let knots = span.spline.knots();
         let last_seg = knots.len() - 2;
         let d3 = |seg: usize, u: f64| {
@@ -189,6 +195,9 @@ impl JerkData {
                         };
                         b_max = b_max.min((v / d).powi(2));
                     }
+                }
+                if let (true, Some(c)) = (moving, chord) {
+                    b_max = b_max.min(c.b_max(&w));
                 }
                 let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
                 if moving && cap.is_finite() {
