@@ -1,6 +1,8 @@
 //! Writers: the schedule as JSON or CSV. Every file is written to a temporary file in the
 //! target's directory and renamed into place, so no half-written output is ever left behind.
 
+pub mod plot;
+
 use std::io::Write;
 use std::path::Path;
 
