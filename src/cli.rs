@@ -265,7 +265,12 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
             .schedules
             .iter()
             .map(|r| writers::plot::ProfileCurve {
-                label: format!("{}: {:.4} s{}", r.label, r.cycle_time_s, if r.verified { "" } else { " (exceeds limits)" }),
+                label: format!(
+                    "{}: {:.4} s{}",
+                    r.label,
+                    r.cycle_time_s,
+                    if r.verified { "" } else { " (exceeds limits)" }
+                ),
                 schedule: &r.schedule,
             })
             .collect();

@@ -433,7 +433,9 @@ fn dynamics(
     for (span, (p, sol)) in spans.iter().zip(problems.iter().zip(solutions)) {
         let b = &sol.b;
         if b.len() != p.u.len() || b.len() < 2 {
-            return Err(Error::Usage("compare: stations and b differ in length".into()));
+            return Err(Error::Usage(
+                "compare: stations and b differ in length".into(),
+            ));
         }
         let dt = interval_times(p, b)?;
         let jets_at = |u: f64| kin.axis_jets(&span.eval(u));
@@ -532,7 +534,9 @@ impl fmt::Display for Comparison {
         line(
             f,
             "cycle time (s)",
-            rows.iter().map(|r| format!("{:.4}", r.cycle_time_s)).collect(),
+            rows.iter()
+                .map(|r| format!("{:.4}", r.cycle_time_s))
+                .collect(),
         )?;
         line(
             f,
@@ -559,7 +563,9 @@ impl fmt::Display for Comparison {
         line(
             f,
             "corners at speed",
-            rows.iter().map(|r| r.corners_at_speed.to_string()).collect(),
+            rows.iter()
+                .map(|r| r.corners_at_speed.to_string())
+                .collect(),
         )?;
         line(
             f,

@@ -72,7 +72,10 @@ pub fn blocks(path: &Path, kin: &Kinematics) -> Vec<Block> {
     let mut out = Vec::new();
     for (si, span) in path.spans.iter().enumerate() {
         let knots = span.spline.knots();
-        let jets: Vec<_> = knots.iter().map(|&u| kin.axis_jets(&span.eval(u))).collect();
+        let jets: Vec<_> = knots
+            .iter()
+            .map(|&u| kin.axis_jets(&span.eval(u)))
+            .collect();
         for k in 0..knots.len() - 1 {
             let len = knots[k + 1] - knots[k];
             let mut d = [0.0; MAX_AXES];
@@ -146,12 +149,12 @@ fn must_stop(a: &Block, b: &Block) -> bool {
 ///
 /// No acceleration is planned: every change of feed (from rest at the start, between blocks,
 /// to rest before a reorientation and at the end) is taken within one servo period `period`,
-/// as a controller without look-ahead would: b ramps linearly over the distance the tip covers
-/// in that period, (F₁ + F₂)·T/2, at the start of the new block (a stop: at the end of the
-/// old one). A block too short for its ramps ramps over what it has. Corners between moving
-/// spans are passed at full feed.
+/// as a controller without look-ahead would, in the faster of the two blocks: b ramps
+/// linearly over the distance the tip covers in that period, (F₁ + F₂)·T/2, so no block
+/// runs above its own feed. A block too short for its ramps takes them over what it has (a
+/// steeper ramp). Corners between moving spans are passed at the lower of the two feeds.
 ///
-/// Returns `Ok(None)` with the reason when the program gives no feed somewhere and the machine
+/// Returns `Ok(Err(reason))` when the program gives no feed somewhere and the machine
 /// file no maximum feed (a joint-space path, for one).
 pub fn programmed_feed(
     machine: &Machine,
@@ -193,46 +196,37 @@ pub fn programmed_feed(
         }
         feeds.push(f);
     }
+    // Speed at each junction: the lower of the two blocks' feeds (0 at rest and at stops).
+    let n = blocks.len();
+    let mut junction = vec![0.0f64; n + 1];
+    for i in 1..n {
+        if !must_stop(&blocks[i - 1], &blocks[i]) {
+            junction[i] = feeds[i - 1].min(feeds[i]);
+        }
+    }
     let mut spans: Vec<Vec<(f64, f64)>> = vec![Vec::new(); path.spans.len()];
-    let mut carried = 0.0f64; // u̇ at the start of the next block
     for (i, b) in blocks.iter().enumerate() {
-        let f = feeds[i];
-        let stop = blocks.get(i + 1).is_none_or(|n| must_stop(b, n));
-        let len = b.length();
-        let x_in = 0.5 * (carried + f) * period;
-        let x_out = if stop { 0.5 * f * period } else { 0.0 };
+        let (f, c0, c1, len) = (feeds[i], junction[i], junction[i + 1], b.length());
+        // Ramps within this block: up from the entry speed at its start, down to the exit
+        // speed at its end, each over the distance one servo period covers.
+        let mut x_in = 0.5 * (c0 + f) * period * f64::from(u8::from(c0 < f));
+        let mut x_out = 0.5 * (c1 + f) * period * f64::from(u8::from(c1 < f));
+        if x_in + x_out > len {
+            let k = len / (x_in + x_out);
+            x_in *= k;
+            x_out *= k;
+        }
         let pts = &mut spans[b.span];
         if pts.is_empty() {
-            pts.push((b.u0, carried * carried));
+            pts.push((b.u0, c0 * c0));
         }
-        if x_in + x_out <= len {
-            if x_in > 0.0 {
-                pts.push((b.u0 + x_in, f * f));
-            }
-            if stop {
-                if len - x_out > x_in {
-                    pts.push((b.u1 - x_out, f * f));
-                }
-                pts.push((b.u1, 0.0));
-                carried = 0.0;
-            } else {
-                if x_in < len {
-                    pts.push((b.u1, f * f));
-                }
-                carried = f;
-            }
-        } else if stop {
-            // Too short for both ramps: up and down over the halves of the block.
-            let peak = (carried * carried).max(f * f * 0.5);
-            pts.push((b.u0 + 0.5 * len, peak));
-            pts.push((b.u1, 0.0));
-            carried = 0.0;
-        } else {
-            // Too short for the ramp: b moves towards F² as far as the block lets it.
-            let end = carried * carried + (f * f - carried * carried) * len / x_in;
-            pts.push((b.u1, end));
-            carried = end.max(0.0).sqrt();
+        if x_in > 0.0 {
+            pts.push((b.u0 + x_in, f * f));
         }
+        if x_out > 0.0 && len - x_out > x_in {
+            pts.push((b.u1 - x_out, f * f));
+        }
+        pts.push((b.u1, c1 * c1));
     }
     Ok(Ok(Profile { spans }))
 }
@@ -387,7 +381,8 @@ pub fn plan_controller(
     // Speeds at the junctions: v[i] at the start of block i, v[n] = 0 at the end.
     let mut v: Vec<f64> = planned.iter().map(|p| p.junction_limit).collect();
     v.push(0.0);
-    let reach = |v0: f64, p: &PlannedBlock| (v0 * v0 + 2.0 * p.acceleration * p.block.length()).sqrt();
+    let reach =
+        |v0: f64, p: &PlannedBlock| (v0 * v0 + 2.0 * p.acceleration * p.block.length()).sqrt();
     for i in (0..n).rev() {
         v[i] = v[i].min(reach(v[i + 1], &planned[i]));
     }

@@ -180,10 +180,7 @@ fn runs_below(points: &[(f64, f64)], y_max: f64) -> Vec<Vec<(f64, f64)>> {
 /// Axis labels of a path: tool-tip length and feed, or a joint-space path's parameter.
 fn path_labels(joint_space: bool) -> (&'static str, &'static str) {
     if joint_space {
-        (
-            "path parameter s (as in the CSV)",
-            "path speed ds/dt (1/s)",
-        )
+        ("path parameter s (as in the CSV)", "path speed ds/dt (1/s)")
     } else {
         ("tool-tip path length s (mm)", "feed V (mm/s)")
     }
@@ -289,7 +286,9 @@ fn draw_solution(
         .filter(|c| c.is_finite())
         .fold(0.0, f64::max);
     // Headroom above the feed for the legend and the limits the feed runs up against.
-    let y_max = (1.7 * v_peak).max(1.1 * cap_peak.min(2.0 * v_peak)).max(1e-9);
+    let y_max = (1.7 * v_peak)
+        .max(1.1 * cap_peak.min(2.0 * v_peak))
+        .max(1e-9);
 
     let root = SVGBackend::with_string(svg, (WIDTH, 1150)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(&x))?;
@@ -539,7 +538,10 @@ fn axis_ratios(
     for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
         for i in 0..p.u.len() {
             for j in 0..na {
-                vel[j].push((st[offset + i].t, machine.axes[j].velocity.ratio(st[offset + i].qd[j])));
+                vel[j].push((
+                    st[offset + i].t,
+                    machine.axes[j].velocity.ratio(st[offset + i].qd[j]),
+                ));
             }
         }
         for k in 0..p.intervals() {
