@@ -201,10 +201,13 @@ pub fn write_solution_plot(
     super::write_atomically(path, svg.as_bytes())
 }
 
+/// (s, V) at an interval's two ends, and the limit binding on it.
+type BoundInterval = ((f64, f64), (f64, f64), Bound);
+
 /// Per-interval feed data of panel 1.
 struct FeedData {
     /// (s, V) per interval end pair, and the interval's binding limit.
-    intervals: Vec<((f64, f64), (f64, f64), Bound)>,
+    intervals: Vec<BoundInterval>,
     mvc: Vec<(f64, f64)>,
     cap: Vec<(f64, f64)>,
     axis_bounds: Vec<Vec<(f64, f64)>>,
@@ -458,7 +461,7 @@ fn draw_solution(
 /// intervals with the same limit. Long ones: per bin of s, the limit binding over most of the
 /// bin's length, and the bin's thinned points.
 fn coloured_runs(
-    intervals: &[((f64, f64), (f64, f64), Bound)],
+    intervals: &[BoundInterval],
     s_max: f64,
 ) -> Vec<(Bound, Vec<(f64, f64)>)> {
     let mut runs: Vec<(Bound, Vec<(f64, f64)>)> = Vec::new();
