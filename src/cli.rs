@@ -27,6 +27,19 @@ pub enum Command {
     Gcode(GcodeArgs),
     /// Solve, then sample every axis's setpoint at a fixed interpolation period.
     Interpolate(InterpolateArgs),
+    /// Compare schedules on one toolpath: the programmed feed, a controller's planner and
+    /// feedopt's time-optimal schedule, all re-simulated alike.
+    Compare(CompareArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Junction deviation δ of the controller baseline, mm (grbl's `$11`): how far the
+    /// virtual arc through a corner may pass from the corner point.
+    #[arg(long, default_value_t = crate::compare::baseline::DEFAULT_JUNCTION_DEVIATION_MM, value_name = "MM")]
+    pub junction_deviation: f64,
 }
 
 #[derive(Debug, Args)]
@@ -43,6 +56,11 @@ pub struct SolveArgs {
     /// FILE.json or FILE.csv.
     #[arg(long, short, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Plot the schedule to FILE.svg: feed against path length, coloured by the limit holding
+    /// it down, with the limits; every axis's velocity and acceleration over its limit against
+    /// time (`compare`: every schedule's feed against path length).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
     /// Total station count (default: refined automatically until doubling changes the cycle
     /// time by less than 0.01 %).
     #[arg(long)]
@@ -135,6 +153,9 @@ impl SolveArgs {
         if let Some(out) = &self.output {
             writers::schedule_format(out)?;
         }
+        if let Some(plot) = &self.plot {
+            writers::plot::plot_format(plot)?;
+        }
         let mut o = Options {
             stations: self.stations,
             solver_kind: match self.solver {
@@ -173,6 +194,33 @@ impl SolveArgs {
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
+    let (input, warnings) = read_input(args)?;
+    let solution = optimize::optimize_input(&machine, &input, &options)?;
+    if let Some(out) = &args.output {
+        writers::write_schedule(out, &solution.schedule)?;
+    }
+    if let Some(plot) = &args.plot {
+        writers::plot::write_solution_plot(
+            plot,
+            &args.toolpath.display().to_string(),
+            &machine,
+            &solution,
+        )?;
+    }
+    let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
+    summary.warnings = warnings;
+    Ok(if args.json {
+        let mut s = serde_json::to_string_pretty(&summary)
+            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+        s.push('\n');
+        s
+    } else {
+        summary.to_string()
+    })
+}
+
+/// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned.
+fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
     let format = args.format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
@@ -191,19 +239,55 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     for w in &warnings {
         eprintln!("feedopt: warning: {w}");
     }
-    let solution = optimize::optimize_input(&machine, &input, &options)?;
-    if let Some(out) = &args.output {
-        writers::write_schedule(out, &solution.schedule)?;
+    Ok((input, warnings))
+}
+
+/// `feedopt compare`: returns what to print on stdout.
+pub fn compare(args: &CompareArgs) -> Result<String> {
+    let a = &args.solve;
+    if a.output.is_some() {
+        return Err(Error::Usage(
+            "compare writes no schedule file (-o): use `feedopt solve -o` for feedopt's".into(),
+        ));
     }
-    let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
-    summary.warnings = warnings;
-    Ok(if args.json {
-        let mut s = serde_json::to_string_pretty(&summary)
+    let options = crate::compare::CompareOptions {
+        solve: a.options()?,
+        junction_deviation: args.junction_deviation,
+    };
+    if !(options.junction_deviation.is_finite() && options.junction_deviation >= 0.0) {
+        return Err(Error::Usage(format!(
+            "--junction-deviation must be ≥ 0 mm, got {}",
+            options.junction_deviation
+        )));
+    }
+    let machine = Machine::from_file(&a.machine)?;
+    let (input, _) = read_input(a)?;
+    let name = a.toolpath.display().to_string();
+    let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
+    if let Some(plot) = &a.plot {
+        let curves: Vec<writers::plot::ProfileCurve> = cmp
+            .schedules
+            .iter()
+            .map(|r| writers::plot::ProfileCurve {
+                label: format!(
+                    "{}: {:.4} s{}",
+                    r.label,
+                    r.cycle_time_s,
+                    if r.verified { "" } else { " (exceeds limits)" }
+                ),
+                schedule: &r.schedule,
+            })
+            .collect();
+        let title = format!("{name} on {}: feed profiles", machine.name);
+        writers::plot::write_profiles_plot(plot, &title, cmp.joint_space, &curves)?;
+    }
+    Ok(if a.json {
+        let mut s = serde_json::to_string_pretty(&cmp)
             .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
         s.push('\n');
         s
     } else {
-        summary.to_string()
+        cmp.to_string()
     })
 }
 
@@ -213,6 +297,7 @@ pub fn run(cli: &Cli) -> Result<String> {
         Command::Solve(args) => solve(args),
         Command::Gcode(args) => gcode(args),
         Command::Interpolate(args) => interpolate(args),
+        Command::Compare(args) => compare(args),
     }
 }
 
@@ -276,6 +361,7 @@ impl PlanArgs {
             start_feed: self.start_feed,
             end_feed: self.end_feed,
             period,
+            plot: None,
         }
     }
 }

@@ -49,6 +49,7 @@
 //! minute as the format defines.
 
 pub mod cli;
+pub mod compare;
 pub mod constraints;
 pub mod error;
 pub mod geometry;

@@ -4,13 +4,52 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use crate::constraints::Bound;
+use crate::constraints::{Bound, SpanProblem};
 use crate::machine::Machine;
 use crate::optimize::{Refinement, Solution};
 use crate::solver::Status;
 
 /// A constraint counts as binding when used to within this fraction of its limit.
 pub const BINDING_TOLERANCE: f64 = 1e-3;
+
+/// The limit holding the feed down on interval k of a span's schedule `b`: the one used most
+/// at either end of the interval (velocity and feed through `b_max`, which names its limit;
+/// every axis's acceleration with the interval's ü), if used to within
+/// [`BINDING_TOLERANCE`]; else [`Bound::None`].
+pub fn interval_binding(p: &SpanProblem, b: &[f64], k: usize) -> Bound {
+    let mut best = (0.0, Bound::None);
+    for e in [k, k + 1] {
+        if p.b_max[e].is_finite() && p.b_max[e] > 0.0 {
+            let r = b[e] / p.b_max[e];
+            if r > best.0 {
+                best = (r, p.b_max_by[e]);
+            }
+        }
+        for (j, lim) in p.acceleration.iter().enumerate() {
+            let r = lim.ratio(p.axis_acceleration(b, k, e, j));
+            if r > best.0 {
+                best = (r, Bound::AxisAcceleration(j));
+            }
+        }
+    }
+    if best.0 >= 1.0 - BINDING_TOLERANCE {
+        best.1
+    } else {
+        Bound::None
+    }
+}
+
+/// How a limit is named in reports and plots: `"X velocity"`, `"C acceleration"`, `"feed"`,
+/// `"none"`.
+pub fn binding_label(bound: Bound, axes: &[&str]) -> String {
+    match bound {
+        Bound::AxisVelocity(j) => format!("{} velocity", axes[j]),
+        Bound::AxisAcceleration(j) => format!("{} acceleration", axes[j]),
+        Bound::Feed => "feed".to_string(),
+        Bound::Chord => "chord error".to_string(),
+        Bound::None => "none".to_string(),
+    }
+}
 
 /// Peak use of an axis's limits.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -98,27 +137,12 @@ impl Summary {
                 }
             }
             for k in 0..p.intervals() {
-                let mut best = (0.0, Bound::None);
                 for e in [k, k + 1] {
-                    if p.b_max[e].is_finite() && p.b_max[e] > 0.0 {
-                        let r = b[e] / p.b_max[e];
-                        if r > best.0 {
-                            best = (r, p.b_max_by[e]);
-                        }
-                    }
                     for (j, lim) in p.acceleration.iter().enumerate() {
-                        let r = lim.ratio(p.axis_acceleration(b, k, e, j));
-                        acc[j] = acc[j].max(r);
-                        if r > best.0 {
-                            best = (r, Bound::AxisAcceleration(j));
-                        }
+                        acc[j] = acc[j].max(lim.ratio(p.axis_acceleration(b, k, e, j)));
                     }
                 }
-                let bound = if best.0 >= 1.0 - BINDING_TOLERANCE {
-                    best.1
-                } else {
-                    Bound::None
-                };
+                let bound = interval_binding(p, b, k);
                 let (a, z) = (&st[offset + k], &st[offset + k + 1]);
                 let e = by_bound.entry(bound).or_insert((0.0, 0.0));
                 e.0 += z.s - a.s;
@@ -128,13 +152,7 @@ impl Summary {
         }
         let length = st.last().map_or(0.0, |s| s.s);
         let time = sol.schedule.cycle_time;
-        let label = |b: Bound| match b {
-            Bound::AxisVelocity(j) => format!("{} velocity", names[j]),
-            Bound::AxisAcceleration(j) => format!("{} acceleration", names[j]),
-            Bound::Feed => "feed".to_string(),
-            Bound::Chord => "chord error".to_string(),
-            Bound::None => "none".to_string(),
-        };
+        let label = |b: Bound| binding_label(b, &names);
         let mut binding: Vec<BindingShare> = by_bound
             .into_iter()
             .map(|(b, (ds, dt))| BindingShare {

@@ -1,0 +1,632 @@
+//! Plots of a schedule (SVG, drawn with `plotters`): where and why the machine slows down.
+//!
+//! [`write_solution_plot`] draws three stacked panels:
+//!
+//! 1. the feed V against the path length s, coloured by the limit that holds it down in each
+//!    interval ([`crate::report::interval_binding`], the same rule as the summary's shares),
+//!    with the limits it runs against: the maximum-velocity curve |P'|·√b_max (every velocity
+//!    limit, the feed cap and the acceleration-limited curvature bound at each station), the
+//!    feed cap, and each axis's velocity bound |P'|·v_q / |q'| (the V at which that axis alone
+//!    reaches its velocity limit);
+//! 2. each axis's |q̇| / v_q against time;
+//! 3. each axis's |q̈| / a_q against time (both ends of every interval, with its ü).
+//!
+//! [`write_profiles_plot`] draws several feed profiles against s in one panel (`feedopt
+//! compare --plot`).
+//!
+//! Only SVG is written: PNG needs a font rasteriser with font files, which feedopt does not
+//! bundle (`rsvg-convert plot.svg -o plot.png` converts). Long schedules are thinned to the
+//! minimum and maximum of each of about two thousand bins along the horizontal axis, so the
+//! envelope is drawn exactly and the file stays small.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use crate::constraints::Bound;
+use crate::error::{Error, Result};
+use crate::geometry::SpanKind;
+use crate::machine::Machine;
+use crate::optimize::Solution;
+use crate::report::{binding_label, interval_binding};
+use crate::schedule::Schedule;
+
+/// Formats a plot can be written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlotFormat {
+    Svg,
+}
+
+/// Checks a plot path before any work is done: a known extension and an existing directory.
+pub fn plot_format(path: &Path) -> Result<PlotFormat> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let format = match ext.as_deref() {
+        Some("svg") => PlotFormat::Svg,
+        Some("png") => {
+            return Err(Error::Usage(format!(
+                "{}: PNG plots are not supported (they need font files feedopt does not \
+                 bundle); write .svg (e.g. `rsvg-convert plot.svg -o plot.png` converts it)",
+                path.display()
+            )));
+        }
+        _ => {
+            return Err(Error::Usage(format!(
+                "{}: unknown plot format (use .svg)",
+                path.display()
+            )));
+        }
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        )));
+    }
+    Ok(format)
+}
+
+/// Bins along the horizontal axis beyond which a series is thinned.
+const BINS: usize = 2000;
+const WIDTH: u32 = 1400;
+const FONT: &str = "sans-serif";
+
+/// Distinct colours: black for the feed, then one per axis limit.
+const PALETTE: [RGBColor; 12] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+    RGBColor(188, 189, 34),
+    RGBColor(127, 127, 127),
+    RGBColor(0, 0, 128),
+    RGBColor(128, 0, 0),
+];
+
+/// Colour of axis `j` (its velocity curves and its velocity binding).
+fn axis_colour(j: usize) -> RGBColor {
+    PALETTE[j % PALETTE.len()]
+}
+
+/// Colour of a binding limit: the axis's colour for its velocity, a darker shade for its
+/// acceleration, teal for the feed, light grey where nothing binds.
+fn bound_colour(b: Bound) -> RGBColor {
+    match b {
+        Bound::Feed => RGBColor(0, 150, 136),
+        Bound::AxisVelocity(j) => axis_colour(j),
+        Bound::AxisAcceleration(j) => {
+            let RGBColor(r, g, b) = axis_colour(j);
+            RGBColor(r / 2, g / 2, b / 2)
+        }
+        Bound::Chord => RGBColor(156, 39, 176),
+        Bound::None => RGBColor(170, 170, 170),
+    }
+}
+
+fn draw_err(path: &Path) -> impl Fn(String) -> Error + '_ {
+    move |e| {
+        Error::io(
+            path,
+            std::io::Error::other(format!("drawing the plot: {e}")),
+        )
+    }
+}
+
+/// Thins a series to the first, minimum, maximum and last point of each of [`BINS`] bins of
+/// x (in order), so its envelope is kept. Short series are returned as they are.
+pub fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    if points.len() <= 2 * BINS {
+        return points.to_vec();
+    }
+    let (x0, x1) = (points[0].0, points[points.len() - 1].0);
+    let width = (x1 - x0).max(f64::MIN_POSITIVE);
+    let bin = |x: f64| (((x - x0) / width * BINS as f64) as usize).min(BINS - 1);
+    let mut out = Vec::with_capacity(4 * BINS);
+    let mut i = 0;
+    while i < points.len() {
+        let b = bin(points[i].0);
+        let start = i;
+        let (mut lo, mut hi) = (i, i);
+        while i < points.len() && bin(points[i].0) == b {
+            if points[i].1 < points[lo].1 {
+                lo = i;
+            }
+            if points[i].1 > points[hi].1 {
+                hi = i;
+            }
+            i += 1;
+        }
+        let mut keep = [start, lo, hi, i - 1];
+        keep.sort_unstable();
+        let mut last = usize::MAX;
+        for k in keep {
+            if k != last {
+                out.push(points[k]);
+                last = k;
+            }
+        }
+    }
+    out
+}
+
+/// Splits a series into runs of finite points at most `y_max` (a bound that leaves the chart
+/// is drawn where it is inside it).
+fn runs_below(points: &[(f64, f64)], y_max: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut runs = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for &(x, y) in points {
+        if y.is_finite() && y <= y_max {
+            cur.push((x, y));
+        } else if !cur.is_empty() {
+            runs.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        runs.push(cur);
+    }
+    runs
+}
+
+/// Axis labels of a path: tool-tip length and feed, or a joint-space path's parameter.
+fn path_labels(joint_space: bool) -> (&'static str, &'static str) {
+    if joint_space {
+        ("path parameter s (as in the CSV)", "path speed ds/dt (1/s)")
+    } else {
+        ("tool-tip path length s (mm)", "feed V (mm/s)")
+    }
+}
+
+/// Writes the three-panel plot of a solution (see the module documentation) to `path` (.svg),
+/// atomically.
+/// `name` names the toolpath in the title.
+pub fn write_solution_plot(
+    path: &Path,
+    name: &str,
+    machine: &Machine,
+    solution: &Solution,
+) -> Result<()> {
+    plot_format(path)?;
+    let mut svg = String::new();
+    draw_solution(&mut svg, name, machine, solution).map_err(draw_err(path))?;
+    super::write_atomically(path, svg.as_bytes())
+}
+
+/// (s, V) at an interval's two ends, and the limit binding on it.
+type BoundInterval = ((f64, f64), (f64, f64), Bound);
+
+/// Per-interval feed data of panel 1.
+struct FeedData {
+    /// (s, V) per interval end pair, and the interval's binding limit.
+    intervals: Vec<BoundInterval>,
+    mvc: Vec<(f64, f64)>,
+    cap: Vec<(f64, f64)>,
+    axis_bounds: Vec<Vec<(f64, f64)>>,
+}
+
+fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
+    let na = solution.kinematics.n_axes().min(machine.axes.len());
+    let st = &solution.schedule.stations;
+    let mut d = FeedData {
+        intervals: Vec::new(),
+        mvc: Vec::new(),
+        cap: Vec::new(),
+        axis_bounds: vec![Vec::new(); na],
+    };
+    let mut offset = 0;
+    for ((p, sol), span) in solution
+        .problems
+        .iter()
+        .zip(&solution.solutions)
+        .zip(&solution.path.spans)
+    {
+        let joint = span.kind == SpanKind::Joint;
+        // V per unit u̇: |P'| on a moving span, 1 on a joint path (a reorientation has none).
+        let scale = |i: usize| if joint { 1.0 } else { p.tip_speed[i] };
+        for i in 0..p.u.len() {
+            let s = st[offset + i].s;
+            if span.kind == SpanKind::Reorientation {
+                continue;
+            }
+            d.mvc.push((s, scale(i) * p.b_max[i].sqrt()));
+            for j in 0..na {
+                let dq = p.jets[i].dq[j];
+                let axis = &machine.axes[j];
+                let v = if dq >= 0.0 {
+                    axis.velocity.max
+                } else {
+                    -axis.velocity.min
+                };
+                d.axis_bounds[j].push((s, scale(i) * v / dq.abs()));
+            }
+        }
+        for k in 0..p.intervals() {
+            let (a, z) = (&st[offset + k], &st[offset + k + 1]);
+            d.intervals
+                .push(((a.s, a.v), (z.s, z.v), interval_binding(p, &sol.b, k)));
+            if !joint && span.kind == SpanKind::Moving {
+                let cap = span.feed_caps[span.spline.segment(0.5 * (p.u[k] + p.u[k + 1]))];
+                d.cap.push((a.s, cap));
+                d.cap.push((z.s, cap));
+            }
+        }
+        offset += p.u.len();
+    }
+    d
+}
+
+fn draw_solution(
+    svg: &mut String,
+    name: &str,
+    machine: &Machine,
+    solution: &Solution,
+) -> std::result::Result<(), String> {
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
+    let joint = solution
+        .path
+        .spans
+        .iter()
+        .any(|s| s.kind == SpanKind::Joint);
+    let (s_label, v_label) = path_labels(joint);
+    let data = feed_data(machine, solution);
+    let st = &solution.schedule.stations;
+    let s_max = st.last().map_or(1.0, |s| s.s).max(1e-9);
+    let v_peak = st.iter().map(|s| s.v).fold(0.0, f64::max);
+    let cap_peak = data
+        .cap
+        .iter()
+        .map(|c| c.1)
+        .filter(|c| c.is_finite())
+        .fold(0.0, f64::max);
+    // Headroom above the feed for the legend and the limits the feed runs up against.
+    let y_max = (1.7 * v_peak)
+        .max(1.1 * cap_peak.min(2.0 * v_peak))
+        .max(1e-9);
+
+    let root = SVGBackend::with_string(svg, (WIDTH, 1150)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let title = format!(
+        "{name} on {}: cycle time {:.4} s",
+        machine.name, solution.schedule.cycle_time
+    );
+    let root = root.titled(&title, (FONT, 22)).map_err(|x| e(&x))?;
+    let (top, bottom) = root.split_vertically(560);
+    let (mid, low) = bottom.split_vertically(290);
+
+    // Panel 1: feed against s.
+    let mut chart = ChartBuilder::on(&top)
+        .caption(
+            "feed, coloured by the limit holding it down, against the limits",
+            (FONT, 17),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..s_max, 0.0..y_max)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc(s_label)
+        .y_desc(v_label)
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (j, pts) in data.axis_bounds.iter().enumerate() {
+        let style = axis_colour(j).mix(0.55).stroke_width(1);
+        let mut first = true;
+        for run in runs_below(&thin(pts), y_max) {
+            let s = chart
+                .draw_series(LineSeries::new(run, style))
+                .map_err(|x| e(&x))?;
+            if first {
+                s.label(format!("{} velocity bound v/|{}'|", names[j], names[j]))
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                first = false;
+            }
+        }
+    }
+    let mvc_style = RGBColor(200, 200, 200).stroke_width(9);
+    let mut first = true;
+    for run in runs_below(&thin(&data.mvc), y_max) {
+        let s = chart
+            .draw_series(LineSeries::new(run, mvc_style))
+            .map_err(|x| e(&x))?;
+        if first {
+            s.label("maximum-velocity curve: velocity limits, feed cap, curvature (at ü = 0)")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], mvc_style));
+            first = false;
+        }
+    }
+    // The feed itself, one polyline per run of intervals with the same binding limit (thinned
+    // per bin of s on long schedules: each bin drawn in the colour of the limit that binds
+    // over most of its length).
+    let mut labelled: Vec<Bound> = Vec::new();
+    for (bound, pts) in coloured_runs(&data.intervals, s_max) {
+        let style = bound_colour(bound).stroke_width(3);
+        let s = chart
+            .draw_series(LineSeries::new(pts, style))
+            .map_err(|x| e(&x))?;
+        if !labelled.contains(&bound) {
+            labelled.push(bound);
+            let what = if bound == Bound::None {
+                "feed V: nothing binds (accelerating / braking between limits)".to_string()
+            } else {
+                format!("feed V held by {}", binding_label(bound, &names))
+            };
+            s.label(what)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+    }
+    // The feed cap on top of the feed (dashed), so both stay visible where the feed runs at it.
+    let cap_style = BLACK.stroke_width(1);
+    let mut first = true;
+    for run in runs_below(&thin(&data.cap), y_max) {
+        let s = chart
+            .draw_series(DashedLineSeries::new(run, 6, 4, cap_style))
+            .map_err(|x| e(&x))?;
+        if first {
+            s.label("feed cap (programmed / machine maximum)")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], cap_style));
+            first = false;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 13))
+        .draw()
+        .map_err(|x| e(&x))?;
+
+    // Panels 2 and 3: axis velocity and acceleration over their limits, against time.
+    let t_max = solution.schedule.cycle_time.max(1e-9);
+    let (vel, acc) = axis_ratios(machine, solution);
+    for (area, series, what) in [
+        (&mid, &vel, "|velocity| / limit"),
+        (&low, &acc, "|acceleration| / limit"),
+    ] {
+        let peak = series
+            .iter()
+            .flat_map(|s| s.iter().map(|p| p.1))
+            .filter(|x| x.is_finite())
+            .fold(1.0, f64::max);
+        let top_y = (1.1 * peak).min(3.0);
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                format!("every axis's {what} (1 = at its limit)"),
+                (FONT, 17),
+            )
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..t_max, 0.0..top_y)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("time t (s)")
+            .y_desc(what)
+            .label_style((FONT, 14))
+            .draw()
+            .map_err(|x| e(&x))?;
+        // The limit first (underneath): an axis running at its limit stays visible on it.
+        chart
+            .draw_series(LineSeries::new(
+                vec![(0.0, 1.0), (t_max, 1.0)],
+                RGBColor(90, 90, 90).stroke_width(3),
+            ))
+            .map_err(|x| e(&x))?;
+        for (j, pts) in series.iter().enumerate() {
+            let style = axis_colour(j).stroke_width(2);
+            for run in runs_below(&thin(pts), top_y) {
+                chart
+                    .draw_series(LineSeries::new(run, style))
+                    .map_err(|x| e(&x))?;
+            }
+        }
+        // The legend: one coloured axis name each, in the panel's top margin, off the data.
+        let (w, _) = area.dim_in_pixel();
+        let slot = 70i32;
+        let x0 = w as i32 - 20 - slot * (names.len() as i32 + 1);
+        area.draw(&Text::new(
+            "limit ━".to_string(),
+            (x0, 6),
+            (FONT, 14).into_font().color(&RGBColor(90, 90, 90)),
+        ))
+        .map_err(|x| e(&x))?;
+        for (j, name) in names.iter().enumerate() {
+            area.draw(&Text::new(
+                format!("━ {name}"),
+                (x0 + slot * (j as i32 + 1), 6),
+                (FONT, 14).into_font().color(&axis_colour(j)),
+            ))
+            .map_err(|x| e(&x))?;
+        }
+    }
+    root.present().map_err(|x| e(&x))?;
+    Ok(())
+}
+
+/// The feed as polylines of one binding limit each. Short schedules: runs of consecutive
+/// intervals with the same limit. Long ones: per bin of s, the limit binding over most of the
+/// bin's length, and the bin's thinned points.
+fn coloured_runs(intervals: &[BoundInterval], s_max: f64) -> Vec<(Bound, Vec<(f64, f64)>)> {
+    let mut runs: Vec<(Bound, Vec<(f64, f64)>)> = Vec::new();
+    if intervals.len() <= 2 * BINS {
+        for &(a, z, b) in intervals {
+            match runs.last_mut() {
+                Some((rb, pts)) if *rb == b => pts.push(z),
+                _ => runs.push((b, vec![a, z])),
+            }
+        }
+        return runs;
+    }
+    let bin = |s: f64| ((s / s_max * BINS as f64) as usize).min(BINS - 1);
+    let mut i = 0;
+    while i < intervals.len() {
+        let b0 = bin(intervals[i].0.0);
+        let mut share: Vec<(Bound, f64)> = Vec::new();
+        let mut pts = vec![intervals[i].0];
+        while i < intervals.len() && bin(intervals[i].0.0) == b0 {
+            let (a, z, b) = intervals[i];
+            match share.iter_mut().find(|x| x.0 == b) {
+                Some(x) => x.1 += z.0 - a.0,
+                None => share.push((b, z.0 - a.0)),
+            }
+            pts.push(z);
+            i += 1;
+        }
+        let dominant = share
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(Bound::None, |x| x.0);
+        let pts = thin_bin(&pts);
+        match runs.last_mut() {
+            Some((rb, run)) if *rb == dominant => run.extend(pts.into_iter().skip(1)),
+            _ => runs.push((dominant, pts)),
+        }
+    }
+    runs
+}
+
+/// First, minimum, maximum and last point of one bin, in order.
+fn thin_bin(pts: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let (mut lo, mut hi) = (0, 0);
+    for (k, p) in pts.iter().enumerate() {
+        if p.1 < pts[lo].1 {
+            lo = k;
+        }
+        if p.1 > pts[hi].1 {
+            hi = k;
+        }
+    }
+    let mut keep = [0, lo, hi, pts.len() - 1];
+    keep.sort_unstable();
+    let mut out = Vec::with_capacity(4);
+    let mut last = usize::MAX;
+    for k in keep {
+        if k != last {
+            out.push(pts[k]);
+            last = k;
+        }
+    }
+    out
+}
+
+/// Per axis, (t, |q̇|/v) at every station and (t, |q̈|/a) at both ends of every interval with
+/// its ü.
+#[allow(clippy::type_complexity)]
+fn axis_ratios(
+    machine: &Machine,
+    solution: &Solution,
+) -> (Vec<Vec<(f64, f64)>>, Vec<Vec<(f64, f64)>>) {
+    let na = solution.kinematics.n_axes().min(machine.axes.len());
+    let st = &solution.schedule.stations;
+    let mut vel = vec![Vec::with_capacity(st.len()); na];
+    let mut acc = vec![Vec::with_capacity(2 * st.len()); na];
+    let mut offset = 0;
+    for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
+        for i in 0..p.u.len() {
+            for j in 0..na {
+                vel[j].push((
+                    st[offset + i].t,
+                    machine.axes[j].velocity.ratio(st[offset + i].qd[j]),
+                ));
+            }
+        }
+        for k in 0..p.intervals() {
+            for e in [k, k + 1] {
+                for j in 0..na {
+                    let a = p.axis_acceleration(&sol.b, k, e, j);
+                    acc[j].push((st[offset + e].t, machine.axes[j].acceleration.ratio(a)));
+                }
+            }
+        }
+        offset += p.u.len();
+    }
+    (vel, acc)
+}
+
+/// One feed profile of [`write_profiles_plot`].
+pub struct ProfileCurve<'a> {
+    pub label: String,
+    pub schedule: &'a Schedule,
+}
+
+/// Writes the feed profiles of several schedules of one path against s in one panel (.svg),
+/// atomically.
+pub fn write_profiles_plot(
+    path: &Path,
+    title: &str,
+    joint_space: bool,
+    curves: &[ProfileCurve],
+) -> Result<()> {
+    plot_format(path)?;
+    let mut svg = String::new();
+    draw_profiles(&mut svg, title, joint_space, curves).map_err(draw_err(path))?;
+    super::write_atomically(path, svg.as_bytes())
+}
+
+fn draw_profiles(
+    svg: &mut String,
+    title: &str,
+    joint_space: bool,
+    curves: &[ProfileCurve],
+) -> std::result::Result<(), String> {
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    let (s_label, v_label) = path_labels(joint_space);
+    let s_max = curves
+        .iter()
+        .filter_map(|c| c.schedule.stations.last().map(|s| s.s))
+        .fold(1e-9, f64::max);
+    let v_max = curves
+        .iter()
+        .flat_map(|c| c.schedule.stations.iter().map(|s| s.v))
+        .fold(1e-9, f64::max);
+    let root = SVGBackend::with_string(svg, (WIDTH, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FONT, 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..s_max, 0.0..1.15 * v_max)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc(s_label)
+        .y_desc(v_label)
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (k, c) in curves.iter().enumerate() {
+        let style = PALETTE[k % PALETTE.len()].stroke_width(2);
+        let pts: Vec<(f64, f64)> = c.schedule.stations.iter().map(|s| (s.s, s.v)).collect();
+        chart
+            .draw_series(LineSeries::new(thin(&pts), style))
+            .map_err(|x| e(&x))?
+            .label(c.label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 13))
+        .draw()
+        .map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))?;
+    Ok(())
+}
