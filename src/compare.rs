@@ -8,7 +8,10 @@
 //! - **controller** — a controller's look-ahead planner: per-block trapezoids with the axes'
 //!   limits applied along each block, junction speeds by grbl's junction deviation, backward
 //!   and forward passes ([`baseline::plan_controller`]);
-//! - **feedopt** — the time-optimal schedule ([`crate::optimize::optimize_input`]).
+//! - **feedopt** — the time-optimal schedule ([`crate::optimize::optimize_input`]),
+//!   acceleration-limited;
+//! - **feedopt_jerk** — the jerk-limited time-optimal schedule (issue 6), when the machine file
+//!   gives jerk limits.
 //!
 //! **One evaluation for all.** Every schedule is expressed the way feedopt expresses its own:
 //! b = u̇² at stations of the same path (feedopt's fitted spans, so every schedule runs on the
@@ -108,8 +111,13 @@ pub const SCHEDULES: &[Entry] = &[
     },
     Entry {
         key: "feedopt",
-        label: "(c) feedopt time-optimal",
+        label: "(c) feedopt time-optimal (acceleration-limited)",
         plan: time_optimal,
+    },
+    Entry {
+        key: "feedopt_jerk",
+        label: "(d) feedopt time-optimal, jerk-limited",
+        plan: jerk_limited,
     },
 ];
 
@@ -162,6 +170,29 @@ fn time_optimal(ctx: &Context) -> Result<std::result::Result<Candidate, String>>
         problems: r.problems.clone(),
         solutions: r.solutions.clone(),
         notes: vec![format!("{} stations, {solver}", r.stations())],
+    }))
+}
+
+/// (d): the jerk-limited optimum on the same path (issue 6), when the machine file gives jerk
+/// limits.
+fn jerk_limited(ctx: &Context) -> Result<std::result::Result<Candidate, String>> {
+    if !ctx.machine.has_jerk() {
+        return Ok(Err("the machine file gives no jerk limits".into()));
+    }
+    let options = Options {
+        jerk_limited: true,
+        solver_kind: crate::solver::SolverKind::Clarabel,
+        ..ctx.options.solve.clone()
+    };
+    let r = optimize::optimize_input(ctx.machine, ctx.input, &options)?;
+    Ok(Ok(Candidate {
+        problems: r.problems,
+        solutions: r.solutions,
+        notes: vec![format!(
+            "{} stations, Clarabel SCP, {} interior-point iterations",
+            r.schedule.stations.len(),
+            r.iterations
+        )],
     }))
 }
 
@@ -289,7 +320,12 @@ pub fn compare(
     toolpath_name: &str,
     options: &CompareOptions,
 ) -> Result<Comparison> {
-    let reference = optimize::optimize_input(machine, input, &options.solve)?;
+    // The reference (c) is acceleration-limited; (d) adds the jerk limits.
+    let accel_only = Options {
+        jerk_limited: false,
+        ..options.solve.clone()
+    };
+    let reference = optimize::optimize_input(machine, input, &accel_only)?;
     let ctx = Context {
         machine,
         input,

@@ -225,7 +225,11 @@ fn every_schedule_is_listed_and_json_has_the_table() {
     );
     let keys: Vec<&str> = cmp.schedules.iter().map(|r| r.key.as_str()).collect();
     let listed: Vec<&str> = feedopt::compare::SCHEDULES.iter().map(|e| e.key).collect();
-    assert_eq!(keys, listed);
+    // Without jerk limits in the machine file the jerk-limited row is omitted, with a reason.
+    assert_eq!(keys, listed[..listed.len() - 1]);
+    assert_eq!(cmp.omitted.len(), 1);
+    assert_eq!(cmp.omitted[0].key, "feedopt_jerk");
+    assert!(cmp.omitted[0].reason.contains("jerk"));
     let json: serde_json::Value = serde_json::to_value(&cmp).unwrap();
     for row in json["schedules"].as_array().unwrap() {
         assert!(row["cycle_time_s"].as_f64().unwrap() > 0.0);
@@ -271,6 +275,11 @@ fn jerk_limits_are_checked_when_the_machine_file_gives_them() {
         c.axes[0].jerk.unwrap() > 1.0 && !c.verified,
         "not jerk-limited (issue 6)"
     );
+    // The jerk-limited schedule keeps every limit, jerk included, and takes longer.
+    let d = cmp.row("feedopt_jerk").expect("a jerk-limited row");
+    assert!(d.verified, "jerk-limited schedule verifies: {:?}", d.axes);
+    assert!(d.axes[0].jerk.unwrap() <= 1.001);
+    assert!(d.cycle_time_s > c.cycle_time_s);
 }
 
 /// The LinuxCNC impeller (G93, 5-axis trunnion): `compare` shows every schedule's worst
