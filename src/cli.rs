@@ -97,6 +97,13 @@ pub struct SolveArgs {
     /// Tool-tip feed at the end of the path, mm/s (default: at rest).
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub end_feed: f64,
+    /// Bound the chord error of each interpolation period (`--period`) by this, mm (seed 004:
+    /// V² ≤ 8δ/(κT²) on a path of curvature κ), checked by the re-simulation.
+    #[arg(long, value_name = "MM")]
+    pub chord_tolerance: Option<f64>,
+    /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
+    #[arg(long)]
+    pub no_jerk: bool,
     /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
     /// (seconds).
     #[arg(long, default_value = "1ms", value_parser = parse_period)]
@@ -166,8 +173,21 @@ impl SolveArgs {
             end_feed: self.end_feed,
             verify: crate::verify::VerifyOptions {
                 period: self.period,
+                chord: match self.chord_tolerance {
+                    None => None,
+                    Some(d) if d.is_finite() && d > 0.0 => Some(crate::constraints::Chord {
+                        tolerance: d,
+                        period: self.period,
+                    }),
+                    Some(d) => {
+                        return Err(Error::Usage(format!(
+                            "--chord-tolerance must be a positive number of mm, got {d}"
+                        )));
+                    }
+                },
                 ..Default::default()
             },
+            jerk_limited: !self.no_jerk,
             ..Options::default()
         };
         o.geometry.corner_angle_deg = self.corner_angle;
@@ -339,6 +359,13 @@ pub struct PlanArgs {
     /// Tool-tip feed at the end of the path, mm/s (default: at rest).
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub end_feed: f64,
+    /// Bound the chord error of each interpolation period (`--period`) by this, mm (seed 004:
+    /// V² ≤ 8δ/(κT²) on a path of curvature κ), checked by the re-simulation.
+    #[arg(long, value_name = "MM")]
+    pub chord_tolerance: Option<f64>,
+    /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
+    #[arg(long)]
+    pub no_jerk: bool,
 }
 
 impl PlanArgs {
@@ -362,6 +389,8 @@ impl PlanArgs {
             end_feed: self.end_feed,
             period,
             plot: None,
+            chord_tolerance: self.chord_tolerance,
+            no_jerk: self.no_jerk,
         }
     }
 }

@@ -27,6 +27,8 @@ pub enum Bound {
     AxisVelocity(usize),
     /// The acceleration limit of axis `j`.
     AxisAcceleration(usize),
+    /// The jerk limit of axis `j` (jerk-limited schedules).
+    AxisJerk(usize),
     /// The programmed feed or the machine's maximum feed.
     Feed,
     /// The chord error of one interpolation period (seed 004).

@@ -195,11 +195,25 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
             stations,
             cycle_time_s: time,
         });
-        let converged = last_time.is_some_and(|a| (a - time).abs() <= options.convergence * time);
+        // A jerk-limited solve stops its SCP at a relative change of `jerk.convergence`: its
+        // times are no finer than that, so doubling the stations cannot be judged finer either.
+        let tol = if plan.machine.has_jerk() {
+            options.convergence.max(10.0 * options.jerk.convergence)
+        } else {
+            options.convergence
+        };
+        let converged = last_time.is_some_and(|a| (a - time).abs() <= tol * time);
         let verification = if options.stations.is_some() || converged {
             let mut v = plan.verify(&lv, options)?;
             let mut round = 0;
             while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
+                if std::env::var_os("FEEDOPT_VERIFY_TRACE").is_some() {
+                    eprintln!(
+                        "verify: {} intervals, worst {:?}",
+                        v.violating_intervals,
+                        v.violations.first()
+                    );
+                }
                 plan.refine_where_violated(&mut lv, &v, options)?;
                 v = plan.verify(&lv, options)?;
                 round += 1;
@@ -459,6 +473,7 @@ impl Plan<'_> {
             .filter_map(|b| match *b {
                 Bound::AxisVelocity(j) => Some(format!("{} velocity", self.axes[j])),
                 Bound::AxisAcceleration(j) => Some(format!("{} acceleration", self.axes[j])),
+                Bound::AxisJerk(j) => Some(format!("{} jerk", self.axes[j])),
                 Bound::Feed => Some("the feed cap".to_string()),
                 Bound::Chord => Some("the chord tolerance".to_string()),
                 Bound::None => None,

@@ -5,18 +5,29 @@ use std::collections::BTreeMap;
 use std::fmt;
 
 use crate::constraints::{Bound, SpanProblem};
+use crate::geometry::Span;
+use crate::kinematics::Kinematics;
 use crate::machine::Machine;
+use crate::motion::Interval;
 use crate::optimize::{Refinement, Solution};
+use crate::solver::SpanSolution;
 use crate::solver::Status;
 
 /// A constraint counts as binding when used to within this fraction of its limit.
 pub const BINDING_TOLERANCE: f64 = 1e-3;
 
-/// The limit holding the feed down on interval k of a span's schedule `b`: the one used most
-/// at either end of the interval (velocity and feed through `b_max`, which names its limit;
-/// every axis's acceleration with the interval's ü), if used to within
+/// The limit holding the feed down on interval k of a span's schedule: the one used most at
+/// either end of the interval (velocity and feed through `b_max`, which names its limit; every
+/// axis's acceleration with the profile's ü there; and, for a jerk-limited profile, the
+/// interval's largest jerk ratio from [`jerk_ratios`]), if used to within
 /// [`BINDING_TOLERANCE`]; else [`Bound::None`].
-pub fn interval_binding(p: &SpanProblem, b: &[f64], k: usize) -> Bound {
+pub fn interval_binding(
+    p: &SpanProblem,
+    sol: &SpanSolution,
+    k: usize,
+    jerk: Option<&[(f64, usize)]>,
+) -> Bound {
+    let b = &sol.b;
     let mut best = (0.0, Bound::None);
     for e in [k, k + 1] {
         if p.b_max[e].is_finite() && p.b_max[e] > 0.0 {
@@ -26,10 +37,15 @@ pub fn interval_binding(p: &SpanProblem, b: &[f64], k: usize) -> Bound {
             }
         }
         for (j, lim) in p.acceleration.iter().enumerate() {
-            let r = lim.ratio(p.axis_acceleration(b, k, e, j));
+            let r = lim.ratio(axis_acceleration(p, sol, k, e, j));
             if r > best.0 {
                 best = (r, Bound::AxisAcceleration(j));
             }
+        }
+    }
+    if let Some(&(r, j)) = jerk.and_then(|v| v.get(k)) {
+        if r > best.0 {
+            best = (r, Bound::AxisJerk(j));
         }
     }
     if best.0 >= 1.0 - BINDING_TOLERANCE {
@@ -39,12 +55,68 @@ pub fn interval_binding(p: &SpanProblem, b: &[f64], k: usize) -> Bound {
     }
 }
 
+/// Axis `j`'s q̈ at station `e` (an end of interval k) under the profile's law.
+fn axis_acceleration(p: &SpanProblem, sol: &SpanSolution, k: usize, e: usize, j: usize) -> f64 {
+    match &sol.a {
+        Some(a) => p.jets[e].ddq[j] * sol.b[e] + p.jets[e].dq[j] * a[e],
+        None => p.axis_acceleration(&sol.b, k, e, j),
+    }
+}
+
+/// Per interval of a jerk-limited profile, the largest |q⃛|/limit at its two ends over the axes
+/// with a jerk limit, and that axis (`q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛` under the motion laws
+/// of [`crate::motion`]); `None` for an acceleration-limited profile or a machine without jerk
+/// limits.
+pub fn jerk_ratios(
+    machine: &Machine,
+    span: &Span,
+    kin: &Kinematics,
+    p: &SpanProblem,
+    sol: &SpanSolution,
+) -> Option<Vec<(f64, usize)>> {
+    let a = sol.a.as_deref()?;
+    if !machine.has_jerk() {
+        return None;
+    }
+    let knots = span.spline.knots();
+    let last = knots.len() - 2;
+    let mut out = Vec::with_capacity(p.intervals());
+    for k in 0..p.intervals() {
+        let iv = Interval::of(&p.u, &sol.b, Some(a), k);
+        let (s0, s1) = iv.ends();
+        let mut best = (0.0, 0);
+        for (e, st) in [(k, s0), (k + 1, s1)] {
+            let u = p.u[e];
+            let mut seg = span.spline.segment(u).min(last);
+            if e == k + 1 && seg > 0 && u <= knots[seg] {
+                seg -= 1;
+            }
+            let w = span.spline.eval_in(seg, u);
+            let d3 = kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, u));
+            let jets = &p.jets[e];
+            for (j, axis) in machine.axes.iter().enumerate().take(kin.n_axes()) {
+                let Some(lim) = axis.jerk else { continue };
+                let q3 = d3[j] * st.ud * st.b
+                    + 3.0 * jets.ddq[j] * st.ud * st.udd
+                    + jets.dq[j] * st.uddd;
+                let r = lim.ratio(q3);
+                if r > best.0 {
+                    best = (r, j);
+                }
+            }
+        }
+        out.push(best);
+    }
+    Some(out)
+}
+
 /// How a limit is named in reports and plots: `"X velocity"`, `"C acceleration"`, `"feed"`,
 /// `"none"`.
 pub fn binding_label(bound: Bound, axes: &[&str]) -> String {
     match bound {
         Bound::AxisVelocity(j) => format!("{} velocity", axes[j]),
         Bound::AxisAcceleration(j) => format!("{} acceleration", axes[j]),
+        Bound::AxisJerk(j) => format!("{} jerk", axes[j]),
         Bound::Feed => "feed".to_string(),
         Bound::Chord => "chord error".to_string(),
         Bound::None => "none".to_string(),
@@ -104,6 +176,10 @@ pub struct Summary {
     pub worst_ratio: Vec<(String, WorstRatio)>,
     /// Worst ratio of the tool-tip feed to its cap (0 without a cap).
     pub worst_feed_ratio: f64,
+    /// Worst chord error of an interpolation period over `--chord-tolerance` (0 without).
+    pub worst_chord_ratio: f64,
+    /// Whether the schedule honours jerk limits (the machine file gives some).
+    pub jerk_limited: bool,
     /// The reader's warnings (`file:line: message`).
     pub warnings: Vec<String>,
 }
@@ -113,6 +189,8 @@ pub struct Summary {
 pub struct WorstRatio {
     pub velocity: f64,
     pub acceleration: f64,
+    /// 0 where the axis has no jerk limit.
+    pub jerk: f64,
 }
 
 fn worst_as_map<S: serde::Serializer>(v: &[(String, WorstRatio)], s: S) -> Result<S::Ok, S::Error> {
@@ -128,8 +206,9 @@ impl Summary {
         let mut by_bound: BTreeMap<Bound, (f64, f64)> = BTreeMap::new();
         let st = &sol.schedule.stations;
         let mut offset = 0;
-        for (p, s) in sol.problems.iter().zip(&sol.solutions) {
+        for ((p, s), span) in sol.problems.iter().zip(&sol.solutions).zip(&sol.path.spans) {
             let b = &s.b;
+            let jerk = jerk_ratios(machine, span, &sol.kinematics, p, s);
             for i in 0..p.u.len() {
                 for (j, axis) in machine.axes.iter().enumerate() {
                     let qd = p.jets[i].dq[j] * b[i].sqrt();
@@ -139,10 +218,10 @@ impl Summary {
             for k in 0..p.intervals() {
                 for e in [k, k + 1] {
                     for (j, lim) in p.acceleration.iter().enumerate() {
-                        acc[j] = acc[j].max(lim.ratio(p.axis_acceleration(b, k, e, j)));
+                        acc[j] = acc[j].max(lim.ratio(axis_acceleration(p, s, k, e, j)));
                     }
                 }
-                let bound = interval_binding(p, b, k);
+                let bound = interval_binding(p, s, k, jerk.as_deref());
                 let (a, z) = (&st[offset + k], &st[offset + k + 1]);
                 let e = by_bound.entry(bound).or_insert((0.0, 0.0));
                 e.0 += z.s - a.s;
@@ -212,11 +291,14 @@ impl Summary {
                         WorstRatio {
                             velocity: w.velocity,
                             acceleration: w.acceleration,
+                            jerk: w.jerk,
                         },
                     )
                 })
                 .collect(),
             worst_feed_ratio: sol.verification.worst_feed,
+            worst_chord_ratio: sol.verification.worst_chord,
+            jerk_limited: sol.solutions.iter().any(|s| s.a.is_some()),
             warnings: Vec::new(),
         }
     }
@@ -291,20 +373,25 @@ impl fmt::Display for Summary {
             self.verify_period_s * 1e3,
             self.worst_ratio
                 .iter()
-                .map(|(_, w)| w.velocity.max(w.acceleration))
-                .fold(self.worst_feed_ratio, f64::max)
+                .map(|(_, w)| w.velocity.max(w.acceleration).max(w.jerk))
+                .fold(self.worst_feed_ratio.max(self.worst_chord_ratio), f64::max)
         )?;
         writeln!(f)?;
         writeln!(
             f,
-            "axis   peak |q̇|/v   peak |q̈|/a   (at stations; re-simulated: |q̇|/v  |q̈|/a)"
+            "axis   peak |q̇|/v   peak |q̈|/a   (at stations; re-simulated: |q̇|/v  |q̈|/a{})",
+            if self.jerk_limited { "  |q⃛|/j" } else { "" }
         )?;
         for ((name, p), (_, w)) in self.axes.iter().zip(&self.worst_ratio) {
-            writeln!(
+            write!(
                 f,
                 "{name:<6} {:>10.3}   {:>10.3}                   {:>10.4} {:>7.4}",
                 p.peak_velocity_ratio, p.peak_acceleration_ratio, w.velocity, w.acceleration
             )?;
+            if self.jerk_limited {
+                write!(f, " {:>7.4}", w.jerk)?;
+            }
+            writeln!(f)?;
         }
         writeln!(f)?;
         writeln!(

@@ -228,8 +228,13 @@ pub fn verify(
             let tb = ta + dt[i];
             // The segment of the spline this interval starts in (a station at a knot starts
             // the next segment: its feed cap applies from there on).
+            let seg_before = seg;
             while seg < last_seg && knots[seg + 1] <= ua {
                 seg += 1;
+            }
+            if jerk && seg != seg_before {
+                // On a knot q''' jumps: the interval starts with its own segment's.
+                at_start = Point::new(span, kin, seg, ua, moving, jerk);
             }
             let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
             acc.check(&at_start, &s0, cap, ua, ta, si, i);

@@ -90,3 +90,93 @@ fn explore_copp_jerk() {
         sum_solve / k * 1e3
     );
 }
+
+#[test]
+#[ignore]
+fn debug_knot() {
+    use feedopt::geometry::{GeometryOptions, Path as GPath};
+    use feedopt::kinematics::Kinematics;
+    let m = Machine::from_file(Path::new("problems/seed_head_head/machine_jerk.json")).unwrap();
+    let tp =
+        feedopt::toolpath::read(Path::new("problems/seed_head_head/impeller_blade.cls")).unwrap();
+    let kin = Kinematics::new(&m);
+    let angles = kin.rotary_angles(&tp.points, &m.axes).unwrap();
+    let path = GPath::build(
+        &tp,
+        &angles,
+        m.feed_max,
+        kin.uses_orientation(),
+        false,
+        &GeometryOptions::default(),
+    )
+    .unwrap();
+    let span = &path.spans[1];
+    let knots = span.spline.knots();
+    let k = knots
+        .iter()
+        .position(|&x| (x - 87.24001595270282).abs() < 1e-6)
+        .unwrap();
+    eprintln!("knot {k} of {}", knots.len());
+    for seg in [k - 1, k] {
+        let w = span.spline.eval_in(seg, knots[k]);
+        let j = kin.axis_jets(&w);
+        let d3 = kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, knots[k]));
+        eprintln!(
+            "seg {seg}: d1 {:?}\n d2 {:?}\n ddq {:?}\n dddq {:?}",
+            w.d1, w.d2, j.ddq, d3
+        );
+    }
+}
+
+#[test]
+#[ignore]
+fn debug_knot2() {
+    use feedopt::motion::Interval;
+    let m = Machine::from_file(Path::new("problems/seed_head_head/machine_jerk.json")).unwrap();
+    let tp =
+        feedopt::toolpath::read(Path::new("problems/seed_head_head/impeller_blade.cls")).unwrap();
+    let o = Options {
+        refine_until_verified: false,
+        stations: Some(2000),
+        ..Options::default()
+    };
+    let sol = feedopt::optimize::optimize(&m, &tp, &o).unwrap();
+    let v = &sol.verification;
+    eprintln!(
+        "violations {}: {:?}",
+        v.violating_intervals,
+        v.violations.first()
+    );
+    let viol = v.violations.first().unwrap();
+    let (p, s) = (&sol.problems[viol.span], &sol.solutions[viol.span]);
+    let span = &sol.path.spans[viol.span];
+    let k = viol.interval;
+    eprintln!(
+        "interval {k}: u {} .. {}, viol u {}",
+        p.u[k],
+        p.u[k + 1],
+        viol.u
+    );
+    let a = s.a.as_ref().unwrap();
+    for kk in [k - 1, k, k + 1] {
+        let iv = Interval::of(&p.u, &s.b, Some(a), kk);
+        let (s0, s1) = iv.ends();
+        for (e, st) in [(kk, s0), (kk + 1, s1)] {
+            for seg in [
+                span.spline.segment(p.u[e]).saturating_sub(1),
+                span.spline.segment(p.u[e]),
+            ] {
+                let w = span.spline.eval_in(seg, p.u[e]);
+                let j = sol.kinematics.axis_jets(&w);
+                let d3 = sol
+                    .kinematics
+                    .axis_third_derivatives(&w, &span.spline.d3_in(seg, p.u[e]));
+                let q3 = d3[4] * st.ud * st.b + 3.0 * j.ddq[4] * st.ud * st.udd + j.dq[4] * st.uddd;
+                eprintln!(
+                    "iv {kk} e {e} u {} seg {seg}: law {:?} b {} a {} uddd {} jerkA {q3}",
+                    p.u[e], iv.law, st.b, st.udd, st.uddd
+                );
+            }
+        }
+    }
+}

@@ -831,11 +831,16 @@ fn subproblem(
                 )));
             }
         };
+        // Any omitted row violated: add it, and with it every omitted row within half of its
+        // limit at this solution (the next solution is likely to lean on them too).
+        let violated = (0..cand.len()).any(|r| !active[r] && cand.value(r, &sol.x) > 1.0 + 1e-9);
         let mut added = 0;
-        for (r, act) in active.iter_mut().enumerate() {
-            if !*act && cand.value(r, &sol.x) > 1.0 + 1e-9 {
-                *act = true;
-                added += 1;
+        if violated {
+            for (r, act) in active.iter_mut().enumerate() {
+                if !*act && cand.value(r, &sol.x) > 2.0 / 3.0 {
+                    *act = true;
+                    added += 1;
+                }
             }
         }
         if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {

@@ -109,6 +109,10 @@ fn bound_colour(b: Bound) -> RGBColor {
             let RGBColor(r, g, b) = axis_colour(j);
             RGBColor(r / 2, g / 2, b / 2)
         }
+        Bound::AxisJerk(j) => {
+            let RGBColor(r, g, b) = axis_colour(j);
+            RGBColor(r / 2 + 127, g / 2 + 127, b / 2 + 127)
+        }
         Bound::Chord => RGBColor(156, 39, 176),
         Bound::None => RGBColor(170, 170, 170),
     }
@@ -250,10 +254,14 @@ fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
                 d.axis_bounds[j].push((s, scale(i) * v / dq.abs()));
             }
         }
+        let jerk = crate::report::jerk_ratios(machine, span, &solution.kinematics, p, sol);
         for k in 0..p.intervals() {
             let (a, z) = (&st[offset + k], &st[offset + k + 1]);
-            d.intervals
-                .push(((a.s, a.v), (z.s, z.v), interval_binding(p, &sol.b, k)));
+            d.intervals.push((
+                (a.s, a.v),
+                (z.s, z.v),
+                interval_binding(p, sol, k, jerk.as_deref()),
+            ));
             if !joint && span.kind == SpanKind::Moving {
                 let cap = span.feed_caps[span.spline.segment(0.5 * (p.u[k] + p.u[k + 1]))];
                 d.cap.push((a.s, cap));
