@@ -699,7 +699,14 @@ impl Sweep {
                 .configure_mesh()
                 .x_desc(xlabel.as_str())
                 .y_desc(format!("dT/d(limit) [s per {}]", self.unit))
-                .y_label_formatter(&|y| format!("{y:.2e}"))
+                .y_label_formatter(&|y| {
+                    // A tick at zero, not at the rounding error next to it.
+                    if y.abs() < 1e-9 * (s1 - s0) {
+                        "0".to_string()
+                    } else {
+                        format!("{y:.2e}")
+                    }
+                })
                 .draw()
                 .map_err(|e| fail(&e))?;
             if self.points.iter().any(|p| p.sensitivity_dual.is_some()) {
@@ -853,4 +860,43 @@ impl fmt::Display for Sweep {
 
 fn truncate(s: &str, n: usize) -> String {
     s.chars().take(n).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::AxisJets;
+
+    #[test]
+    fn the_vertex_bound_moves_with_the_limits_that_make_it() {
+        // Axis 0 (q' = 1, q'' = 1, ±2) and axis 1 (q' = −1, q'' = 1, ±1): in the (b, ü) plane
+        // the rows are ü ≤ 2 − b, ü ≥ −2 − b, ü ≥ b − 1, ü ≤ b + 1; the polygon closes where
+        // 2 − b = b − 1, so b* = (a₀ + a₁)/2 = 1.5: ∂b*/∂μ is a₀/2 = 1 for axis 0, a₁/2 = 0.5
+        // for axis 1.
+        let mut jet = AxisJets::default();
+        (jet.dq[0], jet.ddq[0], jet.dq[1], jet.ddq[1]) = (1.0, 1.0, -1.0, 1.0);
+        let acceleration = vec![Limit::symmetric(2.0), Limit::symmetric(1.0)];
+        let (_, b_star, _) = essential_rows(&jet, &acceleration, 10.0);
+        assert!((b_star - 1.5).abs() < 1e-12);
+        let p = SpanProblem {
+            u: vec![0.0, 1.0],
+            b_max: vec![b_star; 2],
+            b_max_by: vec![Bound::AxisAcceleration(0); 2],
+            tip_speed: vec![0.0; 2],
+            jets: vec![jet; 2],
+            acceleration,
+            essential: vec![u16::MAX; 2],
+            b_start: 0.0,
+            b_end: 0.0,
+        };
+        assert!((db_star_dmu(&p, 0, 0) - 1.0).abs() < 1e-8);
+        assert!((db_star_dmu(&p, 0, 1) - 0.5).abs() < 1e-8);
+    }
+
+    #[test]
+    fn smoothness_needs_a_line_and_one_sign() {
+        assert!(smooth(-1.0, -0.9, -0.8));
+        assert!(!smooth(-1.0, -0.5, -0.8)); // a kink
+        assert!(!smooth(-0.01, 0.0, 0.01)); // noise around zero
+    }
 }

@@ -286,9 +286,90 @@ fn impeller_c_acceleration_sweep_at_full_resolution() {
         &m,
         &input,
         "impeller-7bl-xyzac.ngc",
-        &SweepOptions::new("C", SweptLimit::Acceleration, 60.0, 300.0, 5),
+        &SweepOptions::new("C", SweptLimit::Acceleration, 60.0, 300.0, 3),
     )
     .unwrap();
     eprintln!("wall time {:.1} s", t0.elapsed().as_secs_f64());
     check_impeller_sweep(&s);
+}
+
+#[test]
+fn the_command_writes_csv_json_and_svg_and_names_unknown_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("m.json");
+    std::fs::write(
+        &m,
+        r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 400, "acceleration": 500},
+                     "Y": {"velocity": 400, "acceleration": 500},
+                     "Z": {"velocity": 400, "acceleration": 500}}}"#,
+    )
+    .unwrap();
+    let t = dir.path().join("line.ngc");
+    std::fs::write(&t, "G21 G90 G0 X0 Y0 Z0\nG1 X100 F60000\n").unwrap();
+    let (csv, svg) = (dir.path().join("s.csv"), dir.path().join("s.svg"));
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .arg("sweep")
+            .arg("--machine")
+            .arg(&m)
+            .arg(&t)
+            .args(["--limit", "acceleration", "--from", "200", "--to", "800"])
+            .args(["--steps", "3", "--stations", "400"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "--axis",
+        "X",
+        "--json",
+        "-o",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    // T = 2√(L/a) at the three limits.
+    for p in points {
+        let a = p["limit"].as_f64().unwrap();
+        let t = p["cycle_time_s"].as_f64().unwrap();
+        assert!(rel(t, 2.0 * (100.0 / a).sqrt()) < 1e-6);
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4);
+    assert!(lines[0].starts_with("limit,cycle_time_s,dT_dlimit_dual,dT_dlimit_fd"));
+    assert!(lines[0].contains("path_share_X_acceleration"));
+    let plot = std::fs::read_to_string(&svg).unwrap();
+    assert!(plot.starts_with("<svg"));
+    for label in [
+        "X acceleration limit [mm/s²]",
+        "cycle time [s]",
+        "dT/d(limit) [s per mm/s²]",
+        "from the duals",
+        "central differences",
+    ] {
+        assert!(plot.contains(label), "the plot lacks {label}");
+    }
+    // The readable table names the axis and its unit.
+    let out = run(&["--axis", "X"]);
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(table.contains("X acceleration limit") && table.contains("[mm/s²]"));
+
+    let out = run(&["--axis", "B"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--axis B") && err.contains("X, Y, Z"), "{err}");
+    let bad = dir.path().join("p.png");
+    let out = run(&["--axis", "X", "--plot", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!bad.exists());
 }
