@@ -30,6 +30,8 @@ pub enum Command {
     /// Compare schedules on one toolpath: the programmed feed, a controller's planner and
     /// feedopt's time-optimal schedule, all re-simulated alike.
     Compare(CompareArgs),
+    /// Constraint study: cycle time and its sensitivity against one axis limit.
+    Sweep(SweepArgs),
 }
 
 #[derive(Debug, Args)]
@@ -43,6 +45,37 @@ pub struct CompareArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Machine, toolpath, --json, -o (here: the sweep table as FILE.csv or FILE.json) and the
+    /// solve options. `--stations N` fixes the stations of every step; without it they are
+    /// refined once at the machine's own limits (with the reachability pass) and then fixed.
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Axis whose limit is swept, as named in the machine file (e.g. C).
+    #[arg(long)]
+    pub axis: String,
+    /// Which limit: velocity or acceleration. An asymmetric limit is scaled proportionally so
+    /// that its max is the value.
+    #[arg(long, value_enum)]
+    pub limit: crate::sweep::SweptLimit,
+    /// First limit value (mm/s, mm/s², deg/s or deg/s²).
+    #[arg(long)]
+    pub from: f64,
+    /// Last limit value.
+    #[arg(long)]
+    pub to: f64,
+    /// Number of values from --from to --to, evenly spaced.
+    #[arg(long, default_value_t = 20)]
+    pub steps: usize,
+    /// Relative step of the central finite differences of the cycle time.
+    #[arg(long, default_value_t = 0.01)]
+    pub fd_step: f64,
+    /// Plot cycle time and sensitivity against the limit to FILE.svg.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
 pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
@@ -53,7 +86,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub json: bool,
     /// Write the full schedule (per station: u, s, t, V, A and every axis's q, q̇, q̈) to
-    /// FILE.json or FILE.csv.
+    /// FILE.json or FILE.csv (sweep: the sweep table).
     #[arg(long, short, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Plot the schedule to FILE.svg: feed against path length, coloured by the limit holding
@@ -311,6 +344,48 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
     })
 }
 
+/// `feedopt sweep`: returns what to print on stdout.
+pub fn sweep(args: &SweepArgs) -> Result<String> {
+    use std::io::IsTerminal;
+    let solve = &args.solve;
+    let options = solve.options()?;
+    if let Some(plot) = &args.plot {
+        let svg = plot
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+        let dir = match plot.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => std::path::Path::new("."),
+        };
+        if !svg || !dir.is_dir() {
+            return Err(Error::Usage(format!(
+                "--plot {}: needs a .svg file in an existing directory",
+                plot.display()
+            )));
+        }
+    }
+    let machine = Machine::from_file(&solve.machine)?;
+    let (input, _) = read_input(solve)?;
+    let mut o =
+        crate::sweep::SweepOptions::new(&args.axis, args.limit, args.from, args.to, args.steps);
+    o.fd_step = args.fd_step;
+    o.solve = options;
+    o.progress = !solve.json && std::io::stderr().is_terminal();
+    let result = crate::sweep::sweep(&machine, &input, &solve.toolpath.display().to_string(), &o)?;
+    if let Some(out) = &solve.output {
+        result.write(out)?;
+    }
+    if let Some(plot) = &args.plot {
+        result.write_plot(plot)?;
+    }
+    if solve.json {
+        result.to_json()
+    } else {
+        Ok(result.to_string())
+    }
+}
+
 /// Runs a parsed command line; returns what to print on stdout.
 pub fn run(cli: &Cli) -> Result<String> {
     match &cli.command {
@@ -318,6 +393,7 @@ pub fn run(cli: &Cli) -> Result<String> {
         Command::Gcode(args) => gcode(args),
         Command::Interpolate(args) => interpolate(args),
         Command::Compare(args) => compare(args),
+        Command::Sweep(args) => sweep(args),
     }
 }
 
@@ -399,22 +475,7 @@ impl PlanArgs {
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
-    let format = args.format.map(|f| match f {
-        FormatChoice::Apt => toolpath::Format::Apt,
-        FormatChoice::Gcode => toolpath::Format::Gcode,
-        FormatChoice::Csv => toolpath::Format::Csv,
-    });
-    let input = toolpath::read_as(&args.toolpath, format, args.dialect)?;
-    if let toolpath::Input::Cl(t) = &input {
-        for w in &t.warnings {
-            eprintln!(
-                "feedopt: warning: {}:{}: {}",
-                args.toolpath.display(),
-                w.line,
-                w.message
-            );
-        }
-    }
+    let (input, _) = read_input(args)?;
     let solution = optimize::optimize_input(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
 }

@@ -61,6 +61,7 @@ pub mod optimize;
 pub mod report;
 pub mod schedule;
 pub mod solver;
+pub mod sweep;
 pub mod toolpath;
 pub mod verify;
 pub mod writers;

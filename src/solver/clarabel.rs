@@ -24,6 +24,26 @@
 //! solver's gap tolerance, never slower than the reachability profile (which is feasible for
 //! every window). Cost and memory then grow
 //! linearly with the stations, and both cores work on one span.
+//!
+//! **Sensitivities from the dual variables.** Clarabel solves min qᵀz s.t. Az + s = h,
+//! s ∈ K, and returns the dual y ∈ K* with q + Aᵀy = 0. The objective here is the cycle time
+//! T itself (s), so by the envelope theorem the optimal T moves with any parameter θ of the
+//! rows as dT/dθ = ∂/∂θ [yᵀ(Az − h)] at the optimum. For the rows that carry a limit:
+//!
+//! - velocity and feed, x_i ≤ b_max_i / B: dT/db_max_i = −y_i / B (s per unit of b = u̇²);
+//! - acceleration, (g·z + c)/a ≤ 1 with a = a_max (or a = a_min < 0, which flips the
+//!   inequality the normalisation divides by): dT/da = −y_r (g·z + c)/a² = −y_r / a, because
+//!   complementary slackness makes (g·z + c)/a = 1 wherever y_r > 0. The same formula holds
+//!   for both sides; for a_min it is positive (a more negative a_min is looser). Summed over
+//!   every row of the axis and side: [`Sensitivity::acceleration`].
+//!
+//! Dropped rows (implied by the others, [`essential_rows`](crate::constraints::essential_rows))
+//! carry no multiplier; the implied bound b* they give is stated as `b_max` instead, so part of
+//! the multiplier of an acceleration-limited station can sit on its `b_max` row: a caller who
+//! changes an acceleration limit must add dT/db_max_i · ∂b*_i/∂a there (see
+//! [`crate::sweep`]). The end stations (fixed b) have no rows. A windowed solve
+//! ([`solve_windowed`]) fixes b at its stitches to values that themselves depend on the limits,
+//! so only [`solve_with_sensitivity`] (one window) returns sensitivities.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -83,8 +103,46 @@ impl Rows {
     }
 }
 
+/// What a linear row bounds (for the sensitivities).
+#[derive(Debug, Clone, Copy)]
+enum RowTag {
+    /// x_i ≤ b_max_i / B.
+    BMax(usize),
+    /// An acceleration row of axis `j` normalised by `limit` (a_max or a_min).
+    Acceleration { j: usize, upper: bool, limit: f64 },
+}
+
+/// First-order sensitivities of one span's optimal time T to its bounds, from the dual
+/// variables (module doc: dT/db_max_i = −y_i/B, dT/da = −Σ y_r/a).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Sensitivity {
+    /// dT/db_max_i at every station, s per unit of b = u̇² (0 where the station has no row: the
+    /// two end stations and stations without a finite bound).
+    pub b_max: Vec<f64>,
+    /// Per axis, dT/da for its two acceleration limits: s per mm/s² (or °/s²).
+    pub acceleration: Vec<SideSensitivity>,
+}
+
+/// dT/d(limit) for the lower and the upper limit of one axis.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SideSensitivity {
+    /// dT/da_min (≥ 0: lowering a_min < 0 loosens it).
+    pub min: f64,
+    /// dT/da_max (≤ 0).
+    pub max: f64,
+}
+
 /// Solves one span's problem.
 pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution> {
+    solve_with_sensitivity(p, settings).map(|(s, _)| s)
+}
+
+/// Solves one span's problem as one cone program (no windows) and returns, with the profile,
+/// the sensitivities of its time to every bound (see the module doc for the derivation).
+pub fn solve_with_sensitivity(
+    p: &SpanProblem,
+    settings: &SolverSettings,
+) -> Result<(SpanSolution, Sensitivity)> {
     let n = p.intervals();
     let lay = Layout { n };
     let scale = {
@@ -110,9 +168,11 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
 
     // Nonnegative rows: A x + s = h, s ≥ 0, i.e. A x ≤ h.
     let mut lin = Rows::default();
+    let mut tags: Vec<RowTag> = Vec::new();
     for i in 1..n {
         if p.b_max[i].is_finite() {
             lin.push(&[(lay.x(i), 1.0)], p.b_max[i] / scale);
+            tags.push(RowTag::BMax(i));
         }
     }
     for k in 0..n {
@@ -140,6 +200,11 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
                     if rows & bit != 0 {
                         let c: Vec<(usize, f64)> = coefs.iter().map(|&(c, v)| (c, v / a)).collect();
                         lin.push(&c, 1.0 - constant / a);
+                        tags.push(RowTag::Acceleration {
+                            j,
+                            upper: bit == 1,
+                            limit: a,
+                        });
                     }
                 }
             }
@@ -245,13 +310,35 @@ pub fn solve(p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution>
         b.push((sol.x[lay.x(i)] * scale).max(0.0));
     }
     b.push(p.b_end);
-    Ok(SpanSolution {
-        a: None,
-        b,
-        status,
-        iterations: sol.iterations,
-        solve_time: sol.solve_time,
-    })
+    // The duals of the linear rows come first in z, in the order of `tags`.
+    let mut sens = Sensitivity {
+        b_max: vec![0.0; n + 1],
+        acceleration: vec![SideSensitivity::default(); p.n_axes()],
+    };
+    for (tag, &y) in tags.iter().zip(&sol.z[..n_lin]) {
+        let y = y.max(0.0); // y ∈ K*: nonnegative up to the solver's tolerance
+        match *tag {
+            RowTag::BMax(i) => sens.b_max[i] = -y / scale,
+            RowTag::Acceleration { j, upper, limit } => {
+                let side = &mut sens.acceleration[j];
+                if upper {
+                    side.max -= y / limit;
+                } else {
+                    side.min -= y / limit;
+                }
+            }
+        }
+    }
+    Ok((
+        SpanSolution {
+            a: None,
+            b,
+            status,
+            iterations: sol.iterations,
+            solve_time: sol.solve_time,
+        },
+        sens,
+    ))
 }
 
 /// Solves one span in windows of at most `settings.window` stations (at least one per thread

@@ -1,0 +1,902 @@
+//! Constraint study (`feedopt sweep`): how the cycle time T depends on one axis limit.
+//!
+//! For each of `steps` values v of one axis's velocity or acceleration limit the path is
+//! solved again and reported: T(v), which limit holds the feed down over what share of the
+//! path and of the time (the classification of [`crate::report::Summary`]), the 1 ms
+//! re-simulation of the step's schedule, and the sensitivity dT/dv (s per mm/s, mm/s², °/s or
+//! °/s²) twice: from the solver's dual variables and by central finite differences.
+//!
+//! **Scaling the limit.** A symmetric limit becomes ±v. An asymmetric one `[min, max]` is
+//! scaled proportionally so that its max is v: `[min·v/max, v]` (both sides move together, so
+//! the study changes one number, not the asymmetry). Every step is therefore the nominal
+//! machine with that axis's limit multiplied by μ = v / max₀.
+//!
+//! **A fixed station set.** The automatic refinement of [`crate::optimize`] picks its station
+//! count from the limits; letting it run at every step would change the discretisation from
+//! step to step, so T(v) would carry discretisation jumps (spoiling monotonicity) and a finite
+//! difference would mix two discretisations. The sweep therefore solves once, at the nominal
+//! limits, with the reachability pass (fast, and its refinement converges where the
+//! discretisation does) and the user's station options (`--stations N` or automatic), and
+//! takes that solve's stations — including those added where its re-simulation failed — for
+//! every step and every finite difference. Each step's schedule is still re-simulated at the
+//! servo period; a step whose limits call for finer stations reports `verified: false` and its
+//! worst ratio rather than being refined.
+//!
+//! **The sensitivity from the duals.** Scale the swept limit by μ around a step (μ = 1 there);
+//! then dT/dv = (1/v)·dT/dμ. Per span, with the multipliers of
+//! [`solve_with_sensitivity`](crate::solver::clarabel::solve_with_sensitivity)
+//! (dT/db_max_i = −y_i/B, dT/da = −Σ y_r/a over an axis's acceleration rows of one side):
+//!
+//! ```text
+//! velocity:      dT/dμ = Σ_i dT/db_max_i · 2 b_max_i          over stations whose b_max is this
+//!                                                              axis's velocity bound (v/q')²
+//! acceleration:  dT/dμ = dT/da_max · a_max + dT/da_min · a_min
+//!                      + Σ_i dT/db_max_i · ∂b*_i/∂μ           over stations whose b_max is the
+//!                                                              acceleration-limited b*_i
+//! ```
+//!
+//! so for an acceleration limit the row part alone is dT/dv = −(1/v) Σ y_r over every row of
+//! the axis (both sides alike: each limit is μ times its nominal value). The second term is
+//! needed because b*_i, the largest b the acceleration rows allow at station i, is stated as
+//! the station's bound `b ≤ b_max` and the interior-point method shares the multiplier between
+//! that bound and the rows it is implied by. ∂b*_i/∂μ is the derivative of
+//! [`essential_rows`]' b* (a closed-form vertex of the station's (b, ü) polygon), taken by a
+//! central difference of relative step 1e-6 (exact to rounding except exactly at a vertex
+//! switch, where T is not differentiable either).
+//!
+//! **One window.** The clarabel solver splits long spans into windows stitched at stations
+//! whose b is fixed to the reachability profile's value. Those stitch values are constants of
+//! each window's problem but move with the limits (a stitch sits where the profile meets a
+//! velocity or acceleration-limited bound), so the windows' duals alone would miss the terms
+//! (∂T_left/∂b_s + ∂T_right/∂b_s)·db_s/dv of every stitch s, and the reach profile's choice of
+//! stitch makes db_s/dv discontinuous. The sweep therefore solves every span as one cone
+//! program (cost and memory still linear in the stations; one span per thread) and gets its
+//! parallelism from running steps in parallel (rayon), with the solver's own thread count
+//! at 1.
+//!
+//! **Finite differences.** T(v(1+h)) and T(v(1−h)) at the same stations, h = `fd_step`
+//! (default 1 %): dT/dv ≈ (T₊ − T₋)/(2hv). The value function T(v) of the discretised problem
+//! is only piecewise smooth: its derivative jumps where the set of active rows changes. The
+//! sweep calls a step *smooth* when the dual sensitivity at v(1−h), v and v(1+h) lies on one
+//! line within 5 % (|s₋ + s₊ − 2s| ≤ 0.05 |s|, and s₋, s, s₊ of one sign) *and* the same limits
+//! hold the feed down somewhere (the labels with a share of the path in the report's binding
+//! table) at all three. Then the active set changes over the bracket only by rows whose
+//! multipliers are small, so the central difference, which averages dT/dv over the bracket,
+//! must agree with the dual at v to O(h²). On a fine discretisation the active set always
+//! shifts by a station or two, each moving dT/dv by O(1/N): that is what the 5 % allows. Where
+//! a limit starts or stops binding inside the bracket, dT/dv jumps and the two estimates may
+//! legitimately differ. Where the swept limit binds nowhere (`binds: false`), dT/dv = 0 and
+//! both estimates are solver noise (|dT/dv|·v/T of order the gap tolerance).
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::constraints::{Bound, SpanProblem, essential_rows};
+use crate::error::{Error, Result};
+use crate::machine::{AxisKind, KinematicsSpec, Limit, Machine};
+use crate::optimize::{Options, Solution, optimize_input};
+use crate::report::{BindingShare, Summary};
+use crate::schedule::Schedule;
+use crate::solver::clarabel::{Sensitivity, solve_with_sensitivity};
+use crate::solver::{self, SolverKind, Status};
+use crate::toolpath::Input;
+use crate::verify::verify;
+use crate::writers::write_atomically;
+
+/// Which limit of the axis is swept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum SweptLimit {
+    Velocity,
+    Acceleration,
+}
+
+impl fmt::Display for SweptLimit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SweptLimit::Velocity => "velocity",
+            SweptLimit::Acceleration => "acceleration",
+        })
+    }
+}
+
+/// What to sweep and how to solve each step.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// Axis name, as in the machine file (e.g. `"C"`).
+    pub axis: String,
+    pub limit: SweptLimit,
+    /// First and last limit value (the max side; mm/s, mm/s², °/s or °/s²).
+    pub from: f64,
+    pub to: f64,
+    /// Number of values, evenly spaced from `from` to `to` (1: `from` only).
+    pub steps: usize,
+    /// Relative step h of the central finite differences, v(1 ± h).
+    pub fd_step: f64,
+    /// Solve options: geometry, stations, solver, verification. The solver's windows and
+    /// threads are overridden (one window, one thread: see the module doc).
+    pub solve: Options,
+    /// Draw a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl SweepOptions {
+    /// Options for `steps` values of `axis`'s `limit` from `from` to `to`, otherwise defaults.
+    pub fn new(axis: &str, limit: SweptLimit, from: f64, to: f64, steps: usize) -> Self {
+        SweepOptions {
+            axis: axis.to_string(),
+            limit,
+            from,
+            to,
+            steps,
+            fd_step: 0.01,
+            solve: Options::default(),
+            progress: false,
+        }
+    }
+
+    /// The limit values of the steps.
+    pub fn values(&self) -> Vec<f64> {
+        if self.steps <= 1 {
+            return vec![self.from];
+        }
+        let n = self.steps - 1;
+        (0..=n)
+            .map(|k| self.from + (self.to - self.from) * k as f64 / n as f64)
+            .collect()
+    }
+
+    fn check(&self) -> Result<()> {
+        if !(self.from.is_finite() && self.to.is_finite() && self.from > 0.0 && self.to > 0.0) {
+            return Err(Error::Usage(format!(
+                "--from and --to must be positive limits, got {} and {}",
+                self.from, self.to
+            )));
+        }
+        if self.steps == 0 {
+            return Err(Error::Usage("--steps must be at least 1".into()));
+        }
+        if self.steps > 1 && self.to <= self.from {
+            return Err(Error::Usage(format!(
+                "--to ({}) must be greater than --from ({}) for more than one step",
+                self.to, self.from
+            )));
+        }
+        if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 0.5) {
+            return Err(Error::Usage(format!(
+                "--fd-step must be a relative step in (0, 0.5), got {}",
+                self.fd_step
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One step of the sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepPoint {
+    /// The swept limit's max side at this step.
+    pub limit: f64,
+    pub cycle_time_s: f64,
+    /// dT/dv from the dual variables, s per unit of the limit (`None` with the reach solver).
+    pub sensitivity_dual: Option<f64>,
+    /// dT/dv by central differences (T₊ − T₋)/(2hv).
+    pub sensitivity_fd: f64,
+    /// T at v(1 − h) and v(1 + h), s.
+    pub cycle_time_minus_s: f64,
+    pub cycle_time_plus_s: f64,
+    /// The dual sensitivity at v(1 − h) and v(1 + h).
+    pub sensitivity_dual_minus: Option<f64>,
+    pub sensitivity_dual_plus: Option<f64>,
+    /// The swept limit holds the feed down somewhere at this step (its share of the path in
+    /// [`binding`](Self::binding) is not 0). Where it does not, dT/dv = 0 and both estimates
+    /// are solver noise.
+    pub binds: bool,
+    /// The binding set does not change over the finite-difference bracket (module doc), so the
+    /// two sensitivities must agree.
+    pub smooth: bool,
+    /// |dual − FD| / |dual| (`None` without duals or where the dual is 0).
+    pub relative_difference: Option<f64>,
+    /// Which limit holds the feed down over what share of the path and of the time.
+    pub binding: Vec<BindingShare>,
+    pub status: Status,
+    /// The step's schedule re-simulated at the servo period keeps every limit.
+    pub verified: bool,
+    /// Its worst ratio to any limit.
+    pub worst_ratio: f64,
+    /// Solver time of the step (the centre solve), s.
+    pub solve_time_s: f64,
+}
+
+/// A whole sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sweep {
+    pub machine: String,
+    pub toolpath: String,
+    pub axis: String,
+    pub limit: SweptLimit,
+    /// Unit of the limit values (`mm/s²`, `deg/s`, …); sensitivities are in s per this unit.
+    pub unit: String,
+    /// The machine's own limit (min, max) before scaling.
+    pub nominal_min: f64,
+    pub nominal_max: f64,
+    /// Stations (fixed for every step) and spans.
+    pub stations: usize,
+    pub spans: usize,
+    /// Relative finite-difference step h.
+    pub fd_step: f64,
+    /// The solver of the steps: `"clarabel"` or `"reach"`.
+    pub solver: String,
+    pub points: Vec<SweepPoint>,
+}
+
+/// `limit` scaled so its max side is `value`: ±value if symmetric, `[min·value/max, value]`
+/// otherwise.
+pub fn scaled_limit(limit: Limit, value: f64) -> Limit {
+    Limit {
+        min: limit.min * (value / limit.max),
+        max: value,
+    }
+}
+
+/// `machine` with the `which` limit of axis `axis` scaled to `value` ([`scaled_limit`]).
+pub fn with_limit(machine: &Machine, axis: usize, which: SweptLimit, value: f64) -> Machine {
+    let mut m = machine.clone();
+    let a = &mut m.axes[axis];
+    match which {
+        SweptLimit::Velocity => a.velocity = scaled_limit(a.velocity, value),
+        SweptLimit::Acceleration => a.acceleration = scaled_limit(a.acceleration, value),
+    }
+    m
+}
+
+/// What stays fixed over the sweep: the path, its kinematics and stations (from the baseline
+/// solve), and the options.
+struct Study<'a> {
+    machine: &'a Machine,
+    axis: usize,
+    which: SweptLimit,
+    base: Solution,
+    options: Options,
+    toolpath: String,
+}
+
+/// One solve at one limit value.
+struct Eval {
+    cycle_time: f64,
+    /// dT/dv from the duals.
+    sensitivity: Option<f64>,
+    summary: Summary,
+}
+
+impl Study<'_> {
+    /// Solves the whole path with the swept limit at `value`, at the baseline's stations.
+    fn evaluate(&self, value: f64) -> Result<Eval> {
+        let machine = with_limit(self.machine, self.axis, self.which, value);
+        let kin = &self.base.kinematics;
+        let spans = &self.base.path.spans;
+        let axes: Vec<String> = machine.axes.iter().map(|a| a.name.clone()).collect();
+        let mut problems = Vec::with_capacity(spans.len());
+        let mut solutions = Vec::with_capacity(spans.len());
+        let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
+        let mut dt_dmu = 0.0;
+        for (si, (span, old)) in spans.iter().zip(&self.base.problems).enumerate() {
+            let mut p = SpanProblem::at_stations(span, kin, &machine, old.u.clone());
+            (p.b_start, p.b_end) = (old.b_start, old.b_end);
+            let greedy = solver::reach::solve(&p).map_err(|inf| {
+                Error::Infeasible(format!(
+                    "with the {} {} limit at {value}: span {si}, station {}, nearest CL line {}: {}",
+                    self.machine.axes[self.axis].name,
+                    self.which,
+                    inf.station,
+                    span.nearest_line(p.u[inf.station]),
+                    inf.what
+                ))
+            })?;
+            let s = match self.options.solver_kind {
+                SolverKind::Reach => greedy,
+                SolverKind::Clarabel => {
+                    let (s, sens) = solve_with_sensitivity(&p, &self.options.solver)?;
+                    dt_dmu += span_dt_dmu(&p, &sens, self.axis, self.which);
+                    s
+                }
+            };
+            status = status.worst(s.status);
+            iterations += s.iterations;
+            solve_time += s.solve_time;
+            problems.push(p);
+            solutions.push(s);
+        }
+        let schedule = Schedule::build(&axes, spans, &problems, &solutions)?;
+        let verification = verify(
+            &machine,
+            kin,
+            spans,
+            &problems,
+            &solutions,
+            &self.options.verify,
+        )?;
+        let cycle_time = schedule.cycle_time;
+        let sol = Solution {
+            path: self.base.path.clone(),
+            kinematics: kin.clone(),
+            problems,
+            solutions,
+            schedule,
+            status,
+            iterations,
+            solve_time,
+            refinement: Vec::new(),
+            verification,
+            verify_period: self.options.verify.period,
+        };
+        let summary = Summary::new(&machine, &self.toolpath, &sol);
+        Ok(Eval {
+            cycle_time,
+            sensitivity: (self.options.solver_kind == SolverKind::Clarabel)
+                .then(|| dt_dmu / machine_limit(&machine, self.axis, self.which).max),
+            summary,
+        })
+    }
+}
+
+fn machine_limit(machine: &Machine, axis: usize, which: SweptLimit) -> Limit {
+    match which {
+        SweptLimit::Velocity => machine.axes[axis].velocity,
+        SweptLimit::Acceleration => machine.axes[axis].acceleration,
+    }
+}
+
+/// dT/dμ of one span when the swept limit of axis `j` is multiplied by μ (module doc).
+pub fn span_dt_dmu(p: &SpanProblem, sens: &Sensitivity, j: usize, which: SweptLimit) -> f64 {
+    match which {
+        SweptLimit::Velocity => (0..p.u.len())
+            .filter(|&i| p.b_max_by[i] == Bound::AxisVelocity(j))
+            .map(|i| sens.b_max[i] * 2.0 * p.b_max[i])
+            .sum(),
+        SweptLimit::Acceleration => {
+            let (lim, s) = (p.acceleration[j], sens.acceleration[j]);
+            let rows = s.max * lim.max + s.min * lim.min;
+            let stations: f64 = (0..p.u.len())
+                .filter(|&i| {
+                    sens.b_max[i] != 0.0 && matches!(p.b_max_by[i], Bound::AxisAcceleration(_))
+                })
+                .map(|i| sens.b_max[i] * db_star_dmu(p, i, j))
+                .sum();
+            rows + stations
+        }
+    }
+}
+
+/// ∂b*_i/∂μ: how the acceleration-limited bound at station `i` moves when both acceleration
+/// limits of axis `j` are multiplied by μ (central difference of [`essential_rows`]' b*).
+fn db_star_dmu(p: &SpanProblem, i: usize, j: usize) -> f64 {
+    const EPS: f64 = 1e-6;
+    // Headroom above the current b*, so that the cap does not clip the perturbed vertex.
+    let cap = 2.0 * p.b_max[i];
+    let at = |mu: f64| {
+        let mut lim = p.acceleration.clone();
+        lim[j] = Limit {
+            min: lim[j].min * mu,
+            max: lim[j].max * mu,
+        };
+        essential_rows(&p.jets[i], &lim, cap).1
+    };
+    (at(1.0 + EPS) - at(1.0 - EPS)) / (2.0 * EPS)
+}
+
+/// Three dual sensitivities lie on one line within 5 % of the middle one, all of one sign.
+fn smooth(minus: f64, mid: f64, plus: f64) -> bool {
+    let same_sign =
+        (minus <= 0.0 && mid <= 0.0 && plus <= 0.0) || (minus >= 0.0 && mid >= 0.0 && plus >= 0.0);
+    same_sign && (minus + plus - 2.0 * mid).abs() <= 0.05 * mid.abs()
+}
+
+/// Runs the sweep (module doc).
+pub fn sweep(
+    machine: &Machine,
+    input: &Input,
+    toolpath: &str,
+    options: &SweepOptions,
+) -> Result<Sweep> {
+    options.check()?;
+    let axis = machine
+        .axes
+        .iter()
+        .position(|a| a.name.eq_ignore_ascii_case(&options.axis))
+        .ok_or_else(|| {
+            let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
+            Error::Usage(format!(
+                "--axis {}: the machine {} has no such axis (axes: {})",
+                options.axis,
+                machine.name,
+                names.join(", ")
+            ))
+        })?;
+    let which = options.limit;
+    let nominal = machine_limit(machine, axis, which);
+    // The stations: one reach solve at the nominal limits, as `solve` would refine them.
+    let base = optimize_input(
+        machine,
+        input,
+        &Options {
+            solver_kind: SolverKind::Reach,
+            ..options.solve.clone()
+        },
+    )?;
+    let mut solve_options = options.solve.clone();
+    solve_options.solver.window = usize::MAX;
+    solve_options.solver.threads = 1;
+    let study = Study {
+        machine,
+        axis,
+        which,
+        base,
+        options: solve_options,
+        toolpath: toolpath.to_string(),
+    };
+    let values = options.values();
+    let h = options.fd_step;
+    let jobs: Vec<(usize, usize, f64)> = values
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &v)| [(k, 0, v * (1.0 - h)), (k, 1, v), (k, 2, v * (1.0 + h))])
+        .collect();
+    let bar = options.progress.then(|| {
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(jobs.len() as u64),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        bar.set_message(format!("{} {} sweep", machine.axes[axis].name, which));
+        bar
+    });
+    let evals: Vec<Result<Eval>> = jobs
+        .par_iter()
+        .map(|&(_, _, v)| {
+            let e = study.evaluate(v);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            e
+        })
+        .collect();
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let mut evals = evals.into_iter();
+    let mut points = Vec::with_capacity(values.len());
+    for &v in &values {
+        let (minus, mid, plus) = match (evals.next(), evals.next(), evals.next()) {
+            (Some(a), Some(b), Some(c)) => (a?, b?, c?),
+            _ => return Err(Error::Solver("a sweep step was lost".into())),
+        };
+        let fd = (plus.cycle_time - minus.cycle_time) / (2.0 * h * v);
+        let label = format!("{} {}", machine.axes[axis].name, which);
+        let binding_set = |e: &Eval| -> Vec<String> {
+            let mut l: Vec<String> = e
+                .summary
+                .binding
+                .iter()
+                .filter(|b| b.share_of_path > 0.0 && b.limit != "none")
+                .map(|b| b.limit.clone())
+                .collect();
+            l.sort();
+            l
+        };
+        let same_set =
+            binding_set(&minus) == binding_set(&mid) && binding_set(&plus) == binding_set(&mid);
+        let binds = binding_set(&mid).contains(&label);
+        let is_smooth = same_set
+            && match (minus.sensitivity, mid.sensitivity, plus.sensitivity) {
+                (Some(a), Some(b), Some(c)) => smooth(a, b, c),
+                _ => false,
+            };
+        let relative_difference = mid
+            .sensitivity
+            .filter(|d| *d != 0.0)
+            .map(|d| (d - fd).abs() / d.abs());
+        points.push(SweepPoint {
+            limit: v,
+            cycle_time_s: mid.cycle_time,
+            sensitivity_dual: mid.sensitivity,
+            sensitivity_fd: fd,
+            cycle_time_minus_s: minus.cycle_time,
+            cycle_time_plus_s: plus.cycle_time,
+            sensitivity_dual_minus: minus.sensitivity,
+            sensitivity_dual_plus: plus.sensitivity,
+            binds,
+            smooth: is_smooth,
+            relative_difference,
+            binding: mid.summary.binding.clone(),
+            status: mid.summary.status,
+            verified: mid.summary.verified,
+            worst_ratio: mid
+                .summary
+                .worst_ratio
+                .iter()
+                .map(|(_, w)| w.velocity.max(w.acceleration))
+                .fold(mid.summary.worst_feed_ratio, f64::max),
+            solve_time_s: mid.summary.solve_time_s,
+        });
+    }
+    let rotary =
+        machine.axes[axis].kind == AxisKind::Rotary && machine.kinematics != KinematicsSpec::Joint;
+    let unit = match (rotary, which) {
+        (false, SweptLimit::Velocity) => "mm/s",
+        (false, SweptLimit::Acceleration) => "mm/s²",
+        (true, SweptLimit::Velocity) => "deg/s",
+        (true, SweptLimit::Acceleration) => "deg/s²",
+    };
+    Ok(Sweep {
+        machine: machine.name.clone(),
+        toolpath: toolpath.to_string(),
+        axis: machine.axes[axis].name.clone(),
+        limit: which,
+        unit: unit.to_string(),
+        nominal_min: nominal.min,
+        nominal_max: nominal.max,
+        stations: study.base.stations(),
+        spans: study.base.problems.len(),
+        fd_step: h,
+        solver: match study.options.solver_kind {
+            SolverKind::Clarabel => "clarabel",
+            SolverKind::Reach => "reach",
+        }
+        .to_string(),
+        points,
+    })
+}
+
+impl Sweep {
+    /// Binding limits over all steps, the most time-consuming first.
+    fn binding_labels(&self) -> Vec<String> {
+        let mut most: BTreeMap<&str, f64> = BTreeMap::new();
+        for p in &self.points {
+            for b in &p.binding {
+                let e = most.entry(b.limit.as_str()).or_insert(0.0);
+                *e = e.max(b.share_of_time);
+            }
+        }
+        let mut labels: Vec<(&str, f64)> = most.into_iter().collect();
+        labels.sort_by(|a, b| b.1.total_cmp(&a.1));
+        labels.into_iter().map(|(l, _)| l.to_string()).collect()
+    }
+
+    /// The sweep as JSON (the [`Sweep`] fields; `null` where a value does not exist).
+    pub fn to_json(&self) -> Result<String> {
+        let mut s = serde_json::to_string_pretty(self)
+            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+        s.push('\n');
+        Ok(s)
+    }
+
+    /// The sweep as CSV, one row per step: `limit, cycle_time_s, dT_dlimit_dual,
+    /// dT_dlimit_fd, cycle_time_minus_s, cycle_time_plus_s, binds, smooth, status, verified,
+    /// worst_ratio`, then `path_share_<limit>` and `time_share_<limit>` for every limit that
+    /// binds somewhere (spaces as `_`). An empty cell: no value (no duals with `reach`).
+    pub fn to_csv(&self) -> String {
+        use std::fmt::Write as _;
+        let labels = self.binding_labels();
+        let mut out = String::from(
+            "limit,cycle_time_s,dT_dlimit_dual,dT_dlimit_fd,cycle_time_minus_s,\
+             cycle_time_plus_s,binds,smooth,status,verified,worst_ratio",
+        );
+        for l in &labels {
+            let l = l.replace(' ', "_");
+            let _ = write!(out, ",path_share_{l},time_share_{l}");
+        }
+        out.push('\n');
+        let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+        for p in &self.points {
+            let status = serde_json::to_value(p.status)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default();
+            let _ = write!(
+                out,
+                "{},{},{},{},{},{},{},{},{},{},{}",
+                p.limit,
+                p.cycle_time_s,
+                opt(p.sensitivity_dual),
+                p.sensitivity_fd,
+                p.cycle_time_minus_s,
+                p.cycle_time_plus_s,
+                p.binds,
+                p.smooth,
+                status,
+                p.verified,
+                p.worst_ratio
+            );
+            for l in &labels {
+                let b = p.binding.iter().find(|b| &b.limit == l);
+                let (sp, st) = b.map_or((0.0, 0.0), |b| (b.share_of_path, b.share_of_time));
+                let _ = write!(out, ",{sp},{st}");
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Writes the table to `path` (`.csv` or `.json`), atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let bytes = match crate::writers::schedule_format(path)? {
+            crate::writers::ScheduleFormat::Json => self.to_json()?.into_bytes(),
+            crate::writers::ScheduleFormat::Csv => self.to_csv().into_bytes(),
+        };
+        write_atomically(path, &bytes)
+    }
+
+    /// An SVG plot: cycle time against the limit (top) and the sensitivity, dual and finite
+    /// differences (bottom); axes labelled with units, legends.
+    pub fn plot_svg(&self) -> Result<String> {
+        use plotters::prelude::*;
+        let fail = |e: &dyn fmt::Display| Error::Solver(format!("plot: {e}"));
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (900, 800)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(&e))?;
+            let (top, bottom) = root.split_vertically(400);
+            let xs: Vec<f64> = self.points.iter().map(|p| p.limit).collect();
+            let (x0, x1) = pad_range(&xs);
+            let xlabel = format!("{} {} limit [{}]", self.axis, self.limit, self.unit);
+
+            let ts: Vec<f64> = self.points.iter().map(|p| p.cycle_time_s).collect();
+            let (y0, y1) = pad_range(&ts);
+            let mut chart = ChartBuilder::on(&top)
+                .caption(
+                    format!("Cycle time against the {} {} limit", self.axis, self.limit),
+                    ("sans-serif", 20),
+                )
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(xlabel.as_str())
+                .y_desc("cycle time [s]")
+                .draw()
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(LineSeries::new(
+                    self.points.iter().map(|p| (p.limit, p.cycle_time_s)),
+                    BLUE.stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?
+                .label("cycle time T")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+            chart
+                .draw_series(
+                    self.points
+                        .iter()
+                        .map(|p| Circle::new((p.limit, p.cycle_time_s), 3, BLUE.filled())),
+                )
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(|e| fail(&e))?;
+
+            let mut ss: Vec<f64> = self.points.iter().map(|p| p.sensitivity_fd).collect();
+            ss.extend(self.points.iter().filter_map(|p| p.sensitivity_dual));
+            let (s0, s1) = pad_range(&ss);
+            let mut chart = ChartBuilder::on(&bottom)
+                .caption("Sensitivity dT/d(limit)", ("sans-serif", 20))
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, s0..s1)
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(xlabel.as_str())
+                .y_desc(format!("dT/d(limit) [s per {}]", self.unit))
+                .y_label_formatter(&|y| {
+                    // A tick at zero, not at the rounding error next to it.
+                    if y.abs() < 1e-9 * (s1 - s0) {
+                        "0".to_string()
+                    } else {
+                        format!("{y:.2e}")
+                    }
+                })
+                .draw()
+                .map_err(|e| fail(&e))?;
+            if self.points.iter().any(|p| p.sensitivity_dual.is_some()) {
+                chart
+                    .draw_series(LineSeries::new(
+                        self.points
+                            .iter()
+                            .filter_map(|p| p.sensitivity_dual.map(|s| (p.limit, s))),
+                        RED.stroke_width(2),
+                    ))
+                    .map_err(|e| fail(&e))?
+                    .label("from the duals")
+                    .legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2))
+                    });
+            }
+            chart
+                .draw_series(
+                    self.points
+                        .iter()
+                        .map(|p| Cross::new((p.limit, p.sensitivity_fd), 5, BLACK.stroke_width(2))),
+                )
+                .map_err(|e| fail(&e))?
+                .label(format!("central differences (±{} %)", 100.0 * self.fd_step))
+                .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::LowerRight)
+                .draw()
+                .map_err(|e| fail(&e))?;
+            root.present().map_err(|e| fail(&e))?;
+        }
+        Ok(svg)
+    }
+
+    /// Writes [`Sweep::plot_svg`] to `path`, atomically.
+    pub fn write_plot(&self, path: &Path) -> Result<()> {
+        write_atomically(path, self.plot_svg()?.as_bytes())
+    }
+}
+
+/// A plotting range around `values` with 5 % margins (never empty).
+fn pad_range(values: &[f64]) -> (f64, f64) {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        0.05 * lo.abs().max(1e-12)
+    };
+    (lo - pad, hi + pad)
+}
+
+impl fmt::Display for Sweep {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "toolpath      {}", self.toolpath)?;
+        writeln!(f, "machine       {}", self.machine)?;
+        writeln!(
+            f,
+            "swept         {} {} limit (nominal [{}, {}] {}), scaled so its max is the value",
+            self.axis, self.limit, self.nominal_min, self.nominal_max, self.unit
+        )?;
+        writeln!(
+            f,
+            "stations      {} in {} span(s), fixed for every step; solver {}; finite differences at ±{} %",
+            self.stations,
+            self.spans,
+            self.solver,
+            100.0 * self.fd_step
+        )?;
+        writeln!(f)?;
+        let labels = self.binding_labels();
+        let unit = format!("[s per {}]", self.unit);
+        write!(
+            f,
+            "{:>12} {:>12} {:>14} {:>14} {:>7} {:>6} {:>8}",
+            format!("[{}]", self.unit),
+            "T [s]",
+            "dT/dv dual",
+            "dT/dv FD",
+            "diff",
+            "smooth",
+            "verified"
+        )?;
+        for l in &labels {
+            write!(f, " {:>15}", truncate(l, 15))?;
+        }
+        writeln!(f)?;
+        write!(
+            f,
+            "{:>12} {:>12} {:>14} {:>14} {:>7} {:>6} {:>8}",
+            "limit", "", unit, unit, "", "", "(worst)"
+        )?;
+        for _ in &labels {
+            write!(f, " {:>15}", "% time")?;
+        }
+        writeln!(f)?;
+        for p in &self.points {
+            write!(
+                f,
+                "{:>12.6} {:>12.5} {:>14} {:>14.5e} {:>7} {:>6} {:>8}",
+                p.limit,
+                p.cycle_time_s,
+                p.sensitivity_dual
+                    .map_or("–".to_string(), |s| format!("{s:.5e}")),
+                p.sensitivity_fd,
+                p.relative_difference
+                    .map_or("–".to_string(), |d| format!("{:.2}%", 100.0 * d)),
+                if !p.binds {
+                    "–"
+                } else if p.smooth {
+                    "yes"
+                } else {
+                    "no"
+                },
+                format!(
+                    "{} {:.3}",
+                    if p.verified { "y" } else { "N" },
+                    p.worst_ratio
+                )
+            )?;
+            for l in &labels {
+                let share = p
+                    .binding
+                    .iter()
+                    .find(|b| &b.limit == l)
+                    .map_or(0.0, |b| b.share_of_time);
+                write!(f, " {:>15.1}", 100.0 * share)?;
+            }
+            writeln!(f)?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "dual: from Clarabel's multipliers; FD: central differences; diff: |dual − FD|/|dual|;"
+        )?;
+        writeln!(
+            f,
+            "smooth: the same limits bind over v(1 ± h) and the dual sensitivity is linear there \
+             (the two must agree); –: the {} {} limit binds nowhere (dT/dv = 0 up to solver noise)",
+            self.axis, self.limit
+        )?;
+        Ok(())
+    }
+}
+
+fn truncate(s: &str, n: usize) -> String {
+    s.chars().take(n).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::AxisJets;
+
+    #[test]
+    fn the_vertex_bound_moves_with_the_limits_that_make_it() {
+        // Axis 0 (q' = 1, q'' = 1, ±2) and axis 1 (q' = −1, q'' = 1, ±1): in the (b, ü) plane
+        // the rows are ü ≤ 2 − b, ü ≥ −2 − b, ü ≥ b − 1, ü ≤ b + 1; the polygon closes where
+        // 2 − b = b − 1, so b* = (a₀ + a₁)/2 = 1.5: ∂b*/∂μ is a₀/2 = 1 for axis 0, a₁/2 = 0.5
+        // for axis 1.
+        let mut jet = AxisJets::default();
+        (jet.dq[0], jet.ddq[0], jet.dq[1], jet.ddq[1]) = (1.0, 1.0, -1.0, 1.0);
+        let acceleration = vec![Limit::symmetric(2.0), Limit::symmetric(1.0)];
+        let (_, b_star, _) = essential_rows(&jet, &acceleration, 10.0);
+        assert!((b_star - 1.5).abs() < 1e-12);
+        let p = SpanProblem {
+            u: vec![0.0, 1.0],
+            b_max: vec![b_star; 2],
+            b_max_by: vec![Bound::AxisAcceleration(0); 2],
+            tip_speed: vec![0.0; 2],
+            jets: vec![jet; 2],
+            acceleration,
+            essential: vec![u16::MAX; 2],
+            b_start: 0.0,
+            b_end: 0.0,
+        };
+        assert!((db_star_dmu(&p, 0, 0) - 1.0).abs() < 1e-8);
+        assert!((db_star_dmu(&p, 0, 1) - 0.5).abs() < 1e-8);
+    }
+
+    #[test]
+    fn smoothness_needs_a_line_and_one_sign() {
+        assert!(smooth(-1.0, -0.9, -0.8));
+        assert!(!smooth(-1.0, -0.5, -0.8)); // a kink
+        assert!(!smooth(-0.01, 0.0, 0.01)); // noise around zero
+    }
+}

@@ -1,0 +1,375 @@
+//! The constraint study (`feedopt sweep`): closed-form sensitivities, duals against finite
+//! differences, and the LinuxCNC impeller (read from ../shared when present).
+
+use std::path::{Path, PathBuf};
+
+use feedopt::machine::{Limit, Machine};
+use feedopt::optimize::Options;
+use feedopt::sweep::{Sweep, SweepOptions, SweptLimit, scaled_limit, sweep};
+use feedopt::toolpath::{self, Input};
+use nalgebra::Vector3;
+
+mod common;
+use common::{UP, machine, toolpath};
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// An xyz machine: X with the given velocity and acceleration, Y and Z fast.
+fn xyz(vx: f64, ax: f64) -> Machine {
+    machine(&format!(
+        r#"{{"name": "xyz", "kinematics": {{"type": "xyz"}},
+            "axes": {{"X": {{"velocity": {vx}, "acceleration": {ax}}},
+                     "Y": {{"velocity": 1e5, "acceleration": 1e5}},
+                     "Z": {{"velocity": 1e5, "acceleration": 1e5}}}}}}"#
+    ))
+}
+
+/// A straight line along X of length `l`, rest to rest.
+fn line(l: f64) -> Input {
+    Input::Cl(toolpath(
+        &[(Vector3::zeros(), UP), (Vector3::new(l, 0.0, 0.0), UP)],
+        None,
+    ))
+}
+
+/// Sweep with a fixed station count.
+fn run(m: &Machine, input: &Input, o: SweepOptions, stations: usize) -> Sweep {
+    let o = SweepOptions {
+        solve: Options {
+            stations: Some(stations),
+            ..Options::default()
+        },
+        ..o
+    };
+    sweep(m, input, "test", &o).expect("sweep runs")
+}
+
+#[test]
+fn acceleration_limited_line_matches_t_equals_two_root_l_over_a() {
+    // Bang-bang: b = 2au to the midpoint and back. With the midpoint a station the
+    // piecewise-linear b is exact, so T = 2√(L/a) and dT/da = −√(L/a)/a exactly. The velocity
+    // limit is above the peak √(aL) ≤ 285 mm/s of every solve (and not absurdly so: the solver
+    // scales b by the velocity bounds).
+    let l = 100.0;
+    let m = xyz(400.0, 500.0);
+    let s = run(
+        &m,
+        &line(l),
+        SweepOptions::new("X", SweptLimit::Acceleration, 200.0, 800.0, 3),
+        1000,
+    );
+    assert_eq!(s.points.len(), 3);
+    for p in &s.points {
+        let a = p.limit;
+        let t = 2.0 * (l / a).sqrt();
+        let dt = -(l / a).sqrt() / a;
+        assert!(
+            rel(p.cycle_time_s, t) < 1e-6,
+            "a {a}: T {} vs {t}",
+            p.cycle_time_s
+        );
+        let dual = p.sensitivity_dual.expect("clarabel gives duals");
+        assert!(rel(dual, dt) < 1e-4, "a {a}: dual {dual} vs {dt}");
+        // Central differences of 2√(L/a) at ±1 %: error ≈ (5/8)h² ≈ 6e-5.
+        assert!(
+            rel(p.sensitivity_fd, dt) < 2e-4,
+            "a {a}: FD {} vs {dt}",
+            p.sensitivity_fd
+        );
+        assert!(p.smooth && p.verified, "a {a}");
+    }
+}
+
+/// L = 100 mm, v = 10 mm/s, a = v²/(2 u_c) with the corner of the trapezoid at u_c = 10.45 mm:
+/// 104.5 intervals of ramp at 1000 stations (Δu = 0.1 mm), the corner halfway between two
+/// stations. (With the corner *on* a station the discretised T(v) has a kink there — the rows
+/// active at that station change — and the dual is one element of the subdifferential, whose
+/// one-sided ends differ by about one station's share of the ramp.)
+const L: f64 = 100.0;
+const V: f64 = 10.0;
+const A: f64 = V * V / (2.0 * 10.45);
+
+#[test]
+fn velocity_limited_line_matches_t_equals_l_over_v_plus_v_over_a() {
+    let m = xyz(V, A);
+    let t = L / V + V / A;
+    // The discrete profile misses the corner by half an interval: O(Δu²) in T, and the
+    // derivative of the discretised T differs from the continuous one by O((Δu/ramp)²).
+    let tol = 5e-4;
+    // Velocity sweep: dT/dv = −L/v² + 1/a.
+    let s = run(
+        &m,
+        &line(L),
+        SweepOptions::new("X", SweptLimit::Velocity, V, V, 1),
+        1000,
+    );
+    let p = &s.points[0];
+    assert!(rel(p.cycle_time_s, t) < 1e-5, "T {} vs {t}", p.cycle_time_s);
+    let dt_dv = -L / (V * V) + 1.0 / A;
+    let dual = p.sensitivity_dual.unwrap();
+    eprintln!(
+        "velocity: T {} vs {t}; dual {dual} FD {} exact {dt_dv}",
+        p.cycle_time_s, p.sensitivity_fd
+    );
+    assert!(rel(dual, dt_dv) < tol, "dual {dual} vs {dt_dv}");
+    assert!(
+        rel(p.sensitivity_fd, dt_dv) < tol,
+        "FD {} vs {dt_dv}",
+        p.sensitivity_fd
+    );
+    // Acceleration sweep at the same point: dT/da = −v/a².
+    let s = run(
+        &m,
+        &line(L),
+        SweepOptions::new("X", SweptLimit::Acceleration, A, A, 1),
+        1000,
+    );
+    let p = &s.points[0];
+    let dt_da = -V / (A * A);
+    let dual = p.sensitivity_dual.unwrap();
+    eprintln!(
+        "acceleration: dual {dual} FD {} exact {dt_da}",
+        p.sensitivity_fd
+    );
+    assert!(rel(dual, dt_da) < tol, "dual {dual} vs {dt_da}");
+    assert!(
+        rel(p.sensitivity_fd, dt_da) < tol,
+        "FD {} vs {dt_da}",
+        p.sensitivity_fd
+    );
+}
+
+/// Tool tip on a circle of radius r, `turns` times round.
+fn circle(r: f64, turns: usize, per_turn: usize) -> Input {
+    let pts: Vec<_> = (0..=turns * per_turn)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / per_turn as f64;
+            (Vector3::new(r * a.cos(), r * a.sin(), 0.0), UP)
+        })
+        .collect();
+    Input::Cl(toolpath(&pts, None))
+}
+
+#[test]
+fn on_a_circle_the_duals_include_the_acceleration_limited_velocity_bound() {
+    // Around a circle the feed is held down by the centripetal acceleration: at many stations
+    // the binding bound is b* (the largest b the acceleration rows allow), stated as b_max.
+    // Its multiplier belongs to the acceleration limit too (∂b*/∂μ), or the dual sensitivity
+    // would fall short of the finite differences.
+    let m = machine(
+        r#"{"name": "xy", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 1e4, "acceleration": 1000},
+                     "Y": {"velocity": 1e4, "acceleration": 2000},
+                     "Z": {"velocity": 1e4, "acceleration": 1000}}}"#,
+    );
+    let s = run(
+        &m,
+        &circle(20.0, 3, 120),
+        SweepOptions::new("X", SweptLimit::Acceleration, 500.0, 1500.0, 3),
+        2000,
+    );
+    for p in &s.points {
+        let dual = p.sensitivity_dual.unwrap();
+        eprintln!(
+            "a {}: T {} dual {dual} FD {} smooth {}",
+            p.limit, p.cycle_time_s, p.sensitivity_fd, p.smooth
+        );
+        assert!(dual < 0.0);
+        assert!(
+            rel(dual, p.sensitivity_fd) < 0.02,
+            "a {}: dual {dual} FD {}",
+            p.limit,
+            p.sensitivity_fd
+        );
+    }
+}
+
+#[test]
+fn an_asymmetric_limit_is_scaled_proportionally() {
+    let l = scaled_limit(
+        Limit {
+            min: -100.0,
+            max: 300.0,
+        },
+        600.0,
+    );
+    assert_eq!((l.min, l.max), (-200.0, 600.0));
+    let l = scaled_limit(Limit::symmetric(300.0), 50.0);
+    assert_eq!((l.min, l.max), (-50.0, 50.0));
+}
+
+fn linuxcnc() -> Option<PathBuf> {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
+    d.join("impeller-7bl-xyzac.ngc").exists().then_some(d)
+}
+
+#[test]
+fn impeller_c_acceleration_sweep_is_monotone_and_duals_match_finite_differences() {
+    let Some(dir) = linuxcnc() else {
+        eprintln!("../shared/realworld/linuxcnc not present: skipped");
+        return;
+    };
+    let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
+    let input = toolpath::read(&dir.join("impeller-7bl-xyzac.ngc")).unwrap();
+    let input = Input::Cl(input);
+    // 5000 requested stations (8,535 with every CL point): each solve well under a second.
+    // The program's own feeds stay: the sweep asks what C's acceleration costs this program.
+    // Below ~250 °/s² the C acceleration holds the feed down somewhere; above, nowhere.
+    let s = run(
+        &m,
+        &input,
+        SweepOptions::new("C", SweptLimit::Acceleration, 40.0, 340.0, 6),
+        5000,
+    );
+    check_impeller_sweep(&s);
+}
+
+/// The acceptance checks of an impeller C-acceleration sweep.
+fn check_impeller_sweep(s: &Sweep) {
+    eprintln!("{s}");
+    let t: Vec<f64> = s.points.iter().map(|p| p.cycle_time_s).collect();
+    for w in t.windows(2) {
+        // Never slower with a larger limit, up to the solver's gap tolerance (1e-6 relative).
+        assert!(w[1] <= w[0] * (1.0 + 1e-6), "T rose: {t:?}");
+    }
+    assert!(
+        t[0] > t[t.len() - 1],
+        "the C acceleration matters at 40 °/s²: {t:?}"
+    );
+    let mut compared = 0;
+    for p in &s.points {
+        let dual = p.sensitivity_dual.unwrap();
+        assert!(p.worst_ratio.is_finite() && p.worst_ratio > 0.0);
+        if p.binds && p.smooth {
+            let d = p.relative_difference.unwrap();
+            assert!(
+                d < 0.05,
+                "{} °/s²: dual {dual} FD {} ({d})",
+                p.limit,
+                p.sensitivity_fd
+            );
+            compared += 1;
+        } else if !p.binds {
+            // Binding nowhere: dT/dv = 0 up to solver noise, both ways. A relative error ε in
+            // T (the gap tolerance, 1e-6, at worst) gives |dT/dv|·v/T up to ε/h = 1e-4.
+            for x in [dual, p.sensitivity_fd] {
+                assert!(
+                    x.abs() * p.limit / p.cycle_time_s < 1e-4,
+                    "{} °/s²: {x}",
+                    p.limit
+                );
+            }
+        }
+    }
+    assert!(
+        compared >= 3,
+        "too few smooth binding steps to compare:\n{s}"
+    );
+}
+
+/// The full-resolution study: automatic refinement at the nominal limits (about 1.4 M
+/// stations), then Clarabel at every step on those stations. Minutes in release:
+/// `cargo test --release --test sweep -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn impeller_c_acceleration_sweep_at_full_resolution() {
+    let Some(dir) = linuxcnc() else {
+        eprintln!("../shared/realworld/linuxcnc not present: skipped");
+        return;
+    };
+    let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
+    let input = Input::Cl(toolpath::read(&dir.join("impeller-7bl-xyzac.ngc")).unwrap());
+    let t0 = std::time::Instant::now();
+    let s = sweep(
+        &m,
+        &input,
+        "impeller-7bl-xyzac.ngc",
+        &SweepOptions::new("C", SweptLimit::Acceleration, 60.0, 300.0, 3),
+    )
+    .unwrap();
+    eprintln!("wall time {:.1} s", t0.elapsed().as_secs_f64());
+    check_impeller_sweep(&s);
+}
+
+#[test]
+fn the_command_writes_csv_json_and_svg_and_names_unknown_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("m.json");
+    std::fs::write(
+        &m,
+        r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 400, "acceleration": 500},
+                     "Y": {"velocity": 400, "acceleration": 500},
+                     "Z": {"velocity": 400, "acceleration": 500}}}"#,
+    )
+    .unwrap();
+    let t = dir.path().join("line.ngc");
+    std::fs::write(&t, "G21 G90 G0 X0 Y0 Z0\nG1 X100 F60000\n").unwrap();
+    let (csv, svg) = (dir.path().join("s.csv"), dir.path().join("s.svg"));
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .arg("sweep")
+            .arg("--machine")
+            .arg(&m)
+            .arg(&t)
+            .args(["--limit", "acceleration", "--from", "200", "--to", "800"])
+            .args(["--steps", "3", "--stations", "400"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "--axis",
+        "X",
+        "--json",
+        "-o",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    // T = 2√(L/a) at the three limits.
+    for p in points {
+        let a = p["limit"].as_f64().unwrap();
+        let t = p["cycle_time_s"].as_f64().unwrap();
+        assert!(rel(t, 2.0 * (100.0 / a).sqrt()) < 1e-6);
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4);
+    assert!(lines[0].starts_with("limit,cycle_time_s,dT_dlimit_dual,dT_dlimit_fd"));
+    assert!(lines[0].contains("path_share_X_acceleration"));
+    let plot = std::fs::read_to_string(&svg).unwrap();
+    assert!(plot.starts_with("<svg"));
+    for label in [
+        "X acceleration limit [mm/s²]",
+        "cycle time [s]",
+        "dT/d(limit) [s per mm/s²]",
+        "from the duals",
+        "central differences",
+    ] {
+        assert!(plot.contains(label), "the plot lacks {label}");
+    }
+    // The readable table names the axis and its unit.
+    let out = run(&["--axis", "X"]);
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(table.contains("X acceleration limit") && table.contains("[mm/s²]"));
+
+    let out = run(&["--axis", "B"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--axis B") && err.contains("X, Y, Z"), "{err}");
+    let bad = dir.path().join("p.png");
+    let out = run(&["--axis", "X", "--plot", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!bad.exists());
+}
