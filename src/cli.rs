@@ -70,9 +70,6 @@ pub struct SweepArgs {
     /// Relative step of the central finite differences of the cycle time.
     #[arg(long, default_value_t = 0.01)]
     pub fd_step: f64,
-    /// Plot cycle time and sensitivity against the limit to FILE.svg.
-    #[arg(long, value_name = "FILE.svg")]
-    pub plot: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -91,7 +88,8 @@ pub struct SolveArgs {
     pub output: Option<PathBuf>,
     /// Plot the schedule to FILE.svg: feed against path length, coloured by the limit holding
     /// it down, with the limits; every axis's velocity and acceleration over its limit against
-    /// time (`compare`: every schedule's feed against path length).
+    /// time (`compare`: every schedule's feed against path length; `sweep`: cycle time and
+    /// sensitivity against the limit).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// Total station count (default: refined automatically until doubling changes the cycle
@@ -349,7 +347,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     use std::io::IsTerminal;
     let solve = &args.solve;
     let options = solve.options()?;
-    if let Some(plot) = &args.plot {
+    if let Some(plot) = &args.solve.plot {
         let svg = plot
             .extension()
             .and_then(|e| e.to_str())
@@ -376,7 +374,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     if let Some(out) = &solve.output {
         result.write(out)?;
     }
-    if let Some(plot) = &args.plot {
+    if let Some(plot) = &args.solve.plot {
         result.write_plot(plot)?;
     }
     if solve.json {

@@ -594,3 +594,11 @@ fn absolute_paths() {
     assert!(Path::new(&abs_out).is_file());
     w.assert_listing(&["machine.json", "line.cls", "abs.json"]);
 }
+
+/// Every subcommand's arguments are well formed (clap's own consistency check: unique names,
+/// valid defaults), so no flattened option set can clash with another at run time.
+#[test]
+fn command_line_definition_is_consistent() {
+    use clap::CommandFactory;
+    feedopt::cli::Cli::command().debug_assert();
+}
