@@ -257,6 +257,21 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
     unreachable!("the refinement loop returns")
 }
 
+/// Stations `u` with the midpoint of every interval in `ks` (sorted, distinct) added.
+fn halve(u: &[f64], ks: &[usize]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(u.len() + ks.len());
+    let mut next = ks.iter().peekable();
+    for k in 0..u.len() - 1 {
+        out.push(u[k]);
+        if next.peek() == Some(&&k) {
+            out.push(0.5 * (u[k] + u[k + 1]));
+            next.next();
+        }
+    }
+    out.push(u[u.len() - 1]);
+    out
+}
+
 /// Rounds of local refinement where the re-simulation failed, before refining everywhere.
 const MAX_LOCAL_ROUNDS: usize = 8;
 
@@ -398,16 +413,7 @@ impl Plan<'_> {
             ks.sort_unstable();
             ks.dedup();
             let old = &lv.problems[si];
-            let mut u = Vec::with_capacity(old.u.len() + ks.len());
-            let mut next = ks.iter().peekable();
-            for k in 0..old.intervals() {
-                u.push(old.u[k]);
-                if next.peek() == Some(&&k) {
-                    u.push(0.5 * (old.u[k] + old.u[k + 1]));
-                    next.next();
-                }
-            }
-            u.push(old.u[old.intervals()]);
+            let u = halve(&old.u, &ks);
             let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
             if let Some(c) = &options.verify.chord {
                 p.apply_chord(&self.path.spans[si], c);
@@ -524,6 +530,26 @@ impl Plan<'_> {
             }
             if si + 1 == spans.len() {
                 p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
+            }
+            if self.machine.has_jerk() && p.intervals() >= 4 {
+                // From rest the jerk-limited profile grows as b ∝ u^(4/3), which the first
+                // quadratic intervals follow least well: halve the two intervals at a rest end.
+                let n = p.intervals();
+                let split: Vec<usize> =
+                    [(p.b_start == 0.0, [0, 1]), (p.b_end == 0.0, [n - 2, n - 1])]
+                        .iter()
+                        .filter(|(rest, _)| *rest)
+                        .flat_map(|(_, ks)| ks.iter().copied())
+                        .collect();
+                if !split.is_empty() {
+                    let u = halve(&p.u, &split);
+                    let (bs, be) = (p.b_start, p.b_end);
+                    p = SpanProblem::at_stations(span, &self.kin, self.machine, u);
+                    if let Some(c) = &options.verify.chord {
+                        p.apply_chord(span, c);
+                    }
+                    (p.b_start, p.b_end) = (bs, be);
+                }
             }
             let warm = previous.map(|lv| (&lv.problems[si], &lv.solutions[si]));
             let s = self.solve_span(si, &p, options, warm)?;

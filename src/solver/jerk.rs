@@ -130,6 +130,10 @@ pub struct Midpoint {
     pub essential: u16,
 }
 
+/// A row joins the active set when its value reaches this fraction of its bound (see
+/// [`subproblem`]).
+const ACTIVE_AT: f64 = 0.85;
+
 /// Samples of a constant-jerk end interval at which the jerk is bounded.
 const REST_SAMPLES: usize = 8;
 
@@ -303,11 +307,14 @@ impl Rows {
 
     /// Row `r` of `other` appended.
     fn copy_row(&mut self, other: &Rows, r: usize) {
-        let coefs: Vec<(usize, f64)> = other
-            .triplets(r)
-            .map(|t| (other.j[t], other.v[t]))
-            .collect();
-        self.push(&coefs, other.h[r]);
+        let row = self.h.len();
+        self.start.push(self.v.len());
+        for t in other.triplets(r) {
+            self.i.push(row);
+            self.j.push(other.j[t]);
+            self.v.push(other.v[t]);
+        }
+        self.h.push(other.h[r]);
     }
 
     fn append(&mut self, other: &Rows) {
@@ -419,8 +426,17 @@ pub fn solve(
     }
     let mut best: Option<(SpanSolution, f64)> = None;
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
+    let mut carried: Vec<bool> = Vec::new();
     for it in 0..options.max_iterations.max(1) {
-        let sol = subproblem(p, jd, &bbar, abar.as_deref(), settings, options.objective)?;
+        let sol = subproblem(
+            p,
+            jd,
+            &bbar,
+            abar.as_deref(),
+            settings,
+            options.objective,
+            &mut carried,
+        )?;
         status = status.worst(sol.status);
         iterations += sol.iterations;
         solve_time += sol.solve_time;
@@ -451,23 +467,73 @@ pub fn solve(
     Ok(sol)
 }
 
-/// A linear expression in the scaled variables: coefficients by column, and a constant.
-#[derive(Default, Clone)]
+/// Most terms an [`Expr`] holds before duplicates are merged.
+const EXPR_CAP: usize = 16;
+
+/// A linear expression in the scaled variables: coefficients by column, and a constant (a
+/// fixed-size buffer: rows are built by the hundred thousand, without allocating).
+#[derive(Clone, Copy)]
 struct Expr {
-    coefs: Vec<(usize, f64)>,
+    terms: [(usize, f64); EXPR_CAP],
+    len: usize,
     constant: f64,
 }
 
-impl Expr {
-    fn scaled(&self, w: f64) -> Expr {
+impl Default for Expr {
+    fn default() -> Self {
         Expr {
-            coefs: self.coefs.iter().map(|&(c, v)| (c, v * w)).collect(),
-            constant: self.constant * w,
+            terms: [(0, 0.0); EXPR_CAP],
+            len: 0,
+            constant: 0.0,
         }
     }
-    fn add(&mut self, other: &Expr) {
-        self.coefs.extend_from_slice(&other.coefs);
-        self.constant += other.constant;
+}
+
+impl Expr {
+    fn var(col: usize) -> Expr {
+        let mut e = Expr::default();
+        e.terms[0] = (col, 1.0);
+        e.len = 1;
+        e
+    }
+    fn constant(c: f64) -> Expr {
+        Expr {
+            constant: c,
+            ..Expr::default()
+        }
+    }
+    fn coefs(&self) -> &[(usize, f64)] {
+        &self.terms[..self.len]
+    }
+    fn scaled(&self, w: f64) -> Expr {
+        let mut e = *self;
+        for t in &mut e.terms[..e.len] {
+            t.1 *= w;
+        }
+        e.constant *= w;
+        e
+    }
+    fn add(&mut self, other: &Expr, w: f64) {
+        for &(c, v) in other.coefs() {
+            self.terms[self.len] = (c, v * w);
+            self.len += 1;
+        }
+        self.constant += other.constant * w;
+    }
+    /// Sums the coefficients that share a column.
+    fn merge(&mut self) {
+        let t = &mut self.terms[..self.len];
+        t.sort_unstable_by_key(|c| c.0);
+        let mut n = 0;
+        for i in 0..t.len() {
+            if n > 0 && t[n - 1].0 == t[i].0 {
+                t[n - 1].1 += t[i].1;
+            } else {
+                t[n] = t[i];
+                n += 1;
+            }
+        }
+        self.len = n;
     }
 }
 
@@ -475,15 +541,15 @@ impl Expr {
 fn sum(terms: &[(&Expr, f64)]) -> Expr {
     let mut e = Expr::default();
     for (t, w) in terms {
-        e.add(&t.scaled(*w));
+        e.add(t, *w);
     }
-    merge_duplicates(&mut e.coefs);
+    e.merge();
     e
 }
 
 /// `e ≤ h` as a row.
 fn le(rows: &mut Rows, e: &Expr, h: f64) {
-    rows.push(&e.coefs, h - e.constant);
+    rows.push(e.coefs(), h - e.constant);
 }
 
 /// The rows at one point of the path, in scaled variables (b = B·xb, a = B·ya):
@@ -493,7 +559,6 @@ fn le(rows: &mut Rows, e: &Expr, h: f64) {
 #[allow(clippy::too_many_arguments)]
 fn point_rows(
     rows: &mut Rows,
-    jrows: &mut Rows,
     p: &SpanProblem,
     jd: &JerkData,
     scale: f64,
@@ -536,9 +601,9 @@ fn point_rows(
         ]);
         for jl in [lim.max, lim.min] {
             let mut row = l.scaled(2.0 * sq / (3.0 * jl));
-            row.add(&xb.scaled(scale / (3.0 * bbar)));
-            merge_duplicates(&mut row.coefs);
-            le(jrows, &row, 1.0);
+            row.add(xb, scale / (3.0 * bbar));
+            row.merge();
+            le(rows, &row, 1.0);
         }
     }
 }
@@ -553,6 +618,7 @@ fn subproblem(
     abar: Option<&[f64]>,
     settings: &SolverSettings,
     objective: Objective,
+    carried: &mut Vec<bool>,
 ) -> Result<SpanSolution> {
     let n = p.intervals();
     let lay = Layout {
@@ -587,23 +653,14 @@ fn subproblem(
     // x_i = b_i/B and y_i = a_i/B as expressions (constants at the end stations, a = 0 there).
     let x = |i: usize| {
         if interior(i) {
-            Expr {
-                coefs: vec![(lay.x(i), 1.0)],
-                constant: 0.0,
-            }
+            Expr::var(lay.x(i))
         } else {
-            Expr {
-                coefs: vec![],
-                constant: xconst(i),
-            }
+            Expr::constant(xconst(i))
         }
     };
     let y = |i: usize| {
         if interior(i) {
-            Expr {
-                coefs: vec![(lay.y(i), 1.0)],
-                constant: 0.0,
-            }
+            Expr::var(lay.y(i))
         } else {
             Expr::default()
         }
@@ -644,7 +701,6 @@ fn subproblem(
             lin.push(&[(lay.x(i), 1.0)], bmax / scale);
         }
         point_rows(
-            &mut lin,
             &mut cand,
             p,
             jd,
@@ -672,7 +728,6 @@ fn subproblem(
             };
             let jet = &p.jets[e];
             point_rows(
-                &mut lin,
                 &mut cand,
                 p,
                 jd,
@@ -693,14 +748,13 @@ fn subproblem(
             let xm = sum(&[(&x(k), 1.0), (&y(k), wa), (&y(k + 1), wb)]);
             let ym = sum(&[(&y(k), 1.0 - th), (&y(k + 1), th)]);
             if m.b_max.is_finite() {
-                le(&mut lin, &xm, m.b_max / scale);
+                le(&mut cand, &xm, m.b_max / scale);
             }
             let bbar_m = match abar {
                 Some(a) => bbar[k] + wa * a[k] + wb * a[k + 1],
                 None => (1.0 - th) * bbar[k] + th * bbar[k + 1],
             };
             point_rows(
-                &mut lin,
                 &mut cand,
                 p,
                 jd,
@@ -768,10 +822,12 @@ fn subproblem(
         }
     }
 
-    // Active set over the jerk rows: most are far from binding (typically a tenth come within
-    // half of their limit). Start with those within half of it at the linearisation point,
-    // solve, add every omitted row the solution violates, and solve again until none is: the
-    // result is the optimum of the full subproblem (the omitted rows hold at it).
+    // Active set over every row but the equalities and the velocity bounds at the stations
+    // (which keep the linear program bounded): most are far from binding (typically a tenth of
+    // the jerk rows come within half of their limit). Start with those within half of it at
+    // the linearisation point, solve, add every omitted row the solution violates (with those
+    // near it), and solve again until none is: the result is the optimum of the full
+    // subproblem (the omitted rows hold at it).
     let mut zbar = vec![0.0; nv];
     for i in 1..n {
         zbar[lay.x(i)] = bbar[i] / scale;
@@ -781,8 +837,11 @@ fn subproblem(
             None => (bbar[i + 1] - bbar[i - 1]) / (2.0 * (p.u[i + 1] - p.u[i - 1])),
         } / scale;
     }
+    // The previous subproblem's active rows stay (same rows, same order, when their count
+    // agrees): the active set changes little from one iterate to the next.
+    let keep = carried.len() == cand.len();
     let mut active: Vec<bool> = (0..cand.len())
-        .map(|r| cand.value(r, &zbar) >= 2.0 / 3.0)
+        .map(|r| (keep && carried[r]) || cand.value(r, &zbar) >= ACTIVE_AT)
         .collect();
     let (mut iterations, mut solve_time) = (0, 0.0);
     let (x, status) = loop {
@@ -837,7 +896,7 @@ fn subproblem(
         let mut added = 0;
         if violated {
             for (r, act) in active.iter_mut().enumerate() {
-                if !*act && cand.value(r, &sol.x) > 2.0 / 3.0 {
+                if !*act && cand.value(r, &sol.x) > ACTIVE_AT {
                     *act = true;
                     added += 1;
                 }
@@ -850,6 +909,7 @@ fn subproblem(
             );
         }
         if added == 0 {
+            *carried = std::mem::take(&mut active);
             break (sol.x.clone(), status);
         }
     };
@@ -870,17 +930,4 @@ fn subproblem(
         iterations,
         solve_time,
     })
-}
-
-/// Sums coefficients that share a column.
-fn merge_duplicates(coefs: &mut Vec<(usize, f64)>) {
-    coefs.sort_by_key(|c| c.0);
-    coefs.dedup_by(|later, first| {
-        if later.0 == first.0 {
-            first.1 += later.1;
-            true
-        } else {
-            false
-        }
-    });
 }
