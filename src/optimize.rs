@@ -531,16 +531,18 @@ impl Plan<'_> {
             if si + 1 == spans.len() {
                 p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
             }
-            if self.machine.has_jerk() && p.intervals() >= 4 {
+            if self.machine.has_jerk() && p.intervals() >= 6 {
                 // From rest the jerk-limited profile grows as b ∝ u^(4/3), which the first
-                // quadratic intervals follow least well: halve the two intervals at a rest end.
+                // quadratic intervals follow least well: halve the three intervals at a rest end.
                 let n = p.intervals();
-                let split: Vec<usize> =
-                    [(p.b_start == 0.0, [0, 1]), (p.b_end == 0.0, [n - 2, n - 1])]
-                        .iter()
-                        .filter(|(rest, _)| *rest)
-                        .flat_map(|(_, ks)| ks.iter().copied())
-                        .collect();
+                let split: Vec<usize> = [
+                    (p.b_start == 0.0, [0, 1, 2]),
+                    (p.b_end == 0.0, [n - 3, n - 2, n - 1]),
+                ]
+                .iter()
+                .filter(|(rest, _)| *rest)
+                .flat_map(|(_, ks)| ks.iter().copied())
+                .collect();
                 if !split.is_empty() {
                     let u = halve(&p.u, &split);
                     let (bs, be) = (p.b_start, p.b_end);

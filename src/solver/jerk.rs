@@ -840,9 +840,13 @@ fn subproblem(
     // The previous subproblem's active rows stay (same rows, same order, when their count
     // agrees): the active set changes little from one iterate to the next.
     let keep = carried.len() == cand.len();
+    let threshold = ACTIVE_AT;
     let mut active: Vec<bool> = (0..cand.len())
-        .map(|r| (keep && carried[r]) || cand.value(r, &zbar) >= ACTIVE_AT)
+        .map(|r| (keep && carried[r]) || cand.value(r, &zbar) >= threshold)
         .collect();
+    // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
+    // cycle time is a tenth of what the iteration's own stopping test resolves.
+    let gap = settings.tol_gap.max(1e-5);
     let (mut iterations, mut solve_time) = (0, 0.0);
     let (x, status) = loop {
         let mut all = Rows::default();
@@ -869,8 +873,8 @@ fn subproblem(
         let s = DefaultSettingsBuilder::default()
             .verbose(std::env::var_os("FEEDOPT_SOLVER_VERBOSE").is_some())
             .max_iter(settings.max_iter)
-            .tol_gap_rel(settings.tol_gap)
-            .tol_gap_abs(settings.tol_gap)
+            .tol_gap_rel(gap)
+            .tol_gap_abs(gap)
             .tol_feas(settings.tol_feas)
             .iterative_refinement_enable(settings.iterative_refinement)
             .build()
