@@ -257,6 +257,9 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
     unreachable!("the refinement loop returns")
 }
 
+/// Geometric grading of the stations into a rest end of a jerk-limited span (levels).
+const GRADING: usize = 4;
+
 /// Stations `u` with the midpoint of every interval in `ks` (sorted, distinct) added.
 fn halve(u: &[f64], ks: &[usize]) -> Vec<f64> {
     let mut out = Vec::with_capacity(u.len() + ks.len());
@@ -532,19 +535,22 @@ impl Plan<'_> {
                 p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
             }
             if self.machine.has_jerk() && p.intervals() >= 6 {
-                // From rest the jerk-limited profile grows as b ∝ u^(4/3), which the first
-                // quadratic intervals follow least well: halve the three intervals at a rest end.
+                // From rest the jerk-limited profile grows as b ∝ u^(4/3) (b'' unbounded), which
+                // evenly spaced quadratic pieces follow badly: grade the stations geometrically
+                // into each rest end (L/2, L/4, … L/2^GRADING of the first three intervals' L).
                 let n = p.intervals();
-                let split: Vec<usize> = [
-                    (p.b_start == 0.0, [0, 1, 2]),
-                    (p.b_end == 0.0, [n - 3, n - 2, n - 1]),
-                ]
-                .iter()
-                .filter(|(rest, _)| *rest)
-                .flat_map(|(_, ks)| ks.iter().copied())
-                .collect();
-                if !split.is_empty() {
-                    let u = halve(&p.u, &split);
+                let mut u = p.u.clone();
+                if p.b_start == 0.0 {
+                    let l = p.u[3] - p.u[0];
+                    u.extend((1..=GRADING).map(|k| p.u[0] + l / f64::powi(2.0, k as i32)));
+                }
+                if p.b_end == 0.0 {
+                    let l = p.u[n] - p.u[n - 3];
+                    u.extend((1..=GRADING).map(|k| p.u[n] - l / f64::powi(2.0, k as i32)));
+                }
+                if u.len() > p.u.len() {
+                    u.sort_by(f64::total_cmp);
+                    u.dedup();
                     let (bs, be) = (p.b_start, p.b_end);
                     p = SpanProblem::at_stations(span, &self.kin, self.machine, u);
                     if let Some(c) = &options.verify.chord {

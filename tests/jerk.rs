@@ -1,12 +1,19 @@
-//! Jerk-limited schedules (issue 6).
+//! Jerk-limited schedules (issue 6): closed form, limits, two objectives agreeing, the COPP
+//! benchmark's jerk-limited paths, and the chord error together with jerk.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
+use feedopt::constraints::Chord;
 use feedopt::machine::Machine;
-use feedopt::optimize::{Options, optimize_joint};
+use feedopt::optimize::{Options, Solution, optimize, optimize_joint};
+use feedopt::solver::jerk::{JerkOptions, Objective};
 use feedopt::toolpath::joint_csv;
+use feedopt::verify::VerifyOptions;
+use nalgebra::Vector3;
 use serde_json::Value;
+
+mod common;
+use common::UP;
 
 #[path = "common/copp.rs"]
 mod copp_data;
@@ -21,162 +28,245 @@ fn copp_dir() -> Option<PathBuf> {
     }
 }
 
-#[test]
-#[ignore]
-fn explore_copp_jerk() {
-    let Some(dir) = copp_dir() else { return };
-    let which = std::env::var("COPP_PATH").unwrap_or_default();
-    let list: Vec<usize> = if which == "all" {
-        (0..20).collect()
-    } else {
-        vec![which.parse().unwrap_or(0)]
-    };
-    let (mut sum_t, mut sum_ref, mut sum_solve) = (0.0, 0.0, 0.0);
-    for &idx in &list {
-        let v: Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join(format!("path_{idx:03}.json"))).unwrap(),
-        )
-        .unwrap();
-        let m = Machine::from_json(
-            Path::new("m.json"),
-            &copp_data::machine_json_jerk(&v["limits"]),
-        )
-        .unwrap();
-        let path = joint_csv::read(&dir.join(format!("path_{idx:03}.csv"))).unwrap();
-        let refine = std::env::var("REFINE").is_ok();
-        let options = Options {
-            stations: Some(1000),
-            refine_until_verified: refine,
-            ..Options::default()
-        };
-        let t0 = Instant::now();
-        let sol = optimize_joint(&m, &path, &options).unwrap();
-        let topp3 = v["results"]["TOPP3-SOCP"]["traversal_time_s"]
-            .as_f64()
-            .unwrap();
-        eprintln!(
-            "path {idx}: T = {:.6} s vs TOPP3-SOCP {topp3:.6} ({:+.4} %), iterations {}, solve {:.1} ms, wall {:.1} ms, stations {}, verified {}, worst {:.5}, violating {}",
-            sol.schedule.cycle_time,
-            100.0 * (sol.schedule.cycle_time / topp3 - 1.0),
-            sol.iterations,
-            sol.solve_time * 1e3,
-            t0.elapsed().as_secs_f64() * 1e3,
-            sol.stations(),
-            sol.verification.verified,
-            sol.verification.worst_ratio(),
-            sol.verification.violating_intervals
-        );
-        if list.len() == 1 {
-            for w in &sol.verification.worst {
-                eprintln!(
-                    "  {}: v {:.4} a {:.4} j {:.4}",
-                    w.name, w.velocity, w.acceleration, w.jerk
-                );
-            }
-        }
-        for v in sol.verification.violations.iter().take(5) {
-            eprintln!("  {v:?}");
-        }
-        sum_t += sol.schedule.cycle_time;
-        sum_ref += topp3;
-        sum_solve += t0.elapsed().as_secs_f64();
-    }
-    let k = list.len() as f64;
-    eprintln!(
-        "mean T {:.6} vs TOPP3-SOCP {:.6} ({:+.4} %), mean wall {:.1} ms",
-        sum_t / k,
-        sum_ref / k,
-        100.0 * (sum_t / sum_ref - 1.0),
-        sum_solve / k * 1e3
-    );
-}
-
-#[test]
-#[ignore]
-fn debug_knot() {
-    use feedopt::geometry::{GeometryOptions, Path as GPath};
-    use feedopt::kinematics::Kinematics;
-    let m = Machine::from_file(Path::new("problems/seed_head_head/machine_jerk.json")).unwrap();
-    let tp =
-        feedopt::toolpath::read(Path::new("problems/seed_head_head/impeller_blade.cls")).unwrap();
-    let kin = Kinematics::new(&m);
-    let angles = kin.rotary_angles(&tp.points, &m.axes).unwrap();
-    let path = GPath::build(
-        &tp,
-        &angles,
-        m.feed_max,
-        kin.uses_orientation(),
-        false,
-        &GeometryOptions::default(),
+/// A COPP path with its jerk limits; returns (machine, path, TOPP3-SOCP time).
+fn copp_case(dir: &Path, idx: usize) -> (Machine, joint_csv::JointPath, f64) {
+    let v: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join(format!("path_{idx:03}.json"))).expect("json"),
     )
-    .unwrap();
-    let span = &path.spans[1];
-    let knots = span.spline.knots();
-    let k = knots
-        .iter()
-        .position(|&x| (x - 87.24001595270282).abs() < 1e-6)
-        .unwrap();
-    eprintln!("knot {k} of {}", knots.len());
-    for seg in [k - 1, k] {
-        let w = span.spline.eval_in(seg, knots[k]);
-        let j = kin.axis_jets(&w);
-        let d3 = kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, knots[k]));
-        eprintln!(
-            "seg {seg}: d1 {:?}\n d2 {:?}\n ddq {:?}\n dddq {:?}",
-            w.d1, w.d2, j.ddq, d3
-        );
+    .expect("valid json");
+    let m = Machine::from_json(
+        Path::new("copp_jerk.json"),
+        &copp_data::machine_json_jerk(&v["limits"]),
+    )
+    .expect("machine");
+    let path = joint_csv::read(&dir.join(format!("path_{idx:03}.csv"))).expect("csv");
+    let topp3 = v["results"]["TOPP3-SOCP"]["traversal_time_s"]
+        .as_f64()
+        .expect("TOPP3-SOCP time");
+    (m, path, topp3)
+}
+
+/// COPP's grid (1,000 intervals) as the start; stations added where the 1 kHz check fails.
+fn copp_options() -> Options {
+    Options {
+        stations: Some(1000),
+        ..Options::default()
     }
 }
 
-#[test]
-#[ignore]
-fn debug_knot2() {
-    use feedopt::motion::Interval;
-    let m = Machine::from_file(Path::new("problems/seed_head_head/machine_jerk.json")).unwrap();
-    let tp =
-        feedopt::toolpath::read(Path::new("problems/seed_head_head/impeller_blade.cls")).unwrap();
-    let o = Options {
-        refine_until_verified: false,
-        stations: Some(2000),
-        ..Options::default()
-    };
-    let sol = feedopt::optimize::optimize(&m, &tp, &o).unwrap();
+fn assert_verified_with_jerk(sol: &Solution, what: &str) {
     let v = &sol.verification;
-    eprintln!(
-        "violations {}: {:?}",
-        v.violating_intervals,
+    assert!(
+        v.verified,
+        "{what}: not verified, worst {:?}",
         v.violations.first()
     );
-    let viol = v.violations.first().unwrap();
-    let (p, s) = (&sol.problems[viol.span], &sol.solutions[viol.span]);
-    let span = &sol.path.spans[viol.span];
-    let k = viol.interval;
-    eprintln!(
-        "interval {k}: u {} .. {}, viol u {}",
-        p.u[k],
-        p.u[k + 1],
-        viol.u
+    assert!(
+        v.worst.iter().all(|w| w.jerk <= 1.001),
+        "{what}: {:?}",
+        v.worst
     );
-    let a = s.a.as_ref().unwrap();
-    for kk in [k - 1, k, k + 1] {
-        let iv = Interval::of(&p.u, &s.b, Some(a), kk);
-        let (s0, s1) = iv.ends();
-        for (e, st) in [(kk, s0), (kk + 1, s1)] {
-            for seg in [
-                span.spline.segment(p.u[e]).saturating_sub(1),
-                span.spline.segment(p.u[e]),
-            ] {
-                let w = span.spline.eval_in(seg, p.u[e]);
-                let j = sol.kinematics.axis_jets(&w);
-                let d3 = sol
-                    .kinematics
-                    .axis_third_derivatives(&w, &span.spline.d3_in(seg, p.u[e]));
-                let q3 = d3[4] * st.ud * st.b + 3.0 * j.ddq[4] * st.ud * st.udd + j.dq[4] * st.uddd;
-                eprintln!(
-                    "iv {kk} e {e} u {} seg {seg}: law {:?} b {} a {} uddd {} jerkA {q3}",
-                    p.u[e], iv.law, st.b, st.udd, st.uddd
-                );
+    assert!(
+        v.worst.iter().any(|w| w.jerk > 0.99),
+        "{what}: some jerk limit binds"
+    );
+    assert!(sol.solutions.iter().all(|s| s.a.is_some()), "{what}");
+}
+
+/// Rest to rest along one axis with only the jerk limit J binding: jerk +J, −J, +J for τ, 2τ,
+/// τ, so L = 2 J τ³ and T = 4 (L / 2J)^{1/3}.
+#[test]
+fn straight_line_with_only_jerk_binding_matches_the_closed_form() {
+    let (len, jerk) = (20.0, 5000.0);
+    let m = common::machine(&format!(
+        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{
+        "X": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
+        "Y": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
+        "Z": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}}}}}}"#
+    ));
+    let pts: Vec<_> = (0..=4)
+        .map(|k| (Vector3::new(len * k as f64 / 4.0, 0.0, 0.0), UP))
+        .collect();
+    // A fixed grid (stations are still added where the 1 kHz check fails): on this case the
+    // jerk discretisation converges slowly (+0.9 % at 8,000 stations, +1.4 % at 400).
+    let o = Options {
+        stations: Some(400),
+        ..Options::default()
+    };
+    let sol = optimize(&m, &common::toolpath(&pts, None), &o).expect("solve");
+    let exact = 4.0 * (len / (2.0 * jerk)).cbrt();
+    let t = sol.schedule.cycle_time;
+    eprintln!("jerk-limited line: {t:.6} s vs {exact:.6} s exact");
+    assert!(
+        t >= exact * (1.0 - 1e-6),
+        "faster than possible: {t} < {exact}"
+    );
+    assert!(t <= exact * 1.02, "{t} vs {exact}");
+    assert_verified_with_jerk(&sol, "line");
+}
+
+/// The bundled 5-axis problem with its jerk-limited machine: slower than acceleration-limited,
+/// every limit (jerk too) kept; with the jerk limits scaled up the time comes down to the
+/// acceleration-limited one.
+#[test]
+fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
+    let m = Machine::from_file(&dir.join("machine_jerk.json")).expect("machine");
+    let tp = feedopt::toolpath::read(&dir.join("impeller_blade.cls")).expect("toolpath");
+    let o = Options {
+        stations: Some(1500),
+        ..Options::default()
+    };
+    let accel = optimize(&m.without_jerk(), &tp, &o).expect("accel");
+    let t_acc = accel.schedule.cycle_time;
+    let mut last = f64::INFINITY;
+    for scale in [1.0, 3.0, 10.0] {
+        let mut mj = m.clone();
+        for a in &mut mj.axes {
+            if let Some(j) = &mut a.jerk {
+                j.min *= scale;
+                j.max *= scale;
             }
         }
+        let sol = optimize(&mj, &tp, &o).expect("jerk-limited");
+        let t = sol.schedule.cycle_time;
+        eprintln!("jerk ×{scale}: {t:.5} s (acceleration-limited {t_acc:.5} s)");
+        assert!(sol.verification.verified, "×{scale}");
+        assert!(t >= t_acc * (1.0 - 1e-3), "×{scale}: {t} < {t_acc}");
+        assert!(t <= last * (1.0 + 1e-3), "×{scale}: {t} after {last}");
+        last = t;
+        if scale == 1.0 {
+            assert_verified_with_jerk(&sol, "bundled");
+            assert!(
+                t > 1.05 * t_acc,
+                "the jerk limits cost time here: {t} vs {t_acc}"
+            );
+        }
+    }
+    assert!(
+        last <= t_acc * 1.04,
+        "jerk ×10 is within 4 % of acceleration-limited: {last} vs {t_acc}"
+    );
+}
+
+/// Two independent subproblem objectives — the linearised time (LP) and the time itself
+/// through cones — reach the same schedule on a COPP path.
+#[test]
+fn linearised_and_cone_objectives_agree() {
+    let Some(dir) = copp_dir() else { return };
+    let (m, path, _) = copp_case(&dir, 1);
+    let solve = |objective| {
+        let o = Options {
+            refine_until_verified: false,
+            jerk: JerkOptions {
+                objective,
+                ..JerkOptions::default()
+            },
+            ..copp_options()
+        };
+        optimize_joint(&m, &path, &o)
+            .expect("solve")
+            .schedule
+            .cycle_time
+    };
+    let (lp, cones) = (solve(Objective::Linearised), solve(Objective::Cones));
+    eprintln!("linearised {lp:.6} s, cones {cones:.6} s");
+    assert!((lp - cones).abs() <= 2e-4 * cones, "{lp} vs {cones}");
+}
+
+/// Three COPP paths with their jerk limits: verified at 1 kHz including jerk, and no slower
+/// than COPP's TOPP3-SOCP (+0.1 %). All twenty: the ignored test below.
+#[test]
+fn copp_jerk_paths_verify_and_match_topp3() {
+    let Some(dir) = copp_dir() else { return };
+    for idx in [0, 7, 13] {
+        let (m, path, topp3) = copp_case(&dir, idx);
+        let sol = optimize_joint(&m, &path, &copp_options()).expect("solve");
+        let t = sol.schedule.cycle_time;
+        eprintln!("path {idx}: {t:.6} s vs TOPP3-SOCP {topp3:.6} s");
+        assert_verified_with_jerk(&sol, &format!("path {idx}"));
+        assert!(t <= topp3 * 1.001, "path {idx}: {t} vs {topp3}");
+    }
+}
+
+/// Issue 6's acceptance on all twenty paths (run by hand in release: the mean time and every
+/// verification; the solve time is measured by `benches/copp.rs`).
+#[test]
+#[ignore]
+fn copp_jerk_all_twenty() {
+    let Some(dir) = copp_dir() else { return };
+    let (mut sum, mut sum_ref) = (0.0, 0.0);
+    for idx in 0..20 {
+        let (m, path, topp3) = copp_case(&dir, idx);
+        let t0 = std::time::Instant::now();
+        let sol = optimize_joint(&m, &path, &copp_options()).expect("solve");
+        let t = sol.schedule.cycle_time;
+        eprintln!(
+            "path {idx:2}: {t:.6} s vs TOPP3-SOCP {topp3:.6} s ({:+.3} %), {} stations, \
+             worst ratio {:.5}, {:.0} ms",
+            100.0 * (t / topp3 - 1.0),
+            sol.stations(),
+            sol.verification.worst_ratio(),
+            t0.elapsed().as_secs_f64() * 1e3
+        );
+        assert_verified_with_jerk(&sol, &format!("path {idx}"));
+        sum += t;
+        sum_ref += topp3;
+    }
+    eprintln!(
+        "mean {:.6} s vs TOPP3-SOCP {:.6} s ({:+.3} %)",
+        sum / 20.0,
+        sum_ref / 20.0,
+        100.0 * (sum / sum_ref - 1.0)
+    );
+    assert!(sum <= sum_ref * 1.001);
+}
+
+/// The chord error of data-sampling interpolation (seed 004) on a circle of radius R at a
+/// period T: V ≤ √(8δR)/T, with and without jerk limits; the re-simulation checks it.
+#[test]
+fn chord_tolerance_bounds_the_feed_on_a_circle_with_and_without_jerk() {
+    let (r, delta, period): (f64, f64, f64) = (20.0, 0.002, 2e-3);
+    let v_chord = (8.0 * delta * r).sqrt() / period; // 126.5 mm/s
+    let pts: Vec<_> = (0..=240)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 120.0;
+            (Vector3::new(r * a.cos(), r * a.sin(), 0.0), UP)
+        })
+        .collect();
+    let tp = common::toolpath(&pts, None);
+    for jerk in ["", r#", "jerk": 2e6"#] {
+        let m = common::machine(&format!(
+            r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{
+            "X": {{"velocity": 1000, "acceleration": 1e5{jerk}}},
+            "Y": {{"velocity": 1000, "acceleration": 1e5{jerk}}},
+            "Z": {{"velocity": 1000, "acceleration": 1e5{jerk}}}}}}}"#
+        ));
+        let o = Options {
+            verify: VerifyOptions {
+                period,
+                chord: Some(Chord {
+                    tolerance: delta,
+                    period,
+                }),
+                ..VerifyOptions::default()
+            },
+            ..Options::default()
+        };
+        let sol = optimize(&m, &tp, &o).expect("solve");
+        let v = &sol.verification;
+        assert!(v.verified, "jerk `{jerk}`: {:?}", v.violations.first());
+        assert!(
+            v.worst_chord <= 1.001 && v.worst_chord > 0.99,
+            "{}",
+            v.worst_chord
+        );
+        // Mid-path the feed sits on the chord bound (a √(aR) of 1414 mm/s is far above).
+        let mid = &sol.schedule.stations[sol.schedule.stations.len() / 2];
+        assert!(
+            (mid.v - v_chord).abs() <= 2e-3 * v_chord,
+            "jerk `{jerk}`: {} vs {v_chord}",
+            mid.v
+        );
     }
 }

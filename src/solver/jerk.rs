@@ -134,6 +134,9 @@ pub struct Midpoint {
 /// [`subproblem`]).
 const ACTIVE_AT: f64 = 0.85;
 
+/// Solves with part of the rows before all are taken (see [`subproblem`]).
+const ACTIVE_ROUNDS: usize = 3;
+
 /// Samples of a constant-jerk end interval at which the jerk is bounded.
 const REST_SAMPLES: usize = 8;
 
@@ -625,9 +628,11 @@ fn subproblem(
         n,
         lp: objective == Objective::Linearised,
     };
+    // B: the median of the linearisation point (the profile is near it; the velocity bounds
+    // can be orders of magnitude above where jerk holds the feed down, which would leave x tiny
+    // and the solver badly scaled).
     let scale = {
-        let mut finite: Vec<f64> = p
-            .b_max
+        let mut finite: Vec<f64> = bbar
             .iter()
             .copied()
             .filter(|b| b.is_finite() && *b > 0.0)
@@ -847,7 +852,7 @@ fn subproblem(
     // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
     // cycle time is a tenth of what the iteration's own stopping test resolves.
     let gap = settings.tol_gap.max(1e-5);
-    let (mut iterations, mut solve_time) = (0, 0.0);
+    let (mut iterations, mut solve_time, mut rounds) = (0, 0.0, 0);
     let (x, status) = loop {
         let mut all = Rows::default();
         all.append(&eq);
@@ -894,13 +899,17 @@ fn subproblem(
                 )));
             }
         };
-        // Any omitted row violated: add it, and with it every omitted row within half of its
-        // limit at this solution (the next solution is likely to lean on them too).
+        // Any omitted row violated: add it, and with it every omitted row near its bound at
+        // this solution (the next solution is likely to lean on them too); after
+        // [`ACTIVE_ROUNDS`] rounds, every row (a start far from the optimum can otherwise
+        // uncover a few rows per round for many rounds).
+        rounds += 1;
         let violated = (0..cand.len()).any(|r| !active[r] && cand.value(r, &sol.x) > 1.0 + 1e-9);
+        let all = rounds >= ACTIVE_ROUNDS;
         let mut added = 0;
         if violated {
             for (r, act) in active.iter_mut().enumerate() {
-                if !*act && cand.value(r, &sol.x) > ACTIVE_AT {
+                if !*act && (all || cand.value(r, &sol.x) > ACTIVE_AT) {
                     *act = true;
                     added += 1;
                 }
