@@ -135,7 +135,7 @@ pub struct Midpoint {
 const ACTIVE_AT: f64 = 0.85;
 
 /// Solves with part of the rows before all are taken (see [`subproblem`]).
-const ACTIVE_ROUNDS: usize = 3;
+const ACTIVE_ROUNDS: usize = 6;
 
 /// Samples of a constant-jerk end interval at which the jerk is bounded.
 const REST_SAMPLES: usize = 8;
