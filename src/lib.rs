@@ -31,10 +31,16 @@
 //!
 //! Each stage is a module with one job and plain data between stages:
 //! [`toolpath`] (readers) → [`geometry`] (spans, splines) → [`kinematics`] (q, t_q, K_q) →
-//! [`constraints`] (rows on b) → [`solver`] (Clarabel; the O(N) reachability pass) →
-//! [`schedule`] (time, eq. 43) → [`verify`] (re-simulation at the servo period) → [`report`]
-//! (summary) and [`writers`] (JSON, CSV). [`optimize::optimize`] runs them all (and
-//! [`optimize::optimize_joint`] for joint-space paths).
+//! [`constraints`] (rows on b) → [`solver`] (Clarabel; the O(N) reachability pass; the
+//! jerk-limited SCP) → [`schedule`] (time, eq. 43, through the [`motion`] laws between
+//! stations) → [`verify`] (re-simulation at the servo period) → [`report`] (summary) and
+//! [`writers`] (JSON, CSV, G-code, plots). [`optimize::optimize`] runs them all (and
+//! [`optimize::optimize_joint`] for joint-space paths). On top: [`interpolate`] (setpoints at
+//! the servo period), [`compare`] (schedules side by side) and [`sweep`] (constraint studies).
+//!
+//! With jerk limits in the machine file the schedule also keeps every axis's jerk
+//! q⃛ = √b (q‴ b + (3/2) q″ b′ + (1/2) q′ b″) within them: not convex in b, solved by sequential
+//! convex programming ([`solver::jerk`]).
 //!
 //! ```no_run
 //! use feedopt::{machine::Machine, optimize, toolpath};
