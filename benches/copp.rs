@@ -19,7 +19,7 @@
 //! 448 ms per path including problem build; TOPP2-RA 1.2 / 9 / 88 ms at 10³ / 10⁴ / 10⁵.
 
 use std::hint::black_box;
-use std::path::{Path as FsPath, PathBuf};
+use std::path::Path as FsPath;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -42,16 +42,6 @@ fn machine(limits: &Value) -> Machine {
 }
 
 const PATHS: usize = 20;
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = FsPath::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/copp_random7");
-    if dir.join("path_000.json").is_file() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: {} is absent", dir.display());
-        None
-    }
-}
 
 struct Case {
     machine: Machine,
@@ -95,7 +85,9 @@ fn problem(case: &Case, parts: usize) -> SpanProblem {
 }
 
 fn bench_copp(c: &mut Criterion) {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let cases = load(&dir);
     let problems: Vec<SpanProblem> = cases.iter().map(|k| problem(k, 1)).collect();
 
@@ -162,7 +154,9 @@ fn bench_copp(c: &mut Criterion) {
 /// this kind of machine (its time includes its TOPP2-RA start, as ours includes the reach pass
 /// and the verification).
 fn bench_copp_jerk(c: &mut Criterion) {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let cases = load(&dir);
     let options = Options {
         stations: Some(1000),
@@ -185,7 +179,9 @@ fn bench_copp_jerk(c: &mut Criterion) {
 }
 
 fn bench_reach_scaling(c: &mut Criterion) {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let cases = load(&dir);
     let case = &cases[0];
     let mut g = c.benchmark_group("reach_scaling");

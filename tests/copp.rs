@@ -28,17 +28,6 @@ use copp_data::machine_json;
 
 const PATHS: usize = 20;
 
-/// The shared benchmark folder, or `None` (with a note on stderr) when it is absent.
-fn data_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/copp_random7");
-    if dir.join("path_000.json").is_file() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: {} is absent", dir.display());
-        None
-    }
-}
-
 /// One benchmark path: its machine (converted), joint path and COPP's reference times.
 struct Case {
     index: usize,
@@ -96,7 +85,9 @@ fn rel(a: f64, b: f64) -> f64 {
 
 #[test]
 fn both_solvers_match_copp_on_its_own_grid() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let mut failures = Vec::new();
     eprintln!(
         "path  T_clarabel      vs COPP2-SOCP   T_reach         vs TOPP2-RA    vs COPP2-SOCP  \
@@ -169,7 +160,9 @@ fn both_solvers_match_copp_on_its_own_grid() {
 /// solves the coarser grid.
 #[test]
 fn cli_solves_a_copp_path() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let case = load(&dir, 0);
     let tmp = tempfile::tempdir().expect("temp dir");
     let machine = tmp.path().join("M.json");

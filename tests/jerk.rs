@@ -1,7 +1,7 @@
 //! Jerk-limited schedules (issue 6): closed form, limits, two objectives agreeing, the COPP
 //! benchmark's jerk-limited paths, and the chord error together with jerk.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use feedopt::constraints::Chord;
 use feedopt::machine::Machine;
@@ -17,16 +17,6 @@ use common::UP;
 
 #[path = "common/copp.rs"]
 mod copp_data;
-
-fn copp_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/copp_random7");
-    if dir.join("path_000.json").is_file() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: {} is absent", dir.display());
-        None
-    }
-}
 
 /// A COPP path with its jerk limits; returns (machine, path, TOPP3-SOCP time).
 fn copp_case(dir: &Path, idx: usize) -> (Machine, joint_csv::JointPath, f64) {
@@ -153,7 +143,9 @@ fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
 /// through cones — reach the same schedule on a COPP path.
 #[test]
 fn linearised_and_cone_objectives_agree() {
-    let Some(dir) = copp_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let (m, path, _) = copp_case(&dir, 1);
     let solve = |objective| {
         let o = Options {
@@ -178,7 +170,9 @@ fn linearised_and_cone_objectives_agree() {
 /// than COPP's TOPP3-SOCP (+0.1 %). All twenty: the ignored test below.
 #[test]
 fn copp_jerk_paths_verify_and_match_topp3() {
-    let Some(dir) = copp_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     for idx in [0, 7, 13] {
         let (m, path, topp3) = copp_case(&dir, idx);
         let sol = optimize_joint(&m, &path, &copp_options()).expect("solve");
@@ -194,7 +188,9 @@ fn copp_jerk_paths_verify_and_match_topp3() {
 #[test]
 #[ignore]
 fn copp_jerk_all_twenty() {
-    let Some(dir) = copp_dir() else { return };
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
     let (mut sum, mut sum_ref) = (0.0, 0.0);
     for idx in 0..20 {
         let (m, path, topp3) = copp_case(&dir, idx);

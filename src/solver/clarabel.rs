@@ -50,7 +50,7 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
-use super::{SolverSettings, SpanSolution, Status};
+use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::SpanProblem;
 use crate::error::{Error, Result};
 
@@ -77,29 +77,6 @@ impl Layout {
     }
     fn len(&self) -> usize {
         3 * (self.n - 1) + 1
-    }
-}
-
-/// A sparse row block under construction (triplets), with its right-hand side.
-#[derive(Default)]
-struct Rows {
-    i: Vec<usize>,
-    j: Vec<usize>,
-    v: Vec<f64>,
-    h: Vec<f64>,
-}
-
-impl Rows {
-    fn push(&mut self, coefs: &[(usize, f64)], h: f64) {
-        let r = self.h.len();
-        for &(j, v) in coefs {
-            if v != 0.0 {
-                self.i.push(r);
-                self.j.push(j);
-                self.v.push(v);
-            }
-        }
-        self.h.push(h);
     }
 }
 

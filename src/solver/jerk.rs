@@ -48,7 +48,7 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
-use super::{SolverSettings, SpanSolution, Status};
+use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::{Chord, SpanProblem, essential_rows};
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
@@ -273,65 +273,6 @@ fn rest_bound(
         }
     }
     bound
-}
-
-/// A sparse row block under construction (triplets in row order), with its right-hand side.
-#[derive(Default)]
-struct Rows {
-    i: Vec<usize>,
-    j: Vec<usize>,
-    v: Vec<f64>,
-    h: Vec<f64>,
-    /// Index of each row's first triplet.
-    start: Vec<usize>,
-}
-
-impl Rows {
-    fn push(&mut self, coefs: &[(usize, f64)], h: f64) {
-        let r = self.h.len();
-        self.start.push(self.v.len());
-        for &(j, v) in coefs {
-            if v != 0.0 {
-                self.i.push(r);
-                self.j.push(j);
-                self.v.push(v);
-            }
-        }
-        self.h.push(h);
-    }
-
-    fn len(&self) -> usize {
-        self.h.len()
-    }
-
-    fn triplets(&self, r: usize) -> std::ops::Range<usize> {
-        self.start[r]..self.start.get(r + 1).copied().unwrap_or(self.v.len())
-    }
-
-    /// Row `r` of `other` appended.
-    fn copy_row(&mut self, other: &Rows, r: usize) {
-        let row = self.h.len();
-        self.start.push(self.v.len());
-        for t in other.triplets(r) {
-            self.i.push(row);
-            self.j.push(other.j[t]);
-            self.v.push(other.v[t]);
-        }
-        self.h.push(other.h[r]);
-    }
-
-    fn append(&mut self, other: &Rows) {
-        for r in 0..other.len() {
-            self.copy_row(other, r);
-        }
-    }
-
-    /// (A z)_r / h_r for a row `A z ≤ h` with h = 1 … : here simply `A_r z − h_r + 1`, so
-    /// that a row holds iff the value is ≤ 1.
-    fn value(&self, r: usize, z: &[f64]) -> f64 {
-        let az: f64 = self.triplets(r).map(|t| self.v[t] * z[self.j[t]]).sum();
-        az - self.h[r] + 1.0
-    }
 }
 
 /// Column indices: x_i, y_i, c_i for interior stations 1 ≤ i ≤ N−1, d_k per interval.

@@ -93,3 +93,62 @@ pub struct SpanSolution {
     /// Wall time of the solver proper (s), excluding problem build.
     pub solve_time: f64,
 }
+
+/// A sparse row block under construction (triplets in row order), with its right-hand side.
+#[derive(Default)]
+pub(crate) struct Rows {
+    pub(crate) i: Vec<usize>,
+    pub(crate) j: Vec<usize>,
+    pub(crate) v: Vec<f64>,
+    pub(crate) h: Vec<f64>,
+    /// Index of each row's first triplet.
+    pub(crate) start: Vec<usize>,
+}
+
+impl Rows {
+    pub(crate) fn push(&mut self, coefs: &[(usize, f64)], h: f64) {
+        let r = self.h.len();
+        self.start.push(self.v.len());
+        for &(j, v) in coefs {
+            if v != 0.0 {
+                self.i.push(r);
+                self.j.push(j);
+                self.v.push(v);
+            }
+        }
+        self.h.push(h);
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.h.len()
+    }
+
+    pub(crate) fn triplets(&self, r: usize) -> std::ops::Range<usize> {
+        self.start[r]..self.start.get(r + 1).copied().unwrap_or(self.v.len())
+    }
+
+    /// Row `r` of `other` appended.
+    pub(crate) fn copy_row(&mut self, other: &Rows, r: usize) {
+        let row = self.h.len();
+        self.start.push(self.v.len());
+        for t in other.triplets(r) {
+            self.i.push(row);
+            self.j.push(other.j[t]);
+            self.v.push(other.v[t]);
+        }
+        self.h.push(other.h[r]);
+    }
+
+    pub(crate) fn append(&mut self, other: &Rows) {
+        for r in 0..other.len() {
+            self.copy_row(other, r);
+        }
+    }
+
+    /// (A z)_r / h_r for a row `A z ≤ h` with h = 1 … : here simply `A_r z − h_r + 1`, so
+    /// that a row holds iff the value is ≤ 1.
+    pub(crate) fn value(&self, r: usize, z: &[f64]) -> f64 {
+        let az: f64 = self.triplets(r).map(|t| self.v[t] * z[self.j[t]]).sum();
+        az - self.h[r] + 1.0
+    }
+}

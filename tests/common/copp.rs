@@ -2,6 +2,7 @@
 //! benches/copp.rs; the data stay in ../shared).
 
 use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
 
 /// The machine file (kinematics `joint`, axis j named `j` as the CSV's `q_j`) of a COPP path's
 /// `limits` (`vel_min`, `vel_max`, `acc_min`, `acc_max` arrays).
@@ -40,4 +41,17 @@ fn machine_json_with(limits: &Value, jerk: bool) -> String {
         axes.insert(j.to_string(), axis);
     }
     json!({"name": "COPP random 7-axis", "kinematics": {"type": "joint"}, "axes": axes}).to_string()
+}
+
+/// The shared benchmark folder (`../shared/bench/copp_random7`), or `None` with a note on
+/// stderr when it is absent.
+#[allow(dead_code)]
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/copp_random7");
+    if dir.join("path_000.json").is_file() {
+        Some(dir)
+    } else {
+        eprintln!("skipping: {} is absent", dir.display());
+        None
+    }
 }
