@@ -858,7 +858,7 @@ fn subproblem(
         }
         if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
             eprintln!(
-                "  active jerk rows {n_jerk} of {}, violated {added}",
+                "  active rows {n_jerk} of {} candidates, {added} added",
                 cand.len()
             );
         }
