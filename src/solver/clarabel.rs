@@ -46,9 +46,7 @@
 //! so only [`solve_with_sensitivity`] (one window) returns sensitivities.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
 use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::SpanProblem;
@@ -253,15 +251,7 @@ pub fn solve_with_sensitivity(
         n_soc,
     ));
 
-    let s = DefaultSettingsBuilder::default()
-        .verbose(std::env::var_os("FEEDOPT_SOLVER_VERBOSE").is_some())
-        .max_iter(settings.max_iter)
-        .tol_gap_rel(settings.tol_gap)
-        .tol_gap_abs(settings.tol_gap)
-        .tol_feas(settings.tol_feas)
-        .iterative_refinement_enable(settings.iterative_refinement)
-        .build()
-        .map_err(|e| Error::Solver(format!("settings: {e:?}")))?;
+    let s = settings.clarabel(settings.tol_gap)?;
     let mut solver = DefaultSolver::new(&pmat, &q, &a, &h, &cones, s)
         .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
     solver.solve();

@@ -44,9 +44,7 @@
 //! interval).
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
 use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::{Chord, SpanProblem, essential_rows};
@@ -816,15 +814,7 @@ fn subproblem(
             SupportedConeT::SecondOrderConeT(3),
             n_soc,
         ));
-        let s = DefaultSettingsBuilder::default()
-            .verbose(std::env::var_os("FEEDOPT_SOLVER_VERBOSE").is_some())
-            .max_iter(settings.max_iter)
-            .tol_gap_rel(gap)
-            .tol_gap_abs(gap)
-            .tol_feas(settings.tol_feas)
-            .iterative_refinement_enable(settings.iterative_refinement)
-            .build()
-            .map_err(|e| Error::Solver(format!("settings: {e:?}")))?;
+        let s = settings.clarabel(gap)?;
         let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
             .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
         solver.solve();

@@ -79,6 +79,25 @@ impl Default for SolverSettings {
     }
 }
 
+impl SolverSettings {
+    /// Clarabel's settings for these, with duality-gap tolerance `gap`
+    /// (`FEEDOPT_SOLVER_VERBOSE` set: Clarabel prints its log).
+    pub(crate) fn clarabel(
+        &self,
+        gap: f64,
+    ) -> crate::error::Result<::clarabel::solver::DefaultSettings<f64>> {
+        ::clarabel::solver::DefaultSettingsBuilder::default()
+            .verbose(std::env::var_os("FEEDOPT_SOLVER_VERBOSE").is_some())
+            .max_iter(self.max_iter)
+            .tol_gap_rel(gap)
+            .tol_gap_abs(gap)
+            .tol_feas(self.tol_feas)
+            .iterative_refinement_enable(self.iterative_refinement)
+            .build()
+            .map_err(|e| crate::error::Error::Solver(format!("settings: {e:?}")))
+    }
+}
+
 /// The optimal profile of one span.
 #[derive(Debug, Clone)]
 pub struct SpanSolution {
