@@ -347,22 +347,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     use std::io::IsTerminal;
     let solve = &args.solve;
     let options = solve.options()?;
-    if let Some(plot) = &args.solve.plot {
-        let svg = plot
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-        let dir = match plot.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => std::path::Path::new("."),
-        };
-        if !svg || !dir.is_dir() {
-            return Err(Error::Usage(format!(
-                "--plot {}: needs a .svg file in an existing directory",
-                plot.display()
-            )));
-        }
-    }
+    // `options()` has checked --plot (and -o) already.
     let machine = Machine::from_file(&solve.machine)?;
     let (input, _) = read_input(solve)?;
     let mut o =
@@ -500,17 +485,7 @@ pub struct GcodeArgs {
 
 /// `feedopt gcode`: returns what to print on stdout.
 pub fn gcode(args: &GcodeArgs) -> Result<String> {
-    let dir = match args.output.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(Error::Usage(format!(
-            "{}: the directory {} does not exist",
-            args.output.display(),
-            dir.display()
-        )));
-    }
+    writers::check_directory(&args.output)?;
     let solve_args = args.plan.solve_args(
         args.input_dialect.unwrap_or(args.dialect),
         crate::verify::VerifyOptions::default().period,

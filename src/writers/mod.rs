@@ -33,15 +33,22 @@ pub fn schedule_format(path: &Path) -> Result<ScheduleFormat> {
             )));
         }
     };
+    check_directory(path)?;
+    Ok(format)
+}
+
+/// An output path's directory must exist (checked before any work is done).
+pub fn check_directory(path: &Path) -> Result<()> {
     let dir = parent_dir(path);
-    if !dir.is_dir() {
-        return Err(Error::Usage(format!(
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(Error::Usage(format!(
             "{}: the directory {} does not exist",
             path.display(),
             dir.display()
-        )));
+        )))
     }
-    Ok(format)
 }
 
 /// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).

@@ -59,17 +59,7 @@ pub fn plot_format(path: &Path) -> Result<PlotFormat> {
             )));
         }
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        return Err(Error::Usage(format!(
-            "{}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        )));
-    }
+    super::check_directory(path)?;
     Ok(format)
 }
 
@@ -139,27 +129,11 @@ pub fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(4 * BINS);
     let mut i = 0;
     while i < points.len() {
-        let b = bin(points[i].0);
-        let start = i;
-        let (mut lo, mut hi) = (i, i);
+        let (b, start) = (bin(points[i].0), i);
         while i < points.len() && bin(points[i].0) == b {
-            if points[i].1 < points[lo].1 {
-                lo = i;
-            }
-            if points[i].1 > points[hi].1 {
-                hi = i;
-            }
             i += 1;
         }
-        let mut keep = [start, lo, hi, i - 1];
-        keep.sort_unstable();
-        let mut last = usize::MAX;
-        for k in keep {
-            if k != last {
-                out.push(points[k]);
-                last = k;
-            }
-        }
+        out.extend(thin_bin(&points[start..i]));
     }
     out
 }
