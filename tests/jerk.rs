@@ -166,6 +166,66 @@ fn linearised_and_cone_objectives_agree() {
     assert!((lp - cones).abs() <= 2e-4 * cones, "{lp} vs {cones}");
 }
 
+/// The cycle time of COPP path `idx` on its fixed grid, cut into windows of `window` stations
+/// solved on `threads` threads (`usize::MAX`: one piece).
+fn copp_fixed_grid_time(dir: &Path, idx: usize, window: usize, threads: usize) -> f64 {
+    let (m, path, _) = copp_case(dir, idx);
+    let mut o = Options {
+        refine_until_verified: false,
+        jerk: JerkOptions {
+            window,
+            ..JerkOptions::default()
+        },
+        ..copp_options()
+    };
+    o.solver.threads = threads;
+    optimize_joint(&m, &path, &o)
+        .expect("solve")
+        .schedule
+        .cycle_time
+}
+
+/// Cutting a span into windows at velocity plateaus (b and ü fixed there, each window its own
+/// SCP) reaches the one-piece SCP's cycle time within its own tolerance (1e-4), and the result
+/// does not depend on how many threads solve the windows. All twenty: the ignored test below.
+#[test]
+fn windows_agree_with_one_piece() {
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
+    let idx = 3;
+    let whole = copp_fixed_grid_time(&dir, idx, usize::MAX, 0);
+    let windows = copp_fixed_grid_time(&dir, idx, JerkOptions::default().window, 0);
+    let serial = copp_fixed_grid_time(&dir, idx, JerkOptions::default().window, 1);
+    eprintln!("path {idx}: one piece {whole:.6} s, windows {windows:.6} s");
+    assert!(
+        (windows - whole).abs() <= 1e-4 * whole,
+        "{windows} vs {whole}"
+    );
+    assert_eq!(
+        windows, serial,
+        "two threads and one give the same schedule"
+    );
+}
+
+#[test]
+#[ignore]
+fn windows_agree_with_one_piece_all_twenty() {
+    let Some(dir) = copp_data::data_dir() else {
+        return;
+    };
+    let mut worst: f64 = 0.0;
+    for idx in 0..20 {
+        let whole = copp_fixed_grid_time(&dir, idx, usize::MAX, 0);
+        let windows = copp_fixed_grid_time(&dir, idx, JerkOptions::default().window, 0);
+        let rel = windows / whole - 1.0;
+        eprintln!("path {idx:2}: one piece {whole:.6} s, windows {windows:.6} s ({rel:+.2e})");
+        worst = worst.max(rel.abs());
+    }
+    eprintln!("largest relative difference {worst:.2e}");
+    assert!(worst <= 1e-4);
+}
+
 /// Three COPP paths with their jerk limits: verified at 1 kHz including jerk, and no slower
 /// than COPP's TOPP3-SOCP (+0.1 %). All twenty: the ignored test below.
 #[test]

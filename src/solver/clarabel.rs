@@ -317,11 +317,7 @@ pub fn solve_windowed(
     settings: &SolverSettings,
 ) -> Result<SpanSolution> {
     let n = p.intervals();
-    let threads = if settings.threads == 0 {
-        std::thread::available_parallelism().map_or(1, |t| t.get())
-    } else {
-        settings.threads
-    };
+    let threads = settings.worker_threads();
     const MIN_WINDOW: usize = 200;
     let windows = n
         .div_ceil(settings.window.max(MIN_WINDOW))
@@ -374,31 +370,9 @@ pub fn solve_windowed(
             p.window(c[0], c[1], bs, be)
         })
         .collect();
-    // Solve the windows on `threads` workers, each taking every threads-th window.
-    let workers = threads.min(parts.len()).max(1);
+    // Solve the windows on `threads` workers.
     let t0 = std::time::Instant::now();
-    let results: Vec<Result<SpanSolution>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|wk| {
-                let parts = &parts;
-                scope.spawn(move || {
-                    (wk..parts.len())
-                        .step_by(workers)
-                        .map(|i| (i, solve(&parts[i], settings)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<(usize, Result<SpanSolution>)> = handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect();
-        all.sort_by_key(|(i, _)| *i);
-        all.into_iter().map(|(_, r)| r).collect()
-    });
-    if results.len() != parts.len() {
-        return Err(Error::Solver("a window solver thread failed".into()));
-    }
+    let results = super::par_map(&parts, threads, |part| solve(part, settings));
     let mut b = Vec::with_capacity(n + 1);
     let (mut status, mut iterations) = (Status::Optimal, 0);
     for (i, r) in results.into_iter().enumerate() {

@@ -34,12 +34,28 @@
 //! b = 3 b̄, a built-in trust region.
 //!
 //! The first linearisation point is the acceleration-limited optimum from the O(N) pass, b̄ =
-//! b_reach, with 1/√b̄ itself as the bound and b ≤ b̄ added (then `L ≤ j/√b̄ ≤ j/√b`): feasible
-//! by construction, however far from jerk-feasible b_reach is. Iterations stop when the cycle
-//! time (eq. 43 under the motion laws) changes by less than [`JerkOptions::convergence`].
+//! b_reach (ü at a station: the mean of its two intervals'). The tangent at *any* b̄ is an
+//! inner approximation, so even this first subproblem's solution is jerk-feasible, however far
+//! from jerk-feasible b_reach is. Iterations stop when the cycle time (eq. 43 under the motion
+//! laws) changes by less than [`JerkOptions::convergence`].
 //!
-//! Each subproblem is a second-order cone program in the scaled variables x = b/B, y = a/B
-//! (B: the median velocity bound), with c_i ≤ √x_i and d_k (c_k + c_{k+1}) ≥ 1 as in
+//! Each subproblem is an LP (the linearised time, [`Objective::Linearised`]) or a second-order
+//! cone program (the time itself, [`Objective::Cones`]) in the scaled variables x = b/B,
+//! y = a/B (B: the median of the first linearisation point); the rows that are far from their
+//! bounds are left out until a solution violates them (an active set, see [`Program::solve`]).
+//!
+//! ## Windows, in parallel
+//!
+//! Where the reach profile runs along the velocity bound for a few stations (set by one axis),
+//! the jerk-limited optimum does too: its acceleration ramps at the jerk limit, so it leaves
+//! and rejoins such a plateau a few stations from its ends. Fixing b and ü at the middle of a
+//! plateau therefore cuts the span into independent pieces; each piece runs its own SCP with
+//! its ends fixed, on as many threads as [`SolverSettings::threads`] allows, and stops at its
+//! own 1e-4 (so the whole does too). A refinement that only adds stations inside some windows
+//! solves only those. On the 20 COPP paths the windowed cycle times are 1e-5 to 3e-5 above the
+//! one-piece ones, within the SCP's own tolerance (test `windows_agree_with_one_piece`).
+//!
+//! The cone form: c_i ≤ √x_i and d_k (c_k + c_{k+1}) ≥ 1 as in
 //! [`super::clarabel`], minimising `Σ 2Δu_k d_k/√B` (`3 Δu_k d_k/√B` on a constant-jerk end
 //! interval).
 
@@ -64,6 +80,9 @@ pub struct JerkOptions {
     pub max_iterations: usize,
     /// The subproblems' objective.
     pub objective: Objective,
+    /// Stations per window: a longer span is cut into windows of about this many stations,
+    /// solved independently and in parallel (see [`solve`]); `usize::MAX`: one piece.
+    pub window: usize,
 }
 
 /// The objective of each convex subproblem.
@@ -88,6 +107,7 @@ impl Default for JerkOptions {
             convergence: 1e-4,
             max_iterations: 30,
             objective: Objective::default(),
+            window: 150,
         }
     }
 }
@@ -105,14 +125,39 @@ pub struct JerkData {
     /// Largest b at station 1 (N−1) for the first (last) interval's constant jerk to stay
     /// within every limit; infinite where the span does not start (end) at rest.
     pub rest_bound: (f64, f64),
-    /// The [`COLLOCATION`] points of every interval, interval by interval.
+    /// The [`collocation`] points of every interval, interval by interval.
     pub mid: Vec<Midpoint>,
+    /// Interval k's collocation points are `mid[mid_start[k]..mid_start[k + 1]]`.
+    pub mid_start: Vec<usize>,
 }
 
 /// Where inside each interval velocity, acceleration and jerk are also bounded (as fractions
 /// of the interval): b is quadratic between stations and may bulge above both ends, and the
 /// geometry's curvature varies in between.
 pub const COLLOCATION: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// The collocation points of the intervals next to a rest end ([`NEAR_REST`]): there b grows
+/// as u^(4/3) from 0, which the quadratic pieces follow with a jerk that curves strongly
+/// inside each interval (on COPP path 3 it peaked 1.7 % above the limit between ¼ and ½ of
+/// the interval after the constant-jerk start).
+pub const COLLOCATION_NEAR_REST: [f64; 15] = [
+    0.0625, 0.125, 0.1875, 0.25, 0.3125, 0.375, 0.4375, 0.5, 0.5625, 0.625, 0.6875, 0.75, 0.8125,
+    0.875, 0.9375,
+];
+
+/// Intervals counted from a rest end that take [`COLLOCATION_NEAR_REST`]: the constant-jerk
+/// interval and the stations graded into it (see [`crate::optimize`]) lie within the first
+/// seven.
+pub const NEAR_REST: usize = 8;
+
+/// The collocation points of interval `k` of `n` (as fractions of it).
+pub fn collocation(k: usize, n: usize, rest_start: bool, rest_end: bool) -> &'static [f64] {
+    if (rest_start && k < NEAR_REST) || (rest_end && k + NEAR_REST >= n) {
+        &COLLOCATION_NEAR_REST
+    } else {
+        &COLLOCATION
+    }
+}
 
 /// The geometry at a collocation point inside an interval.
 #[derive(Debug, Clone)]
@@ -182,8 +227,14 @@ impl JerkData {
             }
         }
         let moving = span.kind == SpanKind::Moving;
+        let (rs, re) = (p.b_start == 0.0, p.b_end == 0.0);
+        let mut mid_start = Vec::with_capacity(n + 1);
+        mid_start.push(0);
+        for k in 0..n {
+            mid_start.push(mid_start[k] + collocation(k, n, rs, re).len());
+        }
         let mid = (0..n)
-            .flat_map(|k| COLLOCATION.iter().map(move |&th| (k, th)))
+            .flat_map(|k| collocation(k, n, rs, re).iter().map(move |&th| (k, th)))
             .map(|(k, th)| {
                 let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
                 let seg = span.spline.segment(um);
@@ -227,6 +278,34 @@ impl JerkData {
             limits,
             rest_bound: rest,
             mid,
+            mid_start,
+        }
+    }
+}
+
+impl JerkData {
+    /// The data of stations `a..=b` (intervals a..b), as [`SpanProblem::window`].
+    pub fn window(&self, a: usize, b: usize) -> JerkData {
+        let n = self.right.len() - 1;
+        let (m0, m1) = (self.mid_start[a], self.mid_start[b]);
+        JerkData {
+            right: self.right[a..=b].to_vec(),
+            left: self.left[a..=b].to_vec(),
+            limits: self.limits.clone(),
+            rest_bound: (
+                if a == 0 {
+                    self.rest_bound.0
+                } else {
+                    f64::INFINITY
+                },
+                if b == n {
+                    self.rest_bound.1
+                } else {
+                    f64::INFINITY
+                },
+            ),
+            mid: self.mid[m0..m1].to_vec(),
+            mid_start: self.mid_start[a..=b].iter().map(|&m| m - m0).collect(),
         }
     }
 }
@@ -315,8 +394,8 @@ impl Layout {
 pub struct Warm {
     pub b: Vec<f64>,
     pub a: Vec<f64>,
-    /// Its cycle time on its own stations.
-    pub time: f64,
+    /// Stations that were not stations of the previous profile.
+    pub fresh: Vec<bool>,
 }
 
 impl Warm {
@@ -324,8 +403,12 @@ impl Warm {
     /// is not jerk-limited.
     pub fn resample(old_p: &SpanProblem, old: &SpanSolution, p: &SpanProblem) -> Option<Warm> {
         let a_old = old.a.as_deref()?;
-        let time = interval_times(old_p, old).ok()?.iter().sum();
-        let (mut b, mut a) = (Vec::with_capacity(p.u.len()), Vec::with_capacity(p.u.len()));
+        let n = p.u.len();
+        let (mut b, mut a, mut fresh) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
         let mut k = 0;
         let last = old_p.intervals() - 1;
         for &u in &p.u {
@@ -336,13 +419,20 @@ impl Warm {
             let (bu, au) = iv.at_x(u - old_p.u[k]);
             b.push(bu);
             a.push(au);
+            fresh.push(u != old_p.u[k] && u != old_p.u[k + 1]);
         }
-        Some(Warm { b, a, time })
+        Some(Warm { b, a, fresh })
     }
 }
 
 /// The jerk-limited optimum of one span: sequential convex programming from the
 /// acceleration-limited reach profile `greedy` (same stations), or from `warm`.
+///
+/// A long span is cut into windows at stations where the starting profile runs along the
+/// velocity bound (see [`cuts`]): b and ü are fixed there, and each window runs its own SCP,
+/// the windows in parallel (`settings.threads`). Where the profile sits on its velocity bound
+/// over several stations, the optimum does too, so the cut costs nothing; a window that cannot
+/// be solved with its ends fixed sends the span back to one piece.
 pub fn solve(
     p: &SpanProblem,
     jd: &JerkData,
@@ -357,28 +447,197 @@ pub fn solve(
             "a jerk-limited span needs at least 3 station intervals, found {n}"
         )));
     }
-    let mut bbar = greedy.b.clone();
-    let mut abar: Option<Vec<f64>> = None;
-    // The time of the previous profile, for the stopping test.
-    let mut last_time: Option<f64> = None;
-    if let Some(w) = warm.filter(|w| w.b.len() == p.u.len() && w.b[1..n].iter().all(|&b| b > 0.0)) {
-        bbar = w.b;
-        abar = Some(w.a);
-        last_time = Some(w.time);
+    let warm = warm.filter(|w| w.b.len() == p.u.len() && w.b[1..n].iter().all(|&b| b > 0.0));
+    let start = match &warm {
+        Some(w) => Start {
+            b: &w.b,
+            a: Some(&w.a),
+        },
+        None => Start {
+            b: &greedy.b,
+            a: None,
+        },
+    };
+    let threads = settings.worker_threads();
+    let cuts = cuts(p, &start, threads, options.window);
+    let trace = std::env::var_os("FEEDOPT_JERK_TRACE").is_some();
+    if cuts.len() > 2 {
+        let t0 = std::time::Instant::now();
+        let windows: Vec<(usize, usize)> = cuts.windows(2).map(|c| (c[0], c[1])).collect();
+        let results = super::par_map(&windows, threads, |&(a, b)| {
+            if let Some(w) = warm.as_ref().filter(|w| !w.fresh[a..=b].contains(&true)) {
+                // No new station in this window: the previous profile is its solution still
+                // (its ends are fixed at that profile's values).
+                return Ok(SpanSolution {
+                    b: w.b[a..=b].to_vec(),
+                    a: Some(w.a[a..=b].to_vec()),
+                    status: Status::Optimal,
+                    iterations: 0,
+                    solve_time: 0.0,
+                });
+            }
+            let (ba, aa) = start.at(p, a);
+            let (bb, ab) = start.at(p, b);
+            let wp = p.window(a, b, ba, bb);
+            let wjd = jd.window(a, b);
+            let ws = Start {
+                b: &start.b[a..=b],
+                a: start.a.map(|x| &x[a..=b]),
+            };
+            solve_piece(&wp, &wjd, &ws, (aa, ab), settings, options)
+        });
+        match stitch(&windows, results) {
+            Ok(mut sol) => {
+                sol.solve_time = t0.elapsed().as_secs_f64();
+                if trace {
+                    eprintln!("SCP in {} windows: {:?}", windows.len(), windows);
+                }
+                return Ok(sol);
+            }
+            Err(e) if trace => eprintln!("SCP windows failed ({e}); one piece"),
+            Err(_) => {}
+        }
     }
+    solve_piece(p, jd, &start, (0.0, 0.0), settings, options)
+}
+
+/// The first linearisation point: b at every station, and ü (a jerk-limited profile) or none
+/// (the reach profile).
+struct Start<'a> {
+    b: &'a [f64],
+    a: Option<&'a [f64]>,
+}
+
+impl Start<'_> {
+    /// (b, ü) at station i: ü as given, or for the reach profile on a velocity plateau the
+    /// slope of the bound, ½ db_max/du (the optimum follows the bound there).
+    fn at(&self, p: &SpanProblem, i: usize) -> (f64, f64) {
+        if i == 0 || i == p.intervals() {
+            // The span's own ends: ü = 0 there.
+            return (self.b[i], 0.0);
+        }
+        let a = match self.a {
+            Some(a) => a[i],
+            None => 0.5 * (p.b_max[i + 1] - p.b_max[i - 1]) / (p.u[i + 1] - p.u[i - 1]),
+        };
+        (self.b[i], a)
+    }
+}
+
+/// Stations fewer than this apart are not cut.
+const MIN_WINDOW: usize = 100;
+
+/// A cut needs the starting profile on the velocity bound, set by the same limit, from
+/// `PLATEAU` stations before it to `PLATEAU` after: a jerk-limited profile leaves a plateau
+/// of the acceleration-limited one a few stations early and rejoins it a few late (its
+/// acceleration ramps at the jerk limit), so the middle of a long plateau is on the bound in
+/// both.
+const PLATEAU: usize = 5;
+
+/// Window boundaries `0 = c_0 < c_1 < … = N`: about `max(threads, N/window)` windows of similar
+/// length (none shorter than [`MIN_WINDOW`]), each cut at the plateau station nearest its
+/// target (within ±40 % of a window); targets without one are skipped.
+fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<usize> {
+    let n = p.intervals();
+    if window == usize::MAX {
+        return vec![0, n];
+    }
+    let windows = threads
+        .max(n.div_ceil(window.max(1)))
+        .min(n / MIN_WINDOW)
+        .max(1);
+    let mut cuts = vec![0usize];
+    if windows > 1 {
+        // A jerk-limited start is on the bound wherever the optimum is (up to the refinement
+        // that follows): its neighbours on the bound suffice.
+        let half = if start.a.is_some() { 1 } else { PLATEAU };
+        let on_plateau = |m: usize| {
+            m > half
+                && m + half < n
+                && (m - half..=m + half).all(|i| {
+                    p.b_max[i].is_finite()
+                        && p.b_max_by[i] == p.b_max_by[m]
+                        && start.b[i] >= (1.0 - 1e-4) * p.b_max[i]
+                })
+        };
+        let len = n / windows;
+        for w in 1..windows {
+            let target = w * n / windows;
+            let reach = 2 * len / 5;
+            let found = (0..=reach)
+                .flat_map(|d| [target.saturating_sub(d), target + d])
+                .find(|&m| on_plateau(m));
+            if let Some(m) = found.filter(|&m| m >= cuts[cuts.len() - 1] + MIN_WINDOW / 2) {
+                cuts.push(m);
+            }
+        }
+    }
+    if n - cuts[cuts.len() - 1] < MIN_WINDOW / 2 {
+        cuts.pop();
+    }
+    cuts.push(n);
+    cuts
+}
+
+/// The windows' profiles joined (each shares its first station with the previous one's last).
+fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Result<SpanSolution> {
+    let mut b = Vec::new();
+    let mut a = Vec::new();
+    let (mut status, mut iterations) = (Status::Optimal, 0);
+    for (w, r) in results.into_iter().enumerate() {
+        let s = r?;
+        let from = if w == 0 { 0 } else { 1 };
+        debug_assert_eq!(s.b.len(), windows[w].1 - windows[w].0 + 1);
+        b.extend_from_slice(&s.b[from..]);
+        a.extend_from_slice(&s.a.as_deref().unwrap_or_default()[from..]);
+        status = status.worst(s.status);
+        iterations += s.iterations;
+    }
+    Ok(SpanSolution {
+        b,
+        a: Some(a),
+        status,
+        iterations,
+        solve_time: 0.0,
+    })
+}
+
+/// The SCP on one piece of a span (the whole span, or a window whose ends are fixed at b =
+/// `p.b_start`, `p.b_end` and ü = `a_ends`).
+fn solve_piece(
+    p: &SpanProblem,
+    jd: &JerkData,
+    start: &Start,
+    a_ends: (f64, f64),
+    settings: &SolverSettings,
+    options: &JerkOptions,
+) -> Result<SpanSolution> {
+    let mut bbar = start.b.to_vec();
+    let mut abar: Option<Vec<f64>> = start.a.map(<[f64]>::to_vec);
+    // The time of the previous profile, for the stopping test.
+    let mut last_time: Option<f64> = match &abar {
+        Some(a) => Some(
+            interval_times(
+                p,
+                &SpanSolution {
+                    b: bbar.clone(),
+                    a: Some(a.clone()),
+                    status: Status::Optimal,
+                    iterations: 0,
+                    solve_time: 0.0,
+                },
+            )?
+            .iter()
+            .sum(),
+        ),
+        None => None,
+    };
     let mut best: Option<(SpanSolution, f64)> = None;
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
     let mut carried: Vec<bool> = Vec::new();
+    let program = Program::new(p, jd, &bbar, a_ends, options.objective);
     for it in 0..options.max_iterations.max(1) {
-        let sol = subproblem(
-            p,
-            jd,
-            &bbar,
-            abar.as_deref(),
-            settings,
-            options.objective,
-            &mut carried,
-        )?;
+        let sol = program.solve(&bbar, abar.as_deref(), settings, &mut carried)?;
         status = status.worst(sol.status);
         iterations += sol.iterations;
         solve_time += sol.solve_time;
@@ -409,469 +668,584 @@ pub fn solve(
     Ok(sol)
 }
 
-/// Most terms an [`Expr`] holds before duplicates are merged.
-const EXPR_CAP: usize = 16;
-
-/// A linear expression in the scaled variables: coefficients by column, and a constant (a
-/// fixed-size buffer: rows are built by the hundred thousand, without allocating).
-#[derive(Clone, Copy)]
-struct Expr {
-    terms: [(usize, f64); EXPR_CAP],
+/// A linear expression in the scaled variables with at most four terms, and a constant.
+#[derive(Debug, Clone, Copy, Default)]
+struct Lin {
+    terms: [(usize, f64); 4],
     len: usize,
     constant: f64,
 }
 
-impl Default for Expr {
-    fn default() -> Self {
-        Expr {
-            terms: [(0, 0.0); EXPR_CAP],
-            len: 0,
-            constant: 0.0,
-        }
+impl Lin {
+    fn var(col: usize) -> Lin {
+        Lin::default().plus(col, 1.0)
     }
-}
-
-impl Expr {
-    fn var(col: usize) -> Expr {
-        let mut e = Expr::default();
-        e.terms[0] = (col, 1.0);
-        e.len = 1;
-        e
-    }
-    fn constant(c: f64) -> Expr {
-        Expr {
+    fn constant(c: f64) -> Lin {
+        Lin {
             constant: c,
-            ..Expr::default()
+            ..Lin::default()
         }
     }
-    fn coefs(&self) -> &[(usize, f64)] {
-        &self.terms[..self.len]
-    }
-    fn scaled(&self, w: f64) -> Expr {
-        let mut e = *self;
-        for t in &mut e.terms[..e.len] {
-            t.1 *= w;
-        }
-        e.constant *= w;
-        e
-    }
-    fn add(&mut self, other: &Expr, w: f64) {
-        for &(c, v) in other.coefs() {
-            self.terms[self.len] = (c, v * w);
+    /// `self + w·col` (merged with a term of the same column).
+    fn plus(mut self, col: usize, w: f64) -> Lin {
+        if let Some(t) = self.terms[..self.len].iter_mut().find(|t| t.0 == col) {
+            t.1 += w;
+        } else {
+            self.terms[self.len] = (col, w);
             self.len += 1;
         }
+        self
+    }
+    /// `self + w·other`.
+    fn add(mut self, other: &Lin, w: f64) -> Lin {
+        for &(c, v) in &other.terms[..other.len] {
+            self = self.plus(c, v * w);
+        }
         self.constant += other.constant * w;
+        self
     }
-    /// Sums the coefficients that share a column.
-    fn merge(&mut self) {
-        let t = &mut self.terms[..self.len];
-        t.sort_unstable_by_key(|c| c.0);
-        let mut n = 0;
-        for i in 0..t.len() {
-            if n > 0 && t[n - 1].0 == t[i].0 {
-                t[n - 1].1 += t[i].1;
-            } else {
-                t[n] = t[i];
-                n += 1;
-            }
-        }
-        self.len = n;
-    }
-}
-
-/// Σ w·e, duplicates merged.
-fn sum(terms: &[(&Expr, f64)]) -> Expr {
-    let mut e = Expr::default();
-    for (t, w) in terms {
-        e.add(t, *w);
-    }
-    e.merge();
-    e
-}
-
-/// `e ≤ h` as a row.
-fn le(rows: &mut Rows, e: &Expr, h: f64) {
-    rows.push(e.coefs(), h - e.constant);
-}
-
-/// The rows at one point of the path, in scaled variables (b = B·xb, a = B·ya):
-/// acceleration `a_min ≤ B (q'' xb + q' ya) ≤ a_max` (the rows of `essential`), and, given
-/// q''' and the interval's slope a' = B·slope, jerk `L/j ≤ (3/2)/√b̄ − b/(2 b̄^{3/2})` with
-/// `L = B (q''' xb + 3 q'' ya + q' slope)`, i.e. `(2/3)√b̄ L/j + b/(3 b̄) ≤ 1`.
-#[allow(clippy::too_many_arguments)]
-fn point_rows(
-    rows: &mut Rows,
-    p: &SpanProblem,
-    jd: &JerkData,
-    scale: f64,
-    jets: &AxisJets,
-    essential: u16,
-    xb: &Expr,
-    ya: &Expr,
-    jerk: Option<(&[f64; MAX_AXES], &Expr, f64)>,
-) {
-    for (j, lim) in p.acceleration.iter().enumerate() {
-        let (dq, ddq) = (jets.dq[j], jets.ddq[j]);
-        let mask = essential >> (2 * j);
-        if (dq == 0.0 && ddq == 0.0) || mask & 3 == 0 {
-            continue;
-        }
-        let e = sum(&[(xb, scale * ddq), (ya, scale * dq)]);
-        for (bit, a) in [(1, lim.max), (2, lim.min)] {
-            if mask & bit != 0 {
-                le(rows, &e.scaled(1.0 / a), 1.0);
-            }
-        }
-    }
-    let Some((d3, slope, bbar)) = jerk else {
-        return;
-    };
-    if bbar <= 0.0 {
-        return;
-    }
-    let sq = bbar.sqrt();
-    for (j, lim) in jd.limits.iter().enumerate() {
-        let Some(lim) = lim else { continue };
-        let (dq, ddq, dddq) = (jets.dq[j], jets.ddq[j], d3[j]);
-        if dq == 0.0 && ddq == 0.0 && dddq == 0.0 {
-            continue;
-        }
-        let l = sum(&[
-            (xb, scale * dddq),
-            (ya, 3.0 * scale * ddq),
-            (slope, scale * dq),
-        ]);
-        for jl in [lim.max, lim.min] {
-            let mut row = l.scaled(2.0 * sq / (3.0 * jl));
-            row.add(xb, scale / (3.0 * bbar));
-            row.merge();
-            le(rows, &row, 1.0);
-        }
-    }
-}
-
-/// One convex subproblem, the jerk rows linearised at the profile (`bbar`, `abar`; without
-/// `abar`, the acceleration-limited reach profile, whose b̄ at interval midpoints is taken as
-/// the mean of its ends).
-fn subproblem(
-    p: &SpanProblem,
-    jd: &JerkData,
-    bbar: &[f64],
-    abar: Option<&[f64]>,
-    settings: &SolverSettings,
-    objective: Objective,
-    carried: &mut Vec<bool>,
-) -> Result<SpanSolution> {
-    let n = p.intervals();
-    let lay = Layout {
-        n,
-        lp: objective == Objective::Linearised,
-    };
-    // B: the median of the linearisation point (the profile is near it; the velocity bounds
-    // can be orders of magnitude above where jerk holds the feed down, which would leave x tiny
-    // and the solver badly scaled).
-    let scale = {
-        let mut finite: Vec<f64> = bbar
+    fn eval(&self, z: &[f64]) -> f64 {
+        self.terms[..self.len]
             .iter()
-            .copied()
-            .filter(|b| b.is_finite() && *b > 0.0)
-            .collect();
-        if finite.is_empty() {
-            1.0
-        } else {
-            let mid = finite.len() / 2;
-            *finite.select_nth_unstable_by(mid, f64::total_cmp).1
-        }
-    };
-    let rest_start = p.b_start == 0.0;
-    let rest_end = p.b_end == 0.0;
-    let is_rest = |k: usize| (k == 0 && rest_start) || (k + 1 == n && rest_end);
-    let interior = |i: usize| i > 0 && i < n;
-    let xconst = |i: usize| {
-        if i == 0 {
-            p.b_start / scale
-        } else {
-            p.b_end / scale
-        }
-    };
-    // x_i = b_i/B and y_i = a_i/B as expressions (constants at the end stations, a = 0 there).
-    let x = |i: usize| {
-        if interior(i) {
-            Expr::var(lay.x(i))
-        } else {
-            Expr::constant(xconst(i))
-        }
-    };
-    let y = |i: usize| {
-        if interior(i) {
-            Expr::var(lay.y(i))
-        } else {
-            Expr::default()
-        }
-    };
+            .fold(self.constant, |acc, &(c, v)| acc + v * z[c])
+    }
+}
 
-    // Equalities (zero cone): b_{k+1} − b_k = Δu (a_k + a_{k+1}) on quadratic intervals; the
-    // constant-jerk ends: a_1 = 2 b_1/(3Δu_0), a_{N−1} = −2 b_{N−1}/(3Δu_{N−1}).
-    let mut eq = Rows::default();
-    for k in 0..n {
-        let du = p.du(k);
-        let e = if k == 0 && rest_start {
-            sum(&[(&y(1), 1.0), (&x(1), -2.0 / (3.0 * du))])
-        } else if k + 1 == n && rest_end {
-            sum(&[(&y(n - 1), 1.0), (&x(n - 1), 2.0 / (3.0 * du))])
-        } else {
-            sum(&[
-                (&x(k + 1), 1.0),
-                (&x(k), -1.0),
-                (&y(k), -du),
-                (&y(k + 1), -du),
-            ])
+/// Where the linearisation point's b̄ at a site comes from.
+#[derive(Debug, Clone, Copy)]
+enum BbarAt {
+    Station(usize),
+    /// Inside interval k: `b_k + wa·a_k + wb·a_{k+1}` under the previous profile's quadratic
+    /// law, or `(1 − θ) b_k + θ b_{k+1}` for the reach profile (no ü).
+    Inside {
+        k: usize,
+        theta: f64,
+        wa: f64,
+        wb: f64,
+    },
+}
+
+/// A point of the path where rows are stated: a station (acceleration), an end of an interval
+/// (jerk, with that interval's a'), or a collocation point (velocity, acceleration, jerk).
+struct Site<'a> {
+    /// b/B, ü/B and (for jerk) a'/B = (ü_{k+1} − ü_k)/(B Δu) there.
+    xb: Lin,
+    ya: Lin,
+    slope: Lin,
+    jets: &'a AxisJets,
+    /// q''' there (jerk rows), on the interval's side of a knot.
+    d3: Option<&'a [f64; MAX_AXES]>,
+    /// Acceleration rows to state ([`crate::constraints::essential_rows`] mask).
+    essential: u16,
+    /// The velocity bound (infinite: none; the stations' bounds are always stated).
+    b_max: f64,
+    at: BbarAt,
+}
+
+/// Which row of a site a candidate is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Velocity,
+    /// Axis, and the upper (`false`) or lower (`true`) limit.
+    Acceleration(u8, bool),
+    Jerk(u8, bool),
+}
+
+/// The values at one site of the expressions its rows are built from.
+#[derive(Clone, Copy, Default)]
+struct SiteValues {
+    x: f64,
+    y: f64,
+    slope: f64,
+}
+
+/// The convex subproblems of one span: everything that stays fixed from one SCP iterate to the
+/// next (stations, geometry, the equalities, the cones, every candidate row's site), built once.
+///
+/// The inequality rows are not built until they join the active set: each is evaluated at its
+/// site from three expression values (b, ü, a' there) and the site's jets, so testing all of
+/// them (≈ 90k on a 1,000-interval 7-axis path) costs a few multiplications each.
+struct Program<'a> {
+    p: &'a SpanProblem,
+    jd: &'a JerkData,
+    lay: Layout,
+    /// B: the median of the first linearisation point (the profile stays near it; the
+    /// velocity bounds can be orders of magnitude above where jerk holds the feed down, which
+    /// would leave x tiny and the solver badly scaled).
+    scale: f64,
+    sites: Vec<Site<'a>>,
+    /// Candidate rows: site index and kind, in site order.
+    cands: Vec<(u32, Kind)>,
+    eq: Rows,
+    /// The velocity bounds at the stations (always stated: they keep the LP bounded).
+    lin: Rows,
+    /// ü at the first and last station.
+    a_ends: (f64, f64),
+    soc: Rows,
+    n_soc: usize,
+}
+
+impl<'a> Program<'a> {
+    fn new(
+        p: &'a SpanProblem,
+        jd: &'a JerkData,
+        bbar: &[f64],
+        a_ends: (f64, f64),
+        objective: Objective,
+    ) -> Self {
+        let n = p.intervals();
+        let lay = Layout {
+            n,
+            lp: objective == Objective::Linearised,
         };
-        le(&mut eq, &e, 0.0);
-    }
-
-    let mut lin = Rows::default();
-    let mut cand = Rows::default();
-    // At the stations: velocity (and the constant-jerk ends' bound) and acceleration.
-    for i in 1..n {
-        let mut bmax = p.b_max[i];
-        if i == 1 {
-            bmax = bmax.min(jd.rest_bound.0);
-        }
-        if i == n - 1 {
-            bmax = bmax.min(jd.rest_bound.1);
-        }
-        if bmax.is_finite() {
-            lin.push(&[(lay.x(i), 1.0)], bmax / scale);
-        }
-        point_rows(
-            &mut cand,
-            p,
-            jd,
-            scale,
-            &p.jets[i],
-            p.essential[i],
-            &x(i),
-            &y(i),
-            None,
-        );
-    }
-    for k in 0..n {
-        if is_rest(k) {
-            continue;
-        }
-        let du = p.du(k);
-        let slope = sum(&[(&y(k + 1), 1.0 / du), (&y(k), -1.0 / du)]);
-        // Jerk at both ends, with this interval's a' and q''' on its side of a knot.
-        for e in [k, k + 1] {
-            let d3 = if e == k { &jd.right[e] } else { &jd.left[e] };
-            let be = if interior(e) {
-                bbar[e]
+        let scale = {
+            let mut finite: Vec<f64> = bbar
+                .iter()
+                .copied()
+                .filter(|b| b.is_finite() && *b > 0.0)
+                .collect();
+            if finite.is_empty() {
+                1.0
             } else {
-                xconst(e) * scale
-            };
-            let jet = &p.jets[e];
-            point_rows(
-                &mut cand,
-                p,
-                jd,
-                scale,
-                jet,
-                0,
-                &x(e),
-                &y(e),
-                Some((d3, &slope, be)),
-            );
-        }
-        // At the collocation points x = θΔu: b(x) = b_k + (2x − x²/Δu) a_k + (x²/Δu) a_{k+1},
-        // a(x) = (1 − θ) a_k + θ a_{k+1} — velocity, acceleration and jerk.
-        let nc = COLLOCATION.len();
-        for m in &jd.mid[nc * k..nc * (k + 1)] {
-            let (th, xx) = (m.theta, m.theta * du);
-            let (wa, wb) = (2.0 * xx - xx * xx / du, xx * xx / du);
-            let xm = sum(&[(&x(k), 1.0), (&y(k), wa), (&y(k + 1), wb)]);
-            let ym = sum(&[(&y(k), 1.0 - th), (&y(k + 1), th)]);
-            if m.b_max.is_finite() {
-                le(&mut cand, &xm, m.b_max / scale);
+                let mid = finite.len() / 2;
+                *finite.select_nth_unstable_by(mid, f64::total_cmp).1
             }
-            let bbar_m = match abar {
-                Some(a) => bbar[k] + wa * a[k] + wb * a[k + 1],
-                None => (1.0 - th) * bbar[k] + th * bbar[k + 1],
-            };
-            point_rows(
-                &mut cand,
-                p,
-                jd,
-                scale,
-                &m.jets,
-                m.essential,
-                &xm,
-                &ym,
-                Some((&m.d3, &slope, bbar_m)),
-            );
-        }
-    }
-    let n_eq = eq.h.len();
-    let n_lin = lin.h.len();
-
-    // Cones: c_i² ≤ x_i, and d_k (c_k + c_{k+1}) ≥ 1 (turned by 45° as in super::clarabel).
-    let mut soc = Rows::default();
-    for i in (1..n).filter(|_| !lay.lp) {
-        soc.push(&[(lay.x(i), -1.0)], 1.0);
-        soc.push(&[(lay.x(i), -1.0)], -1.0);
-        soc.push(&[(lay.c(i), -2.0)], 0.0);
-    }
-    let r = std::f64::consts::FRAC_1_SQRT_2;
-    for k in (0..n).filter(|_| !lay.lp) {
-        let mut e_const = 0.0;
-        let mut row0 = vec![(lay.d(k), -1.0)];
-        let mut row1 = vec![(lay.d(k), -r)];
-        let mut row2 = vec![(lay.d(k), -r)];
-        for i in [k, k + 1] {
+        };
+        let (rest_start, rest_end) = (p.b_start == 0.0, p.b_end == 0.0);
+        let is_rest = |k: usize| (k == 0 && rest_start) || (k + 1 == n && rest_end);
+        let interior = |i: usize| i > 0 && i < n;
+        let xconst = |i: usize| {
+            if i == 0 {
+                p.b_start / scale
+            } else {
+                p.b_end / scale
+            }
+        };
+        // x_i = b_i/B and y_i = a_i/B (constants at the end stations).
+        let x = |i: usize| {
             if interior(i) {
-                row0.push((lay.c(i), -1.0));
-                row1.push((lay.c(i), r));
-                row2.push((lay.c(i), r));
+                Lin::var(lay.x(i))
             } else {
-                e_const += xconst(i).sqrt();
+                Lin::constant(xconst(i))
             }
-        }
-        soc.push(&row0, e_const);
-        soc.push(&row1, r * (-e_const - 2.0));
-        soc.push(&row2, r * (-e_const + 2.0));
-    }
-    let n_soc = soc.h.len() / 3;
-    let nv = lay.len();
-    let mut q = vec![0.0; nv];
-    if lay.lp {
-        // The gradient of T = Σ 2Δu/(√b_k + √b_{k+1}) (3Δu/√b on a constant-jerk end) at b̄.
-        let root = |i: usize| bbar[i].max(1e-300).sqrt();
+        };
+        let y = |i: usize| {
+            if interior(i) {
+                Lin::var(lay.y(i))
+            } else if i == 0 {
+                Lin::constant(a_ends.0 / scale)
+            } else {
+                Lin::constant(a_ends.1 / scale)
+            }
+        };
+
+        // Equalities (zero cone): b_{k+1} − b_k = Δu (a_k + a_{k+1}) on quadratic intervals;
+        // the constant-jerk ends: a_1 = 2 b_1/(3Δu_0), a_{N−1} = −2 b_{N−1}/(3Δu_{N−1}).
+        let mut eq = Rows::default();
         for k in 0..n {
             let du = p.du(k);
-            if is_rest(k) {
-                let i = if k == 0 { 1 } else { n - 1 };
-                q[lay.x(i)] -= 1.5 * du * scale / (bbar[i].max(1e-300) * root(i));
+            let e = if k == 0 && rest_start {
+                y(1).add(&x(1), -2.0 / (3.0 * du))
+            } else if k + 1 == n && rest_end {
+                y(n - 1).add(&x(n - 1), 2.0 / (3.0 * du))
             } else {
-                let sum = root(k) + root(k + 1);
-                for i in [k, k + 1] {
-                    if interior(i) {
-                        q[lay.x(i)] -= du * scale / (sum * sum * root(i));
+                x(k + 1)
+                    .add(&x(k), -1.0)
+                    .add(&y(k), -du)
+                    .add(&y(k + 1), -du)
+            };
+            eq.push(&e.terms[..e.len], -e.constant);
+        }
+
+        // The sites: stations (velocity in `lin`, acceleration), both ends of every quadratic
+        // interval (jerk with the interval's a' and q''' on its side of a knot), collocation
+        // points (all three).
+        let mut lin = Rows::default();
+        let mut sites = Vec::with_capacity(4 * n + jd.mid.len());
+        for i in 1..n {
+            let mut bmax = p.b_max[i];
+            if i == 1 {
+                bmax = bmax.min(jd.rest_bound.0);
+            }
+            if i == n - 1 {
+                bmax = bmax.min(jd.rest_bound.1);
+            }
+            if bmax.is_finite() {
+                lin.push(&[(lay.x(i), 1.0)], bmax / scale);
+            }
+            sites.push(Site {
+                xb: x(i),
+                ya: y(i),
+                slope: Lin::default(),
+                jets: &p.jets[i],
+                d3: None,
+                essential: p.essential[i],
+                b_max: f64::INFINITY,
+                at: BbarAt::Station(i),
+            });
+        }
+        for k in (0..n).filter(|&k| !is_rest(k)) {
+            let du = p.du(k);
+            let slope = Lin::default()
+                .add(&y(k + 1), 1.0 / du)
+                .add(&y(k), -1.0 / du);
+            for (e, d3) in [(k, &jd.right[k]), (k + 1, &jd.left[k + 1])] {
+                sites.push(Site {
+                    xb: x(e),
+                    ya: y(e),
+                    slope,
+                    jets: &p.jets[e],
+                    d3: Some(d3),
+                    essential: 0,
+                    b_max: f64::INFINITY,
+                    at: BbarAt::Station(e),
+                });
+            }
+            // At θ: b(x) = b_k + (2x − x²/Δu) a_k + (x²/Δu) a_{k+1} (x = θΔu),
+            // a(x) = (1 − θ) a_k + θ a_{k+1}.
+            for m in &jd.mid[jd.mid_start[k]..jd.mid_start[k + 1]] {
+                let (th, xx) = (m.theta, m.theta * du);
+                let (wa, wb) = (2.0 * xx - xx * xx / du, xx * xx / du);
+                sites.push(Site {
+                    xb: x(k).add(&y(k), wa).add(&y(k + 1), wb),
+                    ya: Lin::default().add(&y(k), 1.0 - th).add(&y(k + 1), th),
+                    slope,
+                    jets: &m.jets,
+                    d3: Some(&m.d3),
+                    essential: m.essential,
+                    b_max: m.b_max,
+                    at: BbarAt::Inside {
+                        k,
+                        theta: th,
+                        wa,
+                        wb,
+                    },
+                });
+            }
+        }
+        let mut cands = Vec::new();
+        for (s, site) in sites.iter().enumerate() {
+            let s = s as u32;
+            if site.b_max.is_finite() {
+                cands.push((s, Kind::Velocity));
+            }
+            for j in 0..p.n_axes() {
+                let (dq, ddq) = (site.jets.dq[j], site.jets.ddq[j]);
+                let mask = site.essential >> (2 * j);
+                if dq == 0.0 && ddq == 0.0 {
+                    continue;
+                }
+                for (bit, lower) in [(1, false), (2, true)] {
+                    if mask & bit != 0 {
+                        cands.push((s, Kind::Acceleration(j as u8, lower)));
+                    }
+                }
+            }
+            if let Some(d3) = site.d3 {
+                for (j, lim) in jd.limits.iter().enumerate() {
+                    let moves = site.jets.dq[j] != 0.0 || site.jets.ddq[j] != 0.0 || d3[j] != 0.0;
+                    if lim.is_some() && moves {
+                        cands.push((s, Kind::Jerk(j as u8, false)));
+                        cands.push((s, Kind::Jerk(j as u8, true)));
                     }
                 }
             }
         }
-    } else {
-        for k in 0..n {
-            q[lay.d(k)] = if is_rest(k) { 3.0 } else { 2.0 } * p.du(k) / scale.sqrt();
+
+        // Cones: c_i² ≤ x_i, and d_k (c_k + c_{k+1}) ≥ 1 (turned by 45° as in super::clarabel).
+        let mut soc = Rows::default();
+        for i in (1..n).filter(|_| !lay.lp) {
+            soc.push(&[(lay.x(i), -1.0)], 1.0);
+            soc.push(&[(lay.x(i), -1.0)], -1.0);
+            soc.push(&[(lay.c(i), -2.0)], 0.0);
+        }
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        for k in (0..n).filter(|_| !lay.lp) {
+            let mut e_const = 0.0;
+            let mut row0 = vec![(lay.d(k), -1.0)];
+            let mut row1 = vec![(lay.d(k), -r)];
+            let mut row2 = vec![(lay.d(k), -r)];
+            for i in [k, k + 1] {
+                if interior(i) {
+                    row0.push((lay.c(i), -1.0));
+                    row1.push((lay.c(i), r));
+                    row2.push((lay.c(i), r));
+                } else {
+                    e_const += xconst(i).sqrt();
+                }
+            }
+            soc.push(&row0, e_const);
+            soc.push(&row1, r * (-e_const - 2.0));
+            soc.push(&row2, r * (-e_const + 2.0));
+        }
+        let n_soc = soc.h.len() / 3;
+        Program {
+            p,
+            jd,
+            lay,
+            scale,
+            sites,
+            cands,
+            eq,
+            lin,
+            a_ends,
+            soc,
+            n_soc,
         }
     }
 
-    // Active set over every row but the equalities and the velocity bounds at the stations
-    // (which keep the linear program bounded): most are far from binding (typically a tenth of
-    // the jerk rows come within half of their limit). Start with those within half of it at
-    // the linearisation point, solve, add every omitted row the solution violates (with those
-    // near it), and solve again until none is: the result is the optimum of the full
-    // subproblem (the omitted rows hold at it).
-    let mut zbar = vec![0.0; nv];
-    for i in 1..n {
-        zbar[lay.x(i)] = bbar[i] / scale;
-        zbar[lay.y(i)] = match abar {
-            Some(a) => a[i],
-            // The reach profile's ü at the station: the mean of its neighbouring intervals'.
-            None => (bbar[i + 1] - bbar[i - 1]) / (2.0 * (p.u[i + 1] - p.u[i - 1])),
-        } / scale;
+    fn is_rest(&self, k: usize) -> bool {
+        let n = self.p.intervals();
+        (k == 0 && self.p.b_start == 0.0) || (k + 1 == n && self.p.b_end == 0.0)
     }
-    // The previous subproblem's active rows stay (same rows, same order, when their count
-    // agrees): the active set changes little from one iterate to the next.
-    let keep = carried.len() == cand.len();
-    let threshold = ACTIVE_AT;
-    let mut active: Vec<bool> = (0..cand.len())
-        .map(|r| (keep && carried[r]) || cand.value(r, &zbar) >= threshold)
-        .collect();
-    // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
-    // cycle time is a tenth of what the iteration's own stopping test resolves.
-    let gap = settings.tol_gap.max(1e-5);
-    let (mut iterations, mut solve_time, mut rounds) = (0, 0.0, 0);
-    let (x, status) = loop {
-        let mut all = Rows::default();
-        all.append(&eq);
-        all.append(&lin);
-        let mut n_jerk = 0;
-        for (r, _) in active.iter().enumerate().filter(|(_, a)| **a) {
-            all.copy_row(&cand, r);
-            n_jerk += 1;
+
+    /// b̄ at every site under the linearisation point.
+    fn bbar_at_sites(&self, bbar: &[f64], abar: Option<&[f64]>) -> Vec<f64> {
+        self.sites
+            .iter()
+            .map(|s| match s.at {
+                BbarAt::Station(i) => bbar[i],
+                BbarAt::Inside { k, theta, wa, wb } => match abar {
+                    Some(a) => bbar[k] + wa * a[k] + wb * a[k + 1],
+                    None => (1.0 - theta) * bbar[k] + theta * bbar[k + 1],
+                },
+            })
+            .collect()
+    }
+
+    /// The value of candidate `c` (it holds iff ≤ 1) from its site's expression values and
+    /// the linearisation point's b̄ there.
+    fn value(&self, c: (u32, Kind), v: &SiteValues, bbar: f64) -> f64 {
+        let site = &self.sites[c.0 as usize];
+        let b = self.scale;
+        match c.1 {
+            Kind::Velocity => v.x * b / site.b_max,
+            Kind::Acceleration(j, lower) => {
+                let j = j as usize;
+                let lim = &self.p.acceleration[j];
+                let a = if lower { lim.min } else { lim.max };
+                b * (site.jets.ddq[j] * v.x + site.jets.dq[j] * v.y) / a
+            }
+            Kind::Jerk(j, lower) => {
+                if bbar <= 0.0 {
+                    return 0.0;
+                }
+                let (k_x, k_y, k_s) = self.jerk_weights(site, j as usize, lower, bbar);
+                k_x * v.x + k_y * v.y + k_s * v.slope
+            }
         }
-        all.append(&soc);
-        let m = all.h.len();
-        let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
-        let pmat = CscMatrix::zeros((nv, nv));
-        let mut cones = Vec::with_capacity(2 + n_soc);
-        cones.push(SupportedConeT::ZeroConeT(n_eq));
-        if n_lin + n_jerk > 0 {
-            cones.push(SupportedConeT::NonnegativeConeT(n_lin + n_jerk));
+    }
+
+    /// The jerk row `(2/3)√b̄ L/j + b/(3 b̄) ≤ 1` with `L = B (q''' x + 3 q'' y + q' a'/B)`
+    /// as coefficients on (x, y, a'/B).
+    fn jerk_weights(&self, site: &Site, j: usize, lower: bool, bbar: f64) -> (f64, f64, f64) {
+        let lim = self.jd.limits[j].expect("a jerk candidate has a limit");
+        let jl = if lower { lim.min } else { lim.max };
+        let d3 = site.d3.expect("a jerk site has q'''");
+        let b = self.scale;
+        let w = 2.0 * bbar.sqrt() * b / (3.0 * jl);
+        (
+            w * d3[j] + b / (3.0 * bbar),
+            3.0 * w * site.jets.ddq[j],
+            w * site.jets.dq[j],
+        )
+    }
+
+    /// Every candidate's value at z (the site expressions evaluated once per site).
+    fn values(&self, z: &[f64], bbar_sites: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let mut last = u32::MAX;
+        let mut sv = SiteValues::default();
+        for &c in &self.cands {
+            if c.0 != last {
+                let s = &self.sites[c.0 as usize];
+                sv = SiteValues {
+                    x: s.xb.eval(z),
+                    y: s.ya.eval(z),
+                    slope: s.slope.eval(z),
+                };
+                last = c.0;
+            }
+            out.push(self.value(c, &sv, bbar_sites[c.0 as usize]));
         }
-        cones.extend(std::iter::repeat_n(
-            SupportedConeT::SecondOrderConeT(3),
-            n_soc,
-        ));
-        let s = settings.clarabel(gap)?;
-        let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
-            .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
-        solver.solve();
-        let sol = &solver.solution;
-        iterations += sol.iterations;
-        solve_time += sol.solve_time;
-        let status = match sol.status {
-            SolverStatus::Solved => Status::Optimal,
-            SolverStatus::AlmostSolved => Status::AlmostOptimal,
-            other => {
-                return Err(Error::Solver(format!(
-                    "jerk-limited subproblem: Clarabel stopped with status {other:?}"
-                )));
+    }
+
+    /// Appends candidate `c` as a row `A z ≤ h` in the scaled variables: velocity
+    /// `x ≤ b_max/B`; acceleration `a_min ≤ B (q'' x + q' y) ≤ a_max`; jerk
+    /// `L/j ≤ (3/2)/√b̄ − b/(2 b̄^{3/2})` (the tangent of 1/√b at b̄), i.e.
+    /// `(2/3)√b̄ L/j + b/(3 b̄) ≤ 1`.
+    fn push_row(&self, rows: &mut Rows, c: (u32, Kind), bbar: f64) {
+        let site = &self.sites[c.0 as usize];
+        let b = self.scale;
+        let (e, h) = match c.1 {
+            Kind::Velocity => (site.xb, site.b_max / b),
+            Kind::Acceleration(j, lower) => {
+                let j = j as usize;
+                let lim = &self.p.acceleration[j];
+                let a = if lower { lim.min } else { lim.max };
+                let e = Lin::default()
+                    .add(&site.xb, b * site.jets.ddq[j] / a)
+                    .add(&site.ya, b * site.jets.dq[j] / a);
+                (e, 1.0)
+            }
+            Kind::Jerk(j, lower) => {
+                let (k_x, k_y, k_s) = self.jerk_weights(site, j as usize, lower, bbar);
+                let e = Lin::default()
+                    .add(&site.xb, k_x)
+                    .add(&site.ya, k_y)
+                    .add(&site.slope, k_s);
+                (e, 1.0)
             }
         };
-        // Any omitted row violated: add it, and with it every omitted row near its bound at
-        // this solution (the next solution is likely to lean on them too); after
-        // [`ACTIVE_ROUNDS`] rounds, every row (a start far from the optimum can otherwise
-        // uncover a few rows per round for many rounds).
-        rounds += 1;
-        let violated = (0..cand.len()).any(|r| !active[r] && cand.value(r, &sol.x) > 1.0 + 1e-9);
-        let all = rounds >= ACTIVE_ROUNDS;
-        let mut added = 0;
-        if violated {
-            for (r, act) in active.iter_mut().enumerate() {
-                if !*act && (all || cand.value(r, &sol.x) > ACTIVE_AT) {
-                    *act = true;
-                    added += 1;
+        rows.push(&e.terms[..e.len], h - e.constant);
+    }
+
+    /// One convex subproblem, the jerk rows linearised at the profile (`bbar`, `abar`; without
+    /// `abar`, the acceleration-limited reach profile, whose b̄ inside an interval is
+    /// interpolated linearly). `carried`: the previous subproblem's active rows, updated.
+    fn solve(
+        &self,
+        bbar: &[f64],
+        abar: Option<&[f64]>,
+        settings: &SolverSettings,
+        carried: &mut Vec<bool>,
+    ) -> Result<SpanSolution> {
+        let (p, lay, scale) = (self.p, &self.lay, self.scale);
+        let n = p.intervals();
+        let interior = |i: usize| i > 0 && i < n;
+        let nv = lay.len();
+        let mut q = vec![0.0; nv];
+        if lay.lp {
+            // The gradient of T = Σ 2Δu/(√b_k + √b_{k+1}) (3Δu/√b on a constant-jerk end) at b̄.
+            let root = |i: usize| bbar[i].max(1e-300).sqrt();
+            for k in 0..n {
+                let du = p.du(k);
+                if self.is_rest(k) {
+                    let i = if k == 0 { 1 } else { n - 1 };
+                    q[lay.x(i)] -= 1.5 * du * scale / (bbar[i].max(1e-300) * root(i));
+                } else {
+                    let sum = root(k) + root(k + 1);
+                    for i in [k, k + 1] {
+                        if interior(i) {
+                            q[lay.x(i)] -= du * scale / (sum * sum * root(i));
+                        }
+                    }
                 }
             }
+        } else {
+            for k in 0..n {
+                q[lay.d(k)] = if self.is_rest(k) { 3.0 } else { 2.0 } * p.du(k) / scale.sqrt();
+            }
         }
-        if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
-            eprintln!(
-                "  active rows {n_jerk} of {} candidates, {added} added",
-                cand.len()
-            );
+        let bbar_sites = self.bbar_at_sites(bbar, abar);
+
+        // Active set over every row but the equalities and the velocity bounds at the stations:
+        // most are far from binding. Start with those within ACTIVE_AT of their bound at the
+        // linearisation point (and the previous subproblem's), solve, add every omitted row the
+        // solution violates (with those near it), and solve again until none is: the result is
+        // the optimum of the full subproblem (the omitted rows hold at it).
+        let mut zbar = vec![0.0; nv];
+        for i in 1..n {
+            zbar[lay.x(i)] = bbar[i] / scale;
+            zbar[lay.y(i)] = match abar {
+                Some(a) => a[i],
+                // The reach profile's ü at the station: the mean of its neighbouring intervals'.
+                None => (bbar[i + 1] - bbar[i - 1]) / (2.0 * (p.u[i + 1] - p.u[i - 1])),
+            } / scale;
         }
-        if added == 0 {
-            *carried = std::mem::take(&mut active);
-            break (sol.x.clone(), status);
+        let mut vals = Vec::with_capacity(self.cands.len());
+        self.values(&zbar, &bbar_sites, &mut vals);
+        let keep = carried.len() == self.cands.len();
+        let mut active: Vec<bool> = (0..self.cands.len())
+            .map(|r| (keep && carried[r]) || vals[r] >= ACTIVE_AT)
+            .collect();
+        // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
+        // cycle time is a tenth of what the iteration's own stopping test resolves.
+        let gap = settings.tol_gap.max(1e-5);
+        let (mut iterations, mut solve_time, mut rounds) = (0, 0.0, 0);
+        let (x, status) = loop {
+            let mut all = Rows::default();
+            all.append(&self.eq);
+            all.append(&self.lin);
+            let mut n_rows = 0;
+            for (r, _) in active.iter().enumerate().filter(|(_, a)| **a) {
+                let c = self.cands[r];
+                self.push_row(&mut all, c, bbar_sites[c.0 as usize]);
+                n_rows += 1;
+            }
+            all.append(&self.soc);
+            let m = all.h.len();
+            let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
+            let pmat = CscMatrix::zeros((nv, nv));
+            let mut cones = Vec::with_capacity(2 + self.n_soc);
+            cones.push(SupportedConeT::ZeroConeT(self.eq.len()));
+            if self.lin.len() + n_rows > 0 {
+                cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
+            }
+            cones.extend(std::iter::repeat_n(
+                SupportedConeT::SecondOrderConeT(3),
+                self.n_soc,
+            ));
+            let s = settings.clarabel(gap)?;
+            let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
+                .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
+            solver.solve();
+            let sol = &solver.solution;
+            iterations += sol.iterations;
+            solve_time += sol.solve_time;
+            let status = match sol.status {
+                SolverStatus::Solved => Status::Optimal,
+                SolverStatus::AlmostSolved => Status::AlmostOptimal,
+                other => {
+                    return Err(Error::Solver(format!(
+                        "jerk-limited subproblem: Clarabel stopped with status {other:?}"
+                    )));
+                }
+            };
+            // Any omitted row violated: add it, and with it every omitted row near its bound
+            // at this solution (the next solution is likely to lean on them too); after
+            // [`ACTIVE_ROUNDS`] rounds, every row (a start far from the optimum can otherwise
+            // uncover a few rows per round for many rounds).
+            rounds += 1;
+            self.values(&sol.x, &bbar_sites, &mut vals);
+            let violated = active.iter().zip(&vals).any(|(a, &v)| !a && v > 1.0 + 1e-9);
+            let every = rounds >= ACTIVE_ROUNDS;
+            let mut added = 0;
+            if violated {
+                for (act, &v) in active.iter_mut().zip(&vals) {
+                    if !*act && (every || v > ACTIVE_AT) {
+                        *act = true;
+                        added += 1;
+                    }
+                }
+            }
+            if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
+                eprintln!(
+                    "  active rows {n_rows} of {} candidates, {added} added",
+                    self.cands.len()
+                );
+            }
+            if added == 0 {
+                *carried = std::mem::take(&mut active);
+                break (sol.x.clone(), status);
+            }
+        };
+        let mut b = Vec::with_capacity(n + 1);
+        let mut acc = Vec::with_capacity(n + 1);
+        b.push(p.b_start);
+        acc.push(self.a_ends.0);
+        for i in 1..n {
+            b.push((x[lay.x(i)] * scale).max(0.0));
+            acc.push(x[lay.y(i)] * scale);
         }
-    };
-    let mut b = Vec::with_capacity(n + 1);
-    let mut acc = Vec::with_capacity(n + 1);
-    b.push(p.b_start);
-    acc.push(0.0);
-    for i in 1..n {
-        b.push((x[lay.x(i)] * scale).max(0.0));
-        acc.push(x[lay.y(i)] * scale);
+        b.push(p.b_end);
+        acc.push(self.a_ends.1);
+        Ok(SpanSolution {
+            a: Some(acc),
+            b,
+            status,
+            iterations,
+            solve_time,
+        })
     }
-    b.push(p.b_end);
-    acc.push(0.0);
-    Ok(SpanSolution {
-        a: Some(acc),
-        b,
-        status,
-        iterations,
-        solve_time,
-    })
 }

@@ -80,6 +80,15 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
+    /// Threads for parallel windows: `threads`, or as many as the machine has when 0.
+    pub fn worker_threads(&self) -> usize {
+        if self.threads == 0 {
+            std::thread::available_parallelism().map_or(1, |t| t.get())
+        } else {
+            self.threads
+        }
+    }
+
     /// Clarabel's settings for these, with duality-gap tolerance `gap`
     /// (`FEEDOPT_SOLVER_VERBOSE` set: Clarabel prints its log).
     pub(crate) fn clarabel(
@@ -96,6 +105,44 @@ impl SolverSettings {
             .build()
             .map_err(|e| crate::error::Error::Solver(format!("settings: {e:?}")))
     }
+}
+
+/// `f` applied to every item on `threads` scoped workers, each taking the next item not yet
+/// taken (windows differ in cost); results in item order.
+pub(crate) fn par_map<T: Sync, R: Send>(
+    items: &[T],
+    threads: usize,
+    f: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    let workers = threads.min(items.len()).max(1);
+    if workers == 1 {
+        return items.iter().map(f).collect();
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut out: Vec<(usize, R)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(item) = items.get(i) else { break };
+                        done.push((i, f(item)));
+                    }
+                    done
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| match h.join() {
+                Ok(done) => done,
+                Err(panic) => std::panic::resume_unwind(panic),
+            })
+            .collect()
+    });
+    out.sort_by_key(|(i, _)| *i);
+    out.into_iter().map(|(_, r)| r).collect()
 }
 
 /// The optimal profile of one span.
@@ -162,12 +209,5 @@ impl Rows {
         for r in 0..other.len() {
             self.copy_row(other, r);
         }
-    }
-
-    /// (A z)_r / h_r for a row `A z ≤ h` with h = 1 … : here simply `A_r z − h_r + 1`, so
-    /// that a row holds iff the value is ≤ 1.
-    pub(crate) fn value(&self, r: usize, z: &[f64]) -> f64 {
-        let az: f64 = self.triplets(r).map(|t| self.v[t] * z[self.j[t]]).sum();
-        az - self.h[r] + 1.0
     }
 }
