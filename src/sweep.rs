@@ -51,8 +51,8 @@
 //! (∂T_left/∂b_s + ∂T_right/∂b_s)·db_s/dv of every stitch s, and the reach profile's choice of
 //! stitch makes db_s/dv discontinuous. The sweep therefore solves every span as one cone
 //! program (cost and memory still linear in the stations; one span per thread) and gets its
-//! parallelism from running steps in parallel (rayon), with the solver's own thread count
-//! at 1.
+//! parallelism from running steps in parallel (rayon), with the solver's and the
+//! re-simulation's own thread counts at 1.
 //!
 //! **Finite differences.** T(v(1+h)) and T(v(1−h)) at the same stations, h = `fd_step`
 //! (default 1 %): dT/dv ≈ (T₊ − T₋)/(2hv). The value function T(v) of the discretised problem
@@ -118,7 +118,8 @@ pub struct SweepOptions {
     /// Relative step h of the central finite differences, v(1 ± h).
     pub fd_step: f64,
     /// Solve options: geometry, stations, solver, verification. The solver's windows and
-    /// threads are overridden (one window, one thread: see the module doc).
+    /// threads and the re-simulation's threads are overridden (one window, one thread: see
+    /// the module doc).
     pub solve: Options,
     /// Draw a progress bar on stderr.
     pub progress: bool,
@@ -431,6 +432,7 @@ pub fn sweep(
     let mut solve_options = options.solve.clone();
     solve_options.solver.window = usize::MAX;
     solve_options.solver.threads = 1;
+    solve_options.verify.threads = 1;
     let study = Study {
         machine,
         axis,

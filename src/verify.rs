@@ -42,6 +42,9 @@ pub struct VerifyOptions {
     /// The chord error of each interpolation period to check (and, in the pipeline, to bound:
     /// [`crate::constraints::Chord`]); `None`: not checked.
     pub chord: Option<Chord>,
+    /// Threads checking chunks of the schedule in parallel (0: as many as the machine has);
+    /// the result does not depend on it.
+    pub threads: usize,
 }
 
 impl Default for VerifyOptions {
@@ -50,6 +53,7 @@ impl Default for VerifyOptions {
             period: 1e-3,
             tolerance: 1e-3,
             chord: None,
+            threads: 0,
         }
     }
 }
@@ -178,108 +182,86 @@ pub fn verify(
     }
     let na = kin.n_axes().min(machine.axes.len());
     let jerk = machine.axes.iter().take(na).any(|a| a.jerk.is_some());
-    let mut acc = Accumulator {
-        limits: machine
-            .axes
-            .iter()
-            .take(na)
-            .map(|a| (a.velocity, a.acceleration, a.jerk))
-            .collect(),
-        threshold: 1.0 + options.tolerance,
-        worst: vec![[0.0; 3]; na],
-        worst_feed: 0.0,
-        worst_chord: 0.0,
-        chord: options.chord,
-        current: None,
-        violations: Vec::new(),
-    };
-    let (mut samples, mut station_checks) = (0usize, 0usize);
-    let mut t0 = 0.0f64; // start of the current span on the global clock
-    for (si, ((span, p), sol)) in spans.iter().zip(problems).zip(solutions).enumerate() {
-        let b = &sol.b;
-        if b.len() != p.u.len() || p.u.len() < 2 {
+    let limits: Vec<(Limit, Limit, Option<Limit>)> = machine
+        .axes
+        .iter()
+        .take(na)
+        .map(|a| (a.velocity, a.acceleration, a.jerk))
+        .collect();
+    // Every span's interval times, and each span's start on the global clock.
+    let mut times = Vec::with_capacity(spans.len());
+    let mut t0 = 0.0f64;
+    for (si, (p, sol)) in problems.iter().zip(solutions).enumerate() {
+        if sol.b.len() != p.u.len() || p.u.len() < 2 {
             return Err(Error::Usage(format!(
                 "verify: span {si} has {} stations but {} values of b",
                 p.u.len(),
-                b.len()
+                sol.b.len()
             )));
         }
         let dt = interval_times(p, sol)?;
-        let knots = span.spline.knots();
-        let last_seg = knots.len() - 2;
-        let moving = span.kind == SpanKind::Moving;
-        let mut seg = 0usize;
-        // First instant of the global clock in this span ([t0, t_end): the end belongs to the
-        // next span's start, except for the final instant, checked explicitly).
-        let mut j = (t0 / period).ceil().max(0.0) as u64;
-        let mut ta = t0;
-        // Geometry at the interval's start station (shared with the previous interval's end).
-        while seg < last_seg && knots[seg + 1] <= p.u[0] {
-            seg += 1;
-        }
-        let mut at_start = Point::new(span, kin, seg, p.u[0], moving, jerk);
-        let n = p.intervals();
-        // ü just before the current station (at rest before a span that starts at rest).
-        let mut udd_before = 0.0;
-        for i in 0..n {
-            let (ua, ub) = (p.u[i], p.u[i + 1]);
-            let iv = Interval::of(&p.u, b, sol.a.as_deref(), i);
-            let (s0, s1) = iv.ends();
-            let tb = ta + dt[i];
-            // The segment of the spline this interval starts in (a station at a knot starts
-            // the next segment: its feed cap applies from there on).
-            let seg_before = seg;
-            while seg < last_seg && knots[seg + 1] <= ua {
-                seg += 1;
-            }
-            if jerk && seg != seg_before {
-                // On a knot q''' jumps: the interval starts with its own segment's.
-                at_start = Point::new(span, kin, seg, ua, moving, jerk);
-            }
-            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-            acc.check(&at_start, &s0, cap, ua, ta, si, i);
-            if jerk && iv.law == Law::Linear && (i > 0 || s0.b == 0.0) {
-                // ü jumps at the station: a controller sampling at the period sees the step
-                // of q̈ within one period.
-                acc.check_step(&at_start, (s0.udd - udd_before) / period, ua, ta, si, i);
-            }
-            udd_before = s1.udd;
-            station_checks += 1;
-            // Servo instants strictly inside the interval (and at its start).
-            loop {
-                let t = j as f64 * period;
-                if t >= tb {
-                    break;
-                }
-                let st = iv.at(t - ta, dt[i]);
-                let u = (ua + st.x).min(ub);
-                // Stay in the left segment at a knot: the interval's own side.
-                while seg < last_seg && knots[seg + 1] < u {
-                    seg += 1;
-                }
-                let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-                let pt = Point::new(span, kin, seg, u, moving, jerk);
-                acc.check(&pt, &st, cap, u, t, si, i);
-                samples += 1;
-                j += 1;
-            }
-            // The interval's end, with this interval's ü.
-            while seg < last_seg && knots[seg + 1] < ub {
-                seg += 1;
-            }
-            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-            let at_end = Point::new(span, kin, seg, ub, moving, jerk);
-            acc.check(&at_end, &s1, cap, ub, tb, si, i);
-            station_checks += 1;
-            acc.close_interval();
-            at_start = at_end;
-            ta = tb;
-        }
-        samples += 1; // the span's last instant (checked as the last interval's end)
-        t0 = ta;
+        let span_start = t0;
+        t0 = dt.iter().fold(t0, |t, d| t + d);
+        times.push((span_start, dt));
     }
-    let violating_intervals = acc.violations.len();
-    let mut violations = acc.violations;
+    // Chunks of CHUNK intervals, checked independently (in parallel) and merged in order: the
+    // same samples, the same result, whatever the number of threads.
+    let mut chunks = Vec::new();
+    for (si, p) in problems.iter().enumerate() {
+        let n = p.intervals();
+        chunks.extend(
+            (0..n)
+                .step_by(CHUNK)
+                .map(|i0| (si, i0, (i0 + CHUNK).min(n))),
+        );
+    }
+    let threads = if options.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |t| t.get())
+    } else {
+        options.threads
+    };
+    let parts = crate::solver::par_map(&chunks, threads, |&(si, i0, i1)| {
+        let mut acc = Accumulator {
+            limits: limits.clone(),
+            threshold: 1.0 + options.tolerance,
+            worst: vec![[0.0; 3]; na],
+            worst_feed: 0.0,
+            worst_chord: 0.0,
+            chord: options.chord,
+            current: None,
+            violations: Vec::new(),
+        };
+        let counts = check_intervals(
+            &mut acc,
+            kin,
+            &spans[si],
+            &problems[si],
+            &solutions[si],
+            (si, i0, i1),
+            &times[si],
+            period,
+            jerk,
+        );
+        (acc, counts)
+    });
+    // Each span's last instant is a sample too (checked as its last interval's end).
+    let (mut samples, mut station_checks) = (problems.len(), 0usize);
+    let mut worst = vec![[0.0f64; 3]; na];
+    let (mut worst_feed, mut worst_chord) = (0.0f64, 0.0f64);
+    let mut violations = Vec::new();
+    for (acc, (s, c)) in parts {
+        samples += s;
+        station_checks += c;
+        for (w, aw) in worst.iter_mut().zip(&acc.worst) {
+            for (x, y) in w.iter_mut().zip(aw) {
+                *x = x.max(*y);
+            }
+        }
+        worst_feed = worst_feed.max(acc.worst_feed);
+        worst_chord = worst_chord.max(acc.worst_chord);
+        violations.extend(acc.violations);
+    }
+    let violating_intervals = violations.len();
     violations.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
     violations.truncate(MAX_VIOLATIONS);
     Ok(Verification {
@@ -290,7 +272,7 @@ pub fn verify(
             .axes
             .iter()
             .take(na)
-            .zip(&acc.worst)
+            .zip(&worst)
             .map(|(a, w)| AxisWorst {
                 name: a.name.clone(),
                 velocity: w[0],
@@ -298,11 +280,120 @@ pub fn verify(
                 jerk: w[2],
             })
             .collect(),
-        worst_feed: acc.worst_feed,
-        worst_chord: acc.worst_chord,
+        worst_feed,
+        worst_chord,
         violating_intervals,
         violations,
     })
+}
+
+/// Station intervals checked per task of the re-simulation.
+const CHUNK: usize = 512;
+
+/// Checks intervals `i0..i1` of span `si` (`at` = (si, i0, i1)) into `acc`: every servo
+/// instant `j · period` of the global clock within them and both ends of every interval.
+/// `times`: the span's start on the global clock and its interval times. Returns the number of
+/// samples and of station checks.
+#[allow(clippy::too_many_arguments)]
+fn check_intervals(
+    acc: &mut Accumulator,
+    kin: &Kinematics,
+    span: &Span,
+    p: &SpanProblem,
+    sol: &SpanSolution,
+    at: (usize, usize, usize),
+    times: &(f64, Vec<f64>),
+    period: f64,
+    jerk: bool,
+) -> (usize, usize) {
+    let (si, i0, i1) = at;
+    let (span_start, dt) = times;
+    let b = &sol.b;
+    let knots = span.spline.knots();
+    let last_seg = knots.len() - 2;
+    let moving = span.kind == SpanKind::Moving;
+    let (mut samples, mut station_checks) = (0usize, 0usize);
+    // The chunk's start on the global clock, summed as when walking the span from its start.
+    let mut ta = dt[..i0].iter().fold(*span_start, |t, d| t + d);
+    // The first instant of the global clock at or after ta (an interval's samples lie in
+    // [ta, tb): its end belongs to the next interval; a span's last instant is counted apart).
+    let mut j = (ta / period).ceil().max(0.0) as u64;
+    while j > 0 && (j - 1) as f64 * period >= ta {
+        j -= 1;
+    }
+    while (j as f64) * period < ta {
+        j += 1;
+    }
+    // The spline segment at the chunk's first station: at a span's start the one starting
+    // there (a station on a knot starts the next segment), else the one the previous interval
+    // ended in (the left side of a knot), as when walking the span from its start.
+    let mut seg = 0usize;
+    while seg < last_seg && (knots[seg + 1] < p.u[i0] || (i0 == 0 && knots[seg + 1] <= p.u[i0])) {
+        seg += 1;
+    }
+    // Geometry at the interval's start station (shared with the previous interval's end).
+    let mut at_start = Point::new(span, kin, seg, p.u[i0], moving, jerk);
+    // ü just before the current station (at rest before a span that starts at rest).
+    let mut udd_before = if i0 == 0 {
+        0.0
+    } else {
+        Interval::of(&p.u, b, sol.a.as_deref(), i0 - 1).ends().1.udd
+    };
+    for i in i0..i1 {
+        let (ua, ub) = (p.u[i], p.u[i + 1]);
+        let iv = Interval::of(&p.u, b, sol.a.as_deref(), i);
+        let (s0, s1) = iv.ends();
+        let tb = ta + dt[i];
+        // The segment of the spline this interval starts in (a station at a knot starts
+        // the next segment: its feed cap applies from there on).
+        let seg_before = seg;
+        while seg < last_seg && knots[seg + 1] <= ua {
+            seg += 1;
+        }
+        if jerk && seg != seg_before {
+            // On a knot q''' jumps: the interval starts with its own segment's.
+            at_start = Point::new(span, kin, seg, ua, moving, jerk);
+        }
+        let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+        acc.check(&at_start, &s0, cap, ua, ta, si, i);
+        if jerk && iv.law == Law::Linear && (i > 0 || s0.b == 0.0) {
+            // ü jumps at the station: a controller sampling at the period sees the step
+            // of q̈ within one period.
+            acc.check_step(&at_start, (s0.udd - udd_before) / period, ua, ta, si, i);
+        }
+        udd_before = s1.udd;
+        station_checks += 1;
+        // Servo instants strictly inside the interval (and at its start).
+        loop {
+            let t = j as f64 * period;
+            if t >= tb {
+                break;
+            }
+            let st = iv.at(t - ta, dt[i]);
+            let u = (ua + st.x).min(ub);
+            // Stay in the left segment at a knot: the interval's own side.
+            while seg < last_seg && knots[seg + 1] < u {
+                seg += 1;
+            }
+            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            let pt = Point::new(span, kin, seg, u, moving, jerk);
+            acc.check(&pt, &st, cap, u, t, si, i);
+            samples += 1;
+            j += 1;
+        }
+        // The interval's end, with this interval's ü.
+        while seg < last_seg && knots[seg + 1] < ub {
+            seg += 1;
+        }
+        let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+        let at_end = Point::new(span, kin, seg, ub, moving, jerk);
+        acc.check(&at_end, &s1, cap, ub, tb, si, i);
+        station_checks += 1;
+        acc.close_interval();
+        at_start = at_end;
+        ta = tb;
+    }
+    (samples, station_checks)
 }
 
 /// The path geometry at one sample: every axis's u-derivatives and |P'|.

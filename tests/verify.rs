@@ -443,3 +443,34 @@ fn the_pipeline_splits_intervals_until_the_schedule_verifies() {
         assert!(u.iter().any(|x| (x - knot).abs() < 1e-12));
     }
 }
+
+/// The re-simulation checks chunks of intervals in parallel: the same samples, worst ratios and
+/// violations (in the same order) on one thread as on three.
+#[test]
+fn the_result_does_not_depend_on_the_threads() {
+    let m = machine(XYZ_2000);
+    let mut sol = solve(
+        &m,
+        &toolpath(&circle(20.0, 2, 120), Some(150.0)),
+        &Options {
+            stations: Some(3000),
+            ..Options::default()
+        },
+    );
+    assert!(sol.problems.iter().any(|p| p.intervals() > 1500));
+    tamper(&mut sol, 1.02);
+    let on = |threads| {
+        check(
+            &m,
+            &sol,
+            &VerifyOptions {
+                threads,
+                ..Default::default()
+            },
+        )
+    };
+    let one = on(1);
+    assert!(!one.verified && one.violating_intervals > 10);
+    assert_eq!(one, on(3));
+    assert_eq!(one, on(0));
+}
