@@ -460,6 +460,7 @@ impl Plan<'_> {
                 self.machine,
                 p,
                 options.verify.chord.as_ref(),
+                options.solver.worker_threads(),
             );
             let warm = previous.and_then(|(op, os)| Warm::resample(op, os, p));
             return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk);

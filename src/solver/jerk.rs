@@ -184,13 +184,15 @@ const ACTIVE_ROUNDS: usize = 6;
 const REST_SAMPLES: usize = 8;
 
 impl JerkData {
-    /// Evaluates q''' at the stations of `p` and the end-interval bounds.
+    /// Evaluates q''' at the stations of `p`, the geometry at the collocation points and the
+    /// end-interval bounds (on `threads` threads, 0: as many as the machine has).
     pub fn new(
         span: &Span,
         kin: &Kinematics,
         machine: &Machine,
         p: &SpanProblem,
         chord: Option<&Chord>,
+        threads: usize,
     ) -> JerkData {
         let knots = span.spline.knots();
         let last_seg = knots.len() - 2;
@@ -198,22 +200,19 @@ impl JerkData {
             let w = span.spline.eval_in(seg, u);
             kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, u))
         };
-        let (mut right, mut left) = (Vec::with_capacity(p.u.len()), Vec::with_capacity(p.u.len()));
-        for &u in &p.u {
+        // q''' on both sides of station u (they differ on a knot: a station there belongs to
+        // the segment before it on its left side).
+        let sides = |u: f64| {
             let seg_r = span.spline.segment(u);
-            // A station on a knot belongs to the segment before it on its left side.
             let seg_l = if seg_r > 0 && u <= knots[seg_r] {
                 seg_r - 1
             } else {
                 seg_r
             };
-            right.push(d3(seg_r.min(last_seg), u));
-            left.push(if seg_l == seg_r {
-                *right.last().unwrap_or(&[0.0; MAX_AXES])
-            } else {
-                d3(seg_l, u)
-            });
-        }
+            let right = d3(seg_r.min(last_seg), u);
+            let left = if seg_l == seg_r { right } else { d3(seg_l, u) };
+            (right, left)
+        };
         let na = p.n_axes();
         let limits: Vec<Option<Limit>> = machine.axes.iter().take(na).map(|a| a.jerk).collect();
         let n = p.intervals();
@@ -233,45 +232,65 @@ impl JerkData {
         for k in 0..n {
             mid_start.push(mid_start[k] + collocation(k, n, rs, re).len());
         }
-        let mid = (0..n)
-            .flat_map(|k| collocation(k, n, rs, re).iter().map(move |&th| (k, th)))
-            .map(|(k, th)| {
-                let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
-                let seg = span.spline.segment(um);
-                let w = span.spline.eval_in(seg, um);
-                let jets = kin.axis_jets(&w);
-                let mut b_max = f64::INFINITY;
-                for (j, axis) in machine.axes.iter().enumerate().take(na) {
-                    let d = jets.dq[j];
-                    if d != 0.0 {
-                        let v = if d > 0.0 {
-                            axis.velocity.max
-                        } else {
-                            axis.velocity.min
-                        };
-                        b_max = b_max.min((v / d).powi(2));
-                    }
+        let midpoint = |(k, th): (usize, f64)| {
+            let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
+            let seg = span.spline.segment(um);
+            let w = span.spline.eval_in(seg, um);
+            let jets = kin.axis_jets(&w);
+            let mut b_max = f64::INFINITY;
+            for (j, axis) in machine.axes.iter().enumerate().take(na) {
+                let d = jets.dq[j];
+                if d != 0.0 {
+                    let v = if d > 0.0 {
+                        axis.velocity.max
+                    } else {
+                        axis.velocity.min
+                    };
+                    b_max = b_max.min((v / d).powi(2));
                 }
-                if let (true, Some(c)) = (moving, chord) {
-                    b_max = b_max.min(c.b_max(&w));
+            }
+            if let (true, Some(c)) = (moving, chord) {
+                b_max = b_max.min(c.b_max(&w));
+            }
+            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            if moving && cap.is_finite() {
+                let speed = (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt();
+                if speed > 0.0 {
+                    b_max = b_max.min((cap / speed).powi(2));
                 }
-                let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-                if moving && cap.is_finite() {
-                    let speed = (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt();
-                    if speed > 0.0 {
-                        b_max = b_max.min((cap / speed).powi(2));
-                    }
-                }
-                let (essential, b_star, _) = essential_rows(&jets, &p.acceleration, b_max);
-                Midpoint {
-                    theta: th,
-                    d3: kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, um)),
-                    jets,
-                    b_max: b_max.min(b_star),
-                    essential,
-                }
-            })
+            }
+            let (essential, b_star, _) = essential_rows(&jets, &p.acceleration, b_max);
+            Midpoint {
+                theta: th,
+                d3: kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, um)),
+                jets,
+                b_max: b_max.min(b_star),
+                essential,
+            }
+        };
+        // Chunks of intervals (their first stations and collocation points) in parallel.
+        const CHUNK: usize = 128;
+        let chunks: Vec<(usize, usize)> = (0..=n)
+            .step_by(CHUNK)
+            .map(|k0| (k0, (k0 + CHUNK).min(n + 1)))
             .collect();
+        let parts = super::par_map(&chunks, threads, |&(k0, k1)| {
+            let stations: Vec<_> = (k0..k1).map(|i| sides(p.u[i])).collect();
+            let mids: Vec<Midpoint> = (k0..k1.min(n))
+                .flat_map(|k| collocation(k, n, rs, re).iter().map(move |&th| (k, th)))
+                .map(midpoint)
+                .collect();
+            (stations, mids)
+        });
+        let (mut right, mut left) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
+        let mut mid = Vec::with_capacity(mid_start[n]);
+        for (stations, mids) in parts {
+            for (r, l) in stations {
+                right.push(r);
+                left.push(l);
+            }
+            mid.extend(mids);
+        }
         JerkData {
             right,
             left,
