@@ -483,7 +483,14 @@ pub fn solve(
     if cuts.len() > 2 {
         let t0 = std::time::Instant::now();
         let windows: Vec<(usize, usize)> = cuts.windows(2).map(|c| (c[0], c[1])).collect();
-        let results = super::par_map(&windows, threads, |&(a, b)| {
+        // The windows at the span's ends first: their dense collocation and their start from
+        // rest make them the slowest, and a slow window taken last leaves the other threads
+        // idle.
+        let last = windows.len() - 1;
+        let mut queue: Vec<usize> = vec![0, last];
+        queue.extend(1..last);
+        let results = super::par_map(&queue, threads, |&w| {
+            let (a, b) = windows[w];
             if let Some(w) = warm.as_ref().filter(|w| !w.fresh[a..=b].contains(&true)) {
                 // No new station in this window: the previous profile is its solution still
                 // (its ends are fixed at that profile's values).
@@ -505,6 +512,10 @@ pub fn solve(
             };
             solve_piece(&wp, &wjd, &ws, (aa, ab), settings, options)
         });
+        let mut results: Vec<(usize, Result<SpanSolution>)> =
+            queue.into_iter().zip(results).collect();
+        results.sort_by_key(|(w, _)| *w);
+        let results = results.into_iter().map(|(_, r)| r).collect();
         match stitch(&windows, results) {
             Ok(mut sol) => {
                 sol.solve_time = t0.elapsed().as_secs_f64();
