@@ -322,7 +322,10 @@ impl Interval {
         (s0, s1)
     }
 
-    /// x with ∫_0^x dξ/√b = τ: safeguarded Newton (dt/dx = 1/√b), bracketed in [0, Δu].
+    /// x reached τ after the interval's start: under the quadratic law ü = a_0 + α x is linear
+    /// in x, so x(τ) solves ẍ = a_0 + α x with x(0) = 0, ẋ(0) = √b_0 in closed form,
+    /// `x = a_0 C + √b_0 S` with `S = sinh(√α τ)/√α` and `C = (cosh(√α τ) − 1)/α` (sin and
+    /// 1 − cos for α < 0; both by their series, entire in α, where |α| τ² is small).
     fn x_at(&self, tau: f64, dur: f64) -> f64 {
         if tau <= 0.0 {
             return 0.0;
@@ -330,32 +333,28 @@ impl Interval {
         if tau >= dur {
             return self.du;
         }
-        let (mut lo, mut hi) = (0.0, self.du);
-        // Start from the constant-ü estimate.
-        let (ra, rb) = (self.b0.sqrt(), self.b1.sqrt());
-        let r = ra + (rb - ra) * tau / dur;
-        let mut x = (0.5 * tau * (ra + r)).clamp(0.0, self.du);
-        for _ in 0..30 {
-            let f = self.time_to(x) - tau;
-            if f.abs() <= 1e-14 * dur {
-                return x;
+        let alpha = (self.a1 - self.a0) / self.du;
+        let z = alpha * tau * tau;
+        let (c, s) = if z.abs() < 0.5 {
+            // C = τ² Σ z^k/(2k+2)!, S = τ Σ z^k/(2k+1)!: 13 terms reach 1e-17 at |z| = 0.5.
+            let (mut c, mut s) = (0.0, 0.0);
+            let (mut tc, mut ts) = (0.5, 1.0);
+            for k in 0..13 {
+                c += tc;
+                s += ts;
+                let m = (2 * k + 2) as f64;
+                ts *= z / (m * (m + 1.0));
+                tc *= z / ((m + 1.0) * (m + 2.0));
             }
-            if f > 0.0 {
-                hi = x;
-            } else {
-                lo = x;
-            }
-            let step = f * self.b_at(x).max(0.0).sqrt();
-            let mut next = x - step;
-            if !(next > lo && next < hi) {
-                next = 0.5 * (lo + hi);
-            }
-            if (next - x).abs() <= 1e-15 * self.du {
-                return next;
-            }
-            x = next;
-        }
-        x
+            (c * tau * tau, s * tau)
+        } else if alpha > 0.0 {
+            let w = alpha.sqrt();
+            (((w * tau).cosh() - 1.0) / alpha, (w * tau).sinh() / w)
+        } else {
+            let w = (-alpha).sqrt();
+            ((1.0 - (w * tau).cos()) / (w * w), (w * tau).sin() / w)
+        };
+        (self.a0 * c + self.b0.sqrt() * s).clamp(0.0, self.du)
     }
 }
 
@@ -414,6 +413,50 @@ mod tests {
         let (e0, e1) = (iv.at(0.0, dur), iv.at(dur, dur));
         assert!((s0.udd - e0.udd).abs() < 1e-12 && (s1.udd - e1.udd).abs() < 1e-9);
         assert!((s1.x - e1.x).abs() < 1e-12 && (s1.ud - e1.ud).abs() < 1e-9);
+    }
+
+    /// ∫_0^x dξ/√(αξ² + βξ + γ) by its antiderivative (β = 2a_0, γ = b_0).
+    fn exact_time(iv: &Interval, x: f64) -> f64 {
+        let alpha = (iv.a1 - iv.a0) / iv.du;
+        let (beta, gamma) = (2.0 * iv.a0, iv.b0);
+        if alpha > 1e-9 {
+            let w = alpha.sqrt();
+            ((2.0 * w * iv.b_at(x).sqrt() + 2.0 * alpha * x + beta)
+                / (2.0 * w * gamma.sqrt() + beta))
+                .ln()
+                / w
+        } else if alpha < -1e-9 {
+            let d = (beta * beta - 4.0 * alpha * gamma).sqrt();
+            ((beta / d).asin() - ((2.0 * alpha * x + beta) / d).asin()) / (-alpha).sqrt()
+        } else {
+            2.0 * (iv.b_at(x).sqrt() - gamma.sqrt()) / beta
+        }
+    }
+
+    #[test]
+    fn the_closed_form_position_inverts_the_time_integral() {
+        // α > 0, α < 0 and α ≈ 0, gentle and steep (the series and the closed forms), and a
+        // decelerating interval: the exact time to x(τ) is τ.
+        for iv in [
+            quad(1.0, 0.5, -0.2, 0.8),
+            quad(4.0, -1.0, 3.0, 2.0),
+            quad(4.0, 0.2, 0.6, 2.0),
+            quad(2.0, 0.3, 0.3 + 1e-14, 1.0),
+            quad(1e-4, 0.5, -0.4, 0.01),
+            quad(9.0, -2.0, -1.0, 1.5),
+            quad(1.0, 30.0, -29.0, 1.0),
+        ] {
+            let dur = iv.duration().unwrap();
+            for k in 1..20 {
+                let tau = dur * k as f64 / 20.0;
+                let x = iv.x_at(tau, dur);
+                let t = exact_time(&iv, x);
+                assert!(
+                    (t - tau).abs() < 1e-12 * dur,
+                    "{iv:?} τ = {tau}: x = {x}, t(x) = {t}"
+                );
+            }
+        }
     }
 
     #[test]
