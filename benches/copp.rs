@@ -152,29 +152,37 @@ fn bench_copp(c: &mut Criterion) {
 /// 1,000 intervals to start, the SCP with Clarabel, stations added until the 1 kHz
 /// re-simulation (jerk included) verifies. Compare with COPP's TOPP3-SOCP, 834 ms per path on
 /// this kind of machine (its time includes its TOPP2-RA start, as ours includes the reach pass
-/// and the verification).
+/// and the verification). `optimize_joint` uses every core the machine has (windows of the
+/// SCP, chunks of the re-simulation); `optimize_joint_one_thread` the same on one.
 fn bench_copp_jerk(c: &mut Criterion) {
     let Some(dir) = copp_data::data_dir() else {
         return;
     };
     let cases = load(&dir);
-    let options = Options {
-        stations: Some(1000),
-        ..Options::default()
-    };
     let mut g = c.benchmark_group("copp20_jerk");
     g.throughput(Throughput::Elements(PATHS as u64));
     g.sample_size(10);
-    g.measurement_time(Duration::from_secs(60));
-    g.bench_function("optimize_joint", |b| {
-        b.iter(|| {
-            for k in &cases {
-                let sol = optimize_joint(&k.machine_jerk, &k.path, &options).expect("solves");
-                assert!(sol.verification.verified);
-                black_box(sol.schedule.cycle_time);
-            }
-        })
-    });
+    for (name, threads, secs) in [
+        ("optimize_joint", 0, 40),
+        ("optimize_joint_one_thread", 1, 60),
+    ] {
+        let mut options = Options {
+            stations: Some(1000),
+            ..Options::default()
+        };
+        options.solver.threads = threads;
+        options.verify.threads = threads;
+        g.measurement_time(Duration::from_secs(secs));
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                for k in &cases {
+                    let sol = optimize_joint(&k.machine_jerk, &k.path, &options).expect("solves");
+                    assert!(sol.verification.verified);
+                    black_box(sol.schedule.cycle_time);
+                }
+            })
+        });
+    }
     g.finish();
 }
 
