@@ -24,7 +24,7 @@
 //!
 //! **The sensitivity from the duals.** Scale the swept limit by μ around a step (μ = 1 there);
 //! then dT/dv = (1/v)·dT/dμ. Per span, with the multipliers of
-//! [`solve_with_sensitivity`](crate::solver::clarabel::solve_with_sensitivity)
+//! [`crate::solver::clarabel::solve_with_sensitivity`]
 //! (dT/db_max_i = −y_i/B, dT/da = −Σ y_r/a over an axis's acceleration rows of one side):
 //!
 //! ```text

@@ -117,7 +117,7 @@ fn draw_err(path: &Path) -> impl Fn(String) -> Error + '_ {
     }
 }
 
-/// Thins a series to the first, minimum, maximum and last point of each of [`BINS`] bins of
+/// Thins a series to the first, minimum, maximum and last point of each of `BINS` bins of
 /// x (in order), so its envelope is kept. Short series are returned as they are.
 pub fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     if points.len() <= 2 * BINS {
