@@ -120,21 +120,8 @@ pub fn solve_with_sensitivity(
 ) -> Result<(SpanSolution, Sensitivity)> {
     let n = p.intervals();
     let lay = Layout { n };
-    let scale = {
-        // The median finite bound: robust against stations where an axis barely moves.
-        let mut finite: Vec<f64> = p
-            .b_max
-            .iter()
-            .copied()
-            .filter(|b| b.is_finite() && *b > 0.0)
-            .collect();
-        if finite.is_empty() {
-            1.0
-        } else {
-            let mid = finite.len() / 2;
-            *finite.select_nth_unstable_by(mid, f64::total_cmp).1
-        }
-    };
+    // The median finite bound.
+    let scale = super::median_scale(&p.b_max);
     let (x0, xn) = (p.b_start / scale, p.b_end / scale);
     let (c0, cn) = (x0.sqrt(), xn.sqrt());
     // A variable or a constant: Some(column) for interior stations.

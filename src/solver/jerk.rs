@@ -829,19 +829,7 @@ impl<'a> Program<'a> {
             n,
             lp: objective == Objective::Linearised,
         };
-        let scale = {
-            let mut finite: Vec<f64> = bbar
-                .iter()
-                .copied()
-                .filter(|b| b.is_finite() && *b > 0.0)
-                .collect();
-            if finite.is_empty() {
-                1.0
-            } else {
-                let mid = finite.len() / 2;
-                *finite.select_nth_unstable_by(mid, f64::total_cmp).1
-            }
-        };
+        let scale = super::median_scale(bbar);
         let (rest_start, rest_end) = (p.b_start == 0.0, p.b_end == 0.0);
         let is_rest = |k: usize| (k == 0 && rest_start) || (k + 1 == n && rest_end);
         let interior = |i: usize| i > 0 && i < n;

@@ -107,6 +107,21 @@ impl SolverSettings {
     }
 }
 
+/// The scale B of a cone program's variables (x = b/B): the median of the finite positive
+/// `values` (robust against stations where an axis barely moves), 1 if there are none.
+pub(crate) fn median_scale(values: &[f64]) -> f64 {
+    let mut finite: Vec<f64> = values
+        .iter()
+        .copied()
+        .filter(|b| b.is_finite() && *b > 0.0)
+        .collect();
+    if finite.is_empty() {
+        return 1.0;
+    }
+    let mid = finite.len() / 2;
+    *finite.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// `f` applied to every item on `threads` scoped workers, each taking the next item not yet
 /// taken (windows differ in cost); results in item order.
 pub(crate) fn par_map<T: Sync, R: Send>(
