@@ -237,6 +237,7 @@ fn realize(ctx: &Context, profile: &Profile, notes: Vec<String>) -> Candidate {
             status: Status::Greedy,
             iterations: 0,
             solve_time: 0.0,
+            scp_iterations: 0,
         });
     }
     Candidate {

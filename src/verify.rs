@@ -656,6 +656,7 @@ mod tests {
             status: Status::Optimal,
             iterations: 0,
             solve_time: 0.0,
+            scp_iterations: 0,
         }
     }
 

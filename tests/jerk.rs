@@ -326,3 +326,46 @@ fn chord_tolerance_bounds_the_feed_on_a_circle_with_and_without_jerk() {
         );
     }
 }
+
+/// A real program with jerk limits: the LinuxCNC boat (table-table BC, 155 spans, ../shared,
+/// read when present) on its machine with jerk = 10 × acceleration per axis, on a fixed grid of
+/// ~4,000 stations. Two failures this caught: a subproblem bent b below 0 inside a long interval
+/// (the objective sees b at stations only) and the schedule stalled; and the linearised time
+/// cycled between iterates on 53 windows until the 30-iterate cap. Now it solves, every SCP
+/// stops within 12 subproblems, and it is no faster than acceleration-limited.
+#[test]
+fn a_linuxcnc_program_with_jerk_limits_solves_without_stalls_or_cycles() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
+    if !dir.join("boat-xyzbc.ngc").exists() {
+        eprintln!("../shared/realworld/linuxcnc not present: skipped");
+        return;
+    }
+    let text = std::fs::read_to_string(dir.join("boat-xyzbc.machine.json")).expect("machine");
+    let mut v: Value = serde_json::from_str(&text).expect("json");
+    for axis in v["axes"].as_object_mut().expect("axes").values_mut() {
+        let acc = axis["acceleration"].as_f64().expect("a number");
+        axis["jerk"] = serde_json::json!(10.0 * acc);
+    }
+    let m = Machine::from_json(Path::new("boat-xyzbc-jerk.json"), &v.to_string()).expect("machine");
+    let t = feedopt::toolpath::read(&dir.join("boat-xyzbc.ngc")).expect("program");
+    let o = Options {
+        stations: Some(4000),
+        refine_until_verified: false,
+        ..Options::default()
+    };
+    let jerk = optimize(&m, &t, &o).expect("solves");
+    let most = jerk.solutions.iter().map(|s| s.scp_iterations).max();
+    let accel = optimize(
+        &m,
+        &t,
+        &Options {
+            jerk_limited: false,
+            ..o.clone()
+        },
+    )
+    .expect("solves");
+    let (tj, ta) = (jerk.schedule.cycle_time, accel.schedule.cycle_time);
+    eprintln!("boat-xyzbc: jerk-limited {tj:.3} s, acceleration-limited {ta:.3} s, SCP ≤ {most:?}");
+    assert!(most.is_some_and(|k| (2..=12).contains(&k)), "{most:?}");
+    assert!(tj.is_finite() && tj >= ta * (1.0 - 1e-4), "{tj} vs {ta}");
+}

@@ -290,6 +290,7 @@ pub fn solve_with_sensitivity(
             status,
             iterations: sol.iterations,
             solve_time: sol.solve_time,
+            scp_iterations: 0,
         },
         sens,
     ))
@@ -374,6 +375,7 @@ pub fn solve_windowed(
         status,
         iterations,
         solve_time: t0.elapsed().as_secs_f64(),
+        scp_iterations: 0,
     })
 }
 

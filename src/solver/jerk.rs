@@ -173,6 +173,13 @@ pub struct Midpoint {
     pub essential: u16,
 }
 
+/// Inside an interval b may not dip below this share of the chord between its stations: the
+/// objective sees b only at the stations (the interval's time as if b were linear in u), so
+/// without it a subproblem could bend b down to 0 between two stations where nothing else
+/// binds (found on a long interval of a LinuxCNC boat program, where the quadratic reached
+/// −3.5 between b = 16 and 13 and the schedule stalled).
+const DIP: f64 = 0.5;
+
 /// A row joins the active set when its value reaches this fraction of its bound (see
 /// [`subproblem`]).
 const ACTIVE_AT: f64 = 0.85;
@@ -501,6 +508,7 @@ pub fn solve(
                     status: Status::Optimal,
                     iterations: 0,
                     solve_time: 0.0,
+                    scp_iterations: 0,
                 });
             }
             let (ba, aa) = start.at(p, a);
@@ -614,9 +622,10 @@ fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<us
 fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Result<SpanSolution> {
     let mut b = Vec::new();
     let mut a = Vec::new();
-    let (mut status, mut iterations) = (Status::Optimal, 0);
+    let (mut status, mut iterations, mut scp) = (Status::Optimal, 0, 0);
     for (w, r) in results.into_iter().enumerate() {
         let s = r?;
+        scp = scp.max(s.scp_iterations);
         let from = if w == 0 { 0 } else { 1 };
         debug_assert_eq!(s.b.len(), windows[w].1 - windows[w].0 + 1);
         b.extend_from_slice(&s.b[from..]);
@@ -630,6 +639,7 @@ fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Res
         status,
         iterations,
         solve_time: 0.0,
+        scp_iterations: scp,
     })
 }
 
@@ -656,6 +666,7 @@ fn solve_piece(
                     status: Status::Optimal,
                     iterations: 0,
                     solve_time: 0.0,
+                    scp_iterations: 0,
                 },
             )?
             .iter()
@@ -667,20 +678,50 @@ fn solve_piece(
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
     let mut carried: Vec<bool> = Vec::new();
     let program = Program::new(p, jd, &bbar, a_ends, options.objective);
+    // Whether (bbar, abar) is an iterate of this SCP (feasible), not the start.
+    let mut from_iterate = false;
+    let mut subproblems = 0;
     for it in 0..options.max_iterations.max(1) {
-        let sol = program.solve(&bbar, abar.as_deref(), settings, &mut carried)?;
+        let mut sol = program.solve(&bbar, abar.as_deref(), settings, &mut carried)?;
+        subproblems += 1;
         status = status.worst(sol.status);
         iterations += sol.iterations;
         solve_time += sol.solve_time;
-        let time: f64 = interval_times(p, &sol)?.iter().sum();
+        let mut time: f64 = interval_times(p, &sol)?.iter().sum();
+        let mut step = 1.0;
+        if let (true, Some(t0), Some(a0)) = (from_iterate, last_time, abar.as_deref()) {
+            // The linearised objective can overshoot: the time then rises from one iterate to
+            // the next, and the iteration may cycle. Both the previous iterate and this
+            // solution satisfy the (convex) subproblem, so every point between them does, and
+            // is jerk-feasible: halve the step until the time does not rise.
+            while time > t0 && step > 1.0 / 64.0 {
+                step *= 0.5;
+                let mix = |old: &[f64], new: &[f64]| -> Vec<f64> {
+                    old.iter()
+                        .zip(new)
+                        .map(|(o, n)| o + step * (n - o))
+                        .collect()
+                };
+                let trial = SpanSolution {
+                    b: mix(&bbar, &sol.b),
+                    a: sol.a.as_deref().map(|a| mix(a0, a)),
+                    ..sol.clone()
+                };
+                let t = interval_times(p, &trial)?.iter().sum();
+                if t < time {
+                    (sol, time) = (trial, t);
+                }
+            }
+        }
         if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
             eprintln!(
-                "SCP {it}: T = {time:.6}, {} IP iterations, {:.1} ms, {:?}",
+                "SCP {it}: T = {time:.6}, {} IP iterations, {:.1} ms, {:?}, step {step}",
                 sol.iterations,
                 sol.solve_time * 1e3,
                 sol.status
             );
         }
+        from_iterate = true;
         let done = last_time.is_some_and(|t| (t - time).abs() <= options.convergence * time);
         last_time = Some(time);
         bbar.clone_from(&sol.b);
@@ -696,6 +737,7 @@ fn solve_piece(
     sol.status = status;
     sol.iterations = iterations;
     sol.solve_time = solve_time;
+    sol.scp_iterations = subproblems;
     Ok(sol)
 }
 
@@ -763,6 +805,8 @@ struct Site<'a> {
     xb: Lin,
     ya: Lin,
     slope: Lin,
+    /// At a collocation point: the chord (1 − θ) x_k + θ x_{k+1} of its interval.
+    chord: Lin,
     jets: &'a AxisJets,
     /// q''' there (jerk rows), on the interval's side of a knot.
     d3: Option<&'a [f64; MAX_AXES]>,
@@ -777,6 +821,8 @@ struct Site<'a> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
     Velocity,
+    /// b at a collocation point at least half its interval's chord (see [`DIP`]).
+    Dip,
     /// Axis, and the upper (`false`) or lower (`true`) limit.
     Acceleration(u8, bool),
     Jerk(u8, bool),
@@ -788,6 +834,7 @@ struct SiteValues {
     x: f64,
     y: f64,
     slope: f64,
+    chord: f64,
 }
 
 /// The convex subproblems of one span: everything that stays fixed from one SCP iterate to the
@@ -896,6 +943,7 @@ impl<'a> Program<'a> {
                 xb: x(i),
                 ya: y(i),
                 slope: Lin::default(),
+                chord: Lin::default(),
                 jets: &p.jets[i],
                 d3: None,
                 essential: p.essential[i],
@@ -913,6 +961,7 @@ impl<'a> Program<'a> {
                     xb: x(e),
                     ya: y(e),
                     slope,
+                    chord: Lin::default(),
                     jets: &p.jets[e],
                     d3: Some(d3),
                     essential: 0,
@@ -929,6 +978,7 @@ impl<'a> Program<'a> {
                     xb: x(k).add(&y(k), wa).add(&y(k + 1), wb),
                     ya: Lin::default().add(&y(k), 1.0 - th).add(&y(k + 1), th),
                     slope,
+                    chord: Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th),
                     jets: &m.jets,
                     d3: Some(&m.d3),
                     essential: m.essential,
@@ -947,6 +997,9 @@ impl<'a> Program<'a> {
             let s = s as u32;
             if site.b_max.is_finite() {
                 cands.push((s, Kind::Velocity));
+            }
+            if site.chord.len > 0 {
+                cands.push((s, Kind::Dip));
             }
             for j in 0..p.n_axes() {
                 let (dq, ddq) = (site.jets.dq[j], site.jets.ddq[j]);
@@ -1039,6 +1092,8 @@ impl<'a> Program<'a> {
         let b = self.scale;
         match c.1 {
             Kind::Velocity => v.x * b / site.b_max,
+            // 1 + (DIP·chord − b)/b̄: above 1 where b dips below its share of the chord.
+            Kind::Dip => 1.0 + (DIP * v.chord - v.x) * b / bbar.max(f64::MIN_POSITIVE),
             Kind::Acceleration(j, lower) => {
                 let j = j as usize;
                 let lim = &self.p.acceleration[j];
@@ -1082,6 +1137,7 @@ impl<'a> Program<'a> {
                     x: s.xb.eval(z),
                     y: s.ya.eval(z),
                     slope: s.slope.eval(z),
+                    chord: s.chord.eval(z),
                 };
                 last = c.0;
             }
@@ -1098,6 +1154,10 @@ impl<'a> Program<'a> {
         let b = self.scale;
         let (e, h) = match c.1 {
             Kind::Velocity => (site.xb, site.b_max / b),
+            Kind::Dip => (
+                Lin::default().add(&site.chord, DIP).add(&site.xb, -1.0),
+                0.0,
+            ),
             Kind::Acceleration(j, lower) => {
                 let j = j as usize;
                 let lim = &self.p.acceleration[j];
@@ -1265,6 +1325,7 @@ impl<'a> Program<'a> {
             status,
             iterations,
             solve_time,
+            scp_iterations: 0,
         })
     }
 }

@@ -173,6 +173,9 @@ pub struct SpanSolution {
     pub iterations: u32,
     /// Wall time of the solver proper (s), excluding problem build.
     pub solve_time: f64,
+    /// Convex subproblems of a jerk-limited solve (the most any window of the span took); 0
+    /// for the other solvers.
+    pub scp_iterations: u32,
 }
 
 /// A sparse row block under construction (triplets in row order), with its right-hand side.

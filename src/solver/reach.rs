@@ -272,5 +272,6 @@ pub fn solve(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
         status: Status::Greedy,
         iterations: 0,
         solve_time: t0.elapsed().as_secs_f64(),
+        scp_iterations: 0,
     })
 }
