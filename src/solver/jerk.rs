@@ -42,7 +42,12 @@
 //! Each subproblem is an LP (the linearised time, [`Objective::Linearised`]) or a second-order
 //! cone program (the time itself, [`Objective::Cones`]) in the scaled variables x = b/B,
 //! y = a/B (B: the median of the first linearisation point); the rows that are far from their
-//! bounds are left out until a solution violates them (an active set).
+//! bounds are left out until a solution violates them (an active set). The linearised time can
+//! overshoot: where the time of a new iterate exceeds the previous one's, the step between
+//! them is halved until it does not (both satisfy the convex subproblem, so every point
+//! between them is jerk-feasible) — without it the iteration cycled on a LinuxCNC program.
+//! Either objective sees b only at the stations, so b is also kept above half its chord at
+//! every collocation point ([`DIP`]).
 //!
 //! ## Windows, in parallel
 //!
@@ -178,7 +183,7 @@ pub struct Midpoint {
 /// without it a subproblem could bend b down to 0 between two stations where nothing else
 /// binds (found on a long interval of a LinuxCNC boat program, where the quadratic reached
 /// −3.5 between b = 16 and 13 and the schedule stalled).
-const DIP: f64 = 0.5;
+pub const DIP: f64 = 0.5;
 
 /// A row joins the active set when its value reaches this fraction of its bound (see
 /// [`subproblem`]).
