@@ -215,11 +215,7 @@ pub fn verify(
                 .map(|i0| (si, i0, (i0 + CHUNK).min(n))),
         );
     }
-    let threads = if options.threads == 0 {
-        std::thread::available_parallelism().map_or(1, |t| t.get())
-    } else {
-        options.threads
-    };
+    let threads = crate::solver::resolve_threads(options.threads);
     let parts = crate::solver::par_map(&chunks, threads, |&(si, i0, i1)| {
         let mut acc = Accumulator {
             limits: limits.clone(),
@@ -478,44 +474,21 @@ impl Accumulator {
         if let Some(c) = self.chord.filter(|_| pt.bend > 0.0) {
             let e = pt.bend * st.b * c.period * c.period / 8.0;
             let x = ratio(c.tolerance, e);
-            if x > self.worst_chord {
-                self.worst_chord = x;
-            }
-            if x > self.threshold {
-                record(
-                    &mut self.current,
-                    span,
-                    interval,
-                    u,
-                    t,
-                    None,
-                    Quantity::Chord,
-                    e,
-                    c.tolerance,
-                    x,
-                );
-            }
+            self.worst_chord = self.worst_chord.max(x);
+            self.note(
+                None,
+                Quantity::Chord,
+                e,
+                c.tolerance,
+                x,
+                (span, interval, u, t),
+            );
         }
         if cap.is_finite() && speed > 0.0 {
             let v = speed * r;
             let x = if v > 0.0 { ratio(cap, v) } else { 0.0 };
-            if x > self.worst_feed {
-                self.worst_feed = x;
-            }
-            if x > self.threshold {
-                record(
-                    &mut self.current,
-                    span,
-                    interval,
-                    u,
-                    t,
-                    None,
-                    Quantity::Feed,
-                    v,
-                    cap,
-                    x,
-                );
-            }
+            self.worst_feed = self.worst_feed.max(x);
+            self.note(None, Quantity::Feed, v, cap, x, (span, interval, u, t));
         }
     }
 
@@ -551,25 +524,38 @@ impl Accumulator {
                 None => return,
             },
         };
-        let (span, interval, u, t) = at;
         let limit = if value >= 0.0 { lim.max } else { lim.min };
         let x = ratio(limit, value);
         if x > self.worst[j][k] {
             self.worst[j][k] = x;
         }
-        if x > self.threshold {
-            record(
-                &mut self.current,
+        self.note(Some(j), kind, value, limit, x, at);
+    }
+
+    /// Keeps ratio `x` of `value` to `limit` as the interval's worst violation when it is one
+    /// (above the threshold) and worse than the one kept; `at` = (span, interval, u, t).
+    fn note(
+        &mut self,
+        axis: Option<usize>,
+        kind: Quantity,
+        value: f64,
+        limit: f64,
+        x: f64,
+        at: (usize, usize, f64, f64),
+    ) {
+        if x > self.threshold && self.current.as_ref().is_none_or(|c| x > c.ratio) {
+            let (span, interval, u, t) = at;
+            self.current = Some(Violation {
                 span,
                 interval,
                 u,
                 t,
-                Some(j),
+                axis,
                 kind,
-                value,
+                value: if value.is_nan() { f64::INFINITY } else { value },
                 limit,
-                x,
-            );
+                ratio: x,
+            });
         }
     }
 
@@ -578,35 +564,6 @@ impl Accumulator {
         if let Some(v) = self.current.take() {
             self.violations.push(v);
         }
-    }
-}
-
-/// Keeps `x` as the interval's worst violation if it is worse than the one kept.
-#[allow(clippy::too_many_arguments)]
-fn record(
-    current: &mut Option<Violation>,
-    span: usize,
-    interval: usize,
-    u: f64,
-    t: f64,
-    axis: Option<usize>,
-    kind: Quantity,
-    value: f64,
-    limit: f64,
-    x: f64,
-) {
-    if current.as_ref().is_none_or(|c| x > c.ratio) {
-        *current = Some(Violation {
-            span,
-            interval,
-            u,
-            t,
-            axis,
-            kind,
-            value: if value.is_nan() { f64::INFINITY } else { value },
-            limit,
-            ratio: x,
-        });
     }
 }
 

@@ -822,6 +822,12 @@ struct Site<'a> {
     at: BbarAt,
 }
 
+/// Whether interval k is a constant-jerk interval from or to rest (the span's first or last,
+/// at an end with b = 0).
+fn is_rest_interval(p: &SpanProblem, k: usize) -> bool {
+    (k == 0 && p.b_start == 0.0) || (k + 1 == p.intervals() && p.b_end == 0.0)
+}
+
 /// Which row of a site a candidate is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
@@ -883,7 +889,7 @@ impl<'a> Program<'a> {
         };
         let scale = super::median_scale(bbar);
         let (rest_start, rest_end) = (p.b_start == 0.0, p.b_end == 0.0);
-        let is_rest = |k: usize| (k == 0 && rest_start) || (k + 1 == n && rest_end);
+        let is_rest = |k: usize| is_rest_interval(p, k);
         let interior = |i: usize| i > 0 && i < n;
         let xconst = |i: usize| {
             if i == 0 {
@@ -1072,8 +1078,7 @@ impl<'a> Program<'a> {
     }
 
     fn is_rest(&self, k: usize) -> bool {
-        let n = self.p.intervals();
-        (k == 0 && self.p.b_start == 0.0) || (k + 1 == n && self.p.b_end == 0.0)
+        is_rest_interval(self.p, k)
     }
 
     /// b̄ at every site under the linearisation point.

@@ -82,11 +82,7 @@ impl Default for SolverSettings {
 impl SolverSettings {
     /// Threads for parallel windows: `threads`, or as many as the machine has when 0.
     pub fn worker_threads(&self) -> usize {
-        if self.threads == 0 {
-            std::thread::available_parallelism().map_or(1, |t| t.get())
-        } else {
-            self.threads
-        }
+        resolve_threads(self.threads)
     }
 
     /// Clarabel's settings for these, with duality-gap tolerance `gap`
@@ -104,6 +100,15 @@ impl SolverSettings {
             .iterative_refinement_enable(self.iterative_refinement)
             .build()
             .map_err(|e| crate::error::Error::Solver(format!("settings: {e:?}")))
+    }
+}
+
+/// A thread count as the options give it: 0 means as many as the machine has.
+pub(crate) fn resolve_threads(threads: usize) -> usize {
+    if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |t| t.get())
+    } else {
+        threads
     }
 }
 
