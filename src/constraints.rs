@@ -115,73 +115,150 @@ impl SpanProblem {
 
     /// Discretises `span` at the given stations (increasing, from 0 to the span's length).
     pub fn at_stations(span: &Span, kin: &Kinematics, machine: &Machine, u: Vec<f64>) -> Self {
-        let n = u.len() - 1;
-        let na = kin.n_axes();
-        let mut jets = Vec::with_capacity(n + 1);
-        let mut tip_speed = Vec::with_capacity(n + 1);
-        for &ui in &u {
-            let w = span.eval(ui);
-            jets.push(kin.axis_jets(&w));
-            tip_speed.push(match span.kind {
-                SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
-                SpanKind::Reorientation | SpanKind::Joint => 0.0,
-            });
-        }
         let feed = station_feed_caps(span, &u);
-        let mut b_max = Vec::with_capacity(n + 1);
-        let mut b_max_by = Vec::with_capacity(n + 1);
-        for i in 0..=n {
-            let mut best = (f64::INFINITY, Bound::None);
-            for (j, axis) in machine.axes.iter().enumerate().take(na) {
-                let d = jets[i].dq[j];
-                if d != 0.0 {
-                    let v = if d > 0.0 {
-                        axis.velocity.max
-                    } else {
-                        axis.velocity.min
-                    };
-                    let b = (v / d).powi(2);
-                    if b < best.0 {
-                        best = (b, Bound::AxisVelocity(j));
-                    }
-                }
-            }
-            if tip_speed[i] > 0.0 && feed[i].is_finite() {
-                let b = (feed[i] / tip_speed[i]).powi(2);
-                if b < best.0 {
-                    best = (b, Bound::Feed);
-                }
-            }
-            b_max.push(best.0);
-            b_max_by.push(best.1);
-        }
-        let acceleration: Vec<Limit> = machine
-            .axes
-            .iter()
-            .take(na)
-            .map(|a| a.acceleration)
-            .collect();
-        let mut essential = Vec::with_capacity(n + 1);
-        for i in 0..=n {
-            let (rows, b_star, by) = essential_rows(&jets[i], &acceleration, b_max[i]);
-            essential.push(rows);
-            // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
-            if b_star < b_max[i] {
-                b_max[i] = b_star;
-                b_max_by[i] = by;
-            }
-        }
-        SpanProblem {
-            u,
-            b_max,
-            b_max_by,
-            tip_speed,
-            jets,
+        let acceleration = axis_accelerations(kin, machine);
+        let mut p = SpanProblem {
+            u: Vec::with_capacity(u.len()),
+            b_max: Vec::with_capacity(u.len()),
+            b_max_by: Vec::with_capacity(u.len()),
+            tip_speed: Vec::with_capacity(u.len()),
+            jets: Vec::with_capacity(u.len()),
             acceleration,
-            essential,
+            essential: Vec::with_capacity(u.len()),
             b_start: 0.0,
             b_end: 0.0,
+        };
+        for (&ui, &cap) in u.iter().zip(&feed) {
+            p.push_station(span, kin, machine, None, ui, cap);
         }
+        p
+    }
+
+    /// Appends station `u` (after the last one) with feed cap `cap` (mm/s) and, if given, the
+    /// chord bound of `chord`: its jets, its merged velocity bound and its essential rows.
+    fn push_station(
+        &mut self,
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        chord: Option<&Chord>,
+        u: f64,
+        cap: f64,
+    ) {
+        let na = kin.n_axes();
+        let w = span.eval(u);
+        let jet = kin.axis_jets(&w);
+        let tip_speed = match span.kind {
+            SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
+            SpanKind::Reorientation | SpanKind::Joint => 0.0,
+        };
+        let mut best = (f64::INFINITY, Bound::None);
+        for (j, axis) in machine.axes.iter().enumerate().take(na) {
+            let d = jet.dq[j];
+            if d != 0.0 {
+                let v = if d > 0.0 {
+                    axis.velocity.max
+                } else {
+                    axis.velocity.min
+                };
+                let b = (v / d).powi(2);
+                if b < best.0 {
+                    best = (b, Bound::AxisVelocity(j));
+                }
+            }
+        }
+        if tip_speed > 0.0 && cap.is_finite() {
+            let b = (cap / tip_speed).powi(2);
+            if b < best.0 {
+                best = (b, Bound::Feed);
+            }
+        }
+        let (rows, b_star, by) = essential_rows(&jet, &self.acceleration, best.0);
+        // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
+        if b_star < best.0 {
+            best = (b_star, by);
+        }
+        if let Some(c) = chord.filter(|_| span.kind == SpanKind::Moving) {
+            let b = c.b_max(&w);
+            if b < best.0 {
+                best = (b, Bound::Chord);
+            }
+        }
+        self.u.push(u);
+        self.b_max.push(best.0);
+        self.b_max_by.push(best.1);
+        self.tip_speed.push(tip_speed);
+        self.jets.push(jet);
+        self.essential.push(rows);
+    }
+
+    /// The same problem with a station added inside every interval `k` of `split` (sorted,
+    /// distinct), at `at(k)` (strictly between u_k and u_{k+1}); the existing stations keep
+    /// their data, only the new ones are evaluated. Every CL knot is a station, so each
+    /// interval lies within one CL move and a new station takes that move's feed cap.
+    pub fn with_inserted(
+        &self,
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        chord: Option<&Chord>,
+        split: &[usize],
+        at: impl Fn(usize) -> f64,
+    ) -> SpanProblem {
+        let n = self.u.len() + split.len();
+        let mut p = SpanProblem {
+            u: Vec::with_capacity(n),
+            b_max: Vec::with_capacity(n),
+            b_max_by: Vec::with_capacity(n),
+            tip_speed: Vec::with_capacity(n),
+            jets: Vec::with_capacity(n),
+            acceleration: self.acceleration.clone(),
+            essential: Vec::with_capacity(n),
+            b_start: self.b_start,
+            b_end: self.b_end,
+        };
+        let mut next = split.iter().peekable();
+        for i in 0..self.u.len() {
+            p.copy_station(self, i);
+            if next.peek() == Some(&&i) {
+                next.next();
+                let u = at(i);
+                debug_assert!(u > self.u[i] && u < self.u[i + 1]);
+                let cap = span.feed_caps[span.spline.segment(u)];
+                p.push_station(span, kin, machine, chord, u, cap);
+            }
+        }
+        p
+    }
+
+    /// The stations `i` with `keep[i]` (the first and the last must be kept), as a problem.
+    pub fn select(&self, keep: &[bool]) -> SpanProblem {
+        let n = keep.iter().filter(|&&k| k).count();
+        let mut p = SpanProblem {
+            u: Vec::with_capacity(n),
+            b_max: Vec::with_capacity(n),
+            b_max_by: Vec::with_capacity(n),
+            tip_speed: Vec::with_capacity(n),
+            jets: Vec::with_capacity(n),
+            acceleration: self.acceleration.clone(),
+            essential: Vec::with_capacity(n),
+            b_start: self.b_start,
+            b_end: self.b_end,
+        };
+        debug_assert!(keep[0] && keep[keep.len() - 1]);
+        for (i, _) in keep.iter().enumerate().filter(|(_, k)| **k) {
+            p.copy_station(self, i);
+        }
+        p
+    }
+
+    fn copy_station(&mut self, from: &SpanProblem, i: usize) {
+        self.u.push(from.u[i]);
+        self.b_max.push(from.b_max[i]);
+        self.b_max_by.push(from.b_max_by[i]);
+        self.tip_speed.push(from.tip_speed[i]);
+        self.jets.push(from.jets[i]);
+        self.essential.push(from.essential[i]);
     }
 
     /// Tightens the velocity bounds of a moving span by the chord error of `chord` (seed 004).
@@ -240,6 +317,16 @@ impl SpanProblem {
     pub fn axis_acceleration(&self, b: &[f64], k: usize, i: usize, j: usize) -> f64 {
         self.jets[i].ddq[j] * b[i] + self.jets[i].dq[j] * self.path_acceleration(b, k)
     }
+}
+
+/// The acceleration limit of each axis the kinematics drives.
+fn axis_accelerations(kin: &Kinematics, machine: &Machine) -> Vec<Limit> {
+    machine
+        .axes
+        .iter()
+        .take(kin.n_axes())
+        .map(|a| a.acceleration)
+        .collect()
 }
 
 /// How finely to place stations on a span.

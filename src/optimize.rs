@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
 use crate::machine::{KinematicsSpec, Machine};
-use crate::schedule::Schedule;
+use crate::schedule::{Schedule, interval_times};
 use crate::solver::jerk::{JerkData, JerkOptions, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
@@ -106,6 +106,11 @@ pub struct Solution {
     pub solve_time: f64,
     /// Station counts tried and their cycle times.
     pub refinement: Vec<Refinement>,
+    /// Estimated relative error of the cycle time against the continuous optimum (automatic
+    /// refinement only; see [`Plan::refine_span`]): the relative change of the time when every
+    /// interval of the returned grid's parent is halved, which bounds the returned grid's
+    /// remaining error wherever the error falls at least linearly with the interval length.
+    pub error_estimate: Option<f64>,
     /// The re-simulation of the returned schedule at the servo period.
     pub verification: Verification,
     /// Its servo period, s.
@@ -184,81 +189,117 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
         kin: Kinematics::new(machine),
         path,
     };
-    let mut refinement = Vec::new();
-    let total = options.stations.unwrap_or(options.initial_stations);
-    let mut last_time: Option<f64> = None;
-    let mut previous: Option<Level> = None;
-    for level in 0.. {
-        let mut lv = plan.solve_at(total, level, options, previous.as_ref())?;
-        let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
-        refinement.push(Refinement {
-            stations,
-            cycle_time_s: time,
-        });
-        // A jerk-limited solve stops its SCP at a relative change of `jerk.convergence`: its
-        // times are no finer than that, so doubling the stations cannot be judged finer either.
-        let tol = if plan.machine.has_jerk() {
-            options.convergence.max(10.0 * options.jerk.convergence)
-        } else {
-            options.convergence
-        };
-        let converged = last_time.is_some_and(|a| (a - time).abs() <= tol * time);
-        let verification = if options.stations.is_some() || converged {
-            let mut v = plan.verify(&lv, options)?;
-            let mut round = 0;
-            while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
-                if std::env::var_os("FEEDOPT_VERIFY_TRACE").is_some() {
-                    eprintln!(
-                        "verify: {} intervals, worst {:?}",
-                        v.violating_intervals,
-                        v.violations.first()
-                    );
-                }
-                plan.refine_where_violated(&mut lv, &v, options)?;
-                v = plan.verify(&lv, options)?;
-                round += 1;
-            }
-            if round > 0 {
-                refinement.push(Refinement {
-                    stations: lv.schedule.stations.len(),
-                    cycle_time_s: lv.schedule.cycle_time,
-                });
-            }
-            Some(v)
-        } else {
-            None
-        };
-        if let Some(verification) =
-            verification.filter(|v| v.verified || !options.refine_until_verified)
-        {
-            return Ok(Solution {
-                path: plan.path,
-                kinematics: plan.kin,
-                problems: lv.problems,
-                solutions: lv.solutions,
-                schedule: lv.schedule,
-                status: lv.status,
-                iterations: lv.iterations,
-                solve_time: lv.solve_time,
-                refinement,
-                verification,
-                verify_period: options.verify.period,
-            });
+    let (mut lv, mut refinement, error_estimate) = match options.stations {
+        Some(total) => {
+            let lv = plan.solve_at(total, 0, options, None)?;
+            let r = Refinement {
+                stations: lv.schedule.stations.len(),
+                cycle_time_s: lv.schedule.cycle_time,
+            };
+            (lv, vec![r], None)
         }
-        if 2 * stations > options.max_stations {
-            return Err(Error::Solver(format!(
-                "no converged schedule that verifies within {} stations (tried: {:?})",
-                options.max_stations, refinement
-            )));
+        None => {
+            let (lv, refinement, estimate) = plan.solve_adaptive(options)?;
+            (lv, refinement, Some(estimate))
         }
-        last_time = Some(time);
-        previous = Some(lv);
+    };
+    let mut v = plan.verify(&lv, options)?;
+    let mut round = 0;
+    while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
+        if std::env::var_os("FEEDOPT_VERIFY_TRACE").is_some() {
+            eprintln!(
+                "verify: {} intervals, worst {:?}",
+                v.violating_intervals,
+                v.violations.first()
+            );
+        }
+        plan.refine_where_violated(&mut lv, &v, options)?;
+        v = plan.verify(&lv, options)?;
+        round += 1;
     }
-    unreachable!("the refinement loop returns")
+    if round > 0 {
+        refinement.push(Refinement {
+            stations: lv.schedule.stations.len(),
+            cycle_time_s: lv.schedule.cycle_time,
+        });
+    }
+    if !v.verified && options.refine_until_verified {
+        let worst = v.violations.first();
+        return Err(Error::Solver(format!(
+            "the schedule still exceeds a limit between stations after {MAX_LOCAL_ROUNDS} rounds \
+             of local refinement ({} intervals{}); try a finer --period or report the program",
+            v.violating_intervals,
+            worst.map_or(String::new(), |w| format!(
+                ", worst {:.4}× at span {} u = {:.6}, nearest CL line {}",
+                w.ratio,
+                w.span,
+                w.u,
+                plan.path.spans[w.span].nearest_line(w.u)
+            ))
+        )));
+    }
+    Ok(Solution {
+        path: plan.path,
+        kinematics: plan.kin,
+        problems: lv.problems,
+        solutions: lv.solutions,
+        schedule: lv.schedule,
+        status: lv.status,
+        iterations: lv.iterations,
+        solve_time: lv.solve_time,
+        refinement,
+        error_estimate,
+        verification: v,
+        verify_period: options.verify.period,
+    })
 }
 
 /// Geometric grading of the stations into a rest end of a jerk-limited span (levels).
 const GRADING: usize = 4;
+
+/// The range of ü that every axis's acceleration allows at station `i` at b (the rows of
+/// [`SpanProblem`], written for ü).
+fn udd_range(p: &SpanProblem, i: usize, b: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    let jet = &p.jets[i];
+    for (j, lim) in p.acceleration.iter().enumerate() {
+        let (d, dd) = (jet.dq[j], jet.ddq[j]);
+        if d != 0.0 {
+            let (x, y) = ((lim.max - dd * b) / d, (lim.min - dd * b) / d);
+            lo = lo.max(x.min(y));
+            hi = hi.min(x.max(y));
+        }
+    }
+    (lo, hi)
+}
+
+/// Where a full-rate ramp inside interval `k` meets the plateau the interval ends on (or
+/// starts from), if it does so inside the interval.
+///
+/// With b linear between stations, an interval from an acceleration-limited ramp onto a
+/// velocity bound (or off it) spreads the change of b over its whole length, at a lower ü
+/// than the limits allow: the lost time is of the order of the interval's time, the first-order
+/// term of the discretisation error (at a rest end below a low feed cap the whole ramp lies in
+/// the first interval). The ramp at the rate allowed at its start (ü_max at u_k and b_k, or
+/// ü_min at u_{k+1} and b_{k+1} for a braking one) reaches the plateau at
+/// u* = u_k + (b_{k+1} − b_k)/(2 ü_max); a station there makes the piecewise-linear b follow
+/// the ramp and the plateau exactly on a straight path (and to second order on a curved one).
+fn ramp_end(p: &SpanProblem, b: &[f64], k: usize) -> Option<f64> {
+    let (u0, u1) = (p.u[k], p.u[k + 1]);
+    let du = u1 - u0;
+    let slope = (b[k + 1] - b[k]) / (2.0 * du);
+    let on_bound = |i: usize| b[i] >= p.b_max[i] * (1.0 - 1e-9);
+    let at = if slope > 0.0 && on_bound(k + 1) {
+        let hi = udd_range(p, k, b[k]).1;
+        (hi > slope * (1.0 + 1e-6)).then(|| u0 + (b[k + 1] - b[k]) / (2.0 * hi))
+    } else if slope < 0.0 && on_bound(k) {
+        let lo = udd_range(p, k + 1, b[k + 1]).0;
+        (lo < slope * (1.0 + 1e-6)).then(|| u1 - (b[k] - b[k + 1]) / (2.0 * -lo))
+    } else {
+        None
+    }?;
+    (at > u0 + 1e-3 * du && at < u1 - 1e-3 * du).then_some(at)
+}
 
 /// Stations `u` with the midpoint of every interval in `ks` (sorted, distinct) added.
 fn halve(u: &[f64], ks: &[usize]) -> Vec<f64> {
@@ -275,8 +316,21 @@ fn halve(u: &[f64], ks: &[usize]) -> Vec<f64> {
     out
 }
 
-/// Rounds of local refinement where the re-simulation failed, before refining everywhere.
-const MAX_LOCAL_ROUNDS: usize = 8;
+/// Rounds of local refinement where the re-simulation failed before giving up (each round
+/// divides the excess between stations by about four).
+const MAX_LOCAL_ROUNDS: usize = 12;
+
+/// Rounds of the adaptive refinement of one span at most (each halves the intervals marked).
+const MAX_ADAPTIVE_ROUNDS: usize = 60;
+
+/// One span refined adaptively: the final grid, its reach profile, the absolute error
+/// estimate (s) and, per round, the stations and time of the fine grid.
+struct Refined {
+    problem: SpanProblem,
+    greedy: SpanSolution,
+    estimate: f64,
+    rounds: Vec<(usize, f64)>,
+}
 
 /// The solve of every span at one refinement level.
 struct Level {
@@ -384,6 +438,215 @@ impl Plan<'_> {
         Ok(())
     }
 
+    /// The reach pass on one span, its infeasibility in words.
+    fn reach(&self, si: usize, p: &SpanProblem) -> Result<SpanSolution> {
+        solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))
+    }
+
+    /// The starting grid of span `si` for the adaptive refinement (every CL knot, each
+    /// segment divided as level 0 of the uniform grid is), with its end speeds.
+    fn initial_problem(&self, si: usize, options: &Options) -> Result<SpanProblem> {
+        let spans = &self.path.spans;
+        let span = &spans[si];
+        let total = options.initial_stations as f64;
+        let grid = Grid {
+            spacing: span.length() / (total * self.weights[si]).max(8.0),
+            min_parts: 1,
+        };
+        let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
+        if let Some(c) = &options.verify.chord {
+            p.apply_chord(span, c);
+        }
+        self.check_travel(si, &p)?;
+        if si == 0 {
+            p.b_start = end_speed(span, &p, 0, options.start_feed, "start")?;
+        }
+        if si + 1 == spans.len() {
+            p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
+        }
+        Ok(p)
+    }
+
+    /// Refines the stations of span `si` where they change its time.
+    ///
+    /// Each round solves the grid G and its bisection F (every interval halved) by the reach
+    /// pass and charges each interval k of G with e_k = |t_k(G) − t_{2k}(F) − t_{2k+1}(F)|,
+    /// the change of its time under halving. When Σ e_k ≤ `convergence` × T(F), F is returned
+    /// with the estimate Σ e_k: under error ∝ h^p (p ≥ 1) F's remaining error is at most
+    /// Σ e_k / (2^p − 1) ≤ Σ e_k (Richardson). Otherwise the intervals with the largest e_k
+    /// are halved — all but the smallest ones whose e_k sum to half the allowance — and the
+    /// round repeats on that grid. Plateaus (feed cap, velocity bound) have e_k = 0 and are
+    /// never refined; the stations go to ramps, rest ends, corners and curvature peaks.
+    fn refine_span(&self, si: usize, options: &Options, budget: usize) -> Result<Refined> {
+        let span = &self.path.spans[si];
+        let chord = options.verify.chord.as_ref();
+        let tol = options.convergence;
+        let mut p = self.initial_problem(si, options)?;
+        let mut g = self.reach(si, &p)?;
+        let mut t = interval_times(&p, &g)?;
+        let mut rounds = Vec::new();
+        loop {
+            let n = p.intervals();
+            let all: Vec<usize> = (0..n).collect();
+            let pf = p.with_inserted(span, &self.kin, self.machine, chord, &all, |k| {
+                0.5 * (p.u[k] + p.u[k + 1])
+            });
+            self.check_travel(si, &pf)?;
+            let gf = self.reach(si, &pf)?;
+            let tf = interval_times(&pf, &gf)?;
+            let time: f64 = tf.iter().sum();
+            let e: Vec<f64> = (0..n)
+                .map(|k| (t[k] - tf[2 * k] - tf[2 * k + 1]).abs())
+                .collect();
+            let estimate: f64 = e.iter().sum();
+            rounds.push((pf.u.len(), time));
+            if estimate <= tol * time
+                || rounds.len() >= MAX_ADAPTIVE_ROUNDS
+                || pf.u.len() + n > budget
+            {
+                return Ok(Refined {
+                    problem: pf,
+                    greedy: gf,
+                    estimate,
+                    rounds,
+                });
+            }
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_unstable_by(|a, b| e[*a].total_cmp(&e[*b]));
+            let allowance = 0.5 * tol * time;
+            let mut keep: Vec<bool> = (0..pf.u.len()).map(|i| i % 2 == 0).collect();
+            let mut acc = 0.0;
+            for &k in &order {
+                acc += e[k];
+                if acc > allowance {
+                    keep[2 * k + 1] = true;
+                }
+            }
+            // Where a marked interval of F ramps onto (or off) a plateau more slowly than the
+            // limits allow, the ramp really ends inside it: a station goes where it does.
+            let kinks: Vec<f64> = order
+                .iter()
+                .filter(|&&k| keep[2 * k + 1])
+                .flat_map(|&k| [2 * k, 2 * k + 1])
+                .filter_map(|f| ramp_end(&pf, &gf.b, f))
+                .collect();
+            p = pf.select(&keep);
+            if !kinks.is_empty() {
+                let mut at: Vec<(usize, f64)> = kinks
+                    .into_iter()
+                    .map(|x| (p.u.partition_point(|&v| v <= x) - 1, x))
+                    .collect();
+                at.sort_unstable_by_key(|a| a.0);
+                at.dedup_by_key(|a| a.0);
+                let ks: Vec<usize> = at.iter().map(|a| a.0).collect();
+                p = p.with_inserted(span, &self.kin, self.machine, chord, &ks, |k| {
+                    at[ks.partition_point(|&x| x < k)].1
+                });
+            }
+            g = self.reach(si, &p)?;
+            t = interval_times(&p, &g)?;
+        }
+    }
+
+    /// Every span refined adaptively ([`Plan::refine_span`], spans in parallel: rest stops
+    /// decouple them exactly), then solved on its final grid by the chosen solver.
+    fn solve_adaptive(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
+        use rayon::prelude::*;
+        let ns = self.path.spans.len();
+        let budget = options.max_stations;
+        let refined: Vec<Refined> = (0..ns)
+            .into_par_iter()
+            .map(|si| self.refine_span(si, options, budget))
+            .collect::<Result<_>>()?;
+        let total: usize = refined.iter().map(|r| r.problem.u.len()).sum();
+        if total > options.max_stations {
+            return Err(Error::Solver(format!(
+                "the path needs more than {} stations to reach a cycle time within {:e} of the \
+                 optimum; a looser --tolerance (smoother fitted path) or fewer, longer CL moves \
+                 help",
+                options.max_stations, options.convergence
+            )));
+        }
+        let most = refined.iter().map(|r| r.rounds.len()).max().unwrap_or(0);
+        let refinement: Vec<Refinement> = (0..most)
+            .map(|r| {
+                let at = |x: &Refined| x.rounds[r.min(x.rounds.len() - 1)];
+                Refinement {
+                    stations: refined.iter().map(|x| at(x).0).sum(),
+                    cycle_time_s: refined.iter().map(|x| at(x).1).sum(),
+                }
+            })
+            .collect();
+        let estimate_s: f64 = refined.iter().map(|r| r.estimate).sum();
+        let solved: Vec<(SpanProblem, SpanSolution)> = refined
+            .into_par_iter()
+            .enumerate()
+            .map(|(si, r)| {
+                let p = self.final_grid(si, r.problem, options);
+                let s = self.solve_span(si, &p, options, None)?;
+                Ok((p, s))
+            })
+            .collect::<Result<_>>()?;
+        let (problems, solutions): (Vec<_>, Vec<_>) = solved.into_iter().unzip();
+        let lv = self.level(problems, solutions)?;
+        let estimate = if lv.schedule.cycle_time > 0.0 {
+            estimate_s / lv.schedule.cycle_time
+        } else {
+            0.0
+        };
+        Ok((lv, refinement, estimate))
+    }
+
+    /// Assembles a level from every span's problem and solution.
+    fn level(&self, problems: Vec<SpanProblem>, solutions: Vec<SpanSolution>) -> Result<Level> {
+        let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
+        for s in &solutions {
+            status = status.worst(s.status);
+            iterations += s.iterations;
+            solve_time += s.solve_time;
+        }
+        let schedule = Schedule::build(&self.axes, &self.path.spans, &problems, &solutions)?;
+        Ok(Level {
+            problems,
+            solutions,
+            schedule,
+            status,
+            iterations,
+            solve_time,
+        })
+    }
+
+    /// The grid a span is finally solved on: for a jerk-limited solve, graded into its rest
+    /// ends (from rest the jerk-limited profile grows as b ∝ u^(4/3), which evenly spaced
+    /// quadratic pieces follow badly: L/2, L/4, … L/2^GRADING of the first three intervals' L).
+    fn final_grid(&self, si: usize, p: SpanProblem, options: &Options) -> SpanProblem {
+        if !self.machine.has_jerk() || p.intervals() < 6 {
+            return p;
+        }
+        let n = p.intervals();
+        let mut u = p.u.clone();
+        if p.b_start == 0.0 {
+            let l = p.u[3] - p.u[0];
+            u.extend((1..=GRADING).map(|k| p.u[0] + l / f64::powi(2.0, k as i32)));
+        }
+        if p.b_end == 0.0 {
+            let l = p.u[n] - p.u[n - 3];
+            u.extend((1..=GRADING).map(|k| p.u[n] - l / f64::powi(2.0, k as i32)));
+        }
+        if u.len() == p.u.len() {
+            return p;
+        }
+        u.sort_by(f64::total_cmp);
+        u.dedup();
+        let span = &self.path.spans[si];
+        let mut q = SpanProblem::at_stations(span, &self.kin, self.machine, u);
+        if let Some(c) = &options.verify.chord {
+            q.apply_chord(span, c);
+        }
+        (q.b_start, q.b_end) = (p.b_start, p.b_end);
+        q
+    }
+
     /// Re-simulates one level's schedule.
     fn verify(&self, lv: &Level, options: &Options) -> Result<Verification> {
         verify(
@@ -467,9 +730,7 @@ impl Plan<'_> {
         }
         Ok(match options.solver_kind {
             SolverKind::Reach => greedy,
-            SolverKind::Clarabel => {
-                solver::clarabel::solve_windowed(p, &greedy.b, &options.solver)?
-            }
+            SolverKind::Clarabel => solver::optimal(p, &greedy, &options.solver)?,
         })
     }
 

@@ -332,6 +332,7 @@ impl Study<'_> {
             iterations,
             solve_time,
             refinement: Vec::new(),
+            error_estimate: None,
             verification,
             verify_period: self.options.verify.period,
         };

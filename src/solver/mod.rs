@@ -234,3 +234,74 @@ impl Rows {
         }
     }
 }
+
+/// The optimum of one span's discretisation, with Clarabel only where it is needed.
+///
+/// The largest profile of the lattice relaxation ([`reach::solve_lattice`]) is at least as fast
+/// as every feasible profile; wherever it also meets the rows the relaxation left out it is the
+/// exact optimum, and no cone program is solved. Otherwise each interval where it breaks such a
+/// row is covered by a window reaching out to the nearest *stitch* on either side — a span end,
+/// or a station inside a plateau of the feasible profile `greedy` (it and both neighbours on
+/// their velocity bound: no feasible profile is faster there, so the relaxation's profile is on
+/// the bound too) — and the windows are solved by Clarabel ([`clarabel::solve_windowed`]) with b
+/// fixed at their ends. Between windows the relaxation's profile meets every row with the same
+/// ends, so it is the optimum there. The stitched profile equals the all-Clarabel windowed
+/// solve of the same stations up to the solvers' tolerances (tested). If Clarabel fails on a
+/// window (a status other than Solved or AlmostSolved), that window keeps `greedy` (feasible),
+/// and the status says [`Status::Greedy`].
+pub fn optimal(
+    p: &crate::constraints::SpanProblem,
+    greedy: &SpanSolution,
+    settings: &SolverSettings,
+) -> crate::error::Result<SpanSolution> {
+    let t0 = std::time::Instant::now();
+    let n = p.intervals();
+    let mut b = match reach::solve_lattice(p) {
+        Ok(m) => m.b,
+        // (cannot happen when `greedy` exists: the relaxation's feasible set is larger)
+        Err(_) => greedy.b.clone(),
+    };
+    let bad = reach::lattice_violations(p, &b, 1e-9);
+    let (mut status, mut iterations) = (Status::Optimal, 0);
+    if !bad.is_empty() {
+        let on_bound =
+            |i: usize| p.b_max[i].is_finite() && greedy.b[i] >= p.b_max[i] * (1.0 - 1e-9);
+        let stitch =
+            |i: usize| i == 0 || i == n || (on_bound(i - 1) && on_bound(i) && on_bound(i + 1));
+        let mut windows: Vec<(usize, usize)> = Vec::new();
+        for &k in &bad {
+            if windows.last().is_some_and(|w| k < w.1) {
+                continue; // inside the previous window
+            }
+            let a = (0..=k).rev().find(|&i| stitch(i)).unwrap_or(0);
+            let c = (k + 1..=n).find(|&i| stitch(i)).unwrap_or(n);
+            match windows.last_mut() {
+                Some(w) if a <= w.1 => w.1 = c,
+                _ => windows.push((a, c)),
+            }
+        }
+        for (a, c) in windows {
+            let w = p.window(a, c, b[a], b[c]);
+            match clarabel::solve_windowed(&w, &greedy.b[a..=c], settings) {
+                Ok(s) => {
+                    status = status.worst(s.status);
+                    iterations += s.iterations;
+                    b[a..=c].copy_from_slice(&s.b);
+                }
+                Err(crate::error::Error::Solver(_)) => {
+                    status = status.worst(Status::Greedy);
+                    b[a..=c].copy_from_slice(&greedy.b[a..=c]);
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+    Ok(SpanSolution {
+        b,
+        a: None,
+        status,
+        iterations,
+        solve_time: t0.elapsed().as_secs_f64(),
+        scp_iterations: 0,
+    })
+}

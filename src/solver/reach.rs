@@ -67,8 +67,9 @@ impl IntervalRows {
         }
     }
 
-    /// Builds interval k's rows, with b_{k+1} restricted to the set `next`.
-    fn build(&mut self, p: &SpanProblem, k: usize, next: &Set) {
+    /// Builds interval k's rows, with b_{k+1} restricted to the set `next`; with
+    /// `lattice_only`, without the rows that are not max-closed (see [`is_lattice_row`]).
+    fn build(&mut self, p: &SpanProblem, k: usize, next: &Set, lattice_only: bool) {
         self.upper.clear();
         self.lower.clear();
         self.x_max = (p.b_max[k], p.b_max_by[k]);
@@ -98,6 +99,9 @@ impl IntervalRows {
                     cy += ddq;
                 } else {
                     cx += ddq;
+                }
+                if lattice_only && !is_lattice_row(cx, cy) {
+                    continue;
                 }
                 if rows & 1 != 0 {
                     self.le(cx, cy, lim.max, j);
@@ -196,8 +200,20 @@ fn speed(p: &SpanProblem, i: usize, b: f64) -> String {
     }
 }
 
+/// Whether the row `cx b_k + cy b_{k+1} ≤ d` (or `≥ d`) keeps the feasible set closed under
+/// the componentwise maximum: its two coefficients must not have the same sign (Topkis,
+/// Veinott). If every row of a problem is such, the feasible profiles form a lattice, its
+/// largest element exists, and because the time decreases in every b it is the optimum.
+pub fn is_lattice_row(cx: f64, cy: f64) -> bool {
+    cx * cy <= 0.0
+}
+
 /// The controllable sets C_k = [lo_k, hi_k] of the backward pass.
 pub fn controllable_sets(p: &SpanProblem) -> Result<Vec<Set>, Infeasible> {
+    sets_of(p, false)
+}
+
+fn sets_of(p: &SpanProblem, lattice_only: bool) -> Result<Vec<Set>, Infeasible> {
     let n = p.intervals();
     if p.b_end > p.b_max[n] * (1.0 + 1e-9) {
         return Err(Infeasible {
@@ -219,7 +235,7 @@ pub fn controllable_sets(p: &SpanProblem) -> Result<Vec<Set>, Infeasible> {
     let mut sets = vec![end; n + 1];
     let mut rows = IntervalRows::default();
     for k in (0..n).rev() {
-        rows.build(p, k, &sets[k + 1]);
+        rows.build(p, k, &sets[k + 1], lattice_only);
         sets[k] = rows.x_range().map_err(|binding| Infeasible {
             station: k,
             binding,
@@ -231,8 +247,53 @@ pub fn controllable_sets(p: &SpanProblem) -> Result<Vec<Set>, Infeasible> {
 
 /// Solves one span by the backward and forward passes.
 pub fn solve(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
+    passes(p, false)
+}
+
+/// The largest profile of the *lattice relaxation*: every row that is not max-closed
+/// ([`is_lattice_row`]) left out. The relaxation's feasible set contains the problem's, so this
+/// profile is at least as fast as any feasible one; where it also meets the rows left out
+/// ([`lattice_violations`] finds none) it is the exact optimum of the discretisation. Errors
+/// as [`solve`] (a relaxation infeasible means the problem is too).
+pub fn solve_lattice(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
+    passes(p, true)
+}
+
+/// The intervals (sorted) where profile `b` breaks one of the rows [`solve_lattice`] leaves
+/// out by more than a relative `tol` of its limit.
+pub fn lattice_violations(p: &SpanProblem, b: &[f64], tol: f64) -> Vec<usize> {
+    let mut out = Vec::new();
+    for k in 0..p.intervals() {
+        let inv = 1.0 / (2.0 * p.du(k));
+        let udd = (b[k + 1] - b[k]) * inv;
+        let broken = [(k, false), (k + 1, true)].into_iter().any(|(e, at_end)| {
+            let jet = &p.jets[e];
+            p.acceleration.iter().enumerate().any(|(j, lim)| {
+                let rows = p.essential[e] >> (2 * j) & 3;
+                let (dq, ddq) = (jet.dq[j], jet.ddq[j]);
+                let (cx, cy) = if at_end {
+                    (-dq * inv, dq * inv + ddq)
+                } else {
+                    (-dq * inv + ddq, dq * inv)
+                };
+                if rows == 0 || is_lattice_row(cx, cy) {
+                    return false;
+                }
+                let a = ddq * b[e] + dq * udd;
+                (rows & 1 != 0 && a > lim.max * (1.0 + tol))
+                    || (rows & 2 != 0 && a < lim.min * (1.0 + tol))
+            })
+        });
+        if broken {
+            out.push(k);
+        }
+    }
+    out
+}
+
+fn passes(p: &SpanProblem, lattice_only: bool) -> Result<SpanSolution, Infeasible> {
     let t0 = std::time::Instant::now();
-    let sets = controllable_sets(p)?;
+    let sets = sets_of(p, lattice_only)?;
     let n = p.intervals();
     let c0 = sets[0];
     if p.b_start > c0.hi * (1.0 + 1e-9) {
@@ -263,7 +324,7 @@ pub fn solve(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
     let mut rows = IntervalRows::default();
     for k in 0..n {
         let next = sets[k + 1];
-        rows.build(p, k, &next);
+        rows.build(p, k, &next, lattice_only);
         b.push(rows.y_max(b[k]).clamp(next.lo, next.hi));
     }
     Ok(SpanSolution {
