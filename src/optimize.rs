@@ -323,13 +323,15 @@ const MAX_LOCAL_ROUNDS: usize = 12;
 /// Rounds of the adaptive refinement of one span at most (each halves the intervals marked).
 const MAX_ADAPTIVE_ROUNDS: usize = 60;
 
-/// One span refined adaptively: the final grid, its reach profile, the absolute error
-/// estimate (s) and, per round, the stations and time of the fine grid.
-struct Refined {
-    problem: SpanProblem,
+/// One round of the adaptive refinement of one span: its fine grid F solved by the reach
+/// pass, F's time, and the change e_k of each coarse interval's time under halving (and
+/// their sum).
+struct Round {
+    fine: SpanProblem,
     greedy: SpanSolution,
+    time: f64,
+    e: Vec<f64>,
     estimate: f64,
-    rounds: Vec<(usize, f64)>,
 }
 
 /// The solve of every span at one refinement level.
@@ -467,122 +469,150 @@ impl Plan<'_> {
         Ok(p)
     }
 
-    /// Refines the stations of span `si` where they change its time.
-    ///
-    /// Each round solves the grid G and its bisection F (every interval halved) by the reach
-    /// pass and charges each interval k of G with e_k = |t_k(G) − t_{2k}(F) − t_{2k+1}(F)|,
-    /// the change of its time under halving. When Σ e_k ≤ `convergence` × T(F), F is returned
-    /// with the estimate Σ e_k: under error ∝ h^p (p ≥ 1) F's remaining error is at most
-    /// Σ e_k / (2^p − 1) ≤ Σ e_k (Richardson). Otherwise the intervals with the largest e_k
-    /// are halved — all but the smallest ones whose e_k sum to half the allowance — and the
-    /// round repeats on that grid. Plateaus (feed cap, velocity bound) have e_k = 0 and are
-    /// never refined; the stations go to ramps, rest ends, corners and curvature peaks.
-    fn refine_span(&self, si: usize, options: &Options, budget: usize) -> Result<Refined> {
+    /// One span's grid G and its bisection F (every interval halved), both solved by the reach
+    /// pass, and e_k = |t_k(G) − t_{2k}(F) − t_{2k+1}(F)| for every interval k of G: the change
+    /// of its time under halving.
+    fn bisect(&self, si: usize, options: &Options, p: SpanProblem) -> Result<Round> {
         let span = &self.path.spans[si];
         let chord = options.verify.chord.as_ref();
-        let tol = options.convergence;
-        let mut p = self.initial_problem(si, options)?;
-        let mut g = self.reach(si, &p)?;
-        let mut t = interval_times(&p, &g)?;
-        let mut rounds = Vec::new();
-        loop {
-            let n = p.intervals();
-            let all: Vec<usize> = (0..n).collect();
-            let pf = p.with_inserted(span, &self.kin, self.machine, chord, &all, |k| {
-                0.5 * (p.u[k] + p.u[k + 1])
-            });
-            self.check_travel(si, &pf)?;
-            let gf = self.reach(si, &pf)?;
-            let tf = interval_times(&pf, &gf)?;
-            let time: f64 = tf.iter().sum();
-            let e: Vec<f64> = (0..n)
-                .map(|k| (t[k] - tf[2 * k] - tf[2 * k + 1]).abs())
-                .collect();
-            let estimate: f64 = e.iter().sum();
-            rounds.push((pf.u.len(), time));
-            if estimate <= tol * time
-                || rounds.len() >= MAX_ADAPTIVE_ROUNDS
-                || pf.u.len() + n > budget
-            {
-                return Ok(Refined {
-                    problem: pf,
-                    greedy: gf,
-                    estimate,
-                    rounds,
-                });
-            }
-            let mut order: Vec<usize> = (0..n).collect();
-            order.sort_unstable_by(|a, b| e[*a].total_cmp(&e[*b]));
-            let allowance = 0.5 * tol * time;
-            let mut keep: Vec<bool> = (0..pf.u.len()).map(|i| i % 2 == 0).collect();
-            let mut acc = 0.0;
-            for &k in &order {
-                acc += e[k];
-                if acc > allowance {
-                    keep[2 * k + 1] = true;
-                }
-            }
-            // Where a marked interval of F ramps onto (or off) a plateau more slowly than the
-            // limits allow, the ramp really ends inside it: a station goes where it does.
-            let kinks: Vec<f64> = order
-                .iter()
-                .filter(|&&k| keep[2 * k + 1])
-                .flat_map(|&k| [2 * k, 2 * k + 1])
-                .filter_map(|f| ramp_end(&pf, &gf.b, f))
-                .collect();
-            p = pf.select(&keep);
-            if !kinks.is_empty() {
-                let mut at: Vec<(usize, f64)> = kinks
-                    .into_iter()
-                    .map(|x| (p.u.partition_point(|&v| v <= x) - 1, x))
-                    .collect();
-                at.sort_unstable_by_key(|a| a.0);
-                at.dedup_by_key(|a| a.0);
-                let ks: Vec<usize> = at.iter().map(|a| a.0).collect();
-                p = p.with_inserted(span, &self.kin, self.machine, chord, &ks, |k| {
-                    at[ks.partition_point(|&x| x < k)].1
-                });
-            }
-            g = self.reach(si, &p)?;
-            t = interval_times(&p, &g)?;
-        }
+        let g = self.reach(si, &p)?;
+        let t = interval_times(&p, &g)?;
+        let n = p.intervals();
+        let all: Vec<usize> = (0..n).collect();
+        let pf = p.with_inserted(span, &self.kin, self.machine, chord, &all, |k| {
+            0.5 * (p.u[k] + p.u[k + 1])
+        });
+        self.check_travel(si, &pf)?;
+        let gf = self.reach(si, &pf)?;
+        let tf = interval_times(&pf, &gf)?;
+        let time = tf.iter().sum();
+        let e: Vec<f64> = (0..n)
+            .map(|k| (t[k] - tf[2 * k] - tf[2 * k + 1]).abs())
+            .collect();
+        Ok(Round {
+            fine: pf,
+            greedy: gf,
+            time,
+            estimate: e.iter().sum(),
+            e,
+        })
     }
 
-    /// Every span refined adaptively ([`Plan::refine_span`], spans in parallel: rest stops
-    /// decouple them exactly), then solved on its final grid by the chosen solver.
+    /// The next grid of a span: G with every interval whose e_k exceeds `threshold` halved
+    /// (the stations of F in it), and a station where a ramp inside it ends ([`ramp_end`]).
+    fn refined_grid(&self, si: usize, options: &Options, r: &Round, threshold: f64) -> SpanProblem {
+        let span = &self.path.spans[si];
+        let chord = options.verify.chord.as_ref();
+        let pf = &r.fine;
+        let mut keep: Vec<bool> = (0..pf.u.len()).map(|i| i % 2 == 0).collect();
+        for (k, &e) in r.e.iter().enumerate() {
+            if e > threshold {
+                keep[2 * k + 1] = true;
+            }
+        }
+        // Where a marked interval of F ramps onto (or off) a plateau more slowly than the
+        // limits allow, the ramp really ends inside it: a station goes where it does.
+        let kinks: Vec<f64> = (0..r.e.len())
+            .filter(|&k| keep[2 * k + 1])
+            .flat_map(|k| [2 * k, 2 * k + 1])
+            .filter_map(|f| ramp_end(pf, &r.greedy.b, f))
+            .collect();
+        let p = pf.select(&keep);
+        if kinks.is_empty() {
+            return p;
+        }
+        let mut at: Vec<(usize, f64)> = kinks
+            .into_iter()
+            .map(|x| (p.u.partition_point(|&v| v <= x) - 1, x))
+            .collect();
+        at.sort_unstable_by_key(|a| a.0);
+        at.dedup_by_key(|a| a.0);
+        let ks: Vec<usize> = at.iter().map(|a| a.0).collect();
+        p.with_inserted(span, &self.kin, self.machine, chord, &ks, |k| {
+            at[ks.partition_point(|&x| x < k)].1
+        })
+    }
+
+    /// Every span refined adaptively, then solved on its final grid by the chosen solver.
+    ///
+    /// Each round takes every span's grid G and its bisection F ([`Plan::bisect`], spans in
+    /// parallel: rest stops decouple them exactly). When Σ e_k over the whole path is at most
+    /// `convergence` × T(F), the grids F are final and Σ e_k / T(F) is the error estimate:
+    /// under an error ∝ h^p (p ≥ 1), F's remaining error is at most Σ e_k / (2^p − 1) ≤ Σ e_k
+    /// (Richardson). Otherwise every interval whose e_k exceeds one threshold for the whole
+    /// path — all but the smallest e_k that sum to half the allowance — is halved, a station
+    /// goes where a ramp ends inside it, and the spans with such intervals run the next round
+    /// (the others keep theirs). Plateaus (feed cap, velocity bound) have e_k = 0 and are never
+    /// refined: the stations go to ramps, rest ends, corners and curvature peaks.
     fn solve_adaptive(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
         use rayon::prelude::*;
         let ns = self.path.spans.len();
-        let budget = options.max_stations;
-        let refined: Vec<Refined> = (0..ns)
+        let tol = options.convergence;
+        let mut rounds: Vec<Round> = (0..ns)
             .into_par_iter()
-            .map(|si| self.refine_span(si, options, budget))
+            .map(|si| self.bisect(si, options, self.initial_problem(si, options)?))
             .collect::<Result<_>>()?;
-        let total: usize = refined.iter().map(|r| r.problem.u.len()).sum();
-        if total > options.max_stations {
-            return Err(Error::Solver(format!(
-                "the path needs more than {} stations to reach a cycle time within {:e} of the \
-                 optimum; a looser --tolerance (smoother fitted path) or fewer, longer CL moves \
-                 help",
-                options.max_stations, options.convergence
-            )));
-        }
-        let most = refined.iter().map(|r| r.rounds.len()).max().unwrap_or(0);
-        let refinement: Vec<Refinement> = (0..most)
-            .map(|r| {
-                let at = |x: &Refined| x.rounds[r.min(x.rounds.len() - 1)];
-                Refinement {
-                    stations: refined.iter().map(|x| at(x).0).sum(),
-                    cycle_time_s: refined.iter().map(|x| at(x).1).sum(),
+        let mut refinement = Vec::new();
+        loop {
+            let time: f64 = rounds.iter().map(|r| r.time).sum();
+            let estimate: f64 = rounds.iter().map(|r| r.estimate).sum();
+            let stations: usize = rounds.iter().map(|r| r.fine.u.len()).sum();
+            refinement.push(Refinement {
+                stations,
+                cycle_time_s: time,
+            });
+            if std::env::var_os("FEEDOPT_REFINE_TRACE").is_some() {
+                eprintln!("refine: {stations} stations, T {time:.6} s, estimate {estimate:.3e} s");
+            }
+            if estimate <= tol * time || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
+                break;
+            }
+            if 2 * stations > options.max_stations {
+                return Err(Error::Solver(format!(
+                    "the cycle time is still {:.1e} (relative) from converged with {stations} \
+                     stations, and halving the intervals that carry that error would pass the \
+                     limit of {} stations; try a looser --tolerance (a smoother fitted path), \
+                     or --stations N for a fixed grid",
+                    estimate / time,
+                    options.max_stations
+                )));
+            }
+            // The threshold: the smallest e_k, summing to half the allowance, stay.
+            let mut all: Vec<f64> = rounds.iter().flat_map(|r| r.e.iter().copied()).collect();
+            all.sort_unstable_by(f64::total_cmp);
+            let allowance = 0.5 * tol * time;
+            let (mut acc, mut threshold) = (0.0, 0.0);
+            for &e in &all {
+                acc += e;
+                if acc > allowance {
+                    break;
                 }
-            })
-            .collect();
-        let estimate_s: f64 = refined.iter().map(|r| r.estimate).sum();
-        let solved: Vec<(SpanProblem, SpanSolution)> = refined
+                threshold = e;
+            }
+            drop(all);
+            let next: Vec<Option<Round>> = rounds
+                .par_iter()
+                .enumerate()
+                .map(|(si, r)| {
+                    if r.e.iter().all(|&e| e <= threshold) {
+                        return Ok(None);
+                    }
+                    let p = self.refined_grid(si, options, r, threshold);
+                    self.bisect(si, options, p).map(Some)
+                })
+                .collect::<Result<_>>()?;
+            for (r, n) in rounds.iter_mut().zip(next) {
+                if let Some(n) = n {
+                    *r = n;
+                }
+            }
+        }
+        let estimate_s: f64 = rounds.iter().map(|r| r.estimate).sum();
+        let solved: Vec<(SpanProblem, SpanSolution)> = rounds
             .into_par_iter()
             .enumerate()
             .map(|(si, r)| {
-                let p = self.final_grid(si, r.problem, options);
+                let p = self.final_grid(si, r.fine, options);
                 let s = self.solve_span(si, &p, options, None)?;
                 Ok((p, s))
             })

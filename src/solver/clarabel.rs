@@ -319,13 +319,7 @@ pub fn solve_windowed(
     // optimum sits on the bound too, so fixing b there loses nothing); nearest the target
     // first. Without such a station in range, the station closest to its bound.
     let len = n / windows;
-    let on_bound = |i: usize| {
-        if p.b_max[i].is_finite() && p.b_max[i] > 0.0 {
-            greedy[i] / p.b_max[i]
-        } else {
-            0.0
-        }
-    };
+    let on_bound = |i: usize| super::on_velocity_bound(p, greedy, i);
     let plateau = |i: usize| (i - 1..=i + 1).all(|k| on_bound(k) >= 1.0 - 1e-9);
     let mut cuts = vec![0usize];
     for w in 1..windows {

@@ -235,6 +235,22 @@ impl Rows {
     }
 }
 
+/// b_i / b_max_i where station i's bound is a velocity limit or the feed cap, 0 where it is the
+/// acceleration-limited maximum b* (or none). A profile on such a bound cannot be faster there,
+/// so a stitch there is safe; b* is where rows that are not max-closed live, and the optimum
+/// can leave it.
+pub(crate) fn on_velocity_bound(p: &crate::constraints::SpanProblem, b: &[f64], i: usize) -> f64 {
+    use crate::constraints::Bound;
+    match p.b_max_by[i] {
+        Bound::AxisVelocity(_) | Bound::Feed | Bound::Chord
+            if p.b_max[i].is_finite() && p.b_max[i] > 0.0 =>
+        {
+            b[i] / p.b_max[i]
+        }
+        _ => 0.0,
+    }
+}
+
 /// The optimum of one span's discretisation, with Clarabel only where it is needed.
 ///
 /// The largest profile of the lattice relaxation ([`reach::solve_lattice`]) is at least as fast
@@ -282,7 +298,12 @@ pub fn optimal(
         }
         for (a, c) in windows {
             let w = p.window(a, c, b[a], b[c]);
-            match clarabel::solve_windowed(&w, &greedy.b[a..=c], settings) {
+            let solved = if c - a <= settings.window {
+                clarabel::solve(&w, settings)
+            } else {
+                clarabel::solve_windowed(&w, &greedy.b[a..=c], settings)
+            };
+            match solved {
                 Ok(s) => {
                     status = status.worst(s.status);
                     iterations += s.iterations;

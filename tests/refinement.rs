@@ -1,0 +1,160 @@
+//! The adaptive station refinement (issue 11): closed forms, the error estimate, the station
+//! count, and the final solve against an all-Clarabel solve on the same grid.
+
+use std::path::Path;
+
+use feedopt::machine::Machine;
+use feedopt::optimize::{Options, Solution, optimize, optimize_input};
+use feedopt::schedule::interval_times;
+use feedopt::solver::{SolverKind, SolverSettings, clarabel};
+use feedopt::toolpath;
+use nalgebra::Vector3;
+
+mod common;
+use common::{UP, machine, toolpath};
+
+const XYZ: &str = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+    "axes": {"X": {"velocity": 500, "acceleration": 3000},
+             "Y": {"velocity": 500, "acceleration": 3000},
+             "Z": {"velocity": 500, "acceleration": 3000}},
+    "feed": {"max": 500}}"#;
+
+/// 400 zig-zag moves of √25.25 mm at 1 mm/s (`G1 X5 Y0.5 F60`, `G1 X0 Y1 F60`, …): every
+/// corner turns by 168°, so every move is a rest-to-rest span whose ramps (1/6000 mm) are far
+/// shorter than any interval a uniform grid would give it.
+fn zigzag() -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    let mut pts = vec![(Vector3::zeros(), UP)];
+    for i in 0..400 {
+        let x = if i % 2 == 0 { 5.0 } else { 0.0 };
+        pts.push((Vector3::new(x, 0.5 * (i + 1) as f64, 0.0), UP));
+    }
+    pts
+}
+
+#[test]
+fn zigzag_converges_to_its_closed_form_in_few_stations() {
+    let m = machine(XYZ);
+    let t = toolpath(&zigzag(), Some(1.0));
+    let sol = optimize(&m, &t, &Options::default()).expect("solves");
+    // Rest to rest along a line of length L at feed V under acceleration A (V²/A ≪ L): a ramp
+    // of V/A s each end, so L/V + V/A per move.
+    let (v, a) = (1.0, 3000.0);
+    let exact = 400.0 * (25.25f64.sqrt() / v + v / a);
+    let time = sol.schedule.cycle_time;
+    let err = (time - exact).abs() / exact;
+    assert!(err < 1e-6, "T {time} vs closed form {exact}: {err:e}");
+    let est = sol.error_estimate.expect("automatic refinement gives an estimate");
+    assert!(est <= 1e-4, "estimate {est:e}");
+    assert!(sol.stations() <= 20_000, "{} stations", sol.stations());
+    assert!(sol.verification.verified);
+}
+
+/// A ramp within a long straight move: the error estimate bounds the true error, which the
+/// closed form gives (rest to rest at the acceleration limit, feed capped).
+#[test]
+fn the_error_estimate_bounds_the_true_error() {
+    let m = machine(XYZ);
+    for (len, feed) in [(100.0, 400.0), (10.0, 100.0), (0.5, 200.0)] {
+        let pts = [(Vector3::zeros(), UP), (Vector3::new(len, 0.0, 0.0), UP)];
+        let t = toolpath(&pts, Some(feed));
+        let sol = optimize(&m, &t, &Options::default()).expect("solves");
+        let a: f64 = 3000.0;
+        // Triangle if the feed cannot be reached, else trapezoid.
+        let exact = if feed * feed / a >= len {
+            2.0 * (len / a).sqrt()
+        } else {
+            len / feed + feed / a
+        };
+        let time = sol.schedule.cycle_time;
+        let err = (time - exact).abs() / exact;
+        let est = sol.error_estimate.expect("estimate");
+        assert!(
+            err <= est.max(1e-12) && est <= 1e-4,
+            "L {len} F {feed}: T {time} vs {exact} ({err:e}), estimate {est:e}"
+        );
+    }
+}
+
+/// The total time of a solution recomputed from its profiles (eq. 43).
+fn time_of(sol: &Solution) -> f64 {
+    sol.problems
+        .iter()
+        .zip(&sol.solutions)
+        .map(|(p, s)| interval_times(p, s).expect("finite").iter().sum::<f64>())
+        .sum()
+}
+
+/// The default answer (lattice relaxation where it is exact, Clarabel on the windows where it
+/// is not) equals Clarabel run on every span in one piece on the same final stations.
+#[test]
+fn default_answer_equals_all_clarabel_on_the_same_grid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    let mut used_clarabel = false;
+    let mut exact_somewhere = false;
+    for (m, t) in [
+        ("xyz_pocket/machine.json", "xyz_pocket/pocket_contour.cls"),
+        ("seed_head_head/machine.json", "seed_head_head/impeller_blade.cls"),
+    ] {
+        let machine = Machine::from_file(&root.join(m)).expect("machine");
+        let input = toolpath::read_input(&root.join(t)).expect("toolpath");
+        let sol = optimize_input(&machine, &input, &Options::default()).expect("solves");
+        let settings = SolverSettings {
+            window: usize::MAX,
+            ..SolverSettings::default()
+        };
+        let mut all_clarabel = 0.0;
+        for (p, s) in sol.problems.iter().zip(&sol.solutions) {
+            let c = clarabel::solve(p, &settings).expect("Clarabel solves the span");
+            all_clarabel += interval_times(p, &c).expect("finite").iter().sum::<f64>();
+            used_clarabel |= s.iterations > 0;
+            exact_somewhere |= s.iterations == 0 && p.intervals() > 10;
+        }
+        let default = time_of(&sol);
+        let rel = (default - all_clarabel).abs() / all_clarabel;
+        assert!(
+            rel <= 1e-6,
+            "{t}: default {default} vs all-Clarabel {all_clarabel}: {rel:e}"
+        );
+    }
+    // Both ways of the final solve were exercised.
+    assert!(used_clarabel && exact_somewhere);
+}
+
+/// A fixed grid (`stations`) is solved as given, without an estimate; the reach solver on the
+/// same stations is never faster than the default.
+#[test]
+fn fixed_grid_has_no_estimate_and_reach_is_not_faster() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    let machine = Machine::from_file(&root.join("xyz_pocket/machine.json")).expect("machine");
+    let input = toolpath::read_input(&root.join("xyz_pocket/pocket_contour.cls")).expect("tp");
+    let fixed = |kind| Options {
+        stations: Some(3000),
+        solver_kind: kind,
+        refine_until_verified: false,
+        ..Options::default()
+    };
+    let c = optimize_input(&machine, &input, &fixed(SolverKind::Clarabel)).expect("solves");
+    let r = optimize_input(&machine, &input, &fixed(SolverKind::Reach)).expect("solves");
+    assert!(c.error_estimate.is_none());
+    assert_eq!(c.stations(), r.stations());
+    assert!(r.schedule.cycle_time >= c.schedule.cycle_time * (1.0 - 1e-7));
+}
+
+/// The LinuxCNC impeller (4,503 lines, 197 spans) by default: within 2e-4 of its converged
+/// cycle time (1173.2516 s, uniform refinement to 1.38 M stations), on a grid that grows with
+/// its features (tens of thousands of stations, not millions).
+#[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
+fn linuxcnc_impeller_by_default() {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
+    let machine =
+        Machine::from_file(&d.join("impeller-7bl-xyzac.machine.json")).expect("machine file");
+    let input = toolpath::read_input(&d.join("impeller-7bl-xyzac.ngc")).expect("program");
+    let sol = optimize_input(&machine, &input, &Options::default()).expect("solves");
+    let t = sol.schedule.cycle_time;
+    let rel = (t - 1173.2516).abs() / 1173.2516;
+    assert!(rel <= 2e-4, "T {t}: {rel:e}");
+    assert!(sol.error_estimate.expect("estimate") <= 1e-4);
+    assert!(sol.stations() < 100_000, "{} stations", sol.stations());
+    assert!(sol.verification.verified);
+}
