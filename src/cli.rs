@@ -241,12 +241,76 @@ impl SolveArgs {
     }
 }
 
+/// A spinner on stderr with the solve's stage and refinement rounds: drawn only when stderr is
+/// a terminal, and only once the solve has run for a second (short solves print nothing).
+struct Bar {
+    bar: indicatif::ProgressBar,
+    start: std::time::Instant,
+    shown: std::sync::atomic::AtomicBool,
+}
+
+impl Bar {
+    fn new() -> Bar {
+        let bar = indicatif::ProgressBar::hidden();
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
+        Bar {
+            bar,
+            start: std::time::Instant::now(),
+            shown: std::sync::atomic::AtomicBool::new(false),
+        }
+    }
+
+    fn show(&self, msg: String) {
+        use std::io::IsTerminal;
+        self.bar.set_message(msg);
+        if self.start.elapsed().as_secs_f64() >= 1.0
+            && std::io::stderr().is_terminal()
+            && !self.shown.swap(true, std::sync::atomic::Ordering::Relaxed)
+        {
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            self.bar
+                .enable_steady_tick(std::time::Duration::from_millis(120));
+        }
+    }
+}
+
+impl optimize::Progress for Bar {
+    fn stage(&self, what: &str) {
+        self.show(what.to_string());
+    }
+    fn round(&self, stations: usize, estimate: f64, target: f64) {
+        self.show(format!(
+            "refining stations: {stations}, estimated error {estimate:.1e} (target {target:.0e})"
+        ));
+    }
+}
+
+impl Drop for Bar {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Solves with a progress bar on a terminal.
+fn solve_with_progress(
+    machine: &Machine,
+    input: &toolpath::Input,
+    options: &Options,
+) -> Result<optimize::Solution> {
+    let bar = Bar::new();
+    optimize::optimize_input_observed(machine, input, options, &bar)
+}
+
 /// `feedopt solve`: returns what to print on stdout.
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
     let (input, warnings) = read_input(args)?;
-    let solution = optimize::optimize_input(&machine, &input, &options)?;
+    let solution = solve_with_progress(&machine, &input, &options)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
@@ -459,7 +523,7 @@ fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize
     let options = args.options()?;
     let machine = Machine::from_file(&args.machine)?;
     let (input, _) = read_input(args)?;
-    let solution = optimize::optimize_input(&machine, &input, &options)?;
+    let solution = solve_with_progress(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
 }
 

@@ -83,6 +83,21 @@ impl Default for Options {
     }
 }
 
+/// Where a long solve is, for a front end that shows it (the CLI draws a progress bar). Every
+/// method has an empty default; calls come from the thread that runs the solve.
+pub trait Progress: Sync {
+    /// A new stage begins (`"refining stations"`, `"solving"`, `"verifying at 1 ms"`, …).
+    fn stage(&self, _what: &str) {}
+    /// A refinement round ended: `stations` in all, the estimated relative error `estimate`,
+    /// and the `target` it must reach.
+    fn round(&self, _stations: usize, _estimate: f64, _target: f64) {}
+}
+
+/// Reports nothing.
+pub struct Silent;
+
+impl Progress for Silent {}
+
 /// One step of the automatic refinement.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Refinement {
@@ -126,6 +141,16 @@ impl Solution {
 
 /// Computes the time-optimal schedule of `toolpath` on `machine`.
 pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Result<Solution> {
+    optimize_observed(machine, toolpath, options, &Silent)
+}
+
+/// [`optimize`], telling `progress` where it is.
+pub fn optimize_observed(
+    machine: &Machine,
+    toolpath: &Toolpath,
+    options: &Options,
+    progress: &dyn Progress,
+) -> Result<Solution> {
     if machine.kinematics == KinematicsSpec::Joint {
         return Err(Error::Usage(format!(
             "{}: a CL toolpath needs a machine with kinematics (xyz, head_head), not a \
@@ -150,7 +175,7 @@ pub fn optimize(machine: &Machine, toolpath: &Toolpath, options: &Options) -> Re
             "no motion: every CL point is at the same position",
         ));
     }
-    optimize_path(machine, path, options)
+    optimize_path(machine, path, options, progress)
 }
 
 /// Computes the time-optimal schedule of a joint-space path (axis positions along s) on a
@@ -162,19 +187,47 @@ pub fn optimize_joint(machine: &Machine, path: &JointPath, options: &Options) ->
             path.source.display()
         )));
     }
-    optimize_path(machine, Path::from_joint(path, machine)?, options)
+    optimize_joint_observed(machine, path, options, &Silent)
+}
+
+/// [`optimize_joint`], telling `progress` where it is.
+pub fn optimize_joint_observed(
+    machine: &Machine,
+    path: &JointPath,
+    options: &Options,
+    progress: &dyn Progress,
+) -> Result<Solution> {
+    if machine.kinematics != KinematicsSpec::Joint {
+        return optimize_joint(machine, path, options);
+    }
+    optimize_path(machine, Path::from_joint(path, machine)?, options, progress)
 }
 
 /// Computes the time-optimal schedule of any input.
 pub fn optimize_input(machine: &Machine, input: &Input, options: &Options) -> Result<Solution> {
+    optimize_input_observed(machine, input, options, &Silent)
+}
+
+/// [`optimize_input`], telling `progress` where it is.
+pub fn optimize_input_observed(
+    machine: &Machine,
+    input: &Input,
+    options: &Options,
+    progress: &dyn Progress,
+) -> Result<Solution> {
     match input {
-        Input::Cl(t) => optimize(machine, t, options),
-        Input::Joint(j) => optimize_joint(machine, j, options),
+        Input::Cl(t) => optimize_observed(machine, t, options, progress),
+        Input::Joint(j) => optimize_joint_observed(machine, j, options, progress),
     }
 }
 
 /// The refinement loop over a built path.
-fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Solution> {
+fn optimize_path(
+    machine: &Machine,
+    path: Path,
+    options: &Options,
+    progress: &dyn Progress,
+) -> Result<Solution> {
     let unlimited;
     let machine = if options.jerk_limited || !machine.has_jerk() {
         machine
@@ -188,6 +241,7 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
         axes: machine.axes.iter().map(|a| a.name.clone()).collect(),
         kin: Kinematics::new(machine),
         path,
+        progress,
     };
     let (mut lv, mut refinement, error_estimate) = match options.stations {
         Some(total) => {
@@ -198,11 +252,20 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
             };
             (lv, vec![r], None)
         }
+        None if plan.machine.has_jerk() => {
+            let (lv, refinement, estimate) = plan.solve_uniform(options)?;
+            (lv, refinement, Some(estimate))
+        }
         None => {
             let (lv, refinement, estimate) = plan.solve_adaptive(options)?;
             (lv, refinement, Some(estimate))
         }
     };
+    plan.progress.stage(&format!(
+        "verifying {} stations at {} ms",
+        lv.schedule.stations.len(),
+        options.verify.period * 1e3
+    ));
     let mut v = plan.verify(&lv, options)?;
     let mut round = 0;
     while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
@@ -213,6 +276,8 @@ fn optimize_path(machine: &Machine, path: Path, options: &Options) -> Result<Sol
                 v.violations.first()
             );
         }
+        plan.progress
+            .stage("adding stations where the re-simulation found a limit exceeded");
         plan.refine_where_violated(&mut lv, &v, options)?;
         v = plan.verify(&lv, options)?;
         round += 1;
@@ -414,6 +479,7 @@ struct Plan<'a> {
     axes: Vec<String>,
     /// Each span's share of the stations.
     weights: Vec<f64>,
+    progress: &'a dyn Progress,
 }
 
 impl Plan<'_> {
@@ -548,6 +614,7 @@ impl Plan<'_> {
         use rayon::prelude::*;
         let ns = self.path.spans.len();
         let tol = options.convergence;
+        self.progress.stage("refining stations");
         let mut rounds: Vec<Round> = (0..ns)
             .into_par_iter()
             .map(|si| self.bisect(si, options, self.initial_problem(si, options)?))
@@ -561,9 +628,7 @@ impl Plan<'_> {
                 stations,
                 cycle_time_s: time,
             });
-            if std::env::var_os("FEEDOPT_REFINE_TRACE").is_some() {
-                eprintln!("refine: {stations} stations, T {time:.6} s, estimate {estimate:.3e} s");
-            }
+            self.progress.round(stations, estimate / time, tol);
             if estimate <= tol * time || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
                 break;
             }
@@ -608,6 +673,10 @@ impl Plan<'_> {
             }
         }
         let estimate_s: f64 = rounds.iter().map(|r| r.estimate).sum();
+        self.progress.stage(&format!(
+            "solving {} stations",
+            rounds.iter().map(|r| r.fine.u.len()).sum::<usize>()
+        ));
         let solved: Vec<(SpanProblem, SpanSolution)> = rounds
             .into_par_iter()
             .enumerate()
@@ -625,6 +694,45 @@ impl Plan<'_> {
             0.0
         };
         Ok((lv, refinement, estimate))
+    }
+
+    /// Jerk-limited solves: every interval halved until doubling the stations changes the
+    /// cycle time by less than the tolerance (at least 10 × the SCP's own), each level's SCP
+    /// started from the level before. The estimate is that last relative change.
+    ///
+    /// The adaptive refinement of [`Plan::solve_adaptive`] places stations for the
+    /// acceleration-limited profile; the jerk-limited one leaves and rejoins its plateaus over
+    /// a distance the jerk sets, where that grid can be coarse, and the SCP's windows need
+    /// plateaus several stations long to cut at.
+    fn solve_uniform(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
+        let tol = options.convergence.max(10.0 * options.jerk.convergence);
+        let mut refinement = Vec::new();
+        let mut previous: Option<Level> = None;
+        for level in 0.. {
+            let lv = self.solve_at(options.initial_stations, level, options, previous.as_ref())?;
+            let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
+            refinement.push(Refinement {
+                stations,
+                cycle_time_s: time,
+            });
+            if let Some(prev) = &previous {
+                let change = (prev.schedule.cycle_time - time).abs() / time;
+                self.progress.round(stations, change, tol);
+                if change <= tol {
+                    return Ok((lv, refinement, change));
+                }
+            }
+            if 2 * stations > options.max_stations {
+                return Err(Error::Solver(format!(
+                    "the jerk-limited cycle time has not converged to {tol:e} within {} \
+                     stations (last: {stations} stations, {time:.4} s); try --stations N for a \
+                     fixed grid, or --no-jerk",
+                    options.max_stations
+                )));
+            }
+            previous = Some(lv);
+        }
+        unreachable!("the refinement loop returns")
     }
 
     /// Assembles a level from every span's problem and solution.

@@ -167,6 +167,9 @@ pub struct Summary {
     pub axes: Vec<(String, AxisPeaks)>,
     pub binding: Vec<BindingShare>,
     pub refinement: Vec<Refinement>,
+    /// Estimated relative error of `cycle_time_s` against the continuous optimum (automatic
+    /// refinement; `null` on a fixed grid): see [`Solution::error_estimate`].
+    pub error_estimate: Option<f64>,
     /// The re-simulation at the servo period found every limit kept (within its tolerance).
     pub verified: bool,
     /// Servo period of the re-simulation, s.
@@ -279,6 +282,7 @@ impl Summary {
                 .collect(),
             binding,
             refinement: sol.refinement.clone(),
+            error_estimate: sol.error_estimate,
             verified: sol.verification.verified,
             verify_period_s: sol.verify_period,
             worst_ratio: sol
@@ -348,6 +352,13 @@ impl fmt::Display for Summary {
             self.spans,
             steps.join(" → ")
         )?;
+        if let Some(e) = self.error_estimate {
+            writeln!(
+                f,
+                "converged     within {e:.1e} of the continuous optimum (estimated: the change \
+                 under one more halving)"
+            )?;
+        }
         let status = match self.status {
             Status::Optimal => "optimal",
             Status::AlmostOptimal => "almost optimal (reduced accuracy)",

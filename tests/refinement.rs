@@ -43,7 +43,9 @@ fn zigzag_converges_to_its_closed_form_in_few_stations() {
     let time = sol.schedule.cycle_time;
     let err = (time - exact).abs() / exact;
     assert!(err < 1e-6, "T {time} vs closed form {exact}: {err:e}");
-    let est = sol.error_estimate.expect("automatic refinement gives an estimate");
+    let est = sol
+        .error_estimate
+        .expect("automatic refinement gives an estimate");
     assert!(est <= 1e-4, "estimate {est:e}");
     assert!(sol.stations() <= 20_000, "{} stations", sol.stations());
     assert!(sol.verification.verified);
@@ -93,7 +95,10 @@ fn default_answer_equals_all_clarabel_on_the_same_grid() {
     let mut exact_somewhere = false;
     for (m, t) in [
         ("xyz_pocket/machine.json", "xyz_pocket/pocket_contour.cls"),
-        ("seed_head_head/machine.json", "seed_head_head/impeller_blade.cls"),
+        (
+            "seed_head_head/machine.json",
+            "seed_head_head/impeller_blade.cls",
+        ),
     ] {
         let machine = Machine::from_file(&root.join(m)).expect("machine");
         let input = toolpath::read_input(&root.join(t)).expect("toolpath");
