@@ -36,13 +36,15 @@ fn zigzag_converges_to_its_closed_form_in_few_stations() {
     let m = machine(XYZ);
     let t = toolpath(&zigzag(), Some(1.0));
     let sol = optimize(&m, &t, &Options::default()).expect("solves");
-    // Rest to rest along a line of length L at feed V under acceleration A (V²/A ≪ L): a ramp
-    // of V/A s each end, so L/V + V/A per move.
-    let (v, a) = (1.0, 3000.0);
-    let exact = 400.0 * (25.25f64.sqrt() / v + v / a);
+    // Rest to rest along a line of length L at feed V under tip acceleration A (V²/A ≪ L): a
+    // ramp of V/A s each end, so L/V + V/A per move. X, moving 5 mm of every L = √25.25 mm,
+    // reaches its 3000 mm/s² first: A = 3000 L / 5.
+    let l = 25.25f64.sqrt();
+    let (v, a) = (1.0, 3000.0 * l / 5.0);
+    let exact = 400.0 * (l / v + v / a);
     let time = sol.schedule.cycle_time;
     let err = (time - exact).abs() / exact;
-    assert!(err < 1e-6, "T {time} vs closed form {exact}: {err:e}");
+    assert!(err < 1e-8, "T {time} vs closed form {exact}: {err:e}");
     let est = sol
         .error_estimate
         .expect("automatic refinement gives an estimate");
