@@ -286,12 +286,10 @@ fn jerk_limits_are_checked_when_the_machine_file_gives_them() {
 /// overshoot; feedopt is no slower than any schedule that keeps every limit, and a schedule
 /// faster than feedopt exceeds some joint limit. The first blocks only (debug builds).
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn impeller_head_compare_acceptance() {
     let dir = Path::new("../shared/realworld/linuxcnc");
-    if !dir.is_dir() {
-        eprintln!("skipped: ../shared/realworld/linuxcnc is absent");
-        return;
-    }
+    assert!(dir.is_dir(), "../shared is present (cfg shared_data)");
     let text = std::fs::read_to_string(dir.join("impeller-7bl-xyzac.ngc")).unwrap();
     let head: String = text.lines().take(400).map(|l| format!("{l}\n")).collect();
     let tmp = tempfile::tempdir().unwrap();
@@ -305,10 +303,7 @@ fn impeller_head_compare_acceptance() {
 #[ignore]
 fn impeller_full_compare_acceptance() {
     let dir = Path::new("../shared/realworld/linuxcnc");
-    if !dir.is_dir() {
-        eprintln!("skipped: ../shared/realworld/linuxcnc is absent");
-        return;
-    }
+    assert!(dir.is_dir(), "../shared is present (cfg shared_data)");
     acceptance(
         &dir.join("impeller-7bl-xyzac.machine.json"),
         &dir.join("impeller-7bl-xyzac.ngc"),

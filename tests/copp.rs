@@ -84,10 +84,9 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn both_solvers_match_copp_on_its_own_grid() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let mut failures = Vec::new();
     eprintln!(
         "path  T_clarabel      vs COPP2-SOCP   T_reach         vs TOPP2-RA    vs COPP2-SOCP  \
@@ -159,10 +158,9 @@ fn both_solvers_match_copp_on_its_own_grid() {
 /// 1,886 when written) and the cycle time rises a little above COPP2-SOCP's (+0.1 %), which
 /// solves the coarser grid.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn cli_solves_a_copp_path() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let case = load(&dir, 0);
     let tmp = tempfile::tempdir().expect("temp dir");
     let machine = tmp.path().join("M.json");

@@ -142,10 +142,9 @@ fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
 /// Two independent subproblem objectives — the linearised time (LP) and the time itself
 /// through cones — reach the same schedule on a COPP path.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn linearised_and_cone_objectives_agree() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let (m, path, _) = copp_case(&dir, 1);
     let solve = |objective| {
         let o = Options {
@@ -189,10 +188,9 @@ fn copp_fixed_grid_time(dir: &Path, idx: usize, window: usize, threads: usize) -
 /// SCP) reaches the one-piece SCP's cycle time within its own tolerance (1e-4), and the result
 /// does not depend on how many threads solve the windows. All twenty: the ignored test below.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn windows_agree_with_one_piece() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let idx = 3;
     let whole = copp_fixed_grid_time(&dir, idx, usize::MAX, 0);
     let windows = copp_fixed_grid_time(&dir, idx, JerkOptions::default().window, 0);
@@ -211,9 +209,7 @@ fn windows_agree_with_one_piece() {
 #[test]
 #[ignore]
 fn windows_agree_with_one_piece_all_twenty() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let mut worst: f64 = 0.0;
     for idx in 0..20 {
         let whole = copp_fixed_grid_time(&dir, idx, usize::MAX, 0);
@@ -229,10 +225,9 @@ fn windows_agree_with_one_piece_all_twenty() {
 /// Three COPP paths with their jerk limits: verified at 1 kHz including jerk, and no slower
 /// than COPP's TOPP3-SOCP (+0.1 %). All twenty: the ignored test below.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn copp_jerk_paths_verify_and_match_topp3() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     for idx in [0, 7, 13] {
         let (m, path, topp3) = copp_case(&dir, idx);
         let sol = optimize_joint(&m, &path, &copp_options()).expect("solve");
@@ -248,9 +243,7 @@ fn copp_jerk_paths_verify_and_match_topp3() {
 #[test]
 #[ignore]
 fn copp_jerk_all_twenty() {
-    let Some(dir) = copp_data::data_dir() else {
-        return;
-    };
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     let (mut sum, mut sum_ref) = (0.0, 0.0);
     for idx in 0..20 {
         let (m, path, topp3) = copp_case(&dir, idx);
@@ -334,12 +327,13 @@ fn chord_tolerance_bounds_the_feed_on_a_circle_with_and_without_jerk() {
 /// cycled between iterates on 53 windows until the 30-iterate cap. Now it solves, every SCP
 /// stops within 12 subproblems, and it is no faster than acceleration-limited.
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn a_linuxcnc_program_with_jerk_limits_solves_without_stalls_or_cycles() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
-    if !dir.join("boat-xyzbc.ngc").exists() {
-        eprintln!("../shared/realworld/linuxcnc not present: skipped");
-        return;
-    }
+    assert!(
+        dir.join("boat-xyzbc.ngc").exists(),
+        "../shared is present (cfg shared_data)"
+    );
     let text = std::fs::read_to_string(dir.join("boat-xyzbc.machine.json")).expect("machine");
     let mut v: Value = serde_json::from_str(&text).expect("json");
     for axis in v["axes"].as_object_mut().expect("axes").values_mut() {

@@ -14,11 +14,9 @@ fn dir() -> Option<PathBuf> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn the_linuxcnc_programs_parse_map_within_travel_and_solve() {
-    let Some(dir) = dir() else {
-        eprintln!("../shared/realworld/linuxcnc not present: skipped");
-        return;
-    };
+    let dir = dir().expect("../shared is present (cfg shared_data)");
     for name in ["boat-xyzbc", "boat-xyzac", "impeller-7bl-xyzac"] {
         let m = Machine::from_file(&dir.join(format!("{name}.machine.json"))).unwrap();
         let t = toolpath::read(&dir.join(format!("{name}.ngc"))).unwrap();

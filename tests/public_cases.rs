@@ -14,11 +14,9 @@ fn cases_dir() -> Option<PathBuf> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn public_cases_match_the_independent_reference_within_half_a_percent() {
-    let Some(dir) = cases_dir() else {
-        eprintln!("../shared/cases not present: skipped");
-        return;
-    };
+    let dir = cases_dir().expect("../shared is present (cfg shared_data)");
     let refs: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("references.json")).unwrap())
             .unwrap();
@@ -53,11 +51,9 @@ fn public_cases_match_the_independent_reference_within_half_a_percent() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn both_solvers_agree_on_the_public_cases_and_every_schedule_verifies() {
-    let Some(dir) = cases_dir() else {
-        eprintln!("../shared/cases not present: skipped");
-        return;
-    };
+    let dir = cases_dir().expect("../shared is present (cfg shared_data)");
     for name in ["p1_spiral_tilt", "p2_xyz_rounded_square", "p3_s_curve_lean"] {
         let m = Machine::from_file(&dir.join(format!("{name}.machine.json"))).unwrap();
         let t = toolpath::read(&dir.join(format!("{name}.cls"))).unwrap();

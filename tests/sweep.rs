@@ -206,11 +206,9 @@ fn linuxcnc() -> Option<PathBuf> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn impeller_c_acceleration_sweep_is_monotone_and_duals_match_finite_differences() {
-    let Some(dir) = linuxcnc() else {
-        eprintln!("../shared/realworld/linuxcnc not present: skipped");
-        return;
-    };
+    let dir = linuxcnc().expect("../shared is present (cfg shared_data)");
     let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
     let input = toolpath::read(&dir.join("impeller-7bl-xyzac.ngc")).unwrap();
     let input = Input::Cl(input);
@@ -275,10 +273,7 @@ fn check_impeller_sweep(s: &Sweep) {
 #[test]
 #[ignore]
 fn impeller_c_acceleration_sweep_at_full_resolution() {
-    let Some(dir) = linuxcnc() else {
-        eprintln!("../shared/realworld/linuxcnc not present: skipped");
-        return;
-    };
+    let dir = linuxcnc().expect("../shared is present (cfg shared_data)");
     let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
     let input = Input::Cl(toolpath::read(&dir.join("impeller-7bl-xyzac.ngc")).unwrap());
     let t0 = std::time::Instant::now();
