@@ -206,17 +206,7 @@ impl SpanProblem {
         at: impl Fn(usize) -> f64,
     ) -> SpanProblem {
         let n = self.u.len() + split.len();
-        let mut p = SpanProblem {
-            u: Vec::with_capacity(n),
-            b_max: Vec::with_capacity(n),
-            b_max_by: Vec::with_capacity(n),
-            tip_speed: Vec::with_capacity(n),
-            jets: Vec::with_capacity(n),
-            acceleration: self.acceleration.clone(),
-            essential: Vec::with_capacity(n),
-            b_start: self.b_start,
-            b_end: self.b_end,
-        };
+        let mut p = self.empty_like(n);
         let mut next = split.iter().peekable();
         for i in 0..self.u.len() {
             p.copy_station(self, i);
@@ -234,7 +224,17 @@ impl SpanProblem {
     /// The stations `i` with `keep[i]` (the first and the last must be kept), as a problem.
     pub fn select(&self, keep: &[bool]) -> SpanProblem {
         let n = keep.iter().filter(|&&k| k).count();
-        let mut p = SpanProblem {
+        let mut p = self.empty_like(n);
+        debug_assert!(keep[0] && keep[keep.len() - 1]);
+        for (i, _) in keep.iter().enumerate().filter(|(_, k)| **k) {
+            p.copy_station(self, i);
+        }
+        p
+    }
+
+    /// No stations yet (room for `n`), the same limits and end speeds.
+    fn empty_like(&self, n: usize) -> SpanProblem {
+        SpanProblem {
             u: Vec::with_capacity(n),
             b_max: Vec::with_capacity(n),
             b_max_by: Vec::with_capacity(n),
@@ -244,12 +244,7 @@ impl SpanProblem {
             essential: Vec::with_capacity(n),
             b_start: self.b_start,
             b_end: self.b_end,
-        };
-        debug_assert!(keep[0] && keep[keep.len() - 1]);
-        for (i, _) in keep.iter().enumerate().filter(|(_, k)| **k) {
-            p.copy_station(self, i);
         }
-        p
     }
 
     fn copy_station(&mut self, from: &SpanProblem, i: usize) {

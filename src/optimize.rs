@@ -511,15 +511,23 @@ impl Plan<'_> {
         solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))
     }
 
-    /// The starting grid of span `si` for the adaptive refinement (every CL knot, each
-    /// segment divided as level 0 of the uniform grid is), with its end speeds.
-    fn initial_problem(&self, si: usize, options: &Options) -> Result<SpanProblem> {
+    /// Span `si` on the uniform grid of refinement `level` (level 0: every CL knot, each
+    /// segment divided so the spans share about `total` stations; level ℓ halves every interval
+    /// of level 0 ℓ times), with its end speeds: the start of the adaptive refinement (level 0)
+    /// and the levels of the jerk-limited one.
+    fn uniform_problem(
+        &self,
+        si: usize,
+        total: usize,
+        level: u32,
+        options: &Options,
+    ) -> Result<SpanProblem> {
         let spans = &self.path.spans;
         let span = &spans[si];
-        let total = options.initial_stations as f64;
+        let parts = 1usize << level;
         let grid = Grid {
-            spacing: span.length() / (total * self.weights[si]).max(8.0),
-            min_parts: 1,
+            spacing: span.length() / (total as f64 * self.weights[si]).max(8.0) / parts as f64,
+            min_parts: parts,
         };
         let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
         if let Some(c) = &options.verify.chord {
@@ -617,7 +625,13 @@ impl Plan<'_> {
         self.progress.stage("refining stations");
         let mut rounds: Vec<Round> = (0..ns)
             .into_par_iter()
-            .map(|si| self.bisect(si, options, self.initial_problem(si, options)?))
+            .map(|si| {
+                self.bisect(
+                    si,
+                    options,
+                    self.uniform_problem(si, options.initial_stations, 0, options)?,
+                )
+            })
             .collect::<Result<_>>()?;
         let mut refinement = Vec::new();
         loop {
@@ -911,70 +925,18 @@ impl Plan<'_> {
         options: &Options,
         previous: Option<&Level>,
     ) -> Result<Level> {
-        let spans = &self.path.spans;
-        let mut problems = Vec::with_capacity(spans.len());
-        let mut solutions = Vec::with_capacity(spans.len());
-        let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
-        for (si, (span, w)) in spans.iter().zip(&self.weights).enumerate() {
-            // Level ℓ halves every interval of level 0 ℓ times.
-            let parts = 1usize << level;
-            let spacing = span.length() / (total as f64 * w).max(8.0) / parts as f64;
-            let grid = Grid {
-                spacing,
-                min_parts: parts,
-            };
-            let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
-            if let Some(c) = &options.verify.chord {
-                p.apply_chord(span, c);
-            }
-            self.check_travel(si, &p)?;
-            if si == 0 {
-                p.b_start = end_speed(span, &p, 0, options.start_feed, "start")?;
-            }
-            if si + 1 == spans.len() {
-                p.b_end = end_speed(span, &p, p.intervals(), options.end_feed, "end")?;
-            }
-            if self.machine.has_jerk() && p.intervals() >= 6 {
-                // From rest the jerk-limited profile grows as b ∝ u^(4/3) (b'' unbounded), which
-                // evenly spaced quadratic pieces follow badly: grade the stations geometrically
-                // into each rest end (L/2, L/4, … L/2^GRADING of the first three intervals' L).
-                let n = p.intervals();
-                let mut u = p.u.clone();
-                if p.b_start == 0.0 {
-                    let l = p.u[3] - p.u[0];
-                    u.extend((1..=GRADING).map(|k| p.u[0] + l / f64::powi(2.0, k as i32)));
-                }
-                if p.b_end == 0.0 {
-                    let l = p.u[n] - p.u[n - 3];
-                    u.extend((1..=GRADING).map(|k| p.u[n] - l / f64::powi(2.0, k as i32)));
-                }
-                if u.len() > p.u.len() {
-                    u.sort_by(f64::total_cmp);
-                    u.dedup();
-                    let (bs, be) = (p.b_start, p.b_end);
-                    p = SpanProblem::at_stations(span, &self.kin, self.machine, u);
-                    if let Some(c) = &options.verify.chord {
-                        p.apply_chord(span, c);
-                    }
-                    (p.b_start, p.b_end) = (bs, be);
-                }
-            }
+        let mut problems = Vec::with_capacity(self.path.spans.len());
+        let mut solutions = Vec::with_capacity(self.path.spans.len());
+        for si in 0..self.path.spans.len() {
+            let p = self.final_grid(
+                si,
+                self.uniform_problem(si, total, level, options)?,
+                options,
+            );
             let warm = previous.map(|lv| (&lv.problems[si], &lv.solutions[si]));
-            let s = self.solve_span(si, &p, options, warm)?;
-            status = status.worst(s.status);
-            iterations += s.iterations;
-            solve_time += s.solve_time;
+            solutions.push(self.solve_span(si, &p, options, warm)?);
             problems.push(p);
-            solutions.push(s);
         }
-        let schedule = Schedule::build(&self.axes, spans, &problems, &solutions)?;
-        Ok(Level {
-            problems,
-            solutions,
-            schedule,
-            status,
-            iterations,
-            solve_time,
-        })
+        self.level(problems, solutions)
     }
 }
