@@ -202,12 +202,44 @@ pub enum Action {
     NoMotion(&'static str),
     /// Stop reading (M2, M30).
     ProgramEnd,
+    /// A Fanuc/LinuxCNC canned cycle (73, 74, 76, 81–89): modal until `G80` or a motion code.
+    Cycle(u32),
+    /// `G80` (Fanuc): cancels the canned cycle; the motion mode stays.
+    CycleCancel,
+    /// `G98` (false: return to the initial level) / `G99` (true: to R).
+    CycleReturn(bool),
+    /// `G28` (1) / `G30` (2): via an intermediate point to a reference point.
+    Reference(u8),
+    /// `G4`: dwell.
+    Dwell,
+    /// Sinumerik programmable frame instructions.
+    Frame(FrameOp),
+    /// Sinumerik `CYCLE800(...)` (swivel plane; `CYCLE800()` cancels).
+    Swivel,
+    /// Fanuc `G68.2` tilted working plane.
+    TiltedPlane,
+    /// Fanuc `G69`: cancels `G68.2`.
+    TiltedPlaneCancel,
+    /// Sinumerik `MCALL`: the cycle in the same block is called after every positioning
+    /// block; bare `MCALL` cancels.
+    ModalCall,
+    /// Sinumerik `CYCLE81`–`CYCLE89` (and the spigot cycles 76/77, an error).
+    SinumerikCycle(u32),
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
     Note(&'static str),
     /// Rejected with this error.
     Unsupported(&'static str),
+}
+
+/// Sinumerik programmable frame instructions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameOp {
+    Trans,
+    ATrans,
+    Rot,
+    ARot,
 }
 
 /// Numbers without a decimal point count least input increments (Fanuc's default).
@@ -253,16 +285,15 @@ use Action::{
 };
 use Address::{ArcCentre, Axis, Unmodelled};
 
-const CANNED: &str = "canned cycles are not supported: post the toolpath as G0/G1/G2/G3";
-const HOME: &str = "G28/G30 (move via a reference point) is not supported";
+const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
 const OFFSETS: &str = "coordinate offsets that shift program coordinates (G92, G52) are not \
                        supported";
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution (G95) is not supported";
 const COMP: &str = "cutter radius compensation is not applied: the programmed path is used";
-const DWELL: &str = "dwell: its time is not part of the toolpath";
-const G10: &str = "G10 changes tool or work offsets: program coordinates are used as written";
+const G10: &str = "G10 sets a tool or work offset and moves nothing; the program's coordinates \
+                   are used as written";
 const UVW: &str = "U V W axes are not modelled: word ignored";
 const TRANSFORM: &str = "coordinate transformations (polar, rotation, scaling, mirroring, tilted \
                          planes) are not supported";
@@ -311,14 +342,14 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("1", Mo(Motion::Linear)),
         ("2", Mo(Motion::ArcCw)),
         ("3", Mo(Motion::ArcCcw)),
-        ("4", NoMotion(DWELL)),
+        ("4", Action::Dwell),
         ("5", Unsup(SPLINES)),
         ("5.1", Unsup(SPLINES)),
         ("5.2", Unsup(SPLINES)),
         ("5.3", Unsup(SPLINES)),
         ("7", Unsup("lathe diameter mode (G7) is not supported")),
         ("8", Action::Ignored),
-        ("10", Note(G10)),
+        ("10", NoMotion(G10)),
         ("17", Action::Plane(Plane::Xy)),
         ("18", Action::Plane(Plane::Zx)),
         ("19", Action::Plane(Plane::Yz)),
@@ -339,9 +370,9 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
                 feed: true,
             },
         ),
-        ("28", Unsup(HOME)),
+        ("28", Action::Reference(1)),
         ("28.1", Action::Ignored),
-        ("30", Unsup(HOME)),
+        ("30", Action::Reference(2)),
         ("30.1", Action::Ignored),
         ("33", Unsup(THREADS)),
         ("33.1", Unsup(THREADS)),
@@ -368,11 +399,22 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("61.1", Action::Ignored),
         ("64", Action::Ignored),
         ("70..72", Unsup(CANNED)),
-        ("73", Unsup(CANNED)),
-        ("74", Unsup(CANNED)),
-        ("76", Unsup(CANNED)),
+        ("73", Action::Cycle(73)),
+        ("74", Action::Cycle(74)),
+        (
+            "76",
+            Unsup("G76 is LinuxCNC's threading cycle: not supported"),
+        ),
         ("80", MotionCancel),
-        ("81..89", Unsup(CANNED)),
+        ("81", Action::Cycle(81)),
+        ("82", Action::Cycle(82)),
+        ("83", Action::Cycle(83)),
+        ("84", Action::Cycle(84)),
+        ("85", Action::Cycle(85)),
+        ("86", Action::Cycle(86)),
+        ("87", Action::Cycle(87)),
+        ("88", Action::Cycle(88)),
+        ("89", Action::Cycle(89)),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
         ("90.1", ArcDistance(Distance::Absolute)),
@@ -386,8 +428,8 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("95", Unsup(PER_REV)),
         ("96", Action::Ignored),
         ("97", Action::Ignored),
-        ("98", Action::Ignored),
-        ("99", Action::Ignored),
+        ("98", Action::CycleReturn(false)),
+        ("99", Action::CycleReturn(true)),
     ],
     m_codes: &[
         ("0", Action::Ignored),
@@ -451,12 +493,12 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("1", Mo(Motion::Linear)),
         ("2", Mo(Motion::ArcCw)),
         ("3", Mo(Motion::ArcCcw)),
-        ("4", NoMotion(DWELL)),
+        ("4", Action::Dwell),
         ("5.1", Action::Ignored),
         ("6.2", Unsup(SPLINES)),
         ("8", Action::Ignored),
         ("9", Action::Ignored),
-        ("10", Note(G10)),
+        ("10", NoMotion(G10)),
         ("11", Action::Ignored),
         ("15", Action::Ignored),
         ("16", Unsup(TRANSFORM)),
@@ -477,9 +519,12 @@ pub static FANUC: DialectSpec = DialectSpec {
                 feed: true,
             },
         ),
-        ("28", Unsup(HOME)),
-        ("29", Unsup(HOME)),
-        ("30", Unsup(HOME)),
+        ("28", Action::Reference(1)),
+        (
+            "29",
+            Unsup("G29 (return from the reference point) is not supported"),
+        ),
+        ("30", Action::Reference(2)),
         ("33", Unsup(THREADS)),
         ("40", Action::Ignored),
         ("41", Note(COMP)),
@@ -495,7 +540,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("51.1", Unsup(TRANSFORM)),
         ("52", Unsup(OFFSETS)),
         ("53", MachineCoordinates),
-        ("53.1", Unsup(TRANSFORM)),
+        ("53.1", Action::Ignored),
         ("54..59", Action::Ignored),
         ("54.1", Action::Ignored),
         ("61..64", Action::Ignored),
@@ -503,11 +548,26 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("66", Unsup("macro calls (G65/G66) are not supported")),
         ("67", Action::Ignored),
         ("68", Unsup(TRANSFORM)),
-        ("68.2", Unsup(TRANSFORM)),
-        ("69", Action::Ignored),
-        ("73..79", Unsup(CANNED)),
-        ("80", Action::Ignored),
-        ("81..89", Unsup(CANNED)),
+        ("68.2", Action::TiltedPlane),
+        ("69", Action::TiltedPlaneCancel),
+        ("73", Action::Cycle(73)),
+        ("74", Action::Cycle(74)),
+        ("75", Unsup(CANNED)),
+        ("76", Action::Cycle(76)),
+        ("77..79", Unsup(CANNED)),
+        ("80", Action::CycleCancel),
+        ("81", Action::Cycle(81)),
+        ("82", Action::Cycle(82)),
+        ("83", Action::Cycle(83)),
+        ("84", Action::Cycle(84)),
+        ("85", Action::Cycle(85)),
+        ("86", Action::Cycle(86)),
+        ("87", Action::Cycle(87)),
+        ("88", Action::Cycle(88)),
+        ("89", Action::Cycle(89)),
+        ("234", Action::Tcp(Tcp::On)),
+        ("254", Action::Ignored),
+        ("255", Action::Ignored),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
         ("92", Unsup(OFFSETS)),
@@ -516,8 +576,8 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("95", Unsup(PER_REV)),
         ("96", Action::Ignored),
         ("97", Action::Ignored),
-        ("98", Action::Ignored),
-        ("99", Action::Ignored),
+        ("98", Action::CycleReturn(false)),
+        ("99", Action::CycleReturn(true)),
     ],
     m_codes: &[
         ("0", Action::Ignored),
@@ -595,7 +655,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("1", Mo(Motion::Linear)),
         ("2", Mo(Motion::ArcCw)),
         ("3", Mo(Motion::ArcCcw)),
-        ("4", NoMotion(DWELL)),
+        ("4", Action::Dwell),
         ("9", Action::Ignored),
         ("17", Action::Plane(Plane::Xy)),
         ("18", Action::Plane(Plane::Zx)),
@@ -678,15 +738,16 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("TRAFOOF", Action::Tcp(Tcp::Off)),
         ("TRACYL", Unsup(TRANSFORM)),
         ("TRANSMIT", Unsup(TRANSFORM)),
-        ("TRANS", Unsup(TRANSFORM)),
-        ("ATRANS", Unsup(TRANSFORM)),
-        ("ROT", Unsup(TRANSFORM)),
-        ("AROT", Unsup(TRANSFORM)),
+        ("TRANS", Action::Frame(FrameOp::Trans)),
+        ("ATRANS", Action::Frame(FrameOp::ATrans)),
+        ("ROT", Action::Frame(FrameOp::Rot)),
+        ("AROT", Action::Frame(FrameOp::ARot)),
+        ("SUPA", MachineCoordinates),
         ("SCALE", Unsup(TRANSFORM)),
         ("ASCALE", Unsup(TRANSFORM)),
         ("MIRROR", Unsup(TRANSFORM)),
         ("AMIRROR", Unsup(TRANSFORM)),
-        ("CYCLE800", Unsup(TRANSFORM)),
+        ("CYCLE800", Action::Swivel),
         (
             "CIP",
             Unsup("arcs through an intermediate point (CIP) are not supported"),
@@ -696,13 +757,19 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("BSPLINE", Unsup(SPLINES)),
         ("CSPLINE", Unsup(SPLINES)),
         ("POLY", Unsup(SPLINES)),
-        ("CYCLE81", Unsup(CANNED)),
-        ("CYCLE82", Unsup(CANNED)),
-        ("CYCLE83", Unsup(CANNED)),
-        ("CYCLE84", Unsup(CANNED)),
-        ("CYCLE85", Unsup(CANNED)),
-        ("CYCLE86", Unsup(CANNED)),
-        ("MCALL", Unsup(CANNED)),
+        ("CYCLE76", Action::SinumerikCycle(76)),
+        ("CYCLE77", Action::SinumerikCycle(77)),
+        ("CYCLE81", Action::SinumerikCycle(81)),
+        ("CYCLE82", Action::SinumerikCycle(82)),
+        ("CYCLE83", Action::SinumerikCycle(83)),
+        ("CYCLE84", Action::SinumerikCycle(84)),
+        ("CYCLE85", Action::SinumerikCycle(85)),
+        ("CYCLE86", Action::SinumerikCycle(86)),
+        ("CYCLE87", Action::SinumerikCycle(87)),
+        ("CYCLE88", Action::SinumerikCycle(88)),
+        ("CYCLE89", Action::SinumerikCycle(89)),
+        ("MCALL", Action::ModalCall),
+        ("FNORM", Action::Ignored),
         ("CALL", Unsup("subprogram calls are not supported")),
         ("GOTOF", Unsup("control flow is not supported")),
         ("GOTOB", Unsup("control flow is not supported")),

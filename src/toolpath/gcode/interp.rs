@@ -3,15 +3,14 @@
 use nalgebra::Vector3;
 use std::path::Path;
 
+use super::cycles::{self, Step};
 use super::dialect::*;
+use super::expr::Variables;
+use super::frames::{self, Frame};
 use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Feed, MM_PER_INCH, Toolpath, Warning};
-
-// ---------------------------------------------------------------------------------------------
-// Interpreting
-// ---------------------------------------------------------------------------------------------
+use crate::toolpath::{ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning};
 
 /// The words of one block, sorted by meaning.
 #[derive(Debug, Default)]
@@ -23,8 +22,16 @@ struct Block {
     turns: Option<f64>,
     extra_turns: Option<f64>,
     feed: Option<f64>,
-    /// Codes and keywords in the order written, with their text.
-    actions: Vec<(String, Action)>,
+    /// Every single-letter word's value as written (cycle and dwell parameters P Q R K L).
+    letters: [Option<Num>; 26],
+    /// Codes and keywords in the order written, with their text and `( … )` arguments.
+    actions: Vec<(String, Action, Option<String>)>,
+}
+
+impl Block {
+    fn letter(&self, c: char) -> Option<Num> {
+        self.letters[(c as u8 - b'A') as usize]
+    }
 }
 
 /// The modal G94 feed.
@@ -36,13 +43,45 @@ struct ModalFeed {
     raw: f64,
 }
 
+/// A Fanuc/LinuxCNC canned cycle in force (modal until G80 or a motion code).
+#[derive(Debug, Clone, Copy)]
+struct CycleMode {
+    kind: cycles::Kind,
+    /// The G code (81 …), for messages.
+    code: u32,
+    /// R and Z (absolute, mm) and Q (mm) and P (s), modal within the cycle.
+    r: Option<f64>,
+    z: Option<f64>,
+    q: Option<f64>,
+    dwell: f64,
+    /// The Z where the cycle mode began (the G98 return level).
+    initial: f64,
+}
+
+/// A Sinumerik `MCALL CYCLE8x(...)` in force: the cycle runs after every positioning block.
+#[derive(Debug, Clone)]
+struct ModalCall {
+    number: u32,
+    args: Vec<Option<f64>>,
+}
+
 const AXIS_NAMES: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
+
+/// Largest coordinate a program may use, mm (and degrees of rotary travel, ×1000): past it a
+/// word is an error naming it, so that arc chord counts and cycle pecks stay bounded.
+pub const MAX_COORDINATE_MM: f64 = 1e6;
+/// Most chords one arc block may become (full turns included).
+pub const MAX_ARC_CHORDS: usize = 1_000_000;
 
 pub(super) struct Interpreter<'a> {
     spec: &'a DialectSpec,
     source: &'a Path,
+    machine: Option<&'a MachineContext>,
+    pub(super) vars: Variables,
     units: Units,
     feed_units: Units,
+    /// A Sinumerik program's first G70/G71 has set the basic system F is read in.
+    basic_system_set: bool,
     distance: Distance,
     arc_distance: Distance,
     plane: Plane,
@@ -50,7 +89,7 @@ pub(super) struct Interpreter<'a> {
     feed: Option<ModalFeed>,
     motion: Option<Motion>,
     tcp: Tcp,
-    /// Modal position: X Y Z in mm, A B C in degrees.
+    /// Modal position in program (frame) coordinates: X Y Z in mm, A B C in degrees.
     pos: [f64; 6],
     /// X Y Z set by an absolute word.
     known: [bool; 3],
@@ -59,18 +98,32 @@ pub(super) struct Interpreter<'a> {
     saw_rotary: bool,
     /// A warning about motion outside TCP mode was given for the current stretch.
     non_tcp_warned: bool,
+    cycle: Option<CycleMode>,
+    /// G99: return to R (else G98: to the initial level).
+    return_to_r: bool,
+    mcall: Option<ModalCall>,
+    programmable: Frame,
+    swivel: Option<Frame>,
     pub(super) ended: bool,
     points: Vec<ClPoint>,
     warnings: Vec<Warning>,
+    dwells: Vec<Dwell>,
 }
 
 impl<'a> Interpreter<'a> {
-    pub(super) fn new(spec: &'a DialectSpec, source: &'a Path) -> Self {
+    pub(super) fn new(
+        spec: &'a DialectSpec,
+        source: &'a Path,
+        machine: Option<&'a MachineContext>,
+    ) -> Self {
         Interpreter {
             spec,
             source,
+            machine,
+            vars: Variables::default(),
             units: Units::Mm,
             feed_units: Units::Mm,
+            basic_system_set: false,
             distance: Distance::Absolute,
             arc_distance: Distance::Incremental,
             plane: Plane::Xy,
@@ -84,9 +137,15 @@ impl<'a> Interpreter<'a> {
             vector: Vector3::new(0.0, 0.0, 1.0),
             saw_rotary: false,
             non_tcp_warned: false,
+            cycle: None,
+            return_to_r: false,
+            mcall: None,
+            programmable: Frame::IDENTITY,
+            swivel: None,
             ended: false,
             points: Vec::new(),
             warnings: Vec::new(),
+            dwells: Vec::new(),
         }
     }
 
@@ -114,6 +173,7 @@ impl<'a> Interpreter<'a> {
             source: self.source.to_path_buf(),
             points: self.points,
             warnings: self.warnings,
+            dwells: self.dwells,
         })
     }
 
@@ -124,8 +184,8 @@ impl<'a> Interpreter<'a> {
         for item in items {
             let (text, address, num) = match item {
                 Item::Word { text, address, num } => (text, address, num),
-                Item::Keyword { text, action } => {
-                    block.actions.push((text, action));
+                Item::Keyword { text, action, args } => {
+                    block.actions.push((text, action, args));
                     continue;
                 }
                 Item::Skipped => continue,
@@ -137,6 +197,15 @@ impl<'a> Interpreter<'a> {
                     continue;
                 }
             };
+            if num.value.abs() > MAX_COORDINATE_MM * 1e3 {
+                return Err(self.error(line, format!("`{text}`: {} is out of range", num.value)));
+            }
+            if let Some(c) = text.chars().next()
+                && c.is_ascii_uppercase()
+                && (text.len() == 1 || !text[1..].starts_with(|ch: char| ch.is_ascii_alphabetic()))
+            {
+                block.letters[(c as u8 - b'A') as usize] = Some(num);
+            }
             let source = self.source;
             let duplicate = |taken: bool| -> Result<()> {
                 if taken {
@@ -152,6 +221,19 @@ impl<'a> Interpreter<'a> {
             match address {
                 Address::Axis(i) => {
                     duplicate(block.axes[i].is_some())?;
+                    if let Some(m) = self.machine
+                        && !m.has_axis(AXIS_NAMES[i])
+                    {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}`: the machine ({}) has no {} axis; use a machine \
+                                 file with that axis or a program posted for this machine",
+                                m.file.display(),
+                                AXIS_NAMES[i]
+                            ),
+                        ));
+                    }
                     block.axes[i] = Some(num);
                 }
                 Address::ArcCentre(i) => {
@@ -188,7 +270,17 @@ impl<'a> Interpreter<'a> {
                         Some(Action::Unsupported(message)) => {
                             return Err(self.error(line, format!("{text}: {message}")));
                         }
-                        Some(action) => block.actions.push((text, action)),
+                        Some(action) => block.actions.push((text, action, None)),
+                        None if address == Address::G => {
+                            return Err(self.error(
+                                line,
+                                format!(
+                                    "{text}: not a {name} G code feedopt knows; a G code may \
+                                     move the tool, so it is not skipped (remove it or post \
+                                     the program for a supported control)"
+                                ),
+                            ));
+                        }
                         None => self.warn(
                             line,
                             format!("unknown word `{text}` (not a {name} code): ignored"),
@@ -224,6 +316,25 @@ impl<'a> Interpreter<'a> {
         }
     }
 
+    /// A cycle parameter list `a,b,,d` (empty: not given), evaluated.
+    fn arguments(&self, line: usize, text: &str) -> Result<Vec<Option<f64>>> {
+        if text.len() > 2000 {
+            return Err(self.error(line, "cycle argument list longer than 2000 characters"));
+        }
+        text.split(',')
+            .map(|a| {
+                let a = a.trim();
+                if a.is_empty() || a.starts_with('"') {
+                    Ok(None)
+                } else {
+                    super::expr::eval(a, &self.vars)
+                        .map(Some)
+                        .map_err(|e| self.error(line, format!("argument `{a}`: {e}")))
+                }
+            })
+            .collect()
+    }
+
     /// Interprets one block.
     pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let block = self.collect(line, items)?;
@@ -233,7 +344,14 @@ impl<'a> Interpreter<'a> {
         let mut machine = false;
         let mut no_motion: Option<&str> = None;
         let mut end = false;
-        for (text, action) in &block.actions {
+        let mut reference: Option<u8> = None;
+        let mut dwell = false;
+        let mut frame_op: Option<(&str, FrameOp)> = None;
+        let mut new_cycle: Option<(&str, u32)> = None;
+        let mut sinumerik_cycle: Option<(String, u32, String)> = None;
+        let mut modal_call = false;
+        let mut tilted_plane = false;
+        for (text, action, args) in &block.actions {
             match *action {
                 Action::FeedMode(mode) => {
                     if (self.spec.g94_clears_feed && mode == FeedMode::PerMinute)
@@ -251,13 +369,36 @@ impl<'a> Interpreter<'a> {
                         ));
                     }
                     motion_code = Some((text.as_str(), m));
+                    self.cycle = None;
                 }
-                Action::MotionCancel => self.motion = None,
+                Action::MotionCancel => {
+                    self.motion = None;
+                    self.cycle = None;
+                }
+                Action::CycleCancel => self.cycle = None,
+                Action::Cycle(code) => new_cycle = Some((text.as_str(), code)),
+                Action::CycleReturn(to_r) => self.return_to_r = to_r,
                 Action::Plane(p) => self.plane = p,
                 Action::Units { units, feed } => {
                     self.units = units;
                     if feed {
                         self.feed_units = units;
+                        self.basic_system_set = true;
+                    } else if !self.basic_system_set {
+                        // Sinumerik G70/G71: F stays in the control's basic system, taken as
+                        // the unit the program first selects.
+                        self.basic_system_set = true;
+                        self.feed_units = units;
+                        if units == Units::Inch {
+                            self.warn(
+                                line,
+                                format!(
+                                    "{text}: F is read in inch/min: a Sinumerik control keeps F \
+                                     in its basic system under G70, taken as inch because the \
+                                     program selects inch first (G700 makes F inch explicitly)"
+                                ),
+                            );
+                        }
                     }
                 }
                 Action::Distance(d) => self.distance = d,
@@ -269,6 +410,36 @@ impl<'a> Interpreter<'a> {
                     self.tcp = t;
                 }
                 Action::MachineCoordinates => machine = true,
+                Action::Reference(k) => reference = Some(k),
+                Action::Dwell => dwell = true,
+                Action::Frame(op) => frame_op = Some((text.as_str(), op)),
+                Action::Swivel => {
+                    let args = match args {
+                        Some(a) => self.arguments(line, a)?,
+                        None => Vec::new(),
+                    };
+                    let scale = self.units.mm_per_unit();
+                    let args: Vec<Option<f64>> = args
+                        .iter()
+                        .enumerate()
+                        .map(|(k, a)| {
+                            a.map(|v| {
+                                if [4, 5, 6, 10, 11, 12].contains(&k) {
+                                    v * scale
+                                } else {
+                                    v
+                                }
+                            })
+                        })
+                        .collect();
+                    self.swivel = frames::cycle800(&args).map_err(|e| self.error(line, e))?;
+                }
+                Action::TiltedPlane => tilted_plane = true,
+                Action::TiltedPlaneCancel => self.swivel = None,
+                Action::ModalCall => modal_call = true,
+                Action::SinumerikCycle(n) => {
+                    sinumerik_cycle = Some((text.clone(), n, args.clone().unwrap_or_default()));
+                }
                 Action::NoMotion(message) => {
                     no_motion = Some(message);
                     self.warn(line, format!("{text}: {message}"));
@@ -296,22 +467,487 @@ impl<'a> Interpreter<'a> {
             self.motion = Some(m);
         }
 
+        if dwell {
+            return self.dwell(line, &block).map(|()| self.end_if(end));
+        }
+        if let Some((text, op)) = frame_op {
+            return self
+                .frame(line, text, op, &block)
+                .map(|()| self.end_if(end));
+        }
+        if tilted_plane {
+            return self.tilted_plane(line, &block).map(|()| self.end_if(end));
+        }
+        if let Some(k) = reference {
+            return self.reference(line, k, &block).map(|()| self.end_if(end));
+        }
+        if let Some((text, number, args)) = sinumerik_cycle {
+            let args = self.arguments(line, &args)?;
+            let args = self.sinumerik_cycle_units(number, args);
+            if modal_call {
+                self.mcall = Some(ModalCall { number, args });
+            } else {
+                self.run_sinumerik_cycle(line, &text, number, &args)?;
+            }
+        } else if modal_call {
+            self.mcall = None;
+        }
+        if let Some((text, code)) = new_cycle {
+            self.start_cycle(line, text, code, &block)?;
+        }
+
         let has_axes = block.axes.iter().any(Option::is_some);
         let has_vector = block.vector.iter().any(Option::is_some);
         let has_centre = block.centre.iter().any(Option::is_some);
+        if self.cycle.is_some() && no_motion.is_none() && !machine {
+            if new_cycle.is_some() || has_axes || block.radius.is_some() {
+                self.hole(line, &block)?;
+            }
+            self.end_if(end);
+            return Ok(());
+        }
         let is_arc = matches!(self.motion, Some(Motion::ArcCw | Motion::ArcCcw));
         let ijk_vector = self.tcp == Tcp::OnIjkVector && !is_arc;
         let moves = no_motion.is_none()
             && (has_axes || has_vector || (has_centre && (ijk_vector || is_arc)));
         if moves {
             self.motion_block(line, &block, machine)?;
+            if let Some(call) = self.mcall.clone()
+                && block.axes[..2].iter().any(Option::is_some)
+            {
+                self.run_sinumerik_cycle(
+                    line,
+                    &format!("MCALL CYCLE{}", call.number),
+                    call.number,
+                    &call.args,
+                )?;
+            }
         } else if no_motion.is_none() && (has_centre || block.radius.is_some()) {
             self.warn(line, "I/J/K or R without a move: ignored");
         }
+        self.end_if(end);
+        Ok(())
+    }
+
+    fn end_if(&mut self, end: bool) {
         if end {
             self.ended = true;
         }
+    }
+
+    /// `G4`: P seconds (LinuxCNC), P milliseconds or X seconds (Fanuc), F seconds (Sinumerik).
+    fn dwell(&mut self, line: usize, block: &Block) -> Result<()> {
+        let seconds = if self.spec.spaces == Spaces::Separate {
+            match (block.feed, block.letter('S')) {
+                (Some(f), _) => f,
+                (None, Some(_)) => {
+                    return Err(self.error(
+                        line,
+                        "G4 S (dwell in spindle revolutions) is not supported: program G4 F \
+                         (seconds)",
+                    ));
+                }
+                (None, None) => return Err(self.error(line, "G4 without F (seconds)")),
+            }
+        } else {
+            match (block.letter('P'), block.axes[0]) {
+                (Some(p), _) if self.spec.integer_increments.is_some() && !p.point => {
+                    p.value / 1000.0
+                }
+                (Some(p), _) => p.value,
+                (None, Some(x)) => x.value,
+                (None, None) => return Err(self.error(line, "G4 without P (the dwell time)")),
+            }
+        };
+        if !(0.0..=1e6).contains(&seconds) {
+            return Err(self.error(line, format!("G4: dwell of {seconds} s is out of range")));
+        }
+        self.add_dwell(line, seconds);
         Ok(())
+    }
+
+    fn add_dwell(&mut self, line: usize, seconds: f64) {
+        if seconds > 0.0 {
+            self.dwells.push(Dwell {
+                point: self.points.len().saturating_sub(1),
+                seconds,
+                line,
+            });
+        }
+    }
+
+    /// Sinumerik `TRANS`/`ATRANS`/`ROT`/`AROT` with the block's X Y Z (none: cancel).
+    fn frame(&mut self, line: usize, text: &str, op: FrameOp, block: &Block) -> Result<()> {
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(line, format!("{text} with A/B/C: not supported")));
+        }
+        let given = block.axes[..3].iter().any(Option::is_some);
+        let v: [f64; 3] = std::array::from_fn(|i| match (block.axes[i], op) {
+            (Some(n), FrameOp::Trans | FrameOp::ATrans) => self.length(n),
+            (Some(n), _) => n.value,
+            (None, _) => 0.0,
+        });
+        let f = match op {
+            FrameOp::Trans | FrameOp::ATrans => Frame::translation(Vector3::from(v)),
+            FrameOp::Rot | FrameOp::ARot => Frame::rotation(frames::rot_zyx(v)),
+        };
+        self.programmable = match op {
+            FrameOp::Trans | FrameOp::Rot if !given => Frame::IDENTITY,
+            FrameOp::Trans | FrameOp::Rot => f,
+            FrameOp::ATrans | FrameOp::ARot => self.programmable.then_inner(&f),
+        };
+        Ok(())
+    }
+
+    /// Fanuc `G68.2 X Y Z I J K`.
+    fn tilted_plane(&mut self, line: usize, block: &Block) -> Result<()> {
+        let origin: [f64; 3] =
+            std::array::from_fn(|i| block.axes[i].map_or(0.0, |n| self.length(n)));
+        let angle = |i: usize| block.centre[i].map_or(0.0, |n| n.value);
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(line, "G68.2 with A/B/C words"));
+        }
+        self.swivel = Some(Frame {
+            r: frames::euler_zxz(angle(0), angle(1), angle(2)),
+            t: Vector3::from(origin),
+        });
+        Ok(())
+    }
+
+    /// The frame from program coordinates to workpiece coordinates.
+    fn frame_now(&self) -> Frame {
+        match &self.swivel {
+            Some(s) => s.then_inner(&self.programmable),
+            None => self.programmable,
+        }
+    }
+
+    /// Machine coordinates → program (frame) coordinates, X Y Z.
+    fn from_machine(&self, m: Vector3<f64>) -> Vector3<f64> {
+        let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+        self.frame_now().invert(&(m - Vector3::from(offset)))
+    }
+
+    fn to_machine(&self, p: Vector3<f64>) -> Vector3<f64> {
+        let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+        self.frame_now().apply(&p) + Vector3::from(offset)
+    }
+
+    /// `G28`/`G30` (k = 1, 2; `G30 P3`: 3): via the intermediate point the axis words give
+    /// (program coordinates, absolute or incremental), to the reference point of the same
+    /// axes (machine coordinates from the machine file). Both moves are rapids.
+    fn reference(&mut self, line: usize, k: u8, block: &Block) -> Result<()> {
+        let k = match (k, block.letter('P')) {
+            (2, Some(p)) if (2.0..=4.0).contains(&p.value) && p.value.fract() == 0.0 => {
+                p.value as usize
+            }
+            (2, Some(p)) => {
+                return Err(self.error(line, format!("G30 P{}: expected P2, P3 or P4", p.value)));
+            }
+            (k, _) => k as usize,
+        };
+        let code = if k == 1 { "G28" } else { "G30" };
+        let named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
+        if named.is_empty() {
+            return Err(self.error(
+                line,
+                format!(
+                    "{code} without axis words (all axes to the reference point) is not \
+                     supported: name the axes (`G91 {code} Z0`)"
+                ),
+            ));
+        }
+        // The intermediate point.
+        let mut via = self.pos;
+        for &i in &named {
+            let Some(num) = block.axes[i] else { continue };
+            let v = if i < 3 {
+                self.length(num)
+            } else {
+                self.angle(num)
+            };
+            via[i] = if self.distance == Distance::Incremental {
+                self.pos[i] + v
+            } else {
+                v
+            };
+        }
+        let mut target = via;
+        let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
+        for &i in &named {
+            let Some(r) = self
+                .machine
+                .and_then(|m| m.reference[i].get(k - 1).copied())
+            else {
+                let file = self.machine.map_or("the machine file".to_string(), |m| {
+                    m.file.display().to_string()
+                });
+                let which = if k == 1 {
+                    "`\"reference\": <position>`".to_string()
+                } else {
+                    format!("a list `\"reference\": [<G28 position>, …]` with {k} entries")
+                };
+                return Err(self.error(
+                    line,
+                    format!(
+                        "{code} moves {} to its reference point, which {file} does not give: \
+                         add {which} to axes.{} (machine coordinates, mm or °)",
+                        AXIS_NAMES[i], AXIS_NAMES[i]
+                    ),
+                ));
+            };
+            if i < 3 {
+                machine_xyz[i] = r;
+            } else {
+                target[i] = r;
+            }
+        }
+        let xyz = self.from_machine(machine_xyz);
+        target[..3].copy_from_slice(xyz.as_slice());
+        for &i in &named {
+            if i >= 3 {
+                self.saw_rotary = true;
+            }
+        }
+        if via != self.pos {
+            self.push(line, &via, Feed::Rapid);
+        }
+        self.push(line, &target, Feed::Rapid);
+        self.pos = target;
+        for i in 0..3 {
+            self.known[i] = true;
+        }
+        Ok(())
+    }
+
+    /// Enters (or changes) a Fanuc/LinuxCNC canned cycle.
+    fn start_cycle(&mut self, line: usize, text: &str, code: u32, block: &Block) -> Result<()> {
+        let Some(kind) = cycles::Kind::from_code(code) else {
+            return Err(self.error(line, format!("{text}: not a drilling cycle feedopt knows")));
+        };
+        if self.plane != Plane::Xy {
+            return Err(self.error(
+                line,
+                format!("{text} outside G17: canned cycles are read in the XY plane only"),
+            ));
+        }
+        if self.feed_mode == FeedMode::InverseTime {
+            return Err(self.error(line, format!("{text} under G93 (inverse time)")));
+        }
+        let initial = self.pos[2];
+        let keep = self.cycle.filter(|c| c.kind == kind);
+        self.cycle = Some(CycleMode {
+            kind,
+            code,
+            r: keep.and_then(|c| c.r),
+            z: keep.and_then(|c| c.z),
+            q: keep.and_then(|c| c.q),
+            dwell: keep.map_or(0.0, |c| c.dwell),
+            initial: self.cycle.map_or(initial, |c| c.initial),
+        });
+        let _ = block;
+        Ok(())
+    }
+
+    /// One hole of the Fanuc/LinuxCNC cycle in force, at the block's X Y (and new R Z Q P).
+    fn hole(&mut self, line: usize, block: &Block) -> Result<()> {
+        let Some(mut c) = self.cycle else {
+            return Ok(());
+        };
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(
+                line,
+                format!("G{}: rotary axis words in a cycle block", c.code),
+            ));
+        }
+        let incremental = self.distance == Distance::Incremental;
+        if let Some(r) = block.radius {
+            let r = self.length(r);
+            c.r = Some(if incremental { c.initial + r } else { r });
+        }
+        let r = c
+            .r
+            .ok_or_else(|| self.error(line, format!("G{}: R (the R plane) is missing", c.code)))?;
+        if let Some(z) = block.axes[2] {
+            let z = self.length(z);
+            c.z = Some(if incremental { r + z } else { z });
+        }
+        let bottom = c.z.ok_or_else(|| {
+            self.error(line, format!("G{}: Z (the hole bottom) is missing", c.code))
+        })?;
+        if let Some(q) = block.letter('Q') {
+            c.q = Some(self.length(q).abs());
+        }
+        if let Some(p) = block.letter('P') {
+            c.dwell = if self.spec.integer_increments.is_some() && !p.point {
+                p.value / 1000.0
+            } else {
+                p.value
+            };
+            if !(0.0..=1e6).contains(&c.dwell) {
+                return Err(self.error(line, format!("G{}: dwell P out of range", c.code)));
+            }
+        }
+        self.cycle = Some(c);
+        let repeats = match block.letter('L').or(block.letter('K')) {
+            None => 1,
+            Some(n)
+                if n.value.fract() == 0.0
+                    && (0.0..=cycles::MAX_REPEATS as f64).contains(&n.value) =>
+            {
+                n.value as usize
+            }
+            Some(n) => {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "G{}: repeat count {} (at most {})",
+                        c.code,
+                        n.value,
+                        cycles::MAX_REPEATS
+                    ),
+                ));
+            }
+        };
+        let clear = if self.return_to_r {
+            r
+        } else {
+            c.initial.max(r)
+        };
+        let h = cycles::Hole {
+            kind: c.kind,
+            r,
+            bottom,
+            q: c.q,
+            dwell: c.dwell,
+            clear,
+            initial: c.initial,
+        };
+        let (steps, note) =
+            cycles::fanuc_steps(&h).map_err(|e| self.error(line, format!("G{}: {e}", c.code)))?;
+        if let Some(note) = note {
+            self.warn(line, format!("G{}: {note}", c.code));
+        }
+        for k in 0..repeats {
+            let mut xy = [self.pos[0], self.pos[1]];
+            for i in 0..2 {
+                if let Some(n) = block.axes[i] {
+                    let v = self.length(n);
+                    xy[i] = if incremental {
+                        self.pos[i] + v
+                    } else if k == 0 {
+                        v
+                    } else {
+                        xy[i]
+                    };
+                    self.known[i] = true;
+                }
+            }
+            // Up to R first when below it, then over the hole, then down to R.
+            if self.pos[2] < r {
+                self.rapid_z(line, r);
+            }
+            if xy != [self.pos[0], self.pos[1]] {
+                let mut q = self.pos;
+                q[0] = xy[0];
+                q[1] = xy[1];
+                self.push(line, &q, Feed::Rapid);
+                self.pos = q;
+            }
+            self.known[2] = true;
+            if c.kind == cycles::Kind::G87 {
+                self.rapid_z(line, r);
+            } else if self.pos[2] != r {
+                self.rapid_z(line, r);
+            }
+            self.run_steps(line, &steps)?;
+        }
+        Ok(())
+    }
+
+    fn rapid_z(&mut self, line: usize, z: f64) {
+        let mut q = self.pos;
+        q[2] = z;
+        if q != self.pos {
+            self.push(line, &q, Feed::Rapid);
+            self.pos = q;
+        }
+    }
+
+    /// Executes cycle steps from the current position.
+    fn run_steps(&mut self, line: usize, steps: &[Step]) -> Result<()> {
+        for step in steps {
+            let mut q = self.pos;
+            let feed = match *step {
+                Step::Rapid(z) => {
+                    q[2] = z;
+                    Feed::Rapid
+                }
+                Step::Feed(z, f) => {
+                    q[2] = z;
+                    match f.or(self.feed.map(|f| f.mm_per_min)) {
+                        Some(mm_per_min) => Feed::Programmed(mm_per_min / 60.0),
+                        None => Feed::Unspecified,
+                    }
+                }
+                Step::ShiftX(dx) => {
+                    q[0] += dx;
+                    Feed::Rapid
+                }
+                Step::Dwell(s) => {
+                    self.add_dwell(line, s);
+                    continue;
+                }
+            };
+            if q != self.pos {
+                self.push(line, &q, feed);
+                self.pos = q;
+            }
+        }
+        Ok(())
+    }
+
+    /// Scales a Sinumerik cycle's length (and feed) parameters to mm (mm/min).
+    fn sinumerik_cycle_units(&self, number: u32, args: Vec<Option<f64>>) -> Vec<Option<f64>> {
+        let length = self.units.mm_per_unit();
+        let feed = self.feed_units.mm_per_unit();
+        args.into_iter()
+            .enumerate()
+            .map(|(k, a)| {
+                a.map(|v| {
+                    let is_length = k <= 4 || (number == 83 && (5..=7).contains(&k));
+                    let is_feed = number == 85 && (6..=7).contains(&k);
+                    if is_length {
+                        v * length
+                    } else if is_feed {
+                        v * feed
+                    } else {
+                        v
+                    }
+                })
+            })
+            .collect()
+    }
+
+    fn run_sinumerik_cycle(
+        &mut self,
+        line: usize,
+        text: &str,
+        number: u32,
+        args: &[Option<f64>],
+    ) -> Result<()> {
+        if self.plane != Plane::Xy {
+            return Err(self.error(
+                line,
+                format!("{text} outside G17: cycles are read in the XY plane only"),
+            ));
+        }
+        let (steps, notes) = cycles::sinumerik_steps(number, args)
+            .map_err(|e| self.error(line, format!("{text}: {e}")))?;
+        for n in notes {
+            self.warn(line, format!("{text}: {n}"));
+        }
+        self.run_steps(line, &steps)
     }
 
     /// A motion block: resolves the target and emits its point(s).
@@ -323,18 +959,13 @@ impl<'a> Interpreter<'a> {
             ));
         };
         let is_arc = matches!(motion, Motion::ArcCw | Motion::ArcCcw);
-        if machine {
-            if is_arc {
-                return Err(self.error(line, "G53 (machine coordinates) with an arc"));
-            }
-            self.warn(
-                line,
-                "G53: machine-coordinate move taken as program coordinates",
-            );
+        if machine && is_arc {
+            return Err(self.error(line, "G53/SUPA (machine coordinates) with an arc"));
         }
 
         let start = self.pos;
         let mut end = start;
+        let mut machine_xyz = self.to_machine(Vector3::new(start[0], start[1], start[2]));
         for (i, word) in block.axes.iter().enumerate() {
             let Some(num) = *word else { continue };
             let value = if i < 3 {
@@ -342,8 +973,19 @@ impl<'a> Interpreter<'a> {
             } else {
                 self.angle(num)
             };
-            if !value.is_finite() {
-                return Err(self.error(line, format!("{}: value out of range", AXIS_NAMES[i])));
+            if !value.is_finite() || value.abs() > MAX_COORDINATE_MM {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "{}: {value} is beyond ±{MAX_COORDINATE_MM} mm (or °)",
+                        AXIS_NAMES[i]
+                    ),
+                ));
+            }
+            if machine && i < 3 {
+                machine_xyz[i] = value;
+                self.known[i] = true;
+                continue;
             }
             let incremental = self.distance == Distance::Incremental && !machine;
             end[i] = if incremental { start[i] + value } else { value };
@@ -353,6 +995,19 @@ impl<'a> Interpreter<'a> {
             if i >= 3 {
                 self.saw_rotary = true;
             }
+        }
+        if machine {
+            let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+            self.warn(
+                line,
+                format!(
+                    "G53/SUPA: machine-coordinate move, taken as program coordinates + the \
+                     work offset ({}, {}, {}) mm",
+                    offset[0], offset[1], offset[2]
+                ),
+            );
+            let p = self.from_machine(machine_xyz);
+            end[..3].copy_from_slice(p.as_slice());
         }
         let unknown: Vec<String> = (0..3)
             .filter(|&i| !self.known[i] && !self.unknown_warned[i])
@@ -442,11 +1097,29 @@ impl<'a> Interpreter<'a> {
     }
 
     fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
+        let frame = self.frame_now();
+        let (p, o, rotary) = if frame.is_identity() {
+            (
+                Vector3::new(q[0], q[1], q[2]),
+                self.vector,
+                Some([q[3], q[4], q[5]]),
+            )
+        } else {
+            let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
+            let o = frame.r * self.vector;
+            // Under a swivel frame the control sets the rotary axes: the tool vector rules.
+            let rotary = if self.swivel.is_some() {
+                None
+            } else {
+                Some([q[3], q[4], q[5]])
+            };
+            (p, o, rotary)
+        };
         self.points.push(ClPoint {
-            p: Vector3::new(q[0], q[1], q[2]),
-            o: self.vector,
+            p,
+            o,
             feed,
-            rotary: Some([q[3], q[4], q[5]]),
+            rotary,
             line,
         });
     }
@@ -625,8 +1298,7 @@ impl<'a> Interpreter<'a> {
         }
 
         let r_max = r_start.max(r_end);
-        let step = 2.0 * (1.0 - MAX_CHORD_ERROR_MM / r_max).max(-1.0).acos();
-        let chords = ((sweep.abs() / step).ceil() as usize).max(1);
+        let chords = crate::toolpath::arc_chords(sweep, r_max).map_err(|e| self.error(line, e))?;
         let mut qs = Vec::with_capacity(chords);
         for k in 1..=chords {
             if k == chords {

@@ -97,17 +97,21 @@
 //!   silently: canned cycles, `G28`/`G30`, `G92`/`G52` offsets, splines, threading, probing,
 //!   polar coordinates, scaling, rotation, mirroring, feed per revolution, subprogram calls.
 
+pub mod cycles;
 mod dialect;
+pub mod expr;
+pub mod frames;
 mod interp;
 mod lexer;
 
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::toolpath::Toolpath;
 pub use crate::toolpath::Units;
+use crate::toolpath::{MachineContext, Toolpath};
 pub use dialect::*;
 use interp::Interpreter;
+pub use interp::{MAX_ARC_CHORDS, MAX_COORDINATE_MM};
 use lexer::{lex, split_blocks};
 
 /// Largest distance between an arc and the chords that replace it (the sagitta), mm: 1 µm.
@@ -159,7 +163,18 @@ pub fn parse(source: &Path, text: &str, dialect: Dialect) -> Result<Toolpath> {
 
 /// Parses G-code text with any dialect table.
 pub fn parse_with(source: &Path, text: &str, spec: &DialectSpec) -> Result<Toolpath> {
-    let mut interp = Interpreter::new(spec, source);
+    parse_for(source, text, spec, None)
+}
+
+/// Parses G-code text with any dialect table for a machine: axis words for axes it lacks are
+/// errors, and `G28`/`G30`/`G53`/`SUPA` use its reference positions and work offset.
+pub fn parse_for(
+    source: &Path,
+    text: &str,
+    spec: &DialectSpec,
+    machine: Option<&MachineContext>,
+) -> Result<Toolpath> {
+    let mut interp = Interpreter::new(spec, source, machine);
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut last_line = 0;
     for (index, raw) in text.lines().enumerate() {
@@ -179,7 +194,8 @@ pub fn parse_with(source: &Path, text: &str, spec: &DialectSpec) -> Result<Toolp
                 interp.warn(line, "block delete `/`: block skipped");
                 continue;
             }
-            let items = lex(spec, block).map_err(|m| Error::parse(source, line, m))?;
+            let items =
+                lex(spec, block, &mut interp.vars).map_err(|m| Error::parse(source, line, m))?;
             interp.block(line, items)?;
             if interp.ended {
                 break;
@@ -190,4 +206,33 @@ pub fn parse_with(source: &Path, text: &str, spec: &DialectSpec) -> Result<Toolp
         }
     }
     interp.finish(last_line)
+}
+
+/// The dialect a program's text (upper-cased) shows, if any: Sinumerik (`TRAORI`, `TRAFOOF`,
+/// `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`,
+/// `G68.2`, `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
+pub fn detect_dialect(upper: &str) -> Option<Dialect> {
+    let has = |w: &str| upper.contains(w);
+    let sinumerik = [
+        "TRAORI", "TRAFOOF", "MCALL", "CYCLE8", "DEF REAL", "SUPA ", "G710", "G700", "MSG(",
+    ]
+    .iter()
+    .any(|w| has(w));
+    let fanuc = ["G43.4", "G43.5", "G68.2", "G05.1", "G5.1", "M98"]
+        .iter()
+        .any(|w| has(w))
+        || upper
+            .lines()
+            .find(|l| !l.trim().is_empty() && !l.trim().starts_with('%'))
+            .is_some_and(|l| {
+                let l = l.trim();
+                l.starts_with('O') && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
+            });
+    let linuxcnc = ["M428", "M429", "M430", "O<"].iter().any(|w| has(w));
+    match (sinumerik, fanuc, linuxcnc) {
+        (true, _, _) => Some(Dialect::Sinumerik),
+        (false, true, _) => Some(Dialect::Fanuc),
+        (false, false, true) => Some(Dialect::LinuxCnc),
+        _ => None,
+    }
 }
