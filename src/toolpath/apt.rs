@@ -542,7 +542,7 @@ impl<'a> Reader<'a> {
             .then(|| v[6] * self.units.mm_per_unit());
         let centre = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
         let axis = Vector3::new(v[3], v[4], v[5]);
-        if !(axis.norm() > 1e-9) {
+        if axis.norm().is_nan() || axis.norm() <= 1e-9 {
             return Err(self.error(line, format!("{word}: the arc axis has no direction")));
         }
         let axis = match self.msys {
@@ -653,7 +653,7 @@ impl<'a> Reader<'a> {
         }
         let p = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
         let w = v.get(3).copied().unwrap_or(1.0);
-        if !(w > 0.0) {
+        if w.is_nan() || w <= 0.0 {
             return Err(self.error(line, format!("CNTRL: weight {w} must be positive")));
         }
         match self.nurbs.as_mut() {

@@ -22,7 +22,7 @@ use crate::machine::{KinematicsSpec, Machine, References};
 pub fn arc_chords(sweep: f64, radius: f64) -> std::result::Result<usize, String> {
     let step = 2.0 * (1.0 - gcode::MAX_CHORD_ERROR_MM / radius).max(-1.0).acos();
     let n = (sweep.abs() / step).ceil();
-    if !(n <= gcode::MAX_ARC_CHORDS as f64) {
+    if n.is_nan() || n > gcode::MAX_ARC_CHORDS as f64 {
         return Err(format!(
             "the arc (radius {radius:.6} mm, {:.1} turns) needs more than {} chords within {} mm",
             sweep.abs() / std::f64::consts::TAU,
@@ -108,7 +108,7 @@ impl Toolpath {
 
     /// Total dwell time, seconds.
     pub fn dwell_time(&self) -> f64 {
-        self.dwells.iter().map(|d| d.seconds).sum()
+        self.dwells.iter().fold(0.0, |sum, d| sum + d.seconds)
     }
 
     /// Whether the tool dwells at CL point `index` (the path must stop there).

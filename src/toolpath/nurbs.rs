@@ -38,7 +38,7 @@ impl Nurbs {
         if knots.iter().any(|k| !k.is_finite()) || knots.windows(2).any(|w| w[1] < w[0]) {
             return Err("knots must be finite and non-decreasing".into());
         }
-        if !(knots[n] > knots[degree]) {
+        if knots[n] <= knots[degree] {
             return Err("the knots leave no parameter range".into());
         }
         let homogeneous = control

@@ -126,7 +126,7 @@ pub struct Hole {
 fn pecks(top: f64, bottom: f64, q: f64) -> Result<Vec<f64>, String> {
     let depth = top - bottom;
     let n = (depth / q).ceil();
-    if !(n <= MAX_PECKS as f64) {
+    if n.is_nan() || n > MAX_PECKS as f64 {
         return Err(format!(
             "{n} pecks of {q} mm in one hole (more than {MAX_PECKS}): check Q"
         ));

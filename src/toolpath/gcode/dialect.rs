@@ -674,6 +674,8 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("42", Note(COMP)),
         ("53", MachineCoordinates),
         ("60", Action::Ignored),
+        ("62", Action::Ignored),
+        ("621", Action::Ignored),
         ("63", Action::Ignored),
         ("64", Action::Ignored),
         (

@@ -623,7 +623,7 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Machine coordinates → program (frame) coordinates, X Y Z.
-    fn from_machine(&self, m: Vector3<f64>) -> Vector3<f64> {
+    fn machine_to_program(&self, m: Vector3<f64>) -> Vector3<f64> {
         let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
         self.frame_now().invert(&(m - Vector3::from(offset)))
     }
@@ -702,7 +702,7 @@ impl<'a> Interpreter<'a> {
                 target[i] = r;
             }
         }
-        let xyz = self.from_machine(machine_xyz);
+        let xyz = self.machine_to_program(machine_xyz);
         target[..3].copy_from_slice(xyz.as_slice());
         for &i in &named {
             if i >= 3 {
@@ -855,11 +855,7 @@ impl<'a> Interpreter<'a> {
                 self.pos = q;
             }
             self.known[2] = true;
-            if c.kind == cycles::Kind::G87 {
-                self.rapid_z(line, r);
-            } else if self.pos[2] != r {
-                self.rapid_z(line, r);
-            }
+            self.rapid_z(line, r);
             self.run_steps(line, &steps)?;
         }
         Ok(())
@@ -1006,7 +1002,7 @@ impl<'a> Interpreter<'a> {
                     offset[0], offset[1], offset[2]
                 ),
             );
-            let p = self.from_machine(machine_xyz);
+            let p = self.machine_to_program(machine_xyz);
             end[..3].copy_from_slice(p.as_slice());
         }
         let unknown: Vec<String> = (0..3)
