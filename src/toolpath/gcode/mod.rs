@@ -70,32 +70,53 @@
 //!   otherwise; `line` = the block's 1-based line. There is no implicit start point: the
 //!   toolpath starts at the end of the first motion block. X, Y or Z not yet programmed at a
 //!   motion block are taken as 0 with a warning (the machine's start position is unknown).
-//! * **G53** (machine coordinates, one block): the move is included, its words read as
-//!   absolute values, with a warning that machine coordinates are taken as program coordinates.
+//! * **G53**, Sinumerik **SUPA** (machine coordinates, one block): the move is included, its
+//!   words read as machine coordinates = program coordinates + the machine's work offset
+//!   ([`MachineContext::work_offset`]; zero without a machine), with a warning saying so.
+//! * **G28/G30** (`G91 G28 Z0`, `G28 X0 Y0 B0`, `G30 P3 …`): a rapid to the intermediate point
+//!   the words give, then a rapid of the named axes to their reference point, read from the
+//!   machine file's `reference` (an error naming `axes.Z.reference` when it is missing).
+//! * **Canned cycles and dwells**: see [`cycles`]; `G4` (P seconds on LinuxCNC, P ms or X
+//!   seconds on Fanuc, F seconds on Sinumerik) and every cycle dwell become
+//!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
+//! * **Variables and expressions**: see [`expr`] (Sinumerik `DEF`, R parameters, Fanuc `#n`).
+//! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
+//! * **Sinumerik units**: `G70`/`G71` change the geometry only; F stays in the control's basic
+//!   system, taken as the unit the program selects first (a warning when that is inch);
+//!   `G700`/`G710` change F too.
+//! * **Bounds**: an axis word beyond ±[`MAX_COORDINATE_MM`] is an error naming it; an arc needs
+//!   at most [`MAX_ARC_CHORDS`] chords (so `P1000000000` turns or `TURN=100000000` are errors
+//!   before any work); exponent notation (`X1e309`) is an error naming the word.
+//! * **The machine**: with [`parse_for`] and a [`MachineContext`], an axis word for an axis the
+//!   machine lacks is an error naming the axis.
 //!
 //! # What is accepted and ignored
 //!
 //! Line numbers `N`; `S`, `T`, `H`, `D` and the other parameter letters of the table; M codes
-//! of the table (spindle, coolant, tool change, pauses); `G40`, `G43` (LinuxCNC), `G49`, work
-//! offsets `G54`–`G59` (`.1 .2 .3`), path control `G61`/`G64`; `%` lines; blank lines. Program
+//! of the table (spindle, coolant, tool change, pauses; Sinumerik `M202(0.0059)` arguments);
+//! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (`.1 .2 .3`), path control
+//! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
+//! coordinates either way; `G234` is TCP on); `%` lines; blank lines; nested `(( ))` comments. Program
 //! end (`M2`, `M30`, Sinumerik `M17`, `RET`, Fanuc `M99`) stops reading: later lines are not
 //! parsed. These codes are accepted with a warning because the toolpath does not carry them:
-//! cutter radius compensation `G41`/`G42` (the programmed path is used), dwell `G4` (its time
-//! is not counted), `G10` offsets. A block starting with `/` (block delete) is skipped with a
+//! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
+//! moves nothing: its axis words are not a move). A block starting with `/` (block delete) is skipped with a
 //! warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
 //! move, are skipped with a warning.
 //!
 //! # What is rejected
 //!
-//! * A word the dialect does not know (letter, G or M code, named word or keyword) is **not** an
-//!   error: it is skipped with a [`Warning`] naming the word and its line, never silently.
+//! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
+//!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
+//!   [`Warning`] naming the word and its line, never silently.
 //! * Errors ([`Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
-//!   `F`), an unclosed `(` comment, parameters and expressions (`#1`, `[...]`, Sinumerik
-//!   `IC(..)`), LinuxCNC O-word control flow, the same word twice in a block, two motion codes in
-//!   one block, axis words without a motion mode, a G93 feed block without F, a negative F,
+//!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
+//!   LinuxCNC O-word control flow, the same word twice in a block, two motion codes in one
+//!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
-//!   silently: canned cycles, `G28`/`G30`, `G92`/`G52` offsets, splines, threading, probing,
-//!   polar coordinates, scaling, rotation, mirroring, feed per revolution, subprogram calls.
+//!   silently: `G92`/`G52` offsets, splines, threading, probing, polar coordinates, scaling,
+//!   mirroring, feed per revolution, subprogram calls (`M98`, Sinumerik `L…`), Sinumerik
+//!   `CYCLE76`/`CYCLE77` (spigot milling).
 
 pub mod cycles;
 mod dialect;
@@ -108,6 +129,8 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 pub use crate::toolpath::Units;
+#[allow(unused_imports)] // named by the module docs
+use crate::toolpath::{ClPoint, Feed, Warning};
 use crate::toolpath::{MachineContext, Toolpath};
 pub use dialect::*;
 use interp::Interpreter;
