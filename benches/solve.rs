@@ -56,6 +56,7 @@ fn toolpath() -> Toolpath {
         source: PathBuf::from("bench.cls"),
         points,
         warnings: Vec::new(),
+        dwells: Vec::new(),
     }
 }
 

@@ -115,9 +115,9 @@ pub struct SolveArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
-    /// G-code dialect: linuxcnc, fanuc or sinumerik.
-    #[arg(long, default_value = "linuxcnc")]
-    pub dialect: crate::toolpath::gcode::Dialect,
+    /// G-code dialect: linuxcnc, fanuc or sinumerik (default: detected from the program).
+    #[arg(long)]
+    pub dialect: Option<crate::toolpath::gcode::Dialect>,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -311,6 +311,7 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     let machine = Machine::from_file(&args.machine)?;
     let (input, warnings) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
+    let (detected, dwell) = reader_used(args, &input)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
@@ -324,6 +325,7 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     }
     let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
     summary.warnings = warnings;
+    summary.set_reader(&detected, dwell);
     Ok(if args.json {
         let mut s = serde_json::to_string_pretty(&summary)
             .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
@@ -341,7 +343,14 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
         FormatChoice::Gcode => toolpath::Format::Gcode,
         FormatChoice::Csv => toolpath::Format::Csv,
     });
-    let input = toolpath::read_as(&args.toolpath, format, args.dialect)?;
+    let (_, references) = Machine::references_from_file(&args.machine)?;
+    let machine = Machine::from_file(&args.machine)?;
+    let options = toolpath::ReadOptions {
+        format,
+        dialect: args.dialect,
+        machine: Some(toolpath::MachineContext::new(&machine, &references)),
+    };
+    let (input, _) = toolpath::read_with(&args.toolpath, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.
     let warnings: Vec<String> = match &input {
         toolpath::Input::Cl(t) => t
@@ -355,6 +364,26 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
         eprintln!("feedopt: warning: {w}");
     }
     Ok((input, warnings))
+}
+
+/// What reader and dialect `read_input` used, and the toolpath's dwell time (s).
+fn reader_used(args: &SolveArgs, input: &toolpath::Input) -> Result<(toolpath::Detected, f64)> {
+    let bytes = std::fs::read(&args.toolpath).map_err(|e| Error::io(&args.toolpath, e))?;
+    let options = toolpath::ReadOptions {
+        format: args.format.map(|f| match f {
+            FormatChoice::Apt => toolpath::Format::Apt,
+            FormatChoice::Gcode => toolpath::Format::Gcode,
+            FormatChoice::Csv => toolpath::Format::Csv,
+        }),
+        dialect: args.dialect,
+        machine: None,
+    };
+    let detected = toolpath::detect(&args.toolpath, &String::from_utf8_lossy(&bytes), &options)?;
+    let dwell = match input {
+        toolpath::Input::Cl(t) => t.dwell_time(),
+        toolpath::Input::Joint(_) => 0.0,
+    };
+    Ok((detected, dwell))
 }
 
 /// `feedopt compare`: returns what to print on stdout.
@@ -506,7 +535,7 @@ impl PlanArgs {
             feed_override: self.feed_override,
             ignore_programmed_feed: self.ignore_programmed_feed,
             format: self.format,
-            dialect,
+            dialect: Some(dialect),
             solver: self.solver,
             start_feed: self.start_feed,
             end_feed: self.end_feed,

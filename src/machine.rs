@@ -15,6 +15,15 @@
 //! feed V; the `feed` section is optional. Unknown fields, missing axes or limits and
 //! non-positive limits are errors that name the field.
 //!
+//! An axis may give its **reference position**, `"reference": 0.0` (mm or degrees, machine
+//! coordinates), or several, `"reference": [0.0, -250.0]`: the first is the point `G28`
+//! (Fanuc, LinuxCNC) returns to, the second the one `G30` goes to (`G30 P3`: the third, …).
+//! Only the toolpath readers use it ([`References`], read by [`Machine::references_from_file`]);
+//! a program that needs a reference the file lacks is an error naming the field to add
+//! (`axes.Z.reference`). Machine coordinates (`G28`, `G53`, Sinumerik `SUPA`) are program
+//! coordinates plus the kinematics' `work-offset` (trunnion tables) or, for every other
+//! kinematics, the program coordinates themselves.
+//!
 //! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
 //!
 //! | `type` | axes | parameters |
@@ -215,6 +224,64 @@ impl Machine {
         }
         .machine(&value)
     }
+}
+
+/// Every axis's reference positions (machine coordinates, mm or degrees), in the machine's
+/// axis order: `axes[k]` is `(name, [first, second, …])`, empty where the file gives none.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct References {
+    /// The machine file (for messages naming the field to add).
+    pub file: PathBuf,
+    pub axes: Vec<(String, Vec<f64>)>,
+}
+
+impl Machine {
+    /// Reads a machine file and the axes' optional `reference` positions.
+    pub fn references_from_file(path: &Path) -> Result<(Machine, References)> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let machine = Machine::from_json(path, &text)?;
+        let references = references_from_json(path, &text, &machine)?;
+        Ok((machine, references))
+    }
+}
+
+/// The axes' `reference` positions of a machine file already read as `machine`.
+pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Result<References> {
+    let value: Value = serde_json::from_str(text).map_err(|e| Error::Parse {
+        file: source.to_path_buf(),
+        line: e.line(),
+        message: format!("invalid JSON: {e}"),
+    })?;
+    let parser = Parser {
+        file: source.to_path_buf(),
+    };
+    let mut axes = Vec::new();
+    for axis in &machine.axes {
+        let field = format!("axes.{}.reference", axis.name);
+        let given = value
+            .get("axes")
+            .and_then(|a| a.get(&axis.name))
+            .and_then(|a| a.get("reference"));
+        let list = match given {
+            None => Vec::new(),
+            Some(Value::Array(items)) if !items.is_empty() => items
+                .iter()
+                .map(|v| parser.number(Some(v), &field))
+                .collect::<Result<Vec<f64>>>()?,
+            Some(v @ Value::Number(_)) => vec![parser.number(Some(v), &field)?],
+            Some(v) => {
+                return Err(parser.err(
+                    &field,
+                    format!("expected a number or a list of numbers (mm or °), found {v}"),
+                ));
+            }
+        };
+        axes.push((axis.name.clone(), list));
+    }
+    Ok(References {
+        file: source.to_path_buf(),
+        axes,
+    })
 }
 
 struct Parser {
@@ -511,7 +578,14 @@ impl Parser {
                 self.only_known(
                     a,
                     &field,
-                    &["velocity", "acceleration", "jerk", "min", "max"],
+                    &[
+                        "velocity",
+                        "acceleration",
+                        "jerk",
+                        "min",
+                        "max",
+                        "reference",
+                    ],
                 )?;
                 Ok(Axis {
                     name: name.to_string(),

@@ -185,6 +185,16 @@ pub struct Summary {
     pub jerk_limited: bool,
     /// The reader's warnings (`file:line: message`).
     pub warnings: Vec<String>,
+    /// The input format read (`apt`, `gcode`, `csv`) and how it was chosen (`option`,
+    /// `extension`, `content`).
+    pub format: String,
+    pub format_by: String,
+    /// The G-code dialect read (G-code only) and how it was chosen (`option`, `content`,
+    /// `extension`, `default`).
+    pub dialect: Option<String>,
+    pub dialect_by: Option<String>,
+    /// Dwells of the program (G4, cycle dwells), s: part of `cycle_time_s`.
+    pub dwell_time_s: f64,
 }
 
 /// Worst use of one axis's limits in the re-simulation.
@@ -304,7 +314,22 @@ impl Summary {
             worst_chord_ratio: sol.verification.worst_chord,
             jerk_limited: sol.solutions.iter().any(|s| s.a.is_some()),
             warnings: Vec::new(),
+            format: String::new(),
+            format_by: String::new(),
+            dialect: None,
+            dialect_by: None,
+            dwell_time_s: 0.0,
         }
+    }
+
+    /// Records the reader used and adds the program's dwells to the cycle time.
+    pub fn set_reader(&mut self, detected: &crate::toolpath::Detected, dwell_time_s: f64) {
+        self.format = detected.format.name().to_string();
+        self.format_by = detected.format_by.to_string();
+        self.dialect = detected.dialect.map(|d| d.name().to_string());
+        self.dialect_by = detected.dialect.map(|_| detected.dialect_by.to_string());
+        self.cycle_time_s += dwell_time_s - self.dwell_time_s;
+        self.dwell_time_s = dwell_time_s;
     }
 }
 
@@ -323,7 +348,29 @@ impl fmt::Display for Summary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "toolpath      {}", self.toolpath)?;
         writeln!(f, "machine       {}", self.machine)?;
-        writeln!(f, "cycle time    {:.4} s", self.cycle_time_s)?;
+        if !self.format.is_empty() {
+            match &self.dialect {
+                Some(d) => writeln!(
+                    f,
+                    "read as       {} ({}), dialect {d} ({})",
+                    self.format,
+                    self.format_by,
+                    self.dialect_by.as_deref().unwrap_or("")
+                )?,
+                None => writeln!(f, "read as       {} ({})", self.format, self.format_by)?,
+            }
+        }
+        if self.dwell_time_s > 0.0 {
+            writeln!(
+                f,
+                "cycle time    {:.4} s (motion {:.4} s + dwells {:.4} s)",
+                self.cycle_time_s,
+                self.cycle_time_s - self.dwell_time_s,
+                self.dwell_time_s
+            )?;
+        } else {
+            writeln!(f, "cycle time    {:.4} s", self.cycle_time_s)?;
+        }
         if self.max_deviation_mm > 0.0 || self.max_deviation_deg > 0.0 {
             writeln!(
                 f,

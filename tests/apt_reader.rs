@@ -275,15 +275,19 @@ fn error_malformed_motion_records() {
     err("MULTAX/SIDEWAYS\nGOTO/1,2,3\n", 1, &["MULTAX", "SIDEWAYS"]);
     err("UNITS/FEET\nGOTO/1,2,3\n", 1, &["UNITS", "FEET"]);
     err("RAPID/ON\nGOTO/1,2,3\n", 1, &["RAPID", "no parameters"]);
+    // An arc whose centre is its start point, a cycle without depth, an unknown cycle, a
+    // record that moves the tool in a way this reader does not follow.
     err(
         "GOTO/0,0,0\nCIRCLE/0,0,0,0,0,1,5\nGOTO/5,0,0\n",
         2,
-        &["CIRCLE", "not supported"],
+        &["CIRCLE", "centre"],
     );
+    err("CYCLE/DRILL,MMPM,100\nGOTO/1,2,3\n", 1, &["CYCLE", "depth"]);
+    err("CYCLE/THREAD,5\nGOTO/1,2,3\n", 1, &["CYCLE/THREAD"]);
     err(
-        "CYCLE/DRILL,5\nGOTO/1,2,3\n",
-        1,
-        &["CYCLE", "not supported"],
+        "GOTO/1,2,3\nGODLTA/0,0,5\n",
+        2,
+        &["GODLTA", "not supported"],
     );
 }
 

@@ -36,6 +36,7 @@ fn groove() -> Toolpath {
             })
             .collect(),
         warnings: Vec::new(),
+        dwells: Vec::new(),
     }
 }
 

@@ -228,6 +228,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         source: PathBuf::from("arc.cls"),
         points: pts,
         warnings: Vec::new(),
+        dwells: Vec::new(),
     };
     (m, t)
 }

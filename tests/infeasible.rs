@@ -51,6 +51,7 @@ fn line() -> Toolpath {
             })
             .collect(),
         warnings: Vec::new(),
+        dwells: Vec::new(),
     }
 }
 
@@ -240,6 +241,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         source: PathBuf::from("reorient.cls"),
         points,
         warnings: Vec::new(),
+        dwells: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -217,6 +217,7 @@ fn random_cl(seed: u64) -> Case {
             source: PathBuf::from(format!("random_{seed}.cls")),
             points,
             warnings: Vec::new(),
+            dwells: Vec::new(),
         },
     }
 }

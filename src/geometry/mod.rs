@@ -213,8 +213,8 @@ impl Path {
 /// The CL points (indices into `toolpath.points`) at the knots of each span [`Path::build`]
 /// makes, before any dresser refit: points that neither move the tip (by more than
 /// [`SAME_POSITION_MM`]) nor, when `orientation_moves_axes`, turn the tool are dropped; the
-/// rest is cut into rest-to-rest spans where the tip starts or stops moving and at corners
-/// sharper than `corner_angle_deg`. Consecutive spans share their boundary point. Empty when
+/// rest is cut into rest-to-rest spans where the tip starts or stops moving, at corners
+/// sharper than `corner_angle_deg` and where the tool dwells ([`Toolpath::dwells`]). Consecutive spans share their boundary point. Empty when
 /// fewer than two points remain.
 pub fn span_points(
     toolpath: &Toolpath,
@@ -256,7 +256,12 @@ pub fn span_points(
         } else {
             false
         };
-        if split {
+        // The tool dwells at this point (or at a point it repeats): an exact stop.
+        let dwell = toolpath
+            .dwells
+            .iter()
+            .any(|d| d.seconds > 0.0 && d.point >= keep[k] && d.point < keep[k + 1]);
+        if split || dwell {
             cuts.push(k);
         }
     }

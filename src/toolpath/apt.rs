@@ -44,18 +44,49 @@
 //! # Records that are skipped
 //!
 //! Records that do not affect the motion are skipped silently; [`NON_MOTION_WORDS`] lists the
-//! known ones (`TOOL PATH`, `TLDATA`, `MSYS`, `LOADTL`, `PPRINT`, `SPINDL`, `COOLNT`,
+//! known ones (`TOOL PATH`, `TLDATA`, `LOADTL`, `PPRINT`, `SPINDL`, `COOLNT`, `CSYS` —
+//! SolidWorks CAM writes it with `TRNTYP/WORLD`: its GOTOs are already in world coordinates —,
 //! `END-OF-PATH`, `FINI`, ...). A record with an *unknown* major word is skipped too, with a
 //! warning naming the word and its line ([`Toolpath::warnings`]): post-processors emit many
 //! vendor-specific words, and none is dropped silently.
 //!
+//! # Arcs, curves, frames and cycles
+//!
+//! * `CIRCLE/cx,cy,cz,i,j,k[,r,…]` (NX, SolidWorks CAM) and `MOVARC/cx,cy,cz,i,j,k[,r,…]`
+//!   (Fusion): the *next* `GOTO` ends an arc about the centre, counter-clockwise about the axis
+//!   (i,j,k) (right hand), from the current point; the motion along the axis is linear (a
+//!   helix) and a start and end radius that differ by less than the G-code tolerance
+//!   ([`super::gcode::ARC_RADIUS_MISMATCH_MM`]) make a spiral. End = start is a full circle.
+//!   The arc is cut into chords exactly as G2/G3 are ([`super::arc_chords`]: sagitta at most
+//!   [`super::gcode::MAX_CHORD_ERROR_MM`]), every chord end a CL point. A radius `r` that
+//!   differs from the start point's distance by more than that tolerance is an error.
+//! * `NURBS/` (NX): the `KNOT/` and `CNTRL/x,y,z[,w]` records that follow (until any other
+//!   record) define a (rational) B-spline whose degree is knots − control points − 1; the curve
+//!   is evaluated (de Boor) and sampled adaptively until every sample interval's chord lies
+//!   within [`super::gcode::MAX_CHORD_ERROR_MM`] of the curve at its midpoint and quarter points
+//!   (at most [`NURBS_MAX_POINTS`] points per curve); each sample is a CL point. The tool
+//!   vector stays the last one.
+//! * `MSYS/x0,y0,z0,xi,xj,xk,yi,yj,yk` (NX): the frame the following records are written in:
+//!   origin and the directions of its X and Y axes in world coordinates (Z = X × Y). Every
+//!   later point becomes origin + R·p and every tool vector R·v; `MSYS/` without numbers (or
+//!   an identity) ends it.
+//! * `CYCLE/DRILL|FACE|DEEP|BRKCHP|TAP|BORE|REAM, …` with the keywords `FEDTO d` (depth below
+//!   the point), `MMPM|IPM f` (feed), `RAPTO c` (clearance above the point), `RTRCTO r`
+//!   (retract level above the point; default: the clearance), `STEP s` (peck, DEEP and
+//!   BRKCHP), `DWELL t` (seconds), or the positional NX form `CYCLE/DRILL,d,MMPM,f,c`: every
+//!   following `GOTO` is a hole at that point, drilled along the tool axis: rapid to the retract
+//!   level over it, rapid to the clearance, feed to the depth (DEEP: pecks of STEP with a rapid
+//!   back to the clearance; BRKCHP: pecks with a retract of
+//!   [`super::gcode::cycles::PECK_CLEARANCE_MM`]), dwell, back to the retract level (TAP, BORE
+//!   and REAM at the feed, the others rapid). `CYCLE/OFF` ends it; `CYCLE/INIT` and `CYCLE/ON`
+//!   change nothing.
+//! * `UNIT/MM` (SolidWorks CAM) is read as `UNITS/MM`.
+//!
 //! # Records that are rejected
 //!
-//! Motion records this reader cannot represent as straight CL moves are errors rather than being
-//! skipped, because skipping them would silently change the geometry: see
-//! [`UNSUPPORTED_MOTION_WORDS`] (`CIRCLE`, `MOVARC`, `GODLTA`, `GOHOME`, and canned cycles
-//! `CYCLE/...` other than `CYCLE/OFF`). Output the toolpath linearised (arcs as `GOTO` chains)
-//! instead.
+//! Motion records this reader cannot represent are errors rather than being skipped, because
+//! skipping them would silently change the geometry: see [`UNSUPPORTED_MOTION_WORDS`]
+//! (`GODLTA`, `GOHOME`, `INDIRV`, `GOFWD`, …).
 //!
 //! Every error is an [`Error::Parse`] naming the file and the 1-based line where the record
 //! starts.
@@ -63,8 +94,14 @@
 use nalgebra::Vector3;
 use std::path::Path;
 
+use nalgebra::Matrix3;
+
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Feed, Toolpath, Units};
+use crate::toolpath::gcode::cycles::PECK_CLEARANCE_MM;
+use crate::toolpath::gcode::{
+    ARC_RADIUS_MISMATCH_MM, ARC_RADIUS_MISMATCH_RELATIVE, MAX_CHORD_ERROR_MM,
+};
+use crate::toolpath::{ClPoint, Dwell, Feed, MachineContext, Toolpath, Units};
 
 /// Tool vectors shorter than this are rejected as having no direction.
 const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
@@ -76,7 +113,8 @@ const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
 pub const NON_MOTION_WORDS: &[&str] = &[
     "TOOL PATH",
     "TLDATA",
-    "MSYS",
+    "CSYS",
+    "TRNTYP",
     "LOADTL",
     "CUTTER",
     "PAINT",
@@ -118,7 +156,13 @@ pub const NON_MOTION_WORDS: &[&str] = &[
 
 /// Major words that move the tool in ways a list of straight CL moves cannot represent; they are
 /// rejected (`CYCLE/OFF` is accepted and skipped).
-pub const UNSUPPORTED_MOTION_WORDS: &[&str] = &["CIRCLE", "MOVARC", "GODLTA", "GOHOME", "CYCLE"];
+pub const UNSUPPORTED_MOTION_WORDS: &[&str] = &[
+    "GODLTA", "GOHOME", "GOFWD", "GOLFT", "GORGT", "GOUP", "GODOWN", "GOBACK", "INDIRV", "INDIRP",
+    "PSIS", "AUTOPS",
+];
+
+/// Most CL points one NURBS curve may become.
+pub const NURBS_MAX_POINTS: usize = 1_000_000;
 
 /// Reads an APT CL file. Bytes that are not valid UTF-8 (e.g. Latin-1 in `PPRINT` text) are
 /// replaced, not rejected.
@@ -130,6 +174,12 @@ pub fn read(path: &Path) -> Result<Toolpath> {
 
 /// Parses APT CL text; `source` is only used to name the file in the result and in errors.
 pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
+    parse_for(source, text, None)
+}
+
+/// Parses APT CL text for a machine (the machine is not needed by any record today; the
+/// signature matches the G-code reader's).
+pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -> Result<Toolpath> {
     let mut reader = Reader::new(source);
     let mut pending: Option<(usize, String)> = None;
     let mut last_line = 0;
@@ -164,6 +214,14 @@ pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
     if let Some((start, record)) = pending.take() {
         reader.record(start, &record)?;
     }
+    reader.flush_nurbs()?;
+    if let Some((line, _)) = reader.arc {
+        return Err(Error::parse(
+            source,
+            line,
+            "CIRCLE/MOVARC without the GOTO that ends the arc",
+        ));
+    }
 
     if reader.points.is_empty() {
         return Err(Error::parse(source, last_line.max(1), "no GOTO records"));
@@ -172,6 +230,7 @@ pub fn parse(source: &Path, text: &str) -> Result<Toolpath> {
         source: source.to_path_buf(),
         points: reader.points,
         warnings: reader.warnings,
+        dwells: reader.dwells,
     })
 }
 
@@ -188,6 +247,34 @@ struct Reader<'a> {
     rapid_next: bool,
     points: Vec<ClPoint>,
     warnings: Vec<crate::toolpath::Warning>,
+    dwells: Vec<Dwell>,
+    /// `MSYS` frame: world = origin + R·p.
+    msys: Option<(Vector3<f64>, Matrix3<f64>)>,
+    /// A `CIRCLE`/`MOVARC` waiting for its end `GOTO`: (line, centre, unit axis, radius).
+    arc: Option<(usize, ArcSpec)>,
+    /// A `NURBS/` being read: (line, knots, control points with weights).
+    nurbs: Option<(usize, Vec<f64>, Vec<[f64; 4]>)>,
+    cycle: Option<AptCycle>,
+}
+
+/// An APT arc's centre, unit axis and radius (if given), in world mm.
+#[derive(Debug, Clone, Copy)]
+struct ArcSpec {
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+    radius: Option<f64>,
+}
+
+/// A `CYCLE/` in force.
+#[derive(Debug, Clone, Copy)]
+struct AptCycle {
+    kind: &'static str,
+    depth: f64,
+    feed: Option<f64>,
+    clearance: f64,
+    retract: f64,
+    step: Option<f64>,
+    dwell: f64,
 }
 
 impl<'a> Reader<'a> {
@@ -201,6 +288,11 @@ impl<'a> Reader<'a> {
             rapid_next: false,
             points: Vec::new(),
             warnings: Vec::new(),
+            dwells: Vec::new(),
+            msys: None,
+            arc: None,
+            nurbs: None,
+            cycle: None,
         }
     }
 
@@ -215,15 +307,26 @@ impl<'a> Reader<'a> {
             None => (record, None),
         };
         let major = normalise_word(major_text);
+        if self.nurbs.is_some() && !matches!(major.as_str(), "KNOT" | "CNTRL") {
+            self.flush_nurbs()?;
+        }
 
         match (major.as_str(), minor) {
             ("GOTO", Some(minor)) => self.goto(line, "GOTO", minor),
             ("FROM", Some(minor)) => self.goto(line, "FROM", minor),
             ("FEDRAT", Some(minor)) => self.fedrat(line, minor),
-            ("UNITS", Some(minor)) => self.units(line, minor),
+            ("UNITS" | "UNIT", Some(minor)) => self.units(line, minor),
             ("MULTAX", minor) => self.multax(line, minor),
             ("RAPID", minor) => self.rapid(line, minor),
-            ("CYCLE", Some(minor)) if normalise_word(minor) == "OFF" => Ok(()),
+            ("CIRCLE" | "MOVARC", Some(minor)) => self.circle(line, &major, minor),
+            ("MSYS", minor) => self.msys(line, minor.unwrap_or("")),
+            ("NURBS", _) => {
+                self.nurbs = Some((line, Vec::new(), Vec::new()));
+                Ok(())
+            }
+            ("KNOT", Some(minor)) => self.knot(line, minor),
+            ("CNTRL", Some(minor)) => self.cntrl(line, minor),
+            ("CYCLE", Some(minor)) => self.cycle(line, minor),
             (word, _) if UNSUPPORTED_MOTION_WORDS.contains(&word) => Err(self.error(
                 line,
                 format!(
@@ -244,7 +347,17 @@ impl<'a> Reader<'a> {
                         .unwrap_or("");
                     if matches!(
                         first,
-                        "GOTO" | "FROM" | "FEDRAT" | "UNITS" | "MULTAX" | "RAPID"
+                        "GOTO"
+                            | "FROM"
+                            | "FEDRAT"
+                            | "UNITS"
+                            | "MULTAX"
+                            | "RAPID"
+                            | "CIRCLE"
+                            | "MOVARC"
+                            | "CYCLE"
+                            | "KNOT"
+                            | "CNTRL"
                     ) {
                         return Err(self.error(
                             line,
@@ -286,9 +399,19 @@ impl<'a> Reader<'a> {
             })?;
         }
 
-        let p = Vector3::new(values[0], values[1], values[2]) * self.units.mm_per_unit();
-        if !p.iter().all(|c| c.is_finite()) {
-            return Err(self.error(line, format!("{word}: position is out of range")));
+        let p =
+            self.world(Vector3::new(values[0], values[1], values[2]) * self.units.mm_per_unit());
+        if !p
+            .iter()
+            .all(|c| c.is_finite() && c.abs() <= crate::toolpath::gcode::MAX_COORDINATE_MM)
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "{word}: position is out of range (beyond ±{} mm)",
+                    crate::toolpath::gcode::MAX_COORDINATE_MM
+                ),
+            ));
         }
         if fields.len() == 6 && self.multax != Some(false) {
             let v = Vector3::new(values[3], values[4], values[5]);
@@ -308,7 +431,11 @@ impl<'a> Reader<'a> {
                     ),
                 ));
             }
-            self.orientation = v / largest / scaled_norm;
+            let v = v / largest / scaled_norm;
+            self.orientation = match self.msys {
+                Some((_, r)) => r * v,
+                None => v,
+            };
         }
 
         let feed = if self.rapid_next {
@@ -317,6 +444,19 @@ impl<'a> Reader<'a> {
         } else {
             self.feed
         };
+        if let Some((arc_line, arc)) = self.arc.take() {
+            return self.arc_to(line, arc_line, arc, p, feed);
+        }
+        if let Some(c) = self.cycle
+            && word == "GOTO"
+        {
+            return self.hole(line, c, p);
+        }
+        self.emit(p, feed, line);
+        Ok(())
+    }
+
+    fn emit(&mut self, p: Vector3<f64>, feed: Feed, line: usize) {
         self.points.push(ClPoint {
             p,
             o: self.orientation,
@@ -324,6 +464,363 @@ impl<'a> Reader<'a> {
             rotary: None,
             line,
         });
+    }
+
+    /// A point in the `MSYS` frame, in world coordinates.
+    fn world(&self, p: Vector3<f64>) -> Vector3<f64> {
+        match self.msys {
+            Some((origin, r)) => origin + r * p,
+            None => p,
+        }
+    }
+
+    /// Numeric fields of a record.
+    fn numbers(&self, line: usize, word: &str, minor: &str) -> Result<Vec<f64>> {
+        minor
+            .split(',')
+            .enumerate()
+            .map(|(k, f)| {
+                number(f).map_err(|bad| {
+                    self.error(line, format!("{word}: number {} {}", k + 1, bad.describe()))
+                })
+            })
+            .collect()
+    }
+
+    /// `MSYS/x0,y0,z0,xi,xj,xk,yi,yj,yk`.
+    fn msys(&mut self, line: usize, minor: &str) -> Result<()> {
+        if minor.trim().is_empty() {
+            self.msys = None;
+            return Ok(());
+        }
+        let v = self.numbers(line, "MSYS", minor)?;
+        if v.len() != 9 {
+            return Err(self.error(
+                line,
+                format!(
+                    "MSYS: expected 9 numbers (origin x,y,z, X axis i,j,k, Y axis i,j,k), found {}",
+                    v.len()
+                ),
+            ));
+        }
+        let origin = Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit();
+        let x = Vector3::new(v[3], v[4], v[5]);
+        let y = Vector3::new(v[6], v[7], v[8]);
+        if (x.norm() - 1.0).abs() > 1e-3 || (y.norm() - 1.0).abs() > 1e-3 || x.dot(&y).abs() > 1e-3
+        {
+            return Err(self.error(
+                line,
+                "MSYS: the X and Y axis directions must be orthogonal unit vectors",
+            ));
+        }
+        let x = x.normalize();
+        let y = (y - x * x.dot(&y)).normalize();
+        let r = Matrix3::from_columns(&[x, y, x.cross(&y)]);
+        self.msys = (origin != Vector3::zeros() || r != Matrix3::identity()).then_some((origin, r));
+        Ok(())
+    }
+
+    /// `CIRCLE/cx,cy,cz,i,j,k[,r,…]` and `MOVARC/…`: the next GOTO ends the arc.
+    fn circle(&mut self, line: usize, word: &str, minor: &str) -> Result<()> {
+        let fields: Vec<&str> = minor.split(',').collect();
+        if fields.len() < 6 {
+            return Err(self.error(
+                line,
+                format!("{word}: expected at least 6 numbers (centre x,y,z, axis i,j,k)"),
+            ));
+        }
+        let mut v = [0.0; 7];
+        for k in 0..fields.len().min(7) {
+            if k == 6 && number(fields[6]).is_err() {
+                break; // MOVARC/…,ANGLE,a: no radius
+            }
+            v[k] = number(fields[k]).map_err(|bad| {
+                self.error(line, format!("{word}: number {} {}", k + 1, bad.describe()))
+            })?;
+        }
+        let radius = (fields.len() >= 7 && number(fields[6]).is_ok())
+            .then(|| v[6] * self.units.mm_per_unit());
+        let centre = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
+        let axis = Vector3::new(v[3], v[4], v[5]);
+        if axis.norm().is_nan() || axis.norm() <= 1e-9 {
+            return Err(self.error(line, format!("{word}: the arc axis has no direction")));
+        }
+        let axis = match self.msys {
+            Some((_, r)) => r * axis.normalize(),
+            None => axis.normalize(),
+        };
+        if self.points.is_empty() {
+            return Err(self.error(
+                line,
+                format!("{word}: an arc needs a start point (a GOTO before it)"),
+            ));
+        }
+        self.arc = Some((
+            line,
+            ArcSpec {
+                centre,
+                axis,
+                radius,
+            },
+        ));
+        Ok(())
+    }
+
+    /// The arc from the last point to `end` about `arc`.
+    fn arc_to(
+        &mut self,
+        line: usize,
+        arc_line: usize,
+        arc: ArcSpec,
+        end: Vector3<f64>,
+        feed: Feed,
+    ) -> Result<()> {
+        let start = self.points.last().map_or(end, |p| p.p);
+        let n = arc.axis;
+        let rs = (start - arc.centre) - n * n.dot(&(start - arc.centre));
+        let re = (end - arc.centre) - n * n.dot(&(end - arc.centre));
+        let (r0, r1) = (rs.norm(), re.norm());
+        let mismatch = (r1 - r0).abs();
+        if r0 == 0.0 || r1 == 0.0 {
+            return Err(self.error(
+                arc_line,
+                "CIRCLE: the centre coincides with the start or end point",
+            ));
+        }
+        if mismatch > ARC_RADIUS_MISMATCH_MM && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r0.max(r1)
+        {
+            return Err(self.error(
+                line,
+                format!("arc end point is not on the circle: radius {r1:.4} mm at the end, {r0:.4} mm at the start"),
+            ));
+        }
+        if let Some(r) = arc.radius
+            && (r.abs() - r0).abs() > ARC_RADIUS_MISMATCH_MM.max(ARC_RADIUS_MISMATCH_RELATIVE * r0)
+        {
+            return Err(self.error(
+                arc_line,
+                format!("CIRCLE: radius {r} mm, but the start point is {r0:.4} mm from the centre"),
+            ));
+        }
+        let u = rs / r0;
+        let w = n.cross(&u);
+        let angle_end = re.dot(&w).atan2(re.dot(&u));
+        let sweep = if (end - start).norm() < 1e-9 {
+            std::f64::consts::TAU
+        } else {
+            angle_end.rem_euclid(std::f64::consts::TAU)
+        };
+        let along0 = n.dot(&(start - arc.centre));
+        let along1 = n.dot(&(end - arc.centre));
+        let chords = super::arc_chords(sweep, r0.max(r1))
+            .map_err(|e| self.error(arc_line, format!("CIRCLE: {e}")))?;
+        for k in 1..=chords {
+            let t = k as f64 / chords as f64;
+            let p = if k == chords {
+                end
+            } else {
+                let phi = t * sweep;
+                let r = r0 + t * (r1 - r0);
+                arc.centre
+                    + n * (along0 + t * (along1 - along0))
+                    + (u * phi.cos() + w * phi.sin()) * r
+            };
+            self.emit(p, feed, line);
+        }
+        Ok(())
+    }
+
+    /// `KNOT/…`: knots of the NURBS being read.
+    fn knot(&mut self, line: usize, minor: &str) -> Result<()> {
+        let v = self.numbers(line, "KNOT", minor.trim_end_matches(','))?;
+        match self.nurbs.as_mut() {
+            Some((_, knots, _)) => {
+                knots.extend(v);
+                Ok(())
+            }
+            None => Err(self.error(line, "KNOT/ outside a NURBS/ curve")),
+        }
+    }
+
+    /// `CNTRL/x,y,z[,w]`: a control point of the NURBS being read.
+    fn cntrl(&mut self, line: usize, minor: &str) -> Result<()> {
+        let v = self.numbers(line, "CNTRL", minor.trim_end_matches(','))?;
+        if v.len() != 3 && v.len() != 4 {
+            return Err(self.error(
+                line,
+                format!("CNTRL: expected x,y,z[,w], found {} numbers", v.len()),
+            ));
+        }
+        let p = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
+        let w = v.get(3).copied().unwrap_or(1.0);
+        if w.is_nan() || w <= 0.0 {
+            return Err(self.error(line, format!("CNTRL: weight {w} must be positive")));
+        }
+        match self.nurbs.as_mut() {
+            Some((_, _, cps)) => {
+                cps.push([p.x, p.y, p.z, w]);
+                Ok(())
+            }
+            None => Err(self.error(line, "CNTRL/ outside a NURBS/ curve")),
+        }
+    }
+
+    /// Evaluates and samples the NURBS read so far.
+    fn flush_nurbs(&mut self) -> Result<()> {
+        let Some((line, knots, cps)) = self.nurbs.take() else {
+            return Ok(());
+        };
+        let curve = super::nurbs::Nurbs::new(knots, cps)
+            .map_err(|e| self.error(line, format!("NURBS: {e}")))?;
+        let samples = curve
+            .sample(MAX_CHORD_ERROR_MM, NURBS_MAX_POINTS)
+            .map_err(|e| self.error(line, format!("NURBS: {e}")))?;
+        let feed = if self.rapid_next {
+            self.rapid_next = false;
+            Feed::Rapid
+        } else {
+            self.feed
+        };
+        for p in samples {
+            self.emit(p, feed, line);
+        }
+        Ok(())
+    }
+
+    /// `CYCLE/…`.
+    fn cycle(&mut self, line: usize, minor: &str) -> Result<()> {
+        let fields: Vec<String> = minor.split(',').map(normalise_word).collect();
+        let kind = fields.first().map(String::as_str).unwrap_or("");
+        let kind: &'static str = match kind {
+            "OFF" => {
+                self.cycle = None;
+                return Ok(());
+            }
+            "INIT" | "ON" | "" => return Ok(()),
+            "DRILL" => "DRILL",
+            "FACE" => "FACE",
+            "DEEP" => "DEEP",
+            "BRKCHP" => "BRKCHP",
+            "TAP" => "TAP",
+            "BORE" => "BORE",
+            "REAM" => "REAM",
+            other => {
+                return Err(self.error(
+                    line,
+                    format!("CYCLE/{other}: not a drilling cycle feedopt knows (DRILL, FACE, DEEP, BRKCHP, TAP, BORE, REAM)"),
+                ));
+            }
+        };
+        let scale = self.units.mm_per_unit();
+        let mut c = AptCycle {
+            kind,
+            depth: f64::NAN,
+            feed: None,
+            clearance: 0.0,
+            retract: f64::NAN,
+            step: None,
+            dwell: 0.0,
+        };
+        let mut positional = 0;
+        let mut k = 1;
+        while k < fields.len() {
+            let f = fields[k].as_str();
+            let next = |k: usize| -> Result<f64> {
+                fields
+                    .get(k + 1)
+                    .ok_or_else(|| self.error(line, format!("CYCLE: `{f}` needs a number")))
+                    .and_then(|t| {
+                        number(t).map_err(|bad| {
+                            self.error(line, format!("CYCLE: {f} {}", bad.describe()))
+                        })
+                    })
+            };
+            match f {
+                "FEDTO" | "DEPTH" => c.depth = next(k)?.abs() * scale,
+                "MMPM" => c.feed = Some(next(k)? / 60.0),
+                "IPM" => c.feed = Some(next(k)? * 25.4 / 60.0),
+                "RAPTO" | "CLEAR" => c.clearance = next(k)? * scale,
+                "RTRCTO" => c.retract = next(k)? * scale,
+                "STEP" | "INCR" => c.step = Some(next(k)?.abs() * scale),
+                "DWELL" => c.dwell = next(k)?.max(0.0),
+                "MMPR" | "IPR" => {
+                    return Err(self.error(line, "CYCLE: feed per revolution is not supported"));
+                }
+                _ => {
+                    let v = number(f)
+                        .map_err(|_| self.error(line, format!("CYCLE: unknown word `{f}`")))?;
+                    match positional {
+                        0 => c.depth = v.abs() * scale,
+                        1 => c.clearance = v * scale,
+                        _ => return Err(self.error(line, format!("CYCLE: unexpected number {v}"))),
+                    }
+                    positional += 1;
+                    k += 1;
+                    continue;
+                }
+            }
+            k += 2;
+        }
+        if !c.depth.is_finite() {
+            return Err(self.error(line, "CYCLE: the depth (FEDTO) is missing"));
+        }
+        if !c.retract.is_finite() {
+            c.retract = c.clearance;
+        }
+        if matches!(kind, "DEEP" | "BRKCHP") && c.step.is_none_or(|s| s <= 0.0) {
+            return Err(self.error(
+                line,
+                format!("CYCLE/{kind}: STEP (the peck) must be positive"),
+            ));
+        }
+        if let Some(s) = c.step
+            && c.depth + c.clearance > s * crate::toolpath::gcode::cycles::MAX_PECKS as f64
+        {
+            return Err(self.error(line, "CYCLE: more pecks than feedopt reads in one hole"));
+        }
+        self.cycle = Some(c);
+        Ok(())
+    }
+
+    /// One hole of the `CYCLE/` in force at `p`, along the tool axis.
+    fn hole(&mut self, line: usize, c: AptCycle, p: Vector3<f64>) -> Result<()> {
+        let o = self.orientation;
+        let at = |h: f64| p + o * h;
+        let feed = c.feed.map_or(self.feed, Feed::Programmed);
+        self.emit(at(c.retract), Feed::Rapid, line);
+        self.emit(at(c.clearance), Feed::Rapid, line);
+        let bottom = -c.depth;
+        match (c.kind, c.step) {
+            ("DEEP" | "BRKCHP", Some(step)) => {
+                let mut h = c.clearance;
+                loop {
+                    let next = (h - step).max(bottom);
+                    self.emit(at(next), feed, line);
+                    if next <= bottom {
+                        break;
+                    }
+                    if c.kind == "DEEP" {
+                        self.emit(at(c.clearance), Feed::Rapid, line);
+                    }
+                    self.emit(at(next + PECK_CLEARANCE_MM), Feed::Rapid, line);
+                    h = next;
+                }
+            }
+            _ => self.emit(at(bottom), feed, line),
+        }
+        if c.dwell > 0.0 {
+            self.dwells.push(Dwell {
+                point: self.points.len() - 1,
+                seconds: c.dwell,
+                line,
+            });
+        }
+        let out = if matches!(c.kind, "TAP" | "BORE" | "REAM") {
+            feed
+        } else {
+            Feed::Rapid
+        };
+        self.emit(at(c.retract), out, line);
         Ok(())
     }
 

@@ -8,11 +8,30 @@
 pub mod apt;
 pub mod gcode;
 pub mod joint_csv;
+pub mod nurbs;
 
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::machine::{KinematicsSpec, Machine, References};
+
+/// The number of chords an arc of `sweep` radians and radius `radius` (mm) is cut into, so that
+/// every chord's sagitta is at most [`gcode::MAX_CHORD_ERROR_MM`]: ⌈sweep / (2 acos(1 − e/r))⌉
+/// (G2/G3 and APT arcs alike); an error past [`gcode::MAX_ARC_CHORDS`].
+pub fn arc_chords(sweep: f64, radius: f64) -> std::result::Result<usize, String> {
+    let step = 2.0 * (1.0 - gcode::MAX_CHORD_ERROR_MM / radius).max(-1.0).acos();
+    let n = (sweep.abs() / step).ceil();
+    if n.is_nan() || n > gcode::MAX_ARC_CHORDS as f64 {
+        return Err(format!(
+            "the arc (radius {radius:.6} mm, {:.1} turns) needs more than {} chords within {} mm",
+            sweep.abs() / std::f64::consts::TAU,
+            gcode::MAX_ARC_CHORDS,
+            gcode::MAX_CHORD_ERROR_MM
+        ));
+    }
+    Ok((n as usize).max(1))
+}
 
 /// Millimetres per inch.
 pub const MM_PER_INCH: f64 = 25.4;
@@ -71,6 +90,42 @@ pub struct Toolpath {
     pub points: Vec<ClPoint>,
     /// Things the reader skipped or doubted, with their lines (never silently dropped).
     pub warnings: Vec<Warning>,
+    /// Dwells (G4, a cycle's dwell at the bottom of a hole): the tool stands still at a CL
+    /// point for a programmed time, which is part of the cycle time.
+    pub dwells: Vec<Dwell>,
+}
+
+impl Toolpath {
+    /// A toolpath without warnings or dwells.
+    pub fn new(source: PathBuf, points: Vec<ClPoint>) -> Self {
+        Toolpath {
+            source,
+            points,
+            warnings: Vec::new(),
+            dwells: Vec::new(),
+        }
+    }
+
+    /// Total dwell time, seconds.
+    pub fn dwell_time(&self) -> f64 {
+        self.dwells.iter().fold(0.0, |sum, d| sum + d.seconds)
+    }
+
+    /// Whether the tool dwells at CL point `index` (the path must stop there).
+    pub fn dwells_at(&self, index: usize) -> bool {
+        self.dwells
+            .iter()
+            .any(|d| d.point == index && d.seconds > 0.0)
+    }
+}
+
+/// The tool stands still at CL point `point` (an index into [`Toolpath::points`]) for
+/// `seconds` before the next move; `line` is the block or record that programs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dwell {
+    pub point: usize,
+    pub seconds: f64,
+    pub line: usize,
 }
 
 /// A reader's warning: a line and what about it.
@@ -80,6 +135,176 @@ pub struct Warning {
     pub message: String,
 }
 
+/// What a reader needs to know about the machine the program runs on: which axes it has (an
+/// axis word for any other is an error naming it), its reference positions (`G28`/`G30`) and
+/// how machine coordinates (`G53`, `SUPA`, the reference points) map to program coordinates.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MachineContext {
+    /// The machine file, for messages that name a field to add.
+    pub file: PathBuf,
+    /// Axis letters the machine has; `None`: any of X Y Z A B C is accepted.
+    pub axes: Option<Vec<char>>,
+    /// Reference positions per axis X Y Z A B C, machine coordinates (mm, degrees): the first
+    /// is `G28`'s, the second `G30`'s, … (empty: the file gives none).
+    pub reference: [Vec<f64>; 6],
+    /// Machine coordinates minus program coordinates, X Y Z, mm (the trunnion kinematics'
+    /// `work-offset`; zero for every other kinematics).
+    pub work_offset: [f64; 3],
+}
+
+impl MachineContext {
+    /// The context of a machine and its reference positions.
+    pub fn new(machine: &Machine, references: &References) -> Self {
+        const NAMES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
+        let axes = (machine.kinematics != KinematicsSpec::Joint).then(|| {
+            machine
+                .axes
+                .iter()
+                .filter_map(|a| a.name.chars().next().filter(|_| a.name.len() == 1))
+                .collect()
+        });
+        let reference = std::array::from_fn(|i| {
+            references
+                .axes
+                .iter()
+                .find(|(n, _)| n == NAMES[i])
+                .map(|(_, r)| r.clone())
+                .unwrap_or_default()
+        });
+        let work_offset = match &machine.kinematics {
+            KinematicsSpec::TableTable { params, .. } => params.work_offset,
+            _ => [0.0; 3],
+        };
+        MachineContext {
+            file: references.file.clone(),
+            axes,
+            reference,
+            work_offset,
+        }
+    }
+
+    /// Whether the machine has axis `letter` (always, when the machine is unknown).
+    pub fn has_axis(&self, letter: char) -> bool {
+        self.axes.as_ref().is_none_or(|a| a.contains(&letter))
+    }
+}
+
+/// How to read an input: the format and G-code dialect (detected when `None`) and the machine.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    pub format: Option<Format>,
+    pub dialect: Option<gcode::Dialect>,
+    pub machine: Option<MachineContext>,
+}
+
+/// What a reader was used, and why.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Detected {
+    pub format: Format,
+    /// The G-code dialect (G-code inputs only).
+    pub dialect: Option<gcode::Dialect>,
+    /// How the format and dialect were chosen: `"option"`, `"extension"`, `"content"` or
+    /// `"default"` (for the dialect when nothing in the file tells).
+    pub format_by: &'static str,
+    pub dialect_by: &'static str,
+}
+
+impl Format {
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Apt => "apt",
+            Format::Gcode => "gcode",
+            Format::Csv => "csv",
+        }
+    }
+}
+
+/// Extensions read as APT CL.
+pub const APT_EXTENSIONS: &[&str] = &["cls", "clsf", "apt", "cl", "aptsource"];
+/// Extensions read as G-code (`.mpf`/`.spf`: Sinumerik main program / subprogram; `.ptp`: NX
+/// post output; `.txt`: by content).
+pub const GCODE_EXTENSIONS: &[&str] = &[
+    "ngc", "nc", "gcode", "tap", "mpf", "spf", "ptp", "eia", "min", "iso", "h", "txt",
+];
+
+/// Chooses the reader and dialect: the options first, then the file's content (a `GOTO/`
+/// record is APT; `TRAORI`, `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are
+/// Sinumerik; `G43.4`, `G43.5`, `G68.2`, `G05.1`, `M98` or an `O1234` program number are
+/// Fanuc; `M428`–`M430` or `O<…>` are LinuxCNC), then the extension (`.mpf`, `.spf`:
+/// Sinumerik), else LinuxCNC.
+pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    let sample: String = text.lines().take(5000).collect::<Vec<_>>().join("\n");
+    let upper = sample.to_ascii_uppercase();
+    let apt_content = upper.lines().any(|l| {
+        let l: String = l.chars().filter(|c| !c.is_whitespace()).collect();
+        l.starts_with("GOTO/") || l.starts_with("FEDRAT/") || l.starts_with("MULTAX")
+    });
+    let (format, format_by) = if let Some(f) = options.format {
+        (f, "option")
+    } else if ext == "csv" {
+        (Format::Csv, "extension")
+    } else if apt_content {
+        (Format::Apt, "content")
+    } else if APT_EXTENSIONS.contains(&ext.as_str()) {
+        (Format::Apt, "extension")
+    } else if GCODE_EXTENSIONS.contains(&ext.as_str()) {
+        (Format::Gcode, "extension")
+    } else if upper.contains('G')
+        && upper
+            .lines()
+            .any(|l| l.trim_start().starts_with(['G', 'N', 'X', 'Y', 'Z']))
+    {
+        (Format::Gcode, "content")
+    } else {
+        return Err(Error::Usage(format!(
+            "{}: cannot tell the toolpath format (extension `.{ext}`, and the content has \
+             neither APT GOTO/ records nor G-code blocks); give --format apt|gcode|csv",
+            path.display()
+        )));
+    };
+    let (dialect, dialect_by) = if format != Format::Gcode {
+        (None, "")
+    } else if let Some(d) = options.dialect {
+        (Some(d), "option")
+    } else if let Some(d) = gcode::detect_dialect(&upper) {
+        (Some(d), "content")
+    } else if matches!(ext.as_str(), "mpf" | "spf") {
+        (Some(gcode::Dialect::Sinumerik), "extension")
+    } else {
+        (Some(gcode::Dialect::default()), "default")
+    };
+    Ok(Detected {
+        format,
+        dialect,
+        format_by,
+        dialect_by,
+    })
+}
+
+/// Reads any input with `options`, detecting what they leave open; says what was used.
+pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let text = String::from_utf8_lossy(&bytes);
+    let detected = detect(path, &text, options)?;
+    let input = match detected.format {
+        Format::Csv => Input::Joint(joint_csv::read(path)?),
+        Format::Apt => Input::Cl(apt::parse_for(path, &text, options.machine.as_ref())?),
+        Format::Gcode => Input::Cl(gcode::parse_for(
+            path,
+            &text,
+            detected.dialect.unwrap_or_default().spec(),
+            options.machine.as_ref(),
+        )?),
+    };
+    Ok((input, detected))
+}
+
 /// Any input path: cutter locations or joint positions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Input {
@@ -87,10 +312,9 @@ pub enum Input {
     Joint(joint_csv::JointPath),
 }
 
-/// Reads any input path, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
-/// `.nc`, `.gcode`, `.tap`: G-code in the default dialect, LinuxCNC; `.csv`: joint space).
+/// Reads any input path, detecting its format and dialect ([`detect`]).
 pub fn read_input(path: &Path) -> Result<Input> {
-    read_as(path, None, gcode::Dialect::default())
+    read_with(path, &ReadOptions::default()).map(|(input, _)| input)
 }
 
 /// An input format, to override the choice by extension.
@@ -101,48 +325,22 @@ pub enum Format {
     Csv,
 }
 
-/// Reads any input path: in `format` if given, else by extension; G-code in `dialect`.
+/// Reads any input path: in `format` if given, else detected; G-code in `dialect`.
 pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> Result<Input> {
-    let by_ext = || {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase())
-            .unwrap_or_default();
-        match ext.as_str() {
-            "csv" => Some(Format::Csv),
-            "ngc" | "nc" | "gcode" | "tap" => Some(Format::Gcode),
-            "cls" | "apt" | "cl" => Some(Format::Apt),
-            _ => None,
-        }
+    let options = ReadOptions {
+        format,
+        dialect: Some(dialect),
+        machine: None,
     };
-    match format.or_else(by_ext) {
-        Some(Format::Csv) => joint_csv::read(path).map(Input::Joint),
-        Some(Format::Gcode) => gcode::read(path, dialect).map(Input::Cl),
-        Some(Format::Apt) => apt::read(path).map(Input::Cl),
-        None => read(path).map(Input::Cl), // says what is wrong with the extension
-    }
+    read_with(path, &options).map(|(input, _)| input)
 }
 
-/// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
-/// `.nc`, `.gcode`, `.tap`: G-code in the default dialect, LinuxCNC).
+/// Reads a CL toolpath file (APT or G-code), detecting its format and dialect ([`detect`]).
 pub fn read(path: &Path) -> Result<Toolpath> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "cls" | "apt" | "cl" => apt::read(path),
-        "ngc" | "nc" | "gcode" | "tap" => gcode::read(path, gcode::Dialect::default()),
-        "" => Err(crate::error::Error::Usage(format!(
-            "{}: the toolpath file has no extension (expected .cls, .apt, .ngc, .nc, .gcode, \
-             .tap or .csv)",
-            path.display()
-        ))),
-        other => Err(crate::error::Error::Usage(format!(
-            "{}: unknown toolpath format `.{other}` (expected .cls, .apt, .ngc, .nc, .gcode, \
-             .tap or .csv)",
+    match read_with(path, &ReadOptions::default())? {
+        (Input::Cl(t), _) => Ok(t),
+        (Input::Joint(_), _) => Err(Error::Usage(format!(
+            "{}: a joint-space path, not a CL toolpath",
             path.display()
         ))),
     }

@@ -1,0 +1,305 @@
+//! Canned drilling cycles, expanded into the moves the control makes along the drilling axis
+//! (Z of the working plane; only G17 is read).
+//!
+//! Each hole is: position over the hole (done by the interpreter: a rapid in X Y at the current
+//! height; LinuxCNC and Fanuc first rapid up to R when the tool is below it), then the
+//! [`Step`]s below, each timed like any move (rapids at the machine's limits, feeds at the
+//! programmed feed) and every dwell counted as time.
+//!
+//! # Fanuc and LinuxCNC (`G73 G74 G76 G81–G89`, `G98`/`G99`, `R Z Q P K/L`)
+//!
+//! Rapid to R; then per cycle; then the return level: `G98` the initial level (the Z where the
+//! cycle mode began, or R if that is lower), `G99` R.
+//!
+//! | cycle | moves |
+//! |---|---|
+//! | G81 | feed to Z, rapid out |
+//! | G82 | feed to Z, dwell P, rapid out |
+//! | G83 | pecks of Q: feed Q deeper, rapid to R, rapid back to [`PECK_CLEARANCE_MM`] above the last depth, … (Fanuc's d, parameter 5115, is machine data: LinuxCNC's 0.010 in is assumed), rapid out |
+//! | G73 | pecks of Q with a short retract by [`PECK_CLEARANCE_MM`] (Fanuc parameter 5114 d) after each, rapid out |
+//! | G74, G84 | tapping: feed to Z, dwell P, feed back to R (the spindle reverses), rapid to the return level |
+//! | G85 | feed to Z, feed back to R |
+//! | G86 | feed to Z, rapid out (spindle stopped) |
+//! | G76 | fine boring: feed to Z, dwell P, shift Q in +X (the shift direction is Fanuc parameter 5101 RD1/RD2: +X assumed), rapid out, shift back |
+//! | G87 | back boring: rapid to R (below the hole), feed up to Z, rapid to the initial level (the shifts of the oriented tool are not modelled) |
+//! | G88 | feed to Z, dwell P, (the operator retracts by hand: not timed, a warning), rapid out |
+//! | G89 | feed to Z, dwell P, feed back to R |
+//!
+//! P is seconds on LinuxCNC and milliseconds on Fanuc. A peck cycle with Q ≤ 0 or without Q
+//! drills in one pass, with a warning. A hole needs at most [`MAX_PECKS`] pecks, else it is an
+//! error. Repeats `L` (LinuxCNC) / `K` (Fanuc) drill the hole again, under G91 each one
+//! shifted by the X Y increment, at most [`MAX_REPEATS`].
+//!
+//! # Sinumerik (`CYCLE81`–`CYCLE89`, `MCALL`)
+//!
+//! Parameters (lengths in the current units): RTP retract plane, RFP reference plane, SDIS
+//! safety distance, DP final depth (absolute) or DPR (relative to RFP). From the position: rapid
+//! to RFP + SDIS, then per cycle, then rapid to RTP. CYCLE81: feed to DP. CYCLE82: feed, dwell
+//! DTB s. CYCLE83 (…, FDEP, FDPR, DAM, DTB, DTS, FRF, VARI): the first depth FDEP (absolute) or
+//! RFP − FDPR, later steps each DAM shorter (never below DAM); VARI = 1 (swarf removal): rapid
+//! to RFP + SDIS after each step, dwell DTS, rapid back to [`PECK_CLEARANCE_MM`] above the
+//! depth; VARI = 0 (chip breaking): retract by [`SINUMERIK_CHIP_BREAK_MM`] (the cycle's default
+//! _VRT); dwell DTB at the final depth. CYCLE84 (rigid tapping): feed to DP, dwell DTB, feed
+//! back to RFP + SDIS — at the programmed F (the post's pitch × speed; MPIT/PIT are not read,
+//! a warning). CYCLE85 (…, DTB, FFR, RFF): feed FFR in, dwell, feed RFF out (0 or empty: the
+//! programmed F). CYCLE86: feed, dwell, rapid out (the lift-off moves RPA/RPO/RPAP are not
+//! read). CYCLE87/CYCLE88: feed, (CYCLE88: dwell), the operator's stop (M0: not timed, a
+//! warning), rapid out. CYCLE89: feed, dwell, feed out. `CYCLE76`/`CYCLE77` are Sinumerik's
+//! spigot milling cycles, not drilling: an error. A cycle whose RTP lies below RFP + SDIS
+//! retracts into the part as written, with a warning.
+
+/// Clearance of a peck's rapid return above the last depth (and G73's retract), mm: LinuxCNC's
+/// 0.010 in; on Fanuc it is parameter 5114/5115.
+pub const PECK_CLEARANCE_MM: f64 = 0.254;
+/// Sinumerik CYCLE83 chip-breaking retract (the cycle's default `_VRT`), mm.
+pub const SINUMERIK_CHIP_BREAK_MM: f64 = 1.0;
+/// Most pecks in one hole.
+pub const MAX_PECKS: usize = 10_000;
+/// Most repeats of one hole (`L`, `K`).
+pub const MAX_REPEATS: usize = 1_000;
+
+/// One move of a cycle along the drilling axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Step {
+    /// Rapid to this Z (mm).
+    Rapid(f64),
+    /// Feed to this Z (mm) at the programmed feed, or at this feed (mm/min).
+    Feed(f64, Option<f64>),
+    /// Dwell, seconds.
+    Dwell(f64),
+    /// Rapid shift in X by this much (mm), at the current Z.
+    ShiftX(f64),
+}
+
+/// Fanuc / LinuxCNC cycles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    G73,
+    G74,
+    G76,
+    G81,
+    G82,
+    G83,
+    G84,
+    G85,
+    G86,
+    G87,
+    G88,
+    G89,
+}
+
+impl Kind {
+    pub fn from_code(code: u32) -> Option<Kind> {
+        Some(match code {
+            73 => Kind::G73,
+            74 => Kind::G74,
+            76 => Kind::G76,
+            81 => Kind::G81,
+            82 => Kind::G82,
+            83 => Kind::G83,
+            84 => Kind::G84,
+            85 => Kind::G85,
+            86 => Kind::G86,
+            87 => Kind::G87,
+            88 => Kind::G88,
+            89 => Kind::G89,
+            _ => return None,
+        })
+    }
+}
+
+/// The data of one Fanuc/LinuxCNC hole, mm and seconds.
+#[derive(Debug, Clone, Copy)]
+pub struct Hole {
+    pub kind: Kind,
+    pub r: f64,
+    pub bottom: f64,
+    /// Peck depth (G73, G83) or shift (G76), mm.
+    pub q: Option<f64>,
+    pub dwell: f64,
+    /// Return level: the initial level (G98) or R (G99).
+    pub clear: f64,
+    pub initial: f64,
+}
+
+/// Pecks from `top` to `bottom` (downwards) of `q` each: the depths reached.
+fn pecks(top: f64, bottom: f64, q: f64) -> Result<Vec<f64>, String> {
+    let depth = top - bottom;
+    let n = (depth / q).ceil();
+    if n.is_nan() || n > MAX_PECKS as f64 {
+        return Err(format!(
+            "{n} pecks of {q} mm in one hole (more than {MAX_PECKS}): check Q"
+        ));
+    }
+    let n = (n as usize).max(1);
+    Ok((1..=n)
+        .map(|k| if k == n { bottom } else { top - k as f64 * q })
+        .collect())
+}
+
+/// The steps of a hole, from R on (the interpreter has rapidded to R already). The second
+/// value names what is not timed, if anything (for a warning).
+pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String> {
+    use Step::*;
+    let mut s = Vec::new();
+    let mut note = None;
+    let peck = |q: Option<f64>| q.filter(|q| *q > 0.0);
+    match h.kind {
+        Kind::G81 => s.extend([Feed(h.bottom, None), Rapid(h.clear)]),
+        Kind::G82 => s.extend([Feed(h.bottom, None), Dwell(h.dwell), Rapid(h.clear)]),
+        Kind::G83 | Kind::G73 => match peck(h.q) {
+            None => {
+                note = Some("peck depth Q missing or ≤ 0: the hole is drilled in one pass");
+                s.extend([Feed(h.bottom, None), Rapid(h.clear)]);
+            }
+            Some(q) => {
+                let depths = pecks(h.r, h.bottom, q)?;
+                let mut last = h.r;
+                for (k, d) in depths.iter().enumerate() {
+                    if k > 0 {
+                        if h.kind == Kind::G83 {
+                            s.push(Rapid(h.r));
+                            s.push(Rapid((last + PECK_CLEARANCE_MM).min(h.r)));
+                        } else {
+                            s.push(Rapid((last + PECK_CLEARANCE_MM).min(h.r)));
+                        }
+                    }
+                    s.push(Feed(*d, None));
+                    last = *d;
+                }
+                s.push(Rapid(h.clear));
+            }
+        },
+        Kind::G74 | Kind::G84 => {
+            s.extend([Feed(h.bottom, None), Dwell(h.dwell), Feed(h.r, None)]);
+            s.push(Rapid(h.clear));
+        }
+        Kind::G85 => s.extend([Feed(h.bottom, None), Feed(h.r, None), Rapid(h.clear)]),
+        Kind::G86 => s.extend([Feed(h.bottom, None), Rapid(h.clear)]),
+        Kind::G89 => s.extend([
+            Feed(h.bottom, None),
+            Dwell(h.dwell),
+            Feed(h.r, None),
+            Rapid(h.clear),
+        ]),
+        Kind::G76 => {
+            let shift = h.q.unwrap_or(0.0).abs();
+            s.extend([Feed(h.bottom, None), Dwell(h.dwell)]);
+            if shift > 0.0 {
+                s.push(ShiftX(shift));
+            }
+            s.push(Rapid(h.clear));
+            if shift > 0.0 {
+                s.push(ShiftX(-shift));
+            }
+        }
+        Kind::G87 => s.extend([Feed(h.bottom, None), Rapid(h.initial.max(h.bottom))]),
+        Kind::G88 => {
+            note = Some("G88 stops for a manual retract: the operator's time is not counted");
+            s.extend([Feed(h.bottom, None), Dwell(h.dwell), Rapid(h.clear)]);
+        }
+    }
+    Ok((s, note))
+}
+
+/// Sinumerik `CYCLE8x(...)` parameters, lengths in mm (already scaled), positional.
+pub fn sinumerik_steps(
+    number: u32,
+    p: &[Option<f64>],
+) -> Result<(Vec<Step>, Vec<&'static str>), String> {
+    use Step::*;
+    let get = |k: usize| p.get(k).copied().flatten();
+    let name = format!("CYCLE{number}");
+    let rtp = get(0).ok_or_else(|| format!("{name}: RTP (retract plane) is missing"))?;
+    let rfp = get(1).unwrap_or(0.0);
+    let sdis = get(2).unwrap_or(0.0).abs();
+    let dp = match (get(3), get(4)) {
+        (Some(dp), _) => dp,
+        (None, Some(dpr)) => rfp - dpr.abs(),
+        (None, None) => return Err(format!("{name}: neither DP nor DPR (the depth) is given")),
+    };
+    let safe = rfp + sdis;
+    let mut notes = Vec::new();
+    if rtp < safe {
+        notes
+            .push("retract plane RTP below RFP + SDIS: the retract moves into the part as written");
+    }
+    let dwell = |k: usize| get(k).unwrap_or(0.0).max(0.0);
+    let mut s = vec![Rapid(safe)];
+    match number {
+        81 => s.push(Feed(dp, None)),
+        82 => s.extend([Feed(dp, None), Dwell(dwell(5))]),
+        83 => {
+            let first = match (get(5), get(6)) {
+                (Some(fdep), _) => rfp - fdep,
+                (None, Some(fdpr)) => fdpr.abs(),
+                (None, None) => rfp - dp,
+            };
+            let first = if first > 0.0 { first } else { rfp - dp };
+            let dam = get(7).unwrap_or(0.0).abs();
+            let (dtb, dts) = (dwell(8), dwell(9));
+            let vari = get(11).unwrap_or(0.0);
+            let mut depth = rfp;
+            let mut step = first;
+            let mut n = 0usize;
+            loop {
+                let next = (depth - step).max(dp);
+                if n > 0 {
+                    if vari == 1.0 {
+                        s.push(Rapid(safe));
+                        if dts > 0.0 {
+                            s.push(Dwell(dts));
+                        }
+                        s.push(Rapid(depth + PECK_CLEARANCE_MM));
+                    } else {
+                        s.push(Rapid(depth + SINUMERIK_CHIP_BREAK_MM));
+                    }
+                }
+                s.push(Feed(next, None));
+                depth = next;
+                n += 1;
+                if depth <= dp {
+                    break;
+                }
+                if n >= MAX_PECKS {
+                    return Err(format!(
+                        "{name}: more than {MAX_PECKS} pecks in one hole: check FDEP/FDPR/DAM"
+                    ));
+                }
+                if dam > 0.0 {
+                    step = (step - dam).max(dam);
+                }
+            }
+            if dtb > 0.0 {
+                s.push(Dwell(dtb));
+            }
+        }
+        84 => {
+            notes.push("CYCLE84 taps at the programmed F (pitch MPIT/PIT not read)");
+            s.extend([Feed(dp, None), Dwell(dwell(5)), Feed(safe, None)]);
+        }
+        85 => {
+            let feed = |k: usize| get(k).filter(|f| *f > 0.0);
+            s.extend([Feed(dp, feed(6)), Dwell(dwell(5)), Feed(safe, feed(7))]);
+        }
+        86 => s.extend([Feed(dp, None), Dwell(dwell(5))]),
+        87 => {
+            notes.push("CYCLE87 stops (M0) for the operator: that time is not counted");
+            s.push(Feed(dp, None));
+        }
+        88 => {
+            notes.push("CYCLE88 stops (M0) for the operator: that time is not counted");
+            s.extend([Feed(dp, None), Dwell(dwell(5))]);
+        }
+        89 => s.extend([Feed(dp, None), Dwell(dwell(5)), Feed(safe, None)]),
+        76 | 77 => {
+            return Err(format!(
+                "{name} is Sinumerik's spigot milling cycle, not a drilling cycle, and is not \
+                 supported: post the operation as G0/G1/G2/G3 (or as CYCLE81–CYCLE89)"
+            ));
+        }
+        _ => return Err(format!("{name} is not a drilling cycle feedopt knows")),
+    }
+    s.push(Rapid(rtp));
+    Ok((s, notes))
+}

@@ -1,0 +1,839 @@
+//! Dialects as data: the tables the one interpreter reads.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::toolpath::Units;
+
+// ---------------------------------------------------------------------------------------------
+// Dialects as data
+// ---------------------------------------------------------------------------------------------
+
+/// The built-in dialects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Dialect {
+    /// LinuxCNC rs274ngc, with the trt sims' `M428`/`M429` switchkins remaps.
+    #[default]
+    LinuxCnc,
+    /// Fanuc (Series 30i style, M series), 5-axis as far as `G43.4`/`G43.5` need.
+    Fanuc,
+    /// Siemens Sinumerik 840D, 5-axis as far as `TRAORI` and tool vectors need.
+    Sinumerik,
+}
+
+impl Dialect {
+    /// All built-in dialects.
+    pub const ALL: [Dialect; 3] = [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik];
+
+    /// The dialect's table.
+    pub fn spec(self) -> &'static DialectSpec {
+        match self {
+            Dialect::LinuxCnc => &LINUXCNC,
+            Dialect::Fanuc => &FANUC,
+            Dialect::Sinumerik => &SINUMERIK,
+        }
+    }
+
+    /// The name used on the command line (`linuxcnc`, `fanuc`, `sinumerik`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::LinuxCnc => "linuxcnc",
+            Dialect::Fanuc => "fanuc",
+            Dialect::Sinumerik => "sinumerik",
+        }
+    }
+}
+
+impl fmt::Display for Dialect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Dialect {
+    type Err = Error;
+
+    /// `linuxcnc`, `fanuc` or `sinumerik` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self> {
+        let wanted = s.trim().to_ascii_lowercase();
+        Dialect::ALL
+            .into_iter()
+            .find(|d| d.name() == wanted)
+            .ok_or_else(|| {
+                Error::Usage(format!(
+                    "unknown G-code dialect `{s}` (expected linuxcnc, fanuc or sinumerik)"
+                ))
+            })
+    }
+}
+
+/// What `;` means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Semicolon {
+    /// A comment to the end of the line.
+    Comment,
+    /// The end of a block (ISO EOB): the rest of the line is another block.
+    EndOfBlock,
+}
+
+/// How whitespace outside comments is treated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spaces {
+    /// Removed before reading (`G1  X  16.339` is `G1X16.339`); words are single letters.
+    Ignored,
+    /// Separates words, which may then be keywords (`TRAORI`) or `NAME=value`.
+    Separate,
+}
+
+/// What a letter or named word addresses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Address {
+    /// Axis 0–5: X Y Z (length) A B C (degrees).
+    Axis(usize),
+    /// Arc centre 0–2 (I J K); under [`Tcp::OnIjkVector`] on G0/G1 blocks, the tool vector.
+    ArcCentre(usize),
+    /// Tool-vector component 0–2 (Sinumerik `A3= B3= C3=`).
+    ToolVector(usize),
+    /// Arc radius (`R`, Sinumerik `CR=`).
+    Radius,
+    /// Number of turns of an arc, 1 = the plain arc (LinuxCNC `P` on G2/G3; ignored elsewhere).
+    ArcTurns,
+    /// Extra full turns of an arc (Sinumerik `TURN=`).
+    ArcExtraTurns,
+    /// Feed `F`.
+    Feed,
+    /// A G code, looked up in [`DialectSpec::g_codes`].
+    G,
+    /// An M code, looked up in [`DialectSpec::m_codes`].
+    M,
+    /// Accepted, no effect on motion (N, S, T, H, D, parameters of other codes).
+    Ignored,
+    /// Accepted but not modelled: skipped with this warning (U V W axes).
+    Unmodelled(&'static str),
+    /// Rejected with this error (LinuxCNC O-words, Sinumerik `L` subprogram calls).
+    Unsupported(&'static str),
+}
+
+/// Motion modes (modal group 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    Rapid,
+    Linear,
+    ArcCw,
+    ArcCcw,
+}
+
+/// Arc planes: XY (G17), ZX (G18), YZ (G19).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plane {
+    Xy,
+    Zx,
+    Yz,
+}
+
+impl Plane {
+    /// (first, second, normal) axis indices, a right-handed triple.
+    pub(super) fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Plane::Xy => (0, 1, 2),
+            Plane::Zx => (2, 0, 1),
+            Plane::Yz => (1, 2, 0),
+        }
+    }
+
+    pub(super) fn code(self) -> &'static str {
+        match self {
+            Plane::Xy => "G17",
+            Plane::Zx => "G18",
+            Plane::Yz => "G19",
+        }
+    }
+}
+
+/// Absolute or incremental values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Distance {
+    Absolute,
+    Incremental,
+}
+
+/// Feed modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeedMode {
+    /// G93: F is 1 / block time in minutes.
+    InverseTime,
+    /// G94: F is length units (or degrees) per minute.
+    PerMinute,
+}
+
+/// Tool-tip (TCP) mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tcp {
+    /// X Y Z are not the tool tip (identity or other kinematics).
+    Off,
+    /// X Y Z are the tool tip; orientation by rotary words or tool-vector words.
+    On,
+    /// As `On`, and I J K on G0/G1 blocks are the tool vector (Fanuc G43.5).
+    OnIjkVector,
+}
+
+/// What a G code, M code or keyword does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    Motion(Motion),
+    /// Cancels the motion mode (LinuxCNC G80): axis words need a new G0–G3.
+    MotionCancel,
+    Plane(Plane),
+    /// Length units; `feed: true` when F is scaled too (all but Sinumerik G70/G71).
+    Units {
+        units: Units,
+        feed: bool,
+    },
+    Distance(Distance),
+    /// I J K absolute (LinuxCNC G90.1) or incremental (G91.1).
+    ArcDistance(Distance),
+    FeedMode(FeedMode),
+    Tcp(Tcp),
+    /// G53: this block's axis words are machine coordinates.
+    MachineCoordinates,
+    /// The block's axis words belong to this code, not to a move (dwell `G4`); the warning
+    /// text says what is not modelled.
+    NoMotion(&'static str),
+    /// Stop reading (M2, M30).
+    ProgramEnd,
+    /// A Fanuc/LinuxCNC canned cycle (73, 74, 76, 81–89): modal until `G80` or a motion code.
+    Cycle(u32),
+    /// `G80` (Fanuc): cancels the canned cycle; the motion mode stays.
+    CycleCancel,
+    /// `G98` (false: return to the initial level) / `G99` (true: to R).
+    CycleReturn(bool),
+    /// `G28` (1) / `G30` (2): via an intermediate point to a reference point.
+    Reference(u8),
+    /// `G4`: dwell.
+    Dwell,
+    /// Sinumerik programmable frame instructions.
+    Frame(FrameOp),
+    /// Sinumerik `CYCLE800(...)` (swivel plane; `CYCLE800()` cancels).
+    Swivel,
+    /// Fanuc `G68.2` tilted working plane.
+    TiltedPlane,
+    /// Fanuc `G69`: cancels `G68.2`.
+    TiltedPlaneCancel,
+    /// Sinumerik `MCALL`: the cycle in the same block is called after every positioning
+    /// block; bare `MCALL` cancels.
+    ModalCall,
+    /// Sinumerik `CYCLE81`–`CYCLE89` (and the spigot cycles 76/77, an error).
+    SinumerikCycle(u32),
+    /// Accepted, no effect on motion.
+    Ignored,
+    /// Accepted with this warning.
+    Note(&'static str),
+    /// Rejected with this error.
+    Unsupported(&'static str),
+}
+
+/// Sinumerik programmable frame instructions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameOp {
+    Trans,
+    ATrans,
+    Rot,
+    ARot,
+}
+
+/// Numbers without a decimal point count least input increments (Fanuc's default).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegerIncrements {
+    /// Length increment under metric units, mm.
+    pub mm: f64,
+    /// Length increment under inch units, inch.
+    pub inch: f64,
+    /// Rotary increment, degrees.
+    pub deg: f64,
+}
+
+/// A dialect, as data the interpreter reads. Code tables map a code (as written after `G`/`M`,
+/// without leading zeros: `"1"`, `"43.4"`) or an inclusive range of whole codes (`"81..89"`)
+/// to an [`Action`]; codes and words missing from the tables are warnings.
+#[derive(Debug, Clone, Copy)]
+pub struct DialectSpec {
+    /// Name used in messages.
+    pub name: &'static str,
+    /// `( … )` are comments.
+    pub paren_comments: bool,
+    pub semicolon: Semicolon,
+    pub spaces: Spaces,
+    /// Single-letter words.
+    pub letters: &'static [(char, Address)],
+    /// `NAME=value` words with a name longer than one letter (Sinumerik).
+    pub named: &'static [(&'static str, Address)],
+    pub g_codes: &'static [(&'static str, Action)],
+    pub m_codes: &'static [(&'static str, Action)],
+    /// Bare keywords (Sinumerik `TRAORI`), possibly followed by `( … )` arguments.
+    pub keywords: &'static [(&'static str, Action)],
+    /// Motion mode at program start (`None`: axis words need a G0–G3 first).
+    pub initial_motion: Option<Motion>,
+    /// Every `G94` sets F to 0 (LinuxCNC); otherwise only leaving G93 forgets F.
+    pub g94_clears_feed: bool,
+    pub integer_increments: Option<IntegerIncrements>,
+}
+
+use Action::{
+    ArcDistance, Distance as Dist, FeedMode as Fm, MachineCoordinates, Motion as Mo, MotionCancel,
+    NoMotion, Note, ProgramEnd, Unsupported as Unsup,
+};
+use Address::{ArcCentre, Axis, Unmodelled};
+
+const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
+const OFFSETS: &str = "coordinate offsets that shift program coordinates (G92, G52) are not \
+                       supported";
+const SPLINES: &str = "spline and polynomial interpolation is not supported";
+const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
+const PER_REV: &str = "feed per revolution (G95) is not supported";
+const COMP: &str = "cutter radius compensation is not applied: the programmed path is used";
+const G10: &str = "G10 sets a tool or work offset and moves nothing; the program's coordinates \
+                   are used as written";
+const UVW: &str = "U V W axes are not modelled: word ignored";
+const TRANSFORM: &str = "coordinate transformations (polar, rotation, scaling, mirroring, tilted \
+                         planes) are not supported";
+
+/// LinuxCNC (rs274ngc). M428/M429/M430 are the trt sims' switchkins remaps (TCP / identity /
+/// user kinematics); M100–M199 are user M codes (ignored).
+pub static LINUXCNC: DialectSpec = DialectSpec {
+    name: "LinuxCNC",
+    paren_comments: true,
+    semicolon: Semicolon::Comment,
+    spaces: Spaces::Ignored,
+    letters: &[
+        ('X', Axis(0)),
+        ('Y', Axis(1)),
+        ('Z', Axis(2)),
+        ('A', Axis(3)),
+        ('B', Axis(4)),
+        ('C', Axis(5)),
+        ('I', ArcCentre(0)),
+        ('J', ArcCentre(1)),
+        ('K', ArcCentre(2)),
+        ('R', Address::Radius),
+        ('P', Address::ArcTurns),
+        ('F', Address::Feed),
+        ('G', Address::G),
+        ('M', Address::M),
+        ('N', Address::Ignored),
+        ('S', Address::Ignored),
+        ('T', Address::Ignored),
+        ('H', Address::Ignored),
+        ('D', Address::Ignored),
+        ('E', Address::Ignored),
+        ('L', Address::Ignored),
+        ('Q', Address::Ignored),
+        ('U', Unmodelled(UVW)),
+        ('V', Unmodelled(UVW)),
+        ('W', Unmodelled(UVW)),
+        (
+            'O',
+            Address::Unsupported("O-word subroutines and control flow are not supported"),
+        ),
+    ],
+    named: &[],
+    g_codes: &[
+        ("0", Mo(Motion::Rapid)),
+        ("1", Mo(Motion::Linear)),
+        ("2", Mo(Motion::ArcCw)),
+        ("3", Mo(Motion::ArcCcw)),
+        ("4", Action::Dwell),
+        ("5", Unsup(SPLINES)),
+        ("5.1", Unsup(SPLINES)),
+        ("5.2", Unsup(SPLINES)),
+        ("5.3", Unsup(SPLINES)),
+        ("7", Unsup("lathe diameter mode (G7) is not supported")),
+        ("8", Action::Ignored),
+        ("10", NoMotion(G10)),
+        ("17", Action::Plane(Plane::Xy)),
+        ("18", Action::Plane(Plane::Zx)),
+        ("19", Action::Plane(Plane::Yz)),
+        ("17.1", Unsup("U V W arc planes are not supported")),
+        ("18.1", Unsup("U V W arc planes are not supported")),
+        ("19.1", Unsup("U V W arc planes are not supported")),
+        (
+            "20",
+            Action::Units {
+                units: Units::Inch,
+                feed: true,
+            },
+        ),
+        (
+            "21",
+            Action::Units {
+                units: Units::Mm,
+                feed: true,
+            },
+        ),
+        ("28", Action::Reference(1)),
+        ("28.1", Action::Ignored),
+        ("30", Action::Reference(2)),
+        ("30.1", Action::Ignored),
+        ("33", Unsup(THREADS)),
+        ("33.1", Unsup(THREADS)),
+        ("38.2", Unsup("probing moves are not supported")),
+        ("38.3", Unsup("probing moves are not supported")),
+        ("38.4", Unsup("probing moves are not supported")),
+        ("38.5", Unsup("probing moves are not supported")),
+        ("40", Action::Ignored),
+        ("41", Note(COMP)),
+        ("41.1", Note(COMP)),
+        ("42", Note(COMP)),
+        ("42.1", Note(COMP)),
+        ("43", Action::Ignored),
+        ("43.1", Action::Ignored),
+        ("43.2", Action::Ignored),
+        ("49", Action::Ignored),
+        ("52", Unsup(OFFSETS)),
+        ("53", MachineCoordinates),
+        ("54..59", Action::Ignored),
+        ("59.1", Action::Ignored),
+        ("59.2", Action::Ignored),
+        ("59.3", Action::Ignored),
+        ("61", Action::Ignored),
+        ("61.1", Action::Ignored),
+        ("64", Action::Ignored),
+        ("70..72", Unsup(CANNED)),
+        ("73", Action::Cycle(73)),
+        ("74", Action::Cycle(74)),
+        (
+            "76",
+            Unsup("G76 is LinuxCNC's threading cycle: not supported"),
+        ),
+        ("80", MotionCancel),
+        ("81", Action::Cycle(81)),
+        ("82", Action::Cycle(82)),
+        ("83", Action::Cycle(83)),
+        ("84", Action::Cycle(84)),
+        ("85", Action::Cycle(85)),
+        ("86", Action::Cycle(86)),
+        ("87", Action::Cycle(87)),
+        ("88", Action::Cycle(88)),
+        ("89", Action::Cycle(89)),
+        ("90", Dist(Distance::Absolute)),
+        ("91", Dist(Distance::Incremental)),
+        ("90.1", ArcDistance(Distance::Absolute)),
+        ("91.1", ArcDistance(Distance::Incremental)),
+        ("92", Unsup(OFFSETS)),
+        ("92.1", Action::Ignored),
+        ("92.2", Action::Ignored),
+        ("92.3", Unsup(OFFSETS)),
+        ("93", Fm(FeedMode::InverseTime)),
+        ("94", Fm(FeedMode::PerMinute)),
+        ("95", Unsup(PER_REV)),
+        ("96", Action::Ignored),
+        ("97", Action::Ignored),
+        ("98", Action::CycleReturn(false)),
+        ("99", Action::CycleReturn(true)),
+    ],
+    m_codes: &[
+        ("0", Action::Ignored),
+        ("1", Action::Ignored),
+        ("2", ProgramEnd),
+        ("3..9", Action::Ignored),
+        ("19", Action::Ignored),
+        ("30", ProgramEnd),
+        ("48..53", Action::Ignored),
+        ("60..68", Action::Ignored),
+        ("70..73", Action::Ignored),
+        ("100..199", Action::Ignored),
+        ("428", Action::Tcp(Tcp::On)),
+        ("429", Action::Tcp(Tcp::Off)),
+        ("430", Action::Tcp(Tcp::Off)),
+    ],
+    keywords: &[],
+    initial_motion: None,
+    g94_clears_feed: true,
+    integer_increments: None,
+};
+
+/// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
+/// other group-08 code (G43, G44, G49) switches TCP off.
+pub static FANUC: DialectSpec = DialectSpec {
+    name: "Fanuc",
+    paren_comments: true,
+    semicolon: Semicolon::EndOfBlock,
+    spaces: Spaces::Ignored,
+    letters: &[
+        ('X', Axis(0)),
+        ('Y', Axis(1)),
+        ('Z', Axis(2)),
+        ('A', Axis(3)),
+        ('B', Axis(4)),
+        ('C', Axis(5)),
+        ('I', ArcCentre(0)),
+        ('J', ArcCentre(1)),
+        ('K', ArcCentre(2)),
+        ('R', Address::Radius),
+        ('F', Address::Feed),
+        ('G', Address::G),
+        ('M', Address::M),
+        ('N', Address::Ignored),
+        ('O', Address::Ignored),
+        ('S', Address::Ignored),
+        ('T', Address::Ignored),
+        ('H', Address::Ignored),
+        ('D', Address::Ignored),
+        ('E', Address::Ignored),
+        ('L', Address::Ignored),
+        ('P', Address::Ignored),
+        ('Q', Address::Ignored),
+        ('U', Unmodelled(UVW)),
+        ('V', Unmodelled(UVW)),
+        ('W', Unmodelled(UVW)),
+    ],
+    named: &[],
+    g_codes: &[
+        ("0", Mo(Motion::Rapid)),
+        ("1", Mo(Motion::Linear)),
+        ("2", Mo(Motion::ArcCw)),
+        ("3", Mo(Motion::ArcCcw)),
+        ("4", Action::Dwell),
+        ("5.1", Action::Ignored),
+        ("6.2", Unsup(SPLINES)),
+        ("8", Action::Ignored),
+        ("9", Action::Ignored),
+        ("10", NoMotion(G10)),
+        ("11", Action::Ignored),
+        ("15", Action::Ignored),
+        ("16", Unsup(TRANSFORM)),
+        ("17", Action::Plane(Plane::Xy)),
+        ("18", Action::Plane(Plane::Zx)),
+        ("19", Action::Plane(Plane::Yz)),
+        (
+            "20",
+            Action::Units {
+                units: Units::Inch,
+                feed: true,
+            },
+        ),
+        (
+            "21",
+            Action::Units {
+                units: Units::Mm,
+                feed: true,
+            },
+        ),
+        ("28", Action::Reference(1)),
+        (
+            "29",
+            Unsup("G29 (return from the reference point) is not supported"),
+        ),
+        ("30", Action::Reference(2)),
+        ("33", Unsup(THREADS)),
+        ("40", Action::Ignored),
+        ("41", Note(COMP)),
+        ("42", Note(COMP)),
+        ("43", Action::Tcp(Tcp::Off)),
+        ("44", Action::Tcp(Tcp::Off)),
+        ("43.4", Action::Tcp(Tcp::On)),
+        ("43.5", Action::Tcp(Tcp::OnIjkVector)),
+        ("49", Action::Tcp(Tcp::Off)),
+        ("50", Action::Ignored),
+        ("51", Unsup(TRANSFORM)),
+        ("50.1", Action::Ignored),
+        ("51.1", Unsup(TRANSFORM)),
+        ("52", Unsup(OFFSETS)),
+        ("53", MachineCoordinates),
+        ("53.1", Action::Ignored),
+        ("54..59", Action::Ignored),
+        ("54.1", Action::Ignored),
+        ("61..64", Action::Ignored),
+        ("65", Unsup("macro calls (G65/G66) are not supported")),
+        ("66", Unsup("macro calls (G65/G66) are not supported")),
+        ("67", Action::Ignored),
+        ("68", Unsup(TRANSFORM)),
+        ("68.2", Action::TiltedPlane),
+        ("69", Action::TiltedPlaneCancel),
+        ("73", Action::Cycle(73)),
+        ("74", Action::Cycle(74)),
+        ("75", Unsup(CANNED)),
+        ("76", Action::Cycle(76)),
+        ("77..79", Unsup(CANNED)),
+        ("80", Action::CycleCancel),
+        ("81", Action::Cycle(81)),
+        ("82", Action::Cycle(82)),
+        ("83", Action::Cycle(83)),
+        ("84", Action::Cycle(84)),
+        ("85", Action::Cycle(85)),
+        ("86", Action::Cycle(86)),
+        ("87", Action::Cycle(87)),
+        ("88", Action::Cycle(88)),
+        ("89", Action::Cycle(89)),
+        ("234", Action::Tcp(Tcp::On)),
+        ("254", Action::Ignored),
+        ("255", Action::Ignored),
+        ("90", Dist(Distance::Absolute)),
+        ("91", Dist(Distance::Incremental)),
+        ("92", Unsup(OFFSETS)),
+        ("93", Fm(FeedMode::InverseTime)),
+        ("94", Fm(FeedMode::PerMinute)),
+        ("95", Unsup(PER_REV)),
+        ("96", Action::Ignored),
+        ("97", Action::Ignored),
+        ("98", Action::CycleReturn(false)),
+        ("99", Action::CycleReturn(true)),
+    ],
+    m_codes: &[
+        ("0", Action::Ignored),
+        ("1", Action::Ignored),
+        ("2", ProgramEnd),
+        ("3..9", Action::Ignored),
+        ("19", Action::Ignored),
+        ("29", Action::Ignored),
+        ("30", ProgramEnd),
+        ("98", Unsup("subprogram calls (M98) are not supported")),
+        ("99", ProgramEnd),
+    ],
+    keywords: &[],
+    initial_motion: Some(Motion::Rapid),
+    g94_clears_feed: false,
+    integer_increments: Some(IntegerIncrements {
+        mm: 0.001,
+        inch: 0.0001,
+        deg: 0.001,
+    }),
+};
+
+/// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
+/// TRAFOOF = off.
+pub static SINUMERIK: DialectSpec = DialectSpec {
+    name: "Sinumerik",
+    paren_comments: false,
+    semicolon: Semicolon::Comment,
+    spaces: Spaces::Separate,
+    letters: &[
+        ('X', Axis(0)),
+        ('Y', Axis(1)),
+        ('Z', Axis(2)),
+        ('A', Axis(3)),
+        ('B', Axis(4)),
+        ('C', Axis(5)),
+        ('I', ArcCentre(0)),
+        ('J', ArcCentre(1)),
+        ('K', ArcCentre(2)),
+        ('F', Address::Feed),
+        ('G', Address::G),
+        ('M', Address::M),
+        ('N', Address::Ignored),
+        ('S', Address::Ignored),
+        ('T', Address::Ignored),
+        ('D', Address::Ignored),
+        ('H', Address::Ignored),
+        ('P', Address::Ignored),
+        (
+            'L',
+            Address::Unsupported("subprogram calls (L…) are not supported"),
+        ),
+    ],
+    named: &[
+        ("A3", Address::ToolVector(0)),
+        ("B3", Address::ToolVector(1)),
+        ("C3", Address::ToolVector(2)),
+        ("CR", Address::Radius),
+        ("TURN", Address::ArcExtraTurns),
+        (
+            "AR",
+            Address::Unsupported("arcs by opening angle (AR=) are not supported"),
+        ),
+        (
+            "AP",
+            Address::Unsupported("polar coordinates (AP=, RP=) are not supported"),
+        ),
+        (
+            "RP",
+            Address::Unsupported("polar coordinates (AP=, RP=) are not supported"),
+        ),
+    ],
+    g_codes: &[
+        ("0", Mo(Motion::Rapid)),
+        ("1", Mo(Motion::Linear)),
+        ("2", Mo(Motion::ArcCw)),
+        ("3", Mo(Motion::ArcCcw)),
+        ("4", Action::Dwell),
+        ("9", Action::Ignored),
+        ("17", Action::Plane(Plane::Xy)),
+        ("18", Action::Plane(Plane::Zx)),
+        ("19", Action::Plane(Plane::Yz)),
+        (
+            "25",
+            NoMotion("G25/G26 working-area limits are not modelled"),
+        ),
+        (
+            "26",
+            NoMotion("G25/G26 working-area limits are not modelled"),
+        ),
+        ("33", Unsup(THREADS)),
+        ("40", Action::Ignored),
+        ("41", Note(COMP)),
+        ("42", Note(COMP)),
+        ("53", MachineCoordinates),
+        ("60", Action::Ignored),
+        ("62", Action::Ignored),
+        ("621", Action::Ignored),
+        ("63", Action::Ignored),
+        ("64", Action::Ignored),
+        (
+            "70",
+            Action::Units {
+                units: Units::Inch,
+                feed: false,
+            },
+        ),
+        (
+            "71",
+            Action::Units {
+                units: Units::Mm,
+                feed: false,
+            },
+        ),
+        ("54..57", Action::Ignored),
+        ("90", Dist(Distance::Absolute)),
+        ("91", Dist(Distance::Incremental)),
+        ("93", Fm(FeedMode::InverseTime)),
+        ("94", Fm(FeedMode::PerMinute)),
+        ("95", Unsup(PER_REV)),
+        ("96", Action::Ignored),
+        ("97", Action::Ignored),
+        ("110..112", Unsup(TRANSFORM)),
+        ("153", MachineCoordinates),
+        ("331", Unsup(THREADS)),
+        ("332", Unsup(THREADS)),
+        ("450", Action::Ignored),
+        ("451", Action::Ignored),
+        ("500", Action::Ignored),
+        ("505..599", Action::Ignored),
+        ("601..603", Action::Ignored),
+        ("641..645", Action::Ignored),
+        (
+            "700",
+            Action::Units {
+                units: Units::Inch,
+                feed: true,
+            },
+        ),
+        (
+            "710",
+            Action::Units {
+                units: Units::Mm,
+                feed: true,
+            },
+        ),
+    ],
+    m_codes: &[
+        ("0", Action::Ignored),
+        ("1", Action::Ignored),
+        ("2", ProgramEnd),
+        ("3..9", Action::Ignored),
+        ("17", ProgramEnd),
+        ("19", Action::Ignored),
+        ("30", ProgramEnd),
+        ("40..45", Action::Ignored),
+    ],
+    keywords: &[
+        ("TRAORI", Action::Tcp(Tcp::On)),
+        ("TRAFOOF", Action::Tcp(Tcp::Off)),
+        ("TRACYL", Unsup(TRANSFORM)),
+        ("TRANSMIT", Unsup(TRANSFORM)),
+        ("TRANS", Action::Frame(FrameOp::Trans)),
+        ("ATRANS", Action::Frame(FrameOp::ATrans)),
+        ("ROT", Action::Frame(FrameOp::Rot)),
+        ("AROT", Action::Frame(FrameOp::ARot)),
+        ("SUPA", MachineCoordinates),
+        ("SCALE", Unsup(TRANSFORM)),
+        ("ASCALE", Unsup(TRANSFORM)),
+        ("MIRROR", Unsup(TRANSFORM)),
+        ("AMIRROR", Unsup(TRANSFORM)),
+        ("CYCLE800", Action::Swivel),
+        (
+            "CIP",
+            Unsup("arcs through an intermediate point (CIP) are not supported"),
+        ),
+        ("CT", Unsup("tangential arcs (CT) are not supported")),
+        ("ASPLINE", Unsup(SPLINES)),
+        ("BSPLINE", Unsup(SPLINES)),
+        ("CSPLINE", Unsup(SPLINES)),
+        ("POLY", Unsup(SPLINES)),
+        ("CYCLE76", Action::SinumerikCycle(76)),
+        ("CYCLE77", Action::SinumerikCycle(77)),
+        ("CYCLE81", Action::SinumerikCycle(81)),
+        ("CYCLE82", Action::SinumerikCycle(82)),
+        ("CYCLE83", Action::SinumerikCycle(83)),
+        ("CYCLE84", Action::SinumerikCycle(84)),
+        ("CYCLE85", Action::SinumerikCycle(85)),
+        ("CYCLE86", Action::SinumerikCycle(86)),
+        ("CYCLE87", Action::SinumerikCycle(87)),
+        ("CYCLE88", Action::SinumerikCycle(88)),
+        ("CYCLE89", Action::SinumerikCycle(89)),
+        ("MCALL", Action::ModalCall),
+        ("FNORM", Action::Ignored),
+        ("CALL", Unsup("subprogram calls are not supported")),
+        ("GOTOF", Unsup("control flow is not supported")),
+        ("GOTOB", Unsup("control flow is not supported")),
+        ("GOTO", Unsup("control flow is not supported")),
+        ("IF", Unsup("control flow is not supported")),
+        ("WHILE", Unsup("control flow is not supported")),
+        ("FOR", Unsup("control flow is not supported")),
+        ("REPEAT", Unsup("control flow is not supported")),
+        ("LOOP", Unsup("control flow is not supported")),
+        ("RET", ProgramEnd),
+        ("SOFT", Action::Ignored),
+        ("BRISK", Action::Ignored),
+        ("FFWON", Action::Ignored),
+        ("FFWOF", Action::Ignored),
+        ("UPATH", Action::Ignored),
+        ("SPATH", Action::Ignored),
+        ("ORIWKS", Action::Ignored),
+        ("ORIMKS", Action::Ignored),
+        ("ORIAXES", Action::Ignored),
+        ("ORIVECT", Action::Ignored),
+        ("ORICONO", Action::Ignored),
+        ("ORIEULER", Action::Ignored),
+        ("ORIRPY", Action::Ignored),
+        ("COMPCAD", Action::Ignored),
+        ("COMPCURV", Action::Ignored),
+        ("COMPOF", Action::Ignored),
+        ("CFC", Action::Ignored),
+        ("CFTCP", Action::Ignored),
+        ("CFIN", Action::Ignored),
+        ("STOPRE", Action::Ignored),
+        ("MSG", Action::Ignored),
+        ("CYCLE832", Action::Ignored),
+    ],
+    initial_motion: Some(Motion::Rapid),
+    g94_clears_feed: false,
+    integer_increments: None,
+};
+
+/// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).
+pub(super) fn lookup_code(table: &[(&'static str, Action)], value: f64) -> Option<Action> {
+    let tenths = (value * 10.0).round();
+    if value < 0.0 || (value * 10.0 - tenths).abs() > 1e-6 || tenths > 1e9 {
+        return None;
+    }
+    let tenths = tenths as u64;
+    let canonical = if tenths % 10 == 0 {
+        format!("{}", tenths / 10)
+    } else {
+        format!("{}.{}", tenths / 10, tenths % 10)
+    };
+    table.iter().find_map(|&(key, action)| {
+        let hit = match key.split_once("..") {
+            Some((lo, hi)) => {
+                let whole = tenths % 10 == 0;
+                let (lo, hi) = (lo.parse::<u64>().ok(), hi.parse::<u64>().ok());
+                whole
+                    && lo
+                        .zip(hi)
+                        .is_some_and(|(lo, hi)| (lo..=hi).contains(&(tenths / 10)))
+            }
+            None => key == canonical,
+        };
+        hit.then_some(action)
+    })
+}

@@ -1,0 +1,287 @@
+//! Variables and arithmetic in address values, as posts write them.
+//!
+//! * Sinumerik: `DEF REAL _X_HOME, _Y_HOME=2` (user variables, 0 until assigned), R parameters
+//!   `R1`…`R999` (0 until assigned), assignments `R1=R2+5`, `_Z=_Z_HOME`, and expressions after
+//!   `=` in any address: `Z=_Z_HOME`, `X=R1*2`, `X=(R1+1)/2`.
+//! * Fanuc and LinuxCNC: numbered parameters `#100` (`#[expr]`), LinuxCNC named parameters
+//!   `#<name>`, assignments `#100=5.`, values `X#100`, `X-#100`, `X[#1+2]`; brackets group.
+//!
+//! Operators `+ - * /` with the usual precedence, unary minus, parentheses (Sinumerik) or
+//! brackets (Fanuc, LinuxCNC), and the functions `SIN COS TAN` (degrees), `SQRT ABS ATAN`
+//! (`ATAN[y]/[x]` as Fanuc writes it is not read: an error), `ROUND TRUNC`. A variable read
+//! before it has a value (Fanuc `#100` never assigned, a name never declared) is an error
+//! naming it; so is a result that is not a finite number. Expressions are at most
+//! [`MAX_EXPRESSION_LEN`] characters and nest at most [`MAX_DEPTH`] deep, so evaluation is
+//! bounded.
+
+use std::collections::HashMap;
+
+/// Longest expression read, characters.
+pub const MAX_EXPRESSION_LEN: usize = 1000;
+/// Deepest nesting of brackets and unary operators.
+pub const MAX_DEPTH: usize = 64;
+
+/// The program's variables: names upper-cased (`_X_HOME`, `R1`, `#100`, `#<DEPTH>`).
+#[derive(Debug, Default, Clone)]
+pub struct Variables {
+    values: HashMap<String, f64>,
+    /// Declared with `DEF` (value 0 until assigned).
+    declared: HashMap<String, ()>,
+}
+
+impl Variables {
+    /// Declares a Sinumerik user variable (value 0).
+    pub fn declare(&mut self, name: &str) {
+        let name = name.to_ascii_uppercase();
+        self.values.entry(name.clone()).or_insert(0.0);
+        self.declared.insert(name, ());
+    }
+
+    /// Whether `name` is a variable an assignment may set: a declared name, an R parameter
+    /// (`R` and digits), a Fanuc `#n` or LinuxCNC `#<name>`.
+    pub fn assignable(&self, name: &str) -> bool {
+        let name = name.to_ascii_uppercase();
+        self.declared.contains_key(&name) || is_r_parameter(&name) || name.starts_with('#')
+    }
+
+    pub fn set(&mut self, name: &str, value: f64) {
+        self.values.insert(name.to_ascii_uppercase(), value);
+    }
+
+    fn get(&self, name: &str) -> Result<f64, String> {
+        let name = name.to_ascii_uppercase();
+        if let Some(v) = self.values.get(&name) {
+            return Ok(*v);
+        }
+        if is_r_parameter(&name) {
+            return Ok(0.0); // Sinumerik R parameters start at 0
+        }
+        Err(if name.starts_with('#') {
+            format!("parameter `{name}` is read before it is set")
+        } else {
+            format!("`{name}` is not a number nor a variable the program defines (DEF)")
+        })
+    }
+}
+
+/// `R` followed by 1–3 digits (Sinumerik R parameters).
+pub fn is_r_parameter(name: &str) -> bool {
+    let upper = name.to_ascii_uppercase();
+    upper.len() >= 2
+        && upper.len() <= 4
+        && upper.starts_with('R')
+        && upper[1..].chars().all(|c| c.is_ascii_digit())
+}
+
+/// Evaluates `text` with `vars`.
+pub fn eval(text: &str, vars: &Variables) -> Result<f64, String> {
+    if text.len() > MAX_EXPRESSION_LEN {
+        return Err(format!(
+            "expression longer than {MAX_EXPRESSION_LEN} characters"
+        ));
+    }
+    let chars: Vec<char> = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let mut p = Parser {
+        chars: &chars,
+        at: 0,
+        vars,
+        depth: 0,
+    };
+    let v = p.sum()?;
+    if p.at != chars.len() {
+        return Err(format!("cannot read `{text}` as a number or expression"));
+    }
+    if !v.is_finite() {
+        return Err(format!("`{text}` is not a finite number"));
+    }
+    Ok(v)
+}
+
+struct Parser<'a> {
+    chars: &'a [char],
+    at: usize,
+    vars: &'a Variables,
+    depth: usize,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<char> {
+        self.chars.get(self.at).copied()
+    }
+
+    fn deeper(&mut self) -> Result<(), String> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(format!("expression nested deeper than {MAX_DEPTH}"));
+        }
+        Ok(())
+    }
+
+    fn sum(&mut self) -> Result<f64, String> {
+        let mut v = self.product()?;
+        while let Some(c @ ('+' | '-')) = self.peek() {
+            self.at += 1;
+            let r = self.product()?;
+            v = if c == '+' { v + r } else { v - r };
+        }
+        Ok(v)
+    }
+
+    fn product(&mut self) -> Result<f64, String> {
+        let mut v = self.unary()?;
+        while let Some(c @ ('*' | '/')) = self.peek() {
+            self.at += 1;
+            let r = self.unary()?;
+            if c == '/' && r == 0.0 {
+                return Err("division by zero".into());
+            }
+            v = if c == '*' { v * r } else { v / r };
+        }
+        Ok(v)
+    }
+
+    fn unary(&mut self) -> Result<f64, String> {
+        match self.peek() {
+            Some(c @ ('-' | '+')) => {
+                self.at += 1;
+                self.deeper()?;
+                let v = self.unary()?;
+                self.depth -= 1;
+                Ok(if c == '-' { -v } else { v })
+            }
+            _ => self.atom(),
+        }
+    }
+
+    fn group(&mut self, close: char) -> Result<f64, String> {
+        self.deeper()?;
+        let v = self.sum()?;
+        if self.peek() != Some(close) {
+            return Err(format!("missing `{close}` in expression"));
+        }
+        self.at += 1;
+        self.depth -= 1;
+        Ok(v)
+    }
+
+    fn atom(&mut self) -> Result<f64, String> {
+        match self.peek() {
+            None => Err("expression ends too early".into()),
+            Some('(') => {
+                self.at += 1;
+                self.group(')')
+            }
+            Some('[') => {
+                self.at += 1;
+                self.group(']')
+            }
+            Some('#') => {
+                self.at += 1;
+                let name = match self.peek() {
+                    Some('<') => {
+                        let start = self.at;
+                        while self.peek().is_some_and(|c| c != '>') {
+                            self.at += 1;
+                        }
+                        if self.peek() != Some('>') {
+                            return Err("unclosed `#<` parameter name".into());
+                        }
+                        self.at += 1;
+                        let n: String = self.chars[start..self.at].iter().collect();
+                        format!("#{n}")
+                    }
+                    Some('[') => {
+                        self.at += 1;
+                        let n = self.group(']')?;
+                        format!("#{}", parameter_number(n)?)
+                    }
+                    _ => {
+                        let start = self.at;
+                        while self.peek().is_some_and(|c| c.is_ascii_digit()) {
+                            self.at += 1;
+                        }
+                        if start == self.at {
+                            return Err("`#` without a parameter number".into());
+                        }
+                        let n: String = self.chars[start..self.at].iter().collect();
+                        format!("#{}", n.trim_start_matches('0'))
+                    }
+                };
+                self.vars.get(&name)
+            }
+            Some(c) if c.is_ascii_digit() || c == '.' => {
+                let start = self.at;
+                while self.peek().is_some_and(|c| c.is_ascii_digit() || c == '.') {
+                    self.at += 1;
+                }
+                let text: String = self.chars[start..self.at].iter().collect();
+                if self.peek().is_some_and(|c| c == 'E' || c == 'e') {
+                    return Err(format!(
+                        "`{text}E…`: exponent notation is not part of G-code; write the number \
+                         in full"
+                    ));
+                }
+                text.parse::<f64>()
+                    .map_err(|_| format!("malformed number `{text}`"))
+            }
+            Some(c) if c.is_ascii_alphabetic() || c == '_' || c == '$' => {
+                let start = self.at;
+                while self
+                    .peek()
+                    .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '$')
+                {
+                    self.at += 1;
+                }
+                let name: String = self.chars[start..self.at].iter().collect();
+                let upper = name.to_ascii_uppercase();
+                let function: Option<fn(f64) -> f64> = match upper.as_str() {
+                    "SIN" => Some(|x: f64| x.to_radians().sin()),
+                    "COS" => Some(|x: f64| x.to_radians().cos()),
+                    "TAN" => Some(|x: f64| x.to_radians().tan()),
+                    "SQRT" => Some(f64::sqrt),
+                    "ABS" => Some(f64::abs),
+                    "ATAN" => Some(|x: f64| x.atan().to_degrees()),
+                    "ROUND" => Some(f64::round),
+                    "TRUNC" | "FIX" => Some(f64::trunc),
+                    _ => None,
+                };
+                if let Some(f) = function
+                    && matches!(self.peek(), Some('(' | '['))
+                {
+                    let close = if self.peek() == Some('(') { ')' } else { ']' };
+                    self.at += 1;
+                    let x = self.group(close)?;
+                    return Ok(f(x));
+                }
+                if upper.starts_with('$') {
+                    return Err(format!(
+                        "system variable `{name}` is not known to feedopt (its value is the \
+                         controller's)"
+                    ));
+                }
+                self.vars.get(&upper)
+            }
+            Some(c) => Err(format!("unexpected `{c}` in expression")),
+        }
+    }
+}
+
+/// A parameter number from an expression value: a whole number 1…99999.
+fn parameter_number(n: f64) -> Result<u32, String> {
+    if n.fract() != 0.0 || !(1.0..=99999.0).contains(&n) {
+        return Err(format!("`#[{n}]` is not a parameter number"));
+    }
+    Ok(n as u32)
+}
+
+/// The normalised name of a Fanuc `#n` (leading zeros dropped), or `None`.
+pub fn hash_name(text: &str) -> Option<String> {
+    let digits = text.strip_prefix('#')?;
+    if let Some(named) = digits.strip_prefix('<') {
+        return named
+            .ends_with('>')
+            .then(|| format!("#<{}", named.to_ascii_uppercase()));
+    }
+    (!digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()))
+        .then(|| format!("#{}", digits.trim_start_matches('0')))
+}

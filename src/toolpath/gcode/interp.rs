@@ -1,0 +1,1352 @@
+//! Interpreting: the modal state and the moves each block makes.
+
+use nalgebra::Vector3;
+use std::path::Path;
+
+use super::cycles::{self, Step};
+use super::dialect::*;
+use super::expr::Variables;
+use super::frames::{self, Frame};
+use super::lexer::{Item, Num};
+use super::*;
+use crate::error::{Error, Result};
+use crate::toolpath::{ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning};
+
+/// The words of one block, sorted by meaning.
+#[derive(Debug, Default)]
+struct Block {
+    axes: [Option<Num>; 6],
+    centre: [Option<Num>; 3],
+    vector: [Option<f64>; 3],
+    radius: Option<Num>,
+    turns: Option<f64>,
+    extra_turns: Option<f64>,
+    feed: Option<f64>,
+    /// Every single-letter word's value as written (cycle and dwell parameters P Q R K L).
+    letters: [Option<Num>; 26],
+    /// Codes and keywords in the order written, with their text and `( … )` arguments.
+    actions: Vec<(String, Action, Option<String>)>,
+}
+
+impl Block {
+    fn letter(&self, c: char) -> Option<Num> {
+        self.letters[(c as u8 - b'A') as usize]
+    }
+}
+
+/// The modal G94 feed.
+#[derive(Debug, Clone, Copy)]
+struct ModalFeed {
+    /// Linear feed, mm/min.
+    mm_per_min: f64,
+    /// F as written (degrees per minute on rotary-only moves).
+    raw: f64,
+}
+
+/// A Fanuc/LinuxCNC canned cycle in force (modal until G80 or a motion code).
+#[derive(Debug, Clone, Copy)]
+struct CycleMode {
+    kind: cycles::Kind,
+    /// The G code (81 …), for messages.
+    code: u32,
+    /// R and Z (absolute, mm) and Q (mm) and P (s), modal within the cycle.
+    r: Option<f64>,
+    z: Option<f64>,
+    q: Option<f64>,
+    dwell: f64,
+    /// The Z where the cycle mode began (the G98 return level).
+    initial: f64,
+}
+
+/// A Sinumerik `MCALL CYCLE8x(...)` in force: the cycle runs after every positioning block.
+#[derive(Debug, Clone)]
+struct ModalCall {
+    number: u32,
+    args: Vec<Option<f64>>,
+}
+
+const AXIS_NAMES: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
+
+/// Largest coordinate a program may use, mm (and degrees of rotary travel, ×1000): past it a
+/// word is an error naming it, so that arc chord counts and cycle pecks stay bounded.
+pub const MAX_COORDINATE_MM: f64 = 1e6;
+/// Most chords one arc block may become (full turns included).
+pub const MAX_ARC_CHORDS: usize = 1_000_000;
+
+pub(super) struct Interpreter<'a> {
+    spec: &'a DialectSpec,
+    source: &'a Path,
+    machine: Option<&'a MachineContext>,
+    pub(super) vars: Variables,
+    units: Units,
+    feed_units: Units,
+    /// A Sinumerik program's first G70/G71 has set the basic system F is read in.
+    basic_system_set: bool,
+    distance: Distance,
+    arc_distance: Distance,
+    plane: Plane,
+    feed_mode: FeedMode,
+    feed: Option<ModalFeed>,
+    motion: Option<Motion>,
+    tcp: Tcp,
+    /// Modal position in program (frame) coordinates: X Y Z in mm, A B C in degrees.
+    pos: [f64; 6],
+    /// X Y Z set by an absolute word.
+    known: [bool; 3],
+    unknown_warned: [bool; 3],
+    vector: Vector3<f64>,
+    saw_rotary: bool,
+    /// A warning about motion outside TCP mode was given for the current stretch.
+    non_tcp_warned: bool,
+    cycle: Option<CycleMode>,
+    /// G99: return to R (else G98: to the initial level).
+    return_to_r: bool,
+    mcall: Option<ModalCall>,
+    programmable: Frame,
+    swivel: Option<Frame>,
+    pub(super) ended: bool,
+    points: Vec<ClPoint>,
+    warnings: Vec<Warning>,
+    dwells: Vec<Dwell>,
+}
+
+impl<'a> Interpreter<'a> {
+    pub(super) fn new(
+        spec: &'a DialectSpec,
+        source: &'a Path,
+        machine: Option<&'a MachineContext>,
+    ) -> Self {
+        Interpreter {
+            spec,
+            source,
+            machine,
+            vars: Variables::default(),
+            units: Units::Mm,
+            feed_units: Units::Mm,
+            basic_system_set: false,
+            distance: Distance::Absolute,
+            arc_distance: Distance::Incremental,
+            plane: Plane::Xy,
+            feed_mode: FeedMode::PerMinute,
+            feed: None,
+            motion: spec.initial_motion,
+            tcp: Tcp::Off,
+            pos: [0.0; 6],
+            known: [false; 3],
+            unknown_warned: [false; 3],
+            vector: Vector3::new(0.0, 0.0, 1.0),
+            saw_rotary: false,
+            non_tcp_warned: false,
+            cycle: None,
+            return_to_r: false,
+            mcall: None,
+            programmable: Frame::IDENTITY,
+            swivel: None,
+            ended: false,
+            points: Vec::new(),
+            warnings: Vec::new(),
+            dwells: Vec::new(),
+        }
+    }
+
+    fn error(&self, line: usize, message: impl Into<String>) -> Error {
+        Error::parse(self.source, line, message)
+    }
+
+    pub(super) fn warn(&mut self, line: usize, message: impl Into<String>) {
+        self.warnings.push(Warning {
+            line,
+            message: message.into(),
+        });
+    }
+
+    pub(super) fn finish(mut self, last_line: usize) -> Result<Toolpath> {
+        if self.points.is_empty() {
+            return Err(self.error(last_line.max(1), "no motion blocks"));
+        }
+        if !self.saw_rotary {
+            for p in &mut self.points {
+                p.rotary = None;
+            }
+        }
+        Ok(Toolpath {
+            source: self.source.to_path_buf(),
+            points: self.points,
+            warnings: self.warnings,
+            dwells: self.dwells,
+        })
+    }
+
+    /// Sorts a block's words, warning about unknown ones.
+    fn collect(&mut self, line: usize, items: Vec<Item>) -> Result<Block> {
+        let mut block = Block::default();
+        let name = self.spec.name;
+        for item in items {
+            let (text, address, num) = match item {
+                Item::Word { text, address, num } => (text, address, num),
+                Item::Keyword { text, action, args } => {
+                    block.actions.push((text, action, args));
+                    continue;
+                }
+                Item::Skipped => continue,
+                Item::Unknown { text } => {
+                    self.warn(
+                        line,
+                        format!("unknown word `{text}` (not a {name} word): ignored"),
+                    );
+                    continue;
+                }
+            };
+            if num.value.abs() > MAX_COORDINATE_MM * 1e3 {
+                return Err(self.error(line, format!("`{text}`: {} is out of range", num.value)));
+            }
+            if let Some(c) = text.chars().next()
+                && c.is_ascii_uppercase()
+                && (text.len() == 1 || !text[1..].starts_with(|ch: char| ch.is_ascii_alphabetic()))
+            {
+                block.letters[(c as u8 - b'A') as usize] = Some(num);
+            }
+            let source = self.source;
+            let duplicate = |taken: bool| -> Result<()> {
+                if taken {
+                    Err(Error::parse(
+                        source,
+                        line,
+                        format!("`{text}`: the same word appears twice in the block"),
+                    ))
+                } else {
+                    Ok(())
+                }
+            };
+            match address {
+                Address::Axis(i) => {
+                    duplicate(block.axes[i].is_some())?;
+                    if let Some(m) = self.machine
+                        && !m.has_axis(AXIS_NAMES[i])
+                    {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}`: the machine ({}) has no {} axis; use a machine \
+                                 file with that axis or a program posted for this machine",
+                                m.file.display(),
+                                AXIS_NAMES[i]
+                            ),
+                        ));
+                    }
+                    block.axes[i] = Some(num);
+                }
+                Address::ArcCentre(i) => {
+                    duplicate(block.centre[i].is_some())?;
+                    block.centre[i] = Some(num);
+                }
+                Address::ToolVector(i) => {
+                    duplicate(block.vector[i].is_some())?;
+                    block.vector[i] = Some(num.value);
+                }
+                Address::Radius => {
+                    duplicate(block.radius.is_some())?;
+                    block.radius = Some(num);
+                }
+                Address::ArcTurns => {
+                    duplicate(block.turns.is_some())?;
+                    block.turns = Some(num.value);
+                }
+                Address::ArcExtraTurns => {
+                    duplicate(block.extra_turns.is_some())?;
+                    block.extra_turns = Some(num.value);
+                }
+                Address::Feed => {
+                    duplicate(block.feed.is_some())?;
+                    block.feed = Some(num.value);
+                }
+                Address::G | Address::M => {
+                    let table = if address == Address::G {
+                        self.spec.g_codes
+                    } else {
+                        self.spec.m_codes
+                    };
+                    match lookup_code(table, num.value) {
+                        Some(Action::Unsupported(message)) => {
+                            return Err(self.error(line, format!("{text}: {message}")));
+                        }
+                        Some(action) => block.actions.push((text, action, None)),
+                        None if address == Address::G => {
+                            return Err(self.error(
+                                line,
+                                format!(
+                                    "{text}: not a {name} G code feedopt knows; a G code may \
+                                     move the tool, so it is not skipped (remove it or post \
+                                     the program for a supported control)"
+                                ),
+                            ));
+                        }
+                        None => self.warn(
+                            line,
+                            format!("unknown word `{text}` (not a {name} code): ignored"),
+                        ),
+                    }
+                }
+                Address::Ignored => {}
+                Address::Unmodelled(message) => self.warn(line, format!("`{text}`: {message}")),
+                Address::Unsupported(message) => {
+                    return Err(self.error(line, format!("{text}: {message}")));
+                }
+            }
+        }
+        Ok(block)
+    }
+
+    /// Scale of a length word (mm per written unit), honouring integer increments.
+    fn length(&self, num: Num) -> f64 {
+        let scale = match (self.spec.integer_increments, num.point) {
+            (Some(inc), false) => match self.units {
+                Units::Mm => inc.mm,
+                Units::Inch => inc.inch * MM_PER_INCH,
+            },
+            _ => self.units.mm_per_unit(),
+        };
+        num.value * scale
+    }
+
+    fn angle(&self, num: Num) -> f64 {
+        match (self.spec.integer_increments, num.point) {
+            (Some(inc), false) => num.value * inc.deg,
+            _ => num.value,
+        }
+    }
+
+    /// A cycle parameter list `a,b,,d` (empty: not given), evaluated.
+    fn arguments(&self, line: usize, text: &str) -> Result<Vec<Option<f64>>> {
+        if text.len() > 2000 {
+            return Err(self.error(line, "cycle argument list longer than 2000 characters"));
+        }
+        text.split(',')
+            .map(|a| {
+                let a = a.trim();
+                if a.is_empty() || a.starts_with('"') {
+                    Ok(None)
+                } else {
+                    super::expr::eval(a, &self.vars)
+                        .map(Some)
+                        .map_err(|e| self.error(line, format!("argument `{a}`: {e}")))
+                }
+            })
+            .collect()
+    }
+
+    /// Interprets one block.
+    pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
+        let block = self.collect(line, items)?;
+
+        // Modal settings first (feed mode, F, units, plane, distance, TCP), then the motion.
+        let mut motion_code: Option<(&str, Motion)> = None;
+        let mut machine = false;
+        let mut no_motion: Option<&str> = None;
+        let mut end = false;
+        let mut reference: Option<u8> = None;
+        let mut dwell = false;
+        let mut frame_op: Option<(&str, FrameOp)> = None;
+        let mut new_cycle: Option<(&str, u32)> = None;
+        let mut sinumerik_cycle: Option<(String, u32, String)> = None;
+        let mut modal_call = false;
+        let mut tilted_plane = false;
+        for (text, action, args) in &block.actions {
+            match *action {
+                Action::FeedMode(mode) => {
+                    if (self.spec.g94_clears_feed && mode == FeedMode::PerMinute)
+                        || (self.feed_mode == FeedMode::InverseTime && mode != self.feed_mode)
+                    {
+                        self.feed = None;
+                    }
+                    self.feed_mode = mode;
+                }
+                Action::Motion(m) => {
+                    if let Some((other, _)) = motion_code {
+                        return Err(self.error(
+                            line,
+                            format!("two motion codes in one block: {other} and {text}"),
+                        ));
+                    }
+                    motion_code = Some((text.as_str(), m));
+                    self.cycle = None;
+                }
+                Action::MotionCancel => {
+                    self.motion = None;
+                    self.cycle = None;
+                }
+                Action::CycleCancel => self.cycle = None,
+                Action::Cycle(code) => new_cycle = Some((text.as_str(), code)),
+                Action::CycleReturn(to_r) => self.return_to_r = to_r,
+                Action::Plane(p) => self.plane = p,
+                Action::Units { units, feed } => {
+                    self.units = units;
+                    if feed {
+                        self.feed_units = units;
+                        self.basic_system_set = true;
+                    } else if !self.basic_system_set {
+                        // Sinumerik G70/G71: F stays in the control's basic system, taken as
+                        // the unit the program first selects.
+                        self.basic_system_set = true;
+                        self.feed_units = units;
+                        if units == Units::Inch {
+                            self.warn(
+                                line,
+                                format!(
+                                    "{text}: F is read in inch/min: a Sinumerik control keeps F \
+                                     in its basic system under G70, taken as inch because the \
+                                     program selects inch first (G700 makes F inch explicitly)"
+                                ),
+                            );
+                        }
+                    }
+                }
+                Action::Distance(d) => self.distance = d,
+                Action::ArcDistance(d) => self.arc_distance = d,
+                Action::Tcp(t) => {
+                    if t != self.tcp {
+                        self.non_tcp_warned = false;
+                    }
+                    self.tcp = t;
+                }
+                Action::MachineCoordinates => machine = true,
+                Action::Reference(k) => reference = Some(k),
+                Action::Dwell => dwell = true,
+                Action::Frame(op) => frame_op = Some((text.as_str(), op)),
+                Action::Swivel => {
+                    let args = match args {
+                        Some(a) => self.arguments(line, a)?,
+                        None => Vec::new(),
+                    };
+                    let scale = self.units.mm_per_unit();
+                    let args: Vec<Option<f64>> = args
+                        .iter()
+                        .enumerate()
+                        .map(|(k, a)| {
+                            a.map(|v| {
+                                if [4, 5, 6, 10, 11, 12].contains(&k) {
+                                    v * scale
+                                } else {
+                                    v
+                                }
+                            })
+                        })
+                        .collect();
+                    self.swivel = frames::cycle800(&args).map_err(|e| self.error(line, e))?;
+                }
+                Action::TiltedPlane => tilted_plane = true,
+                Action::TiltedPlaneCancel => self.swivel = None,
+                Action::ModalCall => modal_call = true,
+                Action::SinumerikCycle(n) => {
+                    sinumerik_cycle = Some((text.clone(), n, args.clone().unwrap_or_default()));
+                }
+                Action::NoMotion(message) => {
+                    no_motion = Some(message);
+                    self.warn(line, format!("{text}: {message}"));
+                }
+                Action::ProgramEnd => end = true,
+                Action::Ignored => {}
+                Action::Note(message) => self.warn(line, format!("{text}: {message}")),
+                Action::Unsupported(message) => {
+                    return Err(self.error(line, format!("{text}: {message}")));
+                }
+            }
+        }
+        if let Some(f) = block.feed {
+            if f < 0.0 {
+                return Err(self.error(line, format!("F{f}: a feed cannot be negative")));
+            }
+            if self.feed_mode == FeedMode::PerMinute {
+                self.feed = (f > 0.0).then(|| ModalFeed {
+                    mm_per_min: f * self.feed_units.mm_per_unit(),
+                    raw: f,
+                });
+            }
+        }
+        if let Some((_, m)) = motion_code {
+            self.motion = Some(m);
+        }
+
+        if dwell {
+            return self.dwell(line, &block).map(|()| self.end_if(end));
+        }
+        if let Some((text, op)) = frame_op {
+            return self
+                .frame(line, text, op, &block)
+                .map(|()| self.end_if(end));
+        }
+        if tilted_plane {
+            return self.tilted_plane(line, &block).map(|()| self.end_if(end));
+        }
+        if let Some(k) = reference {
+            return self.reference(line, k, &block).map(|()| self.end_if(end));
+        }
+        if let Some((text, number, args)) = sinumerik_cycle {
+            let args = self.arguments(line, &args)?;
+            let args = self.sinumerik_cycle_units(number, args);
+            if modal_call {
+                self.mcall = Some(ModalCall { number, args });
+            } else {
+                self.run_sinumerik_cycle(line, &text, number, &args)?;
+            }
+        } else if modal_call {
+            self.mcall = None;
+        }
+        if let Some((text, code)) = new_cycle {
+            self.start_cycle(line, text, code, &block)?;
+        }
+
+        let has_axes = block.axes.iter().any(Option::is_some);
+        let has_vector = block.vector.iter().any(Option::is_some);
+        let has_centre = block.centre.iter().any(Option::is_some);
+        if self.cycle.is_some() && no_motion.is_none() && !machine {
+            if new_cycle.is_some() || has_axes || block.radius.is_some() {
+                self.hole(line, &block)?;
+            }
+            self.end_if(end);
+            return Ok(());
+        }
+        let is_arc = matches!(self.motion, Some(Motion::ArcCw | Motion::ArcCcw));
+        let ijk_vector = self.tcp == Tcp::OnIjkVector && !is_arc;
+        let moves = no_motion.is_none()
+            && (has_axes || has_vector || (has_centre && (ijk_vector || is_arc)));
+        if moves {
+            self.motion_block(line, &block, machine)?;
+            if let Some(call) = self.mcall.clone()
+                && block.axes[..2].iter().any(Option::is_some)
+            {
+                self.run_sinumerik_cycle(
+                    line,
+                    &format!("MCALL CYCLE{}", call.number),
+                    call.number,
+                    &call.args,
+                )?;
+            }
+        } else if no_motion.is_none() && (has_centre || block.radius.is_some()) {
+            self.warn(line, "I/J/K or R without a move: ignored");
+        }
+        self.end_if(end);
+        Ok(())
+    }
+
+    fn end_if(&mut self, end: bool) {
+        if end {
+            self.ended = true;
+        }
+    }
+
+    /// `G4`: P seconds (LinuxCNC), P milliseconds or X seconds (Fanuc), F seconds (Sinumerik).
+    fn dwell(&mut self, line: usize, block: &Block) -> Result<()> {
+        let seconds = if self.spec.spaces == Spaces::Separate {
+            match (block.feed, block.letter('S')) {
+                (Some(f), _) => f,
+                (None, Some(_)) => {
+                    return Err(self.error(
+                        line,
+                        "G4 S (dwell in spindle revolutions) is not supported: program G4 F \
+                         (seconds)",
+                    ));
+                }
+                (None, None) => return Err(self.error(line, "G4 without F (seconds)")),
+            }
+        } else {
+            match (block.letter('P'), block.axes[0]) {
+                (Some(p), _) if self.spec.integer_increments.is_some() && !p.point => {
+                    p.value / 1000.0
+                }
+                (Some(p), _) => p.value,
+                (None, Some(x)) => x.value,
+                (None, None) => return Err(self.error(line, "G4 without P (the dwell time)")),
+            }
+        };
+        if !(0.0..=1e6).contains(&seconds) {
+            return Err(self.error(line, format!("G4: dwell of {seconds} s is out of range")));
+        }
+        self.add_dwell(line, seconds);
+        Ok(())
+    }
+
+    fn add_dwell(&mut self, line: usize, seconds: f64) {
+        if seconds > 0.0 {
+            self.dwells.push(Dwell {
+                point: self.points.len().saturating_sub(1),
+                seconds,
+                line,
+            });
+        }
+    }
+
+    /// Sinumerik `TRANS`/`ATRANS`/`ROT`/`AROT` with the block's X Y Z (none: cancel).
+    fn frame(&mut self, line: usize, text: &str, op: FrameOp, block: &Block) -> Result<()> {
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(line, format!("{text} with A/B/C: not supported")));
+        }
+        let given = block.axes[..3].iter().any(Option::is_some);
+        let v: [f64; 3] = std::array::from_fn(|i| match (block.axes[i], op) {
+            (Some(n), FrameOp::Trans | FrameOp::ATrans) => self.length(n),
+            (Some(n), _) => n.value,
+            (None, _) => 0.0,
+        });
+        let f = match op {
+            FrameOp::Trans | FrameOp::ATrans => Frame::translation(Vector3::from(v)),
+            FrameOp::Rot | FrameOp::ARot => Frame::rotation(frames::rot_zyx(v)),
+        };
+        self.programmable = match op {
+            FrameOp::Trans | FrameOp::Rot if !given => Frame::IDENTITY,
+            FrameOp::Trans | FrameOp::Rot => f,
+            FrameOp::ATrans | FrameOp::ARot => self.programmable.then_inner(&f),
+        };
+        Ok(())
+    }
+
+    /// Fanuc `G68.2 X Y Z I J K`.
+    fn tilted_plane(&mut self, line: usize, block: &Block) -> Result<()> {
+        let origin: [f64; 3] =
+            std::array::from_fn(|i| block.axes[i].map_or(0.0, |n| self.length(n)));
+        let angle = |i: usize| block.centre[i].map_or(0.0, |n| n.value);
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(line, "G68.2 with A/B/C words"));
+        }
+        self.swivel = Some(Frame {
+            r: frames::euler_zxz(angle(0), angle(1), angle(2)),
+            t: Vector3::from(origin),
+        });
+        Ok(())
+    }
+
+    /// The frame from program coordinates to workpiece coordinates.
+    fn frame_now(&self) -> Frame {
+        match &self.swivel {
+            Some(s) => s.then_inner(&self.programmable),
+            None => self.programmable,
+        }
+    }
+
+    /// Machine coordinates → program (frame) coordinates, X Y Z.
+    fn machine_to_program(&self, m: Vector3<f64>) -> Vector3<f64> {
+        let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+        self.frame_now().invert(&(m - Vector3::from(offset)))
+    }
+
+    fn to_machine(&self, p: Vector3<f64>) -> Vector3<f64> {
+        let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+        self.frame_now().apply(&p) + Vector3::from(offset)
+    }
+
+    /// `G28`/`G30` (k = 1, 2; `G30 P3`: 3): via the intermediate point the axis words give
+    /// (program coordinates, absolute or incremental), to the reference point of the same
+    /// axes (machine coordinates from the machine file). Both moves are rapids.
+    fn reference(&mut self, line: usize, k: u8, block: &Block) -> Result<()> {
+        let k = match (k, block.letter('P')) {
+            (2, Some(p)) if (2.0..=4.0).contains(&p.value) && p.value.fract() == 0.0 => {
+                p.value as usize
+            }
+            (2, Some(p)) => {
+                return Err(self.error(line, format!("G30 P{}: expected P2, P3 or P4", p.value)));
+            }
+            (k, _) => k as usize,
+        };
+        let code = if k == 1 { "G28" } else { "G30" };
+        let named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
+        if named.is_empty() {
+            return Err(self.error(
+                line,
+                format!(
+                    "{code} without axis words (all axes to the reference point) is not \
+                     supported: name the axes (`G91 {code} Z0`)"
+                ),
+            ));
+        }
+        // The intermediate point.
+        let mut via = self.pos;
+        for &i in &named {
+            let Some(num) = block.axes[i] else { continue };
+            let v = if i < 3 {
+                self.length(num)
+            } else {
+                self.angle(num)
+            };
+            via[i] = if self.distance == Distance::Incremental {
+                self.pos[i] + v
+            } else {
+                v
+            };
+        }
+        let mut target = via;
+        let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
+        for &i in &named {
+            let Some(r) = self
+                .machine
+                .and_then(|m| m.reference[i].get(k - 1).copied())
+            else {
+                let file = self.machine.map_or("the machine file".to_string(), |m| {
+                    m.file.display().to_string()
+                });
+                let which = if k == 1 {
+                    "`\"reference\": <position>`".to_string()
+                } else {
+                    format!("a list `\"reference\": [<G28 position>, …]` with {k} entries")
+                };
+                return Err(self.error(
+                    line,
+                    format!(
+                        "{code} moves {} to its reference point, which {file} does not give: \
+                         add {which} to axes.{} (machine coordinates, mm or °)",
+                        AXIS_NAMES[i], AXIS_NAMES[i]
+                    ),
+                ));
+            };
+            if i < 3 {
+                machine_xyz[i] = r;
+            } else {
+                target[i] = r;
+            }
+        }
+        let xyz = self.machine_to_program(machine_xyz);
+        target[..3].copy_from_slice(xyz.as_slice());
+        for &i in &named {
+            if i >= 3 {
+                self.saw_rotary = true;
+            }
+        }
+        if via != self.pos {
+            self.push(line, &via, Feed::Rapid);
+        }
+        self.push(line, &target, Feed::Rapid);
+        self.pos = target;
+        for i in 0..3 {
+            self.known[i] = true;
+        }
+        Ok(())
+    }
+
+    /// Enters (or changes) a Fanuc/LinuxCNC canned cycle.
+    fn start_cycle(&mut self, line: usize, text: &str, code: u32, block: &Block) -> Result<()> {
+        let Some(kind) = cycles::Kind::from_code(code) else {
+            return Err(self.error(line, format!("{text}: not a drilling cycle feedopt knows")));
+        };
+        if self.plane != Plane::Xy {
+            return Err(self.error(
+                line,
+                format!("{text} outside G17: canned cycles are read in the XY plane only"),
+            ));
+        }
+        if self.feed_mode == FeedMode::InverseTime {
+            return Err(self.error(line, format!("{text} under G93 (inverse time)")));
+        }
+        let initial = self.pos[2];
+        let keep = self.cycle.filter(|c| c.kind == kind);
+        self.cycle = Some(CycleMode {
+            kind,
+            code,
+            r: keep.and_then(|c| c.r),
+            z: keep.and_then(|c| c.z),
+            q: keep.and_then(|c| c.q),
+            dwell: keep.map_or(0.0, |c| c.dwell),
+            initial: self.cycle.map_or(initial, |c| c.initial),
+        });
+        let _ = block;
+        Ok(())
+    }
+
+    /// One hole of the Fanuc/LinuxCNC cycle in force, at the block's X Y (and new R Z Q P).
+    fn hole(&mut self, line: usize, block: &Block) -> Result<()> {
+        let Some(mut c) = self.cycle else {
+            return Ok(());
+        };
+        if block.axes[3..].iter().any(Option::is_some) {
+            return Err(self.error(
+                line,
+                format!("G{}: rotary axis words in a cycle block", c.code),
+            ));
+        }
+        let incremental = self.distance == Distance::Incremental;
+        if let Some(r) = block.radius {
+            let r = self.length(r);
+            c.r = Some(if incremental { c.initial + r } else { r });
+        }
+        let r = c
+            .r
+            .ok_or_else(|| self.error(line, format!("G{}: R (the R plane) is missing", c.code)))?;
+        if let Some(z) = block.axes[2] {
+            let z = self.length(z);
+            c.z = Some(if incremental { r + z } else { z });
+        }
+        let bottom = c.z.ok_or_else(|| {
+            self.error(line, format!("G{}: Z (the hole bottom) is missing", c.code))
+        })?;
+        if let Some(q) = block.letter('Q') {
+            c.q = Some(self.length(q).abs());
+        }
+        if let Some(p) = block.letter('P') {
+            c.dwell = if self.spec.integer_increments.is_some() && !p.point {
+                p.value / 1000.0
+            } else {
+                p.value
+            };
+            if !(0.0..=1e6).contains(&c.dwell) {
+                return Err(self.error(line, format!("G{}: dwell P out of range", c.code)));
+            }
+        }
+        self.cycle = Some(c);
+        let repeats = match block.letter('L').or(block.letter('K')) {
+            None => 1,
+            Some(n)
+                if n.value.fract() == 0.0
+                    && (0.0..=cycles::MAX_REPEATS as f64).contains(&n.value) =>
+            {
+                n.value as usize
+            }
+            Some(n) => {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "G{}: repeat count {} (at most {})",
+                        c.code,
+                        n.value,
+                        cycles::MAX_REPEATS
+                    ),
+                ));
+            }
+        };
+        let clear = if self.return_to_r {
+            r
+        } else {
+            c.initial.max(r)
+        };
+        let h = cycles::Hole {
+            kind: c.kind,
+            r,
+            bottom,
+            q: c.q,
+            dwell: c.dwell,
+            clear,
+            initial: c.initial,
+        };
+        let (steps, note) =
+            cycles::fanuc_steps(&h).map_err(|e| self.error(line, format!("G{}: {e}", c.code)))?;
+        if let Some(note) = note {
+            self.warn(line, format!("G{}: {note}", c.code));
+        }
+        for k in 0..repeats {
+            let mut xy = [self.pos[0], self.pos[1]];
+            for i in 0..2 {
+                if let Some(n) = block.axes[i] {
+                    let v = self.length(n);
+                    xy[i] = if incremental {
+                        self.pos[i] + v
+                    } else if k == 0 {
+                        v
+                    } else {
+                        xy[i]
+                    };
+                    self.known[i] = true;
+                }
+            }
+            // Up to R first when below it, then over the hole, then down to R.
+            if self.pos[2] < r {
+                self.rapid_z(line, r);
+            }
+            if xy != [self.pos[0], self.pos[1]] {
+                let mut q = self.pos;
+                q[0] = xy[0];
+                q[1] = xy[1];
+                self.push(line, &q, Feed::Rapid);
+                self.pos = q;
+            }
+            self.known[2] = true;
+            self.rapid_z(line, r);
+            self.run_steps(line, &steps)?;
+        }
+        Ok(())
+    }
+
+    fn rapid_z(&mut self, line: usize, z: f64) {
+        let mut q = self.pos;
+        q[2] = z;
+        if q != self.pos {
+            self.push(line, &q, Feed::Rapid);
+            self.pos = q;
+        }
+    }
+
+    /// Executes cycle steps from the current position.
+    fn run_steps(&mut self, line: usize, steps: &[Step]) -> Result<()> {
+        for step in steps {
+            let mut q = self.pos;
+            let feed = match *step {
+                Step::Rapid(z) => {
+                    q[2] = z;
+                    Feed::Rapid
+                }
+                Step::Feed(z, f) => {
+                    q[2] = z;
+                    match f.or(self.feed.map(|f| f.mm_per_min)) {
+                        Some(mm_per_min) => Feed::Programmed(mm_per_min / 60.0),
+                        None => Feed::Unspecified,
+                    }
+                }
+                Step::ShiftX(dx) => {
+                    q[0] += dx;
+                    Feed::Rapid
+                }
+                Step::Dwell(s) => {
+                    self.add_dwell(line, s);
+                    continue;
+                }
+            };
+            if q != self.pos {
+                self.push(line, &q, feed);
+                self.pos = q;
+            }
+        }
+        Ok(())
+    }
+
+    /// Scales a Sinumerik cycle's length (and feed) parameters to mm (mm/min).
+    fn sinumerik_cycle_units(&self, number: u32, args: Vec<Option<f64>>) -> Vec<Option<f64>> {
+        let length = self.units.mm_per_unit();
+        let feed = self.feed_units.mm_per_unit();
+        args.into_iter()
+            .enumerate()
+            .map(|(k, a)| {
+                a.map(|v| {
+                    let is_length = k <= 4 || (number == 83 && (5..=7).contains(&k));
+                    let is_feed = number == 85 && (6..=7).contains(&k);
+                    if is_length {
+                        v * length
+                    } else if is_feed {
+                        v * feed
+                    } else {
+                        v
+                    }
+                })
+            })
+            .collect()
+    }
+
+    fn run_sinumerik_cycle(
+        &mut self,
+        line: usize,
+        text: &str,
+        number: u32,
+        args: &[Option<f64>],
+    ) -> Result<()> {
+        if self.plane != Plane::Xy {
+            return Err(self.error(
+                line,
+                format!("{text} outside G17: cycles are read in the XY plane only"),
+            ));
+        }
+        let (steps, notes) = cycles::sinumerik_steps(number, args)
+            .map_err(|e| self.error(line, format!("{text}: {e}")))?;
+        for n in notes {
+            self.warn(line, format!("{text}: {n}"));
+        }
+        self.run_steps(line, &steps)
+    }
+
+    /// A motion block: resolves the target and emits its point(s).
+    fn motion_block(&mut self, line: usize, block: &Block, machine: bool) -> Result<()> {
+        let Some(motion) = self.motion else {
+            return Err(self.error(
+                line,
+                "axis words without a motion mode: program G0, G1, G2 or G3 first",
+            ));
+        };
+        let is_arc = matches!(motion, Motion::ArcCw | Motion::ArcCcw);
+        if machine && is_arc {
+            return Err(self.error(line, "G53/SUPA (machine coordinates) with an arc"));
+        }
+
+        let start = self.pos;
+        let mut end = start;
+        let mut machine_xyz = self.to_machine(Vector3::new(start[0], start[1], start[2]));
+        for (i, word) in block.axes.iter().enumerate() {
+            let Some(num) = *word else { continue };
+            let value = if i < 3 {
+                self.length(num)
+            } else {
+                self.angle(num)
+            };
+            if !value.is_finite() || value.abs() > MAX_COORDINATE_MM {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "{}: {value} is beyond ±{MAX_COORDINATE_MM} mm (or °)",
+                        AXIS_NAMES[i]
+                    ),
+                ));
+            }
+            if machine && i < 3 {
+                machine_xyz[i] = value;
+                self.known[i] = true;
+                continue;
+            }
+            let incremental = self.distance == Distance::Incremental && !machine;
+            end[i] = if incremental { start[i] + value } else { value };
+            if i < 3 && !incremental {
+                self.known[i] = true;
+            }
+            if i >= 3 {
+                self.saw_rotary = true;
+            }
+        }
+        if machine {
+            let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+            self.warn(
+                line,
+                format!(
+                    "G53/SUPA: machine-coordinate move, taken as program coordinates + the \
+                     work offset ({}, {}, {}) mm",
+                    offset[0], offset[1], offset[2]
+                ),
+            );
+            let p = self.machine_to_program(machine_xyz);
+            end[..3].copy_from_slice(p.as_slice());
+        }
+        let unknown: Vec<String> = (0..3)
+            .filter(|&i| !self.known[i] && !self.unknown_warned[i])
+            .map(|i| AXIS_NAMES[i].to_string())
+            .collect();
+        if !unknown.is_empty() {
+            for i in 0..3 {
+                if !self.known[i] {
+                    self.unknown_warned[i] = true;
+                }
+            }
+            self.warn(
+                line,
+                format!(
+                    "{} not programmed yet: taken as 0 (the start position is unknown)",
+                    unknown.join(", ")
+                ),
+            );
+        }
+
+        // Tool vector: Sinumerik-style words, or I J K on G0/G1 under Fanuc G43.5.
+        let vector_words: [Option<f64>; 3] = if self.tcp == Tcp::OnIjkVector && !is_arc {
+            std::array::from_fn(|i| block.centre[i].map(|n| n.value))
+        } else {
+            block.vector
+        };
+        if vector_words.iter().any(Option::is_some) {
+            let v = Vector3::new(
+                vector_words[0].unwrap_or(0.0),
+                vector_words[1].unwrap_or(0.0),
+                vector_words[2].unwrap_or(0.0),
+            );
+            let largest = v.amax();
+            let scaled_norm = if largest > 0.0 {
+                (v / largest).norm()
+            } else {
+                0.0
+            };
+            if largest * scaled_norm < MIN_TOOL_VECTOR_NORM {
+                return Err(self.error(
+                    line,
+                    format!("tool vector ({}, {}, {}) has no direction", v.x, v.y, v.z),
+                ));
+            }
+            self.vector = v / largest / scaled_norm;
+        } else if !is_arc {
+            let stray: Vec<&str> = ["I", "J", "K"]
+                .iter()
+                .zip(&block.centre)
+                .filter(|(_, c)| c.is_some())
+                .map(|(n, _)| *n)
+                .collect();
+            if !stray.is_empty() || block.radius.is_some() {
+                let mut words = stray.join(" ");
+                if block.radius.is_some() {
+                    if !words.is_empty() {
+                        words.push(' ');
+                    }
+                    words.push('R');
+                }
+                self.warn(line, format!("{words} on a straight move: ignored"));
+            }
+        }
+
+        if self.tcp == Tcp::Off
+            && !self.non_tcp_warned
+            && (end[3..] != [0.0; 3]
+                || block.axes[3..].iter().any(Option::is_some)
+                || vector_words.iter().any(Option::is_some))
+        {
+            self.non_tcp_warned = true;
+            self.warn(
+                line,
+                "motion with rotary axes or a tool vector outside tool-tip (TCP) mode: X Y Z \
+                 taken as the tool tip",
+            );
+        }
+
+        if is_arc {
+            self.arc(line, motion, block, start, end)?;
+        } else {
+            let feed = self.linear_feed(line, motion, block, &start, &end)?;
+            self.push(line, &end, feed);
+        }
+        self.pos = end;
+        Ok(())
+    }
+
+    fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
+        let frame = self.frame_now();
+        let (p, o, rotary) = if frame.is_identity() {
+            (
+                Vector3::new(q[0], q[1], q[2]),
+                self.vector,
+                Some([q[3], q[4], q[5]]),
+            )
+        } else {
+            let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
+            let o = frame.r * self.vector;
+            // Under a swivel frame the control sets the rotary axes: the tool vector rules.
+            let rotary = if self.swivel.is_some() {
+                None
+            } else {
+                Some([q[3], q[4], q[5]])
+            };
+            (p, o, rotary)
+        };
+        self.points.push(ClPoint {
+            p,
+            o,
+            feed,
+            rotary,
+            line,
+        });
+    }
+
+    /// The F of a G93 feed block, seconds for the whole block.
+    fn inverse_time(&self, line: usize, block: &Block) -> Result<f64> {
+        match block.feed {
+            None => Err(self.error(
+                line,
+                "G93 (inverse time): F is required on every G1/G2/G3 block",
+            )),
+            Some(f) if f <= 0.0 => Err(self.error(
+                line,
+                format!("G93 (inverse time): F must be positive, found {f}"),
+            )),
+            Some(f) => Ok(60.0 / f),
+        }
+    }
+
+    fn linear_feed(
+        &self,
+        line: usize,
+        motion: Motion,
+        block: &Block,
+        start: &[f64; 6],
+        end: &[f64; 6],
+    ) -> Result<Feed> {
+        if motion == Motion::Rapid {
+            return Ok(Feed::Rapid);
+        }
+        if self.feed_mode == FeedMode::InverseTime {
+            return Ok(Feed::BlockTime(self.inverse_time(line, block)?));
+        }
+        let Some(feed) = self.feed else {
+            return Ok(Feed::Unspecified);
+        };
+        let moves_xyz = (0..3).any(|i| (end[i] - start[i]).abs() > XYZ_MOVE_THRESHOLD_MM);
+        let rotary = (3..6)
+            .map(|i| (end[i] - start[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        Ok(if !moves_xyz && rotary > 0.0 {
+            Feed::BlockTime(rotary / (feed.raw / 60.0))
+        } else {
+            Feed::Programmed(feed.mm_per_min / 60.0)
+        })
+    }
+
+    /// G2/G3: linearises the arc into chords.
+    fn arc(
+        &mut self,
+        line: usize,
+        motion: Motion,
+        block: &Block,
+        start: [f64; 6],
+        end: [f64; 6],
+    ) -> Result<()> {
+        let (a, b, n) = self.plane.axes();
+        let plane = self.plane.code();
+        let centre_names = ['I', 'J', 'K'];
+        if block.centre[n].is_some() {
+            self.warn(
+                line,
+                format!(
+                    "{} is not a centre word of a {plane} arc: ignored",
+                    centre_names[n]
+                ),
+            );
+        }
+        let ccw = motion == Motion::ArcCcw;
+        let (s0, s1) = (start[a], start[b]);
+        let (e0, e1) = (end[a], end[b]);
+        let chord = (e0 - s0).hypot(e1 - s1);
+        let in_plane = block.centre[a].is_some() || block.centre[b].is_some();
+
+        let (c0, c1) = if let Some(r) = block.radius {
+            if in_plane {
+                return Err(self.error(line, "an arc with both R and I/J/K"));
+            }
+            let r = self.length(r);
+            if chord < FULL_CIRCLE_MM {
+                return Err(self.error(
+                    line,
+                    "an R arc needs an end point different from its start (use I/J/K for a \
+                     full circle)",
+                ));
+            }
+            if r == 0.0 {
+                return Err(self.error(line, "arc radius R is 0"));
+            }
+            let half = chord / 2.0;
+            if half > r.abs() + R_ARC_TOLERANCE_MM {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "arc radius {:.4} mm is smaller than half the distance to the end point \
+                         ({half:.4} mm)",
+                        r.abs()
+                    ),
+                ));
+            }
+            let h = (r * r - half * half).max(0.0).sqrt();
+            let (m0, m1) = ((s0 + e0) / 2.0, (s1 + e1) / 2.0);
+            // Left of the chord direction: counter-clockwise short arcs, clockwise long ones.
+            let (l0, l1) = (-(e1 - s1) / chord, (e0 - s0) / chord);
+            let side = if ccw == (r > 0.0) { 1.0 } else { -1.0 };
+            (m0 + side * h * l0, m1 + side * h * l1)
+        } else {
+            if !in_plane {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "{} arc needs its centre ({}, {}) or a radius R",
+                        plane, centre_names[a], centre_names[b]
+                    ),
+                ));
+            }
+            let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
+            match self.arc_distance {
+                Distance::Incremental => (s0 + word(a), s1 + word(b)),
+                Distance::Absolute => (word(a), word(b)),
+            }
+        };
+
+        let r_start = (s0 - c0).hypot(s1 - c1);
+        let r_end = (e0 - c0).hypot(e1 - c1);
+        let mismatch = (r_end - r_start).abs();
+        if mismatch > ARC_RADIUS_MISMATCH_MM
+            && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r_start.max(r_end)
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "arc end point is not on the circle: radius {r_end:.4} mm at the end, \
+                     {r_start:.4} mm at the start"
+                ),
+            ));
+        }
+        if r_start == 0.0 || r_end == 0.0 {
+            return Err(self.error(line, "arc centre coincides with its start or end point"));
+        }
+
+        let theta_s = (s1 - c1).atan2(s0 - c0);
+        let theta_e = (e1 - c1).atan2(e0 - c0);
+        let tau = std::f64::consts::TAU;
+        let mut sweep = if chord < FULL_CIRCLE_MM {
+            tau
+        } else if ccw {
+            (theta_e - theta_s).rem_euclid(tau)
+        } else {
+            (theta_s - theta_e).rem_euclid(tau)
+        };
+        let extra = match (block.turns, block.extra_turns) {
+            (Some(p), _) => {
+                if p < 1.0 || p.fract() != 0.0 {
+                    return Err(self.error(
+                        line,
+                        format!("arc turns P must be a whole number ≥ 1, found {p}"),
+                    ));
+                }
+                p - 1.0
+            }
+            (None, Some(t)) => {
+                if t < 0.0 || t.fract() != 0.0 {
+                    return Err(
+                        self.error(line, format!("TURN must be a whole number ≥ 0, found {t}"))
+                    );
+                }
+                t
+            }
+            (None, None) => 0.0,
+        };
+        sweep += extra * tau;
+        if !ccw {
+            sweep = -sweep;
+        }
+
+        let r_max = r_start.max(r_end);
+        let chords = crate::toolpath::arc_chords(sweep, r_max).map_err(|e| self.error(line, e))?;
+        let mut qs = Vec::with_capacity(chords);
+        for k in 1..=chords {
+            if k == chords {
+                qs.push(end);
+                break;
+            }
+            let t = k as f64 / chords as f64;
+            let phi = theta_s + t * sweep;
+            let r = r_start + t * (r_end - r_start);
+            let mut q = [0.0; 6];
+            for i in 0..6 {
+                q[i] = start[i] + t * (end[i] - start[i]);
+            }
+            q[a] = c0 + r * phi.cos();
+            q[b] = c1 + r * phi.sin();
+            qs.push(q);
+        }
+
+        match self.feed_mode {
+            FeedMode::InverseTime => {
+                let total = self.inverse_time(line, block)?;
+                let mut lengths = Vec::with_capacity(qs.len());
+                let mut prev = start;
+                for q in &qs {
+                    lengths.push(
+                        ((q[0] - prev[0]).powi(2)
+                            + (q[1] - prev[1]).powi(2)
+                            + (q[2] - prev[2]).powi(2))
+                        .sqrt(),
+                    );
+                    prev = *q;
+                }
+                let sum: f64 = lengths.iter().sum();
+                for (q, len) in qs.iter().zip(&lengths) {
+                    let share = if sum > 0.0 {
+                        len / sum
+                    } else {
+                        1.0 / qs.len() as f64
+                    };
+                    self.push(line, q, Feed::BlockTime(total * share));
+                }
+            }
+            FeedMode::PerMinute => {
+                let feed = match self.feed {
+                    Some(f) => Feed::Programmed(f.mm_per_min / 60.0),
+                    None => Feed::Unspecified,
+                };
+                for q in &qs {
+                    self.push(line, q, feed);
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,450 @@
+//! Lexing: comments, blocks and words, resolved through a dialect table; variables and
+//! expressions ([`super::expr`]) are evaluated here, left to right, as the block is read.
+
+use super::dialect::{Action, Address, DialectSpec, Semicolon, Spaces};
+use super::expr::{self, Variables};
+
+/// Removes comments and splits a line into block texts (more than one only where `;` ends a
+/// block). Double-quoted strings are kept whole. `( … )` comments may nest (Haas writes
+/// `((NAME))`).
+pub(super) fn split_blocks(
+    spec: &DialectSpec,
+    line: &str,
+) -> std::result::Result<Vec<String>, String> {
+    let mut blocks = Vec::new();
+    let mut current = String::new();
+    let mut chars = line.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '(' if spec.paren_comments => {
+                let mut depth = 1usize;
+                for c in chars.by_ref() {
+                    match c {
+                        '(' => depth += 1,
+                        ')' => depth -= 1,
+                        _ => {}
+                    }
+                    if depth == 0 {
+                        break;
+                    }
+                }
+                if depth > 0 {
+                    return Err("unclosed `(` comment".to_string());
+                }
+            }
+            ';' => match spec.semicolon {
+                Semicolon::Comment => break,
+                Semicolon::EndOfBlock => blocks.push(std::mem::take(&mut current)),
+            },
+            '"' => {
+                current.push(c);
+                let mut closed = false;
+                for q in chars.by_ref() {
+                    current.push(q);
+                    if q == '"' {
+                        closed = true;
+                        break;
+                    }
+                }
+                if !closed {
+                    return Err("unclosed `\"` string".to_string());
+                }
+            }
+            _ => current.push(c),
+        }
+    }
+    blocks.push(current);
+    Ok(blocks)
+}
+
+/// A number as written after a letter or `=`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Num {
+    pub(super) value: f64,
+    /// Written with a decimal point, or computed (matters under
+    /// [`DialectSpec::integer_increments`]).
+    pub(super) point: bool,
+}
+
+/// One word of a block, resolved through the dialect table.
+#[derive(Debug, Clone)]
+pub(super) enum Item {
+    /// A letter or named word with a number.
+    Word {
+        text: String,
+        address: Address,
+        num: Num,
+    },
+    /// A keyword the table knows, with its `( … )` arguments as written (without the
+    /// parentheses).
+    Keyword {
+        text: String,
+        action: Action,
+        args: Option<String>,
+    },
+    /// A known word whose value is not a number and does not matter (Sinumerik `T="MILL"`).
+    Skipped,
+    /// A word the dialect does not know.
+    Unknown { text: String },
+}
+
+/// Parses the number after a letter or `=`: optional sign, digits with at most one decimal
+/// point, at least one digit.
+fn number(text: &str) -> Option<Num> {
+    let body = text.strip_prefix(['+', '-']).unwrap_or(text);
+    let digits = body.chars().filter(char::is_ascii_digit).count();
+    let points = body.chars().filter(|&c| c == '.').count();
+    if digits == 0 || points > 1 || digits + points != body.len() {
+        return None;
+    }
+    let value: f64 = text.parse().ok()?;
+    value.is_finite().then_some(Num {
+        value,
+        point: points == 1,
+    })
+}
+
+/// A number, or an expression evaluated with `vars`.
+fn value(text: &str, vars: &Variables) -> std::result::Result<Num, String> {
+    if let Some(n) = number(text) {
+        return Ok(n);
+    }
+    expr::eval(text, vars).map(|value| Num { value, point: true })
+}
+
+fn letter_address(spec: &DialectSpec, letter: char) -> Option<Address> {
+    spec.letters
+        .iter()
+        .find(|(l, _)| *l == letter)
+        .map(|&(_, a)| a)
+}
+
+/// The end of a value starting at `i`: a sign, then a number, a `#` parameter or a `[ … ]`
+/// group, then (for parameters and groups) more operators and operands up to the next
+/// letter outside brackets.
+fn scan_value(chars: &[char], mut i: usize) -> usize {
+    let mut depth = 0usize;
+    let mut expression = false;
+    while i < chars.len() {
+        let c = chars[i];
+        match c {
+            '[' => {
+                depth += 1;
+                expression = true;
+            }
+            ']' => depth = depth.saturating_sub(1),
+            '#' => expression = true,
+            '<' if expression => {
+                // LinuxCNC #<name>
+                while i < chars.len() && chars[i] != '>' {
+                    i += 1;
+                }
+            }
+            _ if depth > 0 => {}
+            c if c.is_ascii_digit() || c == '.' || c == '+' || c == '-' => {}
+            '*' | '/' if expression => {}
+            _ => break,
+        }
+        i += 1;
+    }
+    i.min(chars.len())
+}
+
+/// Reads `LNUMBER LNUMBER …` (single-letter words, no spaces), `#n=expr` assignments and
+/// expression values into `items`.
+fn lex_letters(
+    spec: &DialectSpec,
+    text: &str,
+    vars: &mut Variables,
+    items: &mut Vec<Item>,
+) -> std::result::Result<(), String> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c == '#' {
+            // An assignment `#100=…` (Fanuc macro B, LinuxCNC parameters).
+            let name_end = scan_name(&chars, i + 1);
+            let name: String = chars[i..name_end].iter().collect();
+            let Some(key) = expr::hash_name(&name) else {
+                return Err(format!("malformed parameter `{name}`"));
+            };
+            if chars.get(name_end) != Some(&'=') {
+                return Err(format!(
+                    "`{name}` without `=`: a parameter must be assigned"
+                ));
+            }
+            let end = scan_value(&chars, name_end + 1);
+            let text: String = chars[name_end + 1..end].iter().collect();
+            let v = expr::eval(&text, vars).map_err(|e| format!("`{name}=`: {e}"))?;
+            vars.set(&key, v);
+            items.push(Item::Skipped);
+            i = end;
+            continue;
+        }
+        if !c.is_ascii_alphabetic() {
+            return Err(match c {
+                '[' | ']' => "an expression `[ … ]` must follow a letter or `=`".to_string(),
+                _ => format!("unexpected character `{c}`"),
+            });
+        }
+        let letter = c.to_ascii_uppercase();
+        let address = letter_address(spec, letter);
+        if let Some(Address::Unsupported(message)) = address {
+            return Err(format!("`{letter}` word: {message}"));
+        }
+        let end = scan_value(&chars, i + 1);
+        let text_value: String = chars[i + 1..end].iter().collect();
+        if end < chars.len()
+            && matches!(chars[end], 'E' | 'e')
+            && chars
+                .get(end + 1)
+                .is_some_and(|c| c.is_ascii_digit() || *c == '+' || *c == '-')
+            && !text_value.is_empty()
+        {
+            let mut stop = end + 1;
+            while stop < chars.len()
+                && (chars[stop].is_ascii_digit() || "+-.".contains(chars[stop]))
+            {
+                stop += 1;
+            }
+            let written: String = chars[i..stop].iter().collect();
+            return Err(format!(
+                "`{written}`: exponent notation is not part of G-code; write the number in full"
+            ));
+        }
+        if text_value.is_empty() {
+            return Err(format!("`{letter}` has no number"));
+        }
+        let num = if text_value.contains(['#', '[']) {
+            value(&text_value, vars).map_err(|e| format!("`{letter}{text_value}`: {e}"))?
+        } else {
+            number(&text_value)
+                .ok_or_else(|| format!("malformed number `{text_value}` after `{letter}`"))?
+        };
+        let text = format!("{letter}{text_value}");
+        items.push(match address {
+            Some(address) => Item::Word { text, address, num },
+            None => Item::Unknown { text },
+        });
+        i = end;
+    }
+    Ok(())
+}
+
+/// End of a parameter name after `#`: digits, `<name>` or `[ … ]`.
+fn scan_name(chars: &[char], mut i: usize) -> usize {
+    if chars.get(i) == Some(&'<') {
+        while i < chars.len() && chars[i] != '>' {
+            i += 1;
+        }
+        return (i + 1).min(chars.len());
+    }
+    while i < chars.len() && chars[i].is_ascii_digit() {
+        i += 1;
+    }
+    i
+}
+
+/// Splits a Sinumerik-style block at spaces outside `( )` and quotes.
+fn split_words(text: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    let mut current = String::new();
+    let mut depth = 0usize;
+    let mut quoted = false;
+    for c in text.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            '(' if !quoted => depth += 1,
+            ')' if !quoted => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        if c.is_whitespace() && depth == 0 && !quoted {
+            if !current.is_empty() {
+                words.push(std::mem::take(&mut current));
+            }
+        } else {
+            current.push(c);
+        }
+    }
+    if !current.is_empty() {
+        words.push(current);
+    }
+    words
+}
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// Reads one block's words through the dialect table.
+pub(super) fn lex(
+    spec: &DialectSpec,
+    block: &str,
+    vars: &mut Variables,
+) -> std::result::Result<Vec<Item>, String> {
+    let mut items = Vec::new();
+    match spec.spaces {
+        Spaces::Ignored => {
+            let compact: String = block.chars().filter(|c| !c.is_whitespace()).collect();
+            lex_letters(spec, &compact, vars, &mut items)?;
+        }
+        Spaces::Separate => {
+            let words = split_words(block);
+            // `N10 DEF REAL _A, _B=2`: declarations.
+            let first = words.iter().position(|w| {
+                !(w.len() > 1
+                    && w.starts_with(['N', 'n'])
+                    && w[1..].chars().all(|c| c.is_ascii_digit()))
+            });
+            if let Some(k) = first
+                && words[k].eq_ignore_ascii_case("DEF")
+            {
+                return declare(&words[k + 1..], vars).map(|()| Vec::new());
+            }
+            for word in words {
+                lex_separate_word(spec, &word, vars, &mut items)?;
+            }
+        }
+    }
+    Ok(items)
+}
+
+/// `DEF REAL _A, _B=2, _C`: declares the names (0, or the value given).
+fn declare(words: &[String], vars: &mut Variables) -> std::result::Result<(), String> {
+    let Some((kind, rest)) = words.split_first() else {
+        return Err("DEF without a type and a name".into());
+    };
+    let kind = kind.to_ascii_uppercase();
+    if !matches!(
+        kind.as_str(),
+        "REAL" | "INT" | "BOOL" | "CHAR" | "STRING" | "AXIS" | "FRAME"
+    ) && !kind.starts_with("STRING[")
+    {
+        return Err(format!("DEF {kind}: unknown variable type"));
+    }
+    let text = rest.join(" ");
+    for part in text.split(',') {
+        let part = part.trim();
+        if part.is_empty() {
+            continue;
+        }
+        let (name, init) = match part.split_once('=') {
+            Some((n, v)) => (n.trim(), Some(v.trim())),
+            None => (part, None),
+        };
+        let name = name.split('[').next().unwrap_or(name);
+        if !is_identifier(name) {
+            return Err(format!("DEF: `{name}` is not a variable name"));
+        }
+        vars.declare(name);
+        if let Some(init) = init
+            && matches!(kind.as_str(), "REAL" | "INT")
+        {
+            let v = expr::eval(init, vars).map_err(|e| format!("DEF {name}: {e}"))?;
+            vars.set(name, v);
+        }
+    }
+    Ok(())
+}
+
+/// One space-separated word: `NAME=value` (an address or an assignment), a keyword (two or
+/// more letters, optional `( … )`), or letter words (`G1`, `X10`, `G1X10`, `M202(0.0059)`).
+fn lex_separate_word(
+    spec: &DialectSpec,
+    word: &str,
+    vars: &mut Variables,
+    items: &mut Vec<Item>,
+) -> std::result::Result<(), String> {
+    let upper = word.to_ascii_uppercase();
+    if let Some((name, text)) = upper.split_once('=')
+        && !name.contains('(')
+    {
+        if !is_identifier(name) {
+            return Err(format!("malformed word `{word}`"));
+        }
+        let address = if name.len() == 1 {
+            letter_address(spec, name.chars().next().unwrap_or(' '))
+        } else {
+            spec.named.iter().find(|(n, _)| *n == name).map(|&(_, a)| a)
+        };
+        let Some(address) = address else {
+            if vars.assignable(name) {
+                let v = expr::eval(text, vars).map_err(|e| format!("`{name}=`: {e}"))?;
+                vars.set(name, v);
+                items.push(Item::Skipped);
+            } else {
+                items.push(Item::Unknown {
+                    text: format!("{name}="),
+                });
+            }
+            return Ok(());
+        };
+        match address {
+            Address::Unsupported(message) => return Err(format!("`{name}=`: {message}")),
+            Address::Ignored if value(text, vars).is_err() => items.push(Item::Skipped),
+            _ => {
+                if text.is_empty() {
+                    return Err(format!("`{name}=` has no number"));
+                }
+                if text.starts_with("IC(") || text.starts_with("AC(") {
+                    return Err(format!(
+                        "`{name}={text}`: IC( )/AC( ) (incremental or absolute for one word) is \
+                         not supported; program G90/G91"
+                    ));
+                }
+                let num = value(text, vars).map_err(|e| format!("`{name}={text}`: {e}"))?;
+                items.push(Item::Word {
+                    text: format!("{name}={text}"),
+                    address,
+                    num,
+                });
+            }
+        }
+        return Ok(());
+    }
+    let mut chars = upper.chars();
+    let first_two_letters = chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    if first_two_letters {
+        let name_end = upper
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(upper.len());
+        let (name, rest) = upper.split_at(name_end);
+        if !(rest.is_empty() || (rest.starts_with('(') && rest.ends_with(')'))) {
+            return Err(format!("malformed word `{word}`"));
+        }
+        let args = rest
+            .strip_prefix('(')
+            .and_then(|r| r.strip_suffix(')'))
+            .map(str::to_string);
+        match spec.keywords.iter().find(|(k, _)| *k == name) {
+            Some(&(_, Action::Unsupported(message))) => return Err(format!("{name}: {message}")),
+            Some(&(_, action)) => items.push(Item::Keyword {
+                text: name.to_string(),
+                action,
+                args,
+            }),
+            None => items.push(Item::Unknown {
+                text: name.to_string(),
+            }),
+        }
+        return Ok(());
+    }
+    // `M202(0.0059)`: an M function with an argument (the argument does not move the tool).
+    if upper.starts_with('M')
+        && let Some(open) = upper.find('(')
+        && upper.ends_with(')')
+    {
+        return lex_letters(spec, &upper[..open], vars, items);
+    }
+    lex_letters(spec, &upper, vars, items)
+}

@@ -1,0 +1,261 @@
+//! G-code reader (RS-274 as LinuxCNC, Fanuc and Sinumerik controllers run it): `.ngc`, `.nc`,
+//! `.gcode`, `.tap`.
+//!
+//! # One interpreter, one table per dialect
+//!
+//! Every dialect is a [`DialectSpec`]: plain data that says how comments look, whether spaces
+//! separate words, which letters and named words exist and what they address, and what each
+//! G code, M code and keyword does (an [`Action`]: motion mode, plane, units, TCP on/off, ...).
+//! A single interpreter reads the program through that table (seed 003's re-programmable
+//! interpreter). Adding a dialect means writing a new `DialectSpec` (and, for the built-in
+//! ones, a [`Dialect`] variant); [`parse_with`] runs any table.
+//!
+//! The built-in tables:
+//!
+//! * [`LINUXCNC`]: comments `( … )` and `;` to the end of the line (a `;` inside `( )` belongs
+//!   to the comment); spaces ignored everywhere (`G1  X  16.339`); TCP on `M428`, off `M429`
+//!   (identity kins) and `M430` (user kins), the trt sims' switchkins remaps; no tool-vector
+//!   words; `G20`/`G21`; axis words before any G0–G3 are an error (LinuxCNC starts in G80).
+//! * [`FANUC`]: comments `( … )`, `;` ends a block; spaces ignored; TCP on `G43.4` (rotary
+//!   words) or `G43.5` (tool vector: `I J K` on G0/G1 blocks), off `G49`, `G43`, `G44`;
+//!   `G20`/`G21`; the motion mode starts as G0; a number without a decimal point in X Y Z A B C
+//!   I J K R counts least input increments (0.001 mm, 0.0001 inch, 0.001°), Fanuc's default.
+//! * [`SINUMERIK`]: `;` comments (parentheses are not comments); spaces separate words, which
+//!   may be keywords (`TRAORI`, `MSG("…")`) or `NAME=value`; TCP on `TRAORI`, off `TRAFOOF`;
+//!   tool vector `A3= B3= C3=`; `CR=` radius, `TURN=` extra turns; `G70`/`G71` inch/mm for
+//!   geometry only, `G700`/`G710` for F too; the motion mode starts as G0.
+//!
+//! # What is read
+//!
+//! * **Motion.** `G0` (rapid), `G1`, `G2`/`G3` (clockwise / counter-clockwise) are modal; a block
+//!   with axis words uses the motion mode in force (so `G54 X1 Y2 A0 C0` under G0 is a rapid).
+//!   Axis words X Y Z (mm, or inch under G20: ×25.4) and A B C (degrees). `G90` absolute, `G91`
+//!   incremental (increments add to the modal position). Rotary words are linear axes that wrap
+//!   nothing: `C350` then `C370` stays 370, never reduced modulo 360.
+//! * **Arcs.** `G17`/`G18`/`G19` select the XY / ZX / YZ plane (counter-clockwise is positive
+//!   rotation about +Z / +Y / +X). The centre is given by I J K (offsets from the start point;
+//!   LinuxCNC `G90.1` makes them absolute, `G91.1` incremental again) or by `R` (Sinumerik `CR=`):
+//!   R > 0 the arc of at most 180°, R < 0 the longer one. Start = end with I J K is a full circle;
+//!   LinuxCNC `P` (number of turns) and Sinumerik `TURN=` (extra turns) add whole turns. The axis
+//!   normal to the plane and the rotary axes move linearly with the angle (helices). An I J K arc
+//!   whose end radius differs from its start radius by more than [`ARC_RADIUS_MISMATCH_MM`] and
+//!   [`ARC_RADIUS_MISMATCH_RELATIVE`] of the radius is an error; a smaller difference is followed
+//!   as a spiral (radius linear in the angle), so the end point is met exactly. An R arc whose
+//!   chord is longer than 2|R| + [`R_ARC_TOLERANCE_MM`] is an error. Arcs are **linearised**:
+//!   chords whose sagitta is at most [`MAX_CHORD_ERROR_MM`] (1 µm), every chord end a
+//!   [`ClPoint`] on the circle with the block's line; the last one is the programmed end point
+//!   exactly.
+//! * **Feeds.** `G0` → [`Feed::Rapid`]. Under `G94` (units per minute) F is modal and stored in
+//!   mm/min (under G20, F × 25.4); a G1/G2/G3 block whose X, Y or Z moves by more than
+//!   [`XYZ_MOVE_THRESHOLD_MM`] gets [`Feed::Programmed`] (F/60 mm/s). When only rotary axes move,
+//!   LinuxCNC's length rule makes F degrees per minute over the A B C distance, so the block gets
+//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). Before any F, or
+//!   after `F0`, feed moves get [`Feed::Unspecified`]. Under `G93` (inverse time) every G1/G2/G3
+//!   block must carry its own F (an error naming the line otherwise) and gets
+//!   [`Feed::BlockTime`] = 60/F s; on an arc that time is split over the chords in proportion to
+//!   their length. Leaving G93 forgets F (LinuxCNC: every `G94` sets F to 0), so a feed move must
+//!   program F again.
+//! * **Tool-tip mode (TCP).** The codes above switch it on and off. In TCP mode X Y Z are the
+//!   tool tip in workpiece coordinates and A B C the rotary axis positions. A motion block that
+//!   has (or keeps) a rotary position or tool vector while TCP is off gets one warning per
+//!   stretch of such blocks: its X Y Z are still taken as the tool tip.
+//! * **Tool vectors.** Sinumerik `A3= B3= C3=`, and Fanuc `I J K` on G0/G1 blocks under `G43.5`,
+//!   set the tool orientation: a component not written in a block that writes another is 0, a
+//!   block that writes none keeps the vector, and the vector is normalised (zero length is an
+//!   error). On arcs I J K stay the centre.
+//! * **Output.** One [`ClPoint`] per linear motion block (its end point), one per chord of an
+//!   arc. `p` = X Y Z in mm in program coordinates; `o` = the tool vector when the program gives
+//!   one, else (0, 0, 1); `rotary` = `Some([A, B, C])` (modal values in degrees, 0 for an axis
+//!   never programmed) on every point when the program has any A, B or C word, `None`
+//!   otherwise; `line` = the block's 1-based line. There is no implicit start point: the
+//!   toolpath starts at the end of the first motion block. X, Y or Z not yet programmed at a
+//!   motion block are taken as 0 with a warning (the machine's start position is unknown).
+//! * **G53**, Sinumerik **SUPA** (machine coordinates, one block): the move is included, its
+//!   words read as machine coordinates = program coordinates + the machine's work offset
+//!   ([`MachineContext::work_offset`]; zero without a machine), with a warning saying so.
+//! * **G28/G30** (`G91 G28 Z0`, `G28 X0 Y0 B0`, `G30 P3 …`): a rapid to the intermediate point
+//!   the words give, then a rapid of the named axes to their reference point, read from the
+//!   machine file's `reference` (an error naming `axes.Z.reference` when it is missing).
+//! * **Canned cycles and dwells**: see [`cycles`]; `G4` (P seconds on LinuxCNC, P ms or X
+//!   seconds on Fanuc, F seconds on Sinumerik) and every cycle dwell become
+//!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
+//! * **Variables and expressions**: see [`expr`] (Sinumerik `DEF`, R parameters, Fanuc `#n`).
+//! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
+//! * **Sinumerik units**: `G70`/`G71` change the geometry only; F stays in the control's basic
+//!   system, taken as the unit the program selects first (a warning when that is inch);
+//!   `G700`/`G710` change F too.
+//! * **Bounds**: an axis word beyond ±[`MAX_COORDINATE_MM`] is an error naming it; an arc needs
+//!   at most [`MAX_ARC_CHORDS`] chords (so `P1000000000` turns or `TURN=100000000` are errors
+//!   before any work); exponent notation (`X1e309`) is an error naming the word.
+//! * **The machine**: with [`parse_for`] and a [`MachineContext`], an axis word for an axis the
+//!   machine lacks is an error naming the axis.
+//!
+//! # What is accepted and ignored
+//!
+//! Line numbers `N`; `S`, `T`, `H`, `D` and the other parameter letters of the table; M codes
+//! of the table (spindle, coolant, tool change, pauses; Sinumerik `M202(0.0059)` arguments);
+//! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (`.1 .2 .3`), path control
+//! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
+//! coordinates either way; `G234` is TCP on); `%` lines; blank lines; nested `(( ))` comments. Program
+//! end (`M2`, `M30`, Sinumerik `M17`, `RET`, Fanuc `M99`) stops reading: later lines are not
+//! parsed. These codes are accepted with a warning because the toolpath does not carry them:
+//! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
+//! moves nothing: its axis words are not a move). A block starting with `/` (block delete) is skipped with a
+//! warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
+//! move, are skipped with a warning.
+//!
+//! # What is rejected
+//!
+//! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
+//!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
+//!   [`Warning`] naming the word and its line, never silently.
+//! * Errors ([`Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
+//!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
+//!   LinuxCNC O-word control flow, the same word twice in a block, two motion codes in one
+//!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
+//!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
+//!   silently: `G92`/`G52` offsets, splines, threading, probing, polar coordinates, scaling,
+//!   mirroring, feed per revolution, subprogram calls (`M98`, Sinumerik `L…`), Sinumerik
+//!   `CYCLE76`/`CYCLE77` (spigot milling).
+
+pub mod cycles;
+mod dialect;
+pub mod expr;
+pub mod frames;
+mod interp;
+mod lexer;
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+pub use crate::toolpath::Units;
+#[allow(unused_imports)] // named by the module docs
+use crate::toolpath::{ClPoint, Feed, Warning};
+use crate::toolpath::{MachineContext, Toolpath};
+pub use dialect::*;
+use interp::Interpreter;
+pub use interp::{MAX_ARC_CHORDS, MAX_COORDINATE_MM};
+use lexer::{lex, split_blocks};
+
+/// Largest distance between an arc and the chords that replace it (the sagitta), mm: 1 µm.
+///
+/// The chord count of an arc of radius r and sweep Δ is ⌈Δ / (2 acos(1 − e/r))⌉ with e this
+/// constant, so every chord's sagitta is at most e (on a helix, the in-plane sagitta).
+pub const MAX_CHORD_ERROR_MM: f64 = 1e-3;
+
+/// LinuxCNC's length rule: a block "moves X Y Z" when any of them moves more than this (mm).
+pub const XYZ_MOVE_THRESHOLD_MM: f64 = 1e-7;
+
+/// I J K arcs: the end radius may differ from the start radius by this much (mm) …
+/// (LinuxCNC's default `CENTER_ARC_RADIUS_TOLERANCE_MM`, 0.02·√2).
+pub const ARC_RADIUS_MISMATCH_MM: f64 = 0.02 * std::f64::consts::SQRT_2;
+
+/// … or by this fraction of the radius, whichever is larger (LinuxCNC's
+/// `SPIRAL_RELATIVE_TOLERANCE`).
+pub const ARC_RADIUS_MISMATCH_RELATIVE: f64 = 1e-3;
+
+/// R arcs: the chord may exceed the diameter by this much, mm (LinuxCNC's
+/// `RADIUS_TOLERANCE_MM`); the centre is then the chord's midpoint.
+pub const R_ARC_TOLERANCE_MM: f64 = 0.00127;
+
+/// An I J K arc whose end is this close to its start (in the plane, mm) is a full circle.
+const FULL_CIRCLE_MM: f64 = 1e-9;
+
+/// Tool vectors shorter than this are rejected as having no direction.
+const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
+
+/// File extensions read as G-code.
+pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap"];
+
+// ---------------------------------------------------------------------------------------------
+// Entry points
+// ---------------------------------------------------------------------------------------------
+
+/// Reads a G-code file. Bytes that are not valid UTF-8 (e.g. Latin-1 in comments) are replaced,
+/// not rejected.
+pub fn read(path: &Path, dialect: Dialect) -> Result<Toolpath> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let text = String::from_utf8_lossy(&bytes);
+    parse(path, &text, dialect)
+}
+
+/// Parses G-code text in a built-in dialect; `source` names the file in the result and errors.
+pub fn parse(source: &Path, text: &str, dialect: Dialect) -> Result<Toolpath> {
+    parse_with(source, text, dialect.spec())
+}
+
+/// Parses G-code text with any dialect table.
+pub fn parse_with(source: &Path, text: &str, spec: &DialectSpec) -> Result<Toolpath> {
+    parse_for(source, text, spec, None)
+}
+
+/// Parses G-code text with any dialect table for a machine: axis words for axes it lacks are
+/// errors, and `G28`/`G30`/`G53`/`SUPA` use its reference positions and work offset.
+pub fn parse_for(
+    source: &Path,
+    text: &str,
+    spec: &DialectSpec,
+    machine: Option<&MachineContext>,
+) -> Result<Toolpath> {
+    let mut interp = Interpreter::new(spec, source, machine);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut last_line = 0;
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        last_line = line;
+        let trimmed = raw.trim();
+        if trimmed.is_empty() || trimmed.starts_with('%') {
+            continue;
+        }
+        let blocks = split_blocks(spec, raw).map_err(|m| Error::parse(source, line, m))?;
+        for block in blocks {
+            let block = block.trim();
+            if block.is_empty() {
+                continue;
+            }
+            if block.starts_with('/') {
+                interp.warn(line, "block delete `/`: block skipped");
+                continue;
+            }
+            let items =
+                lex(spec, block, &mut interp.vars).map_err(|m| Error::parse(source, line, m))?;
+            interp.block(line, items)?;
+            if interp.ended {
+                break;
+            }
+        }
+        if interp.ended {
+            break;
+        }
+    }
+    interp.finish(last_line)
+}
+
+/// The dialect a program's text (upper-cased) shows, if any: Sinumerik (`TRAORI`, `TRAFOOF`,
+/// `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`,
+/// `G68.2`, `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
+pub fn detect_dialect(upper: &str) -> Option<Dialect> {
+    let has = |w: &str| upper.contains(w);
+    let sinumerik = [
+        "TRAORI", "TRAFOOF", "MCALL", "CYCLE8", "DEF REAL", "SUPA ", "G710", "G700", "MSG(",
+    ]
+    .iter()
+    .any(|w| has(w));
+    let fanuc = ["G43.4", "G43.5", "G68.2", "G05.1", "G5.1", "M98"]
+        .iter()
+        .any(|w| has(w))
+        || upper
+            .lines()
+            .find(|l| !l.trim().is_empty() && !l.trim().starts_with('%'))
+            .is_some_and(|l| {
+                let l = l.trim();
+                l.starts_with('O') && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
+            });
+    let linuxcnc = ["M428", "M429", "M430", "O<"].iter().any(|w| has(w));
+    match (sinumerik, fanuc, linuxcnc) {
+        (true, _, _) => Some(Dialect::Sinumerik),
+        (false, true, _) => Some(Dialect::Fanuc),
+        (false, false, true) => Some(Dialect::LinuxCnc),
+        _ => None,
+    }
+}

@@ -1,0 +1,294 @@
+//! What CAM posts write (issue 12): canned cycles, reference moves, arcs, NURBS, frames, units
+//! and axes, each against hand-computed moves and times.
+
+use feedopt::error::Error;
+use feedopt::toolpath::gcode::{Dialect, parse, parse_for};
+use feedopt::toolpath::{Feed, MachineContext, Toolpath, apt};
+use nalgebra::Vector3;
+use std::path::Path;
+
+fn gcode(dialect: Dialect, text: &str) -> Toolpath {
+    parse(Path::new("t.ngc"), text, dialect).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+fn apt_ok(text: &str) -> Toolpath {
+    apt::parse(Path::new("t.cls"), text).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
+    Vector3::new(x, y, z)
+}
+
+fn assert_close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) {
+    assert!((a - b).norm() <= tol, "{a:?} != {b:?}");
+}
+
+/// Time of the feed moves at their programmed feeds, s.
+fn feed_time(tp: &Toolpath) -> f64 {
+    tp.points
+        .windows(2)
+        .map(|w| match w[1].feed {
+            Feed::Programmed(f) => (w[1].p - w[0].p).norm() / f,
+            _ => 0.0,
+        })
+        .sum()
+}
+
+fn message(e: Error) -> String {
+    e.to_string()
+}
+
+#[test]
+fn g83_peck_cycle_moves_and_time() {
+    // Initial level 10, R 2, bottom −3, pecks of 2: depths 0, −2, −3; after each peck a rapid
+    // to R and back to 0.254 mm above the last depth; G98 returns to the initial level.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X0 Y0 Z10\nG98 G83 X5 Y0 Z-3 R2 Q2 F60\nG80\n",
+    );
+    let z: Vec<f64> = tp.points[1..].iter().map(|p| p.p.z).collect();
+    let want = [10.0, 2.0, 0.0, 2.0, 0.254, -2.0, 2.0, -1.746, -3.0, 10.0];
+    assert_eq!(z.len(), want.len(), "{z:?}");
+    for (a, b) in z.iter().zip(want) {
+        assert!((a - b).abs() < 1e-9, "{z:?}");
+    }
+    assert!(tp.points[1..].iter().all(|p| p.p.x == 5.0));
+    // Feed moves: 2 + 2.254 + 1.254 mm at 1 mm/s; every other move is a rapid.
+    assert!((feed_time(&tp) - 5.508).abs() < 1e-9, "{}", feed_time(&tp));
+    let rapids = tp.points[1..]
+        .iter()
+        .filter(|p| p.feed == Feed::Rapid)
+        .count();
+    assert_eq!(rapids, 7);
+    // G99 returns to R instead; Fanuc P is milliseconds (G82 P1500 = 1.5 s), counted.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0 Y0 Z10.\nG99 G82 X5. Y0 Z-3. R2. P1500 F60.\nX6.\nG80\n",
+    );
+    assert!((tp.dwell_time() - 3.0).abs() < 1e-12, "{:?}", tp.dwells);
+    assert_eq!(tp.points.last().map(|p| p.p), Some(v(6.0, 0.0, 2.0)));
+}
+
+#[test]
+fn mcall_cycle83_at_three_positions() {
+    // RTP 20, RFP 0, SDIS 2, DP −10, FDEP −4 (first depth 4), VARI 1 (swarf removal):
+    // depths −4, −8, −10; per hole 6 + 4.254 + 2.254 mm of feed at 2 mm/s = 6.254 s.
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "G71 G90 G0 X0 Y0 Z20\nF120\nMCALL CYCLE83(20,0,2,-10,,-4,,,,,,1)\nX10\nX20\nX30\nMCALL\nX40\n",
+    );
+    let bottoms: Vec<f64> = tp
+        .points
+        .iter()
+        .filter(|p| (p.p.z + 10.0).abs() < 1e-9)
+        .map(|p| p.p.x)
+        .collect();
+    assert_eq!(bottoms, vec![10.0, 20.0, 30.0]);
+    assert!(
+        (feed_time(&tp) - 3.0 * 6.254).abs() < 1e-9,
+        "{}",
+        feed_time(&tp)
+    );
+    // After the bare MCALL, X40 is only a rapid at the retract plane.
+    let last = tp.points.last().map(|p| p.p);
+    assert_eq!(last, Some(v(40.0, 0.0, 20.0)));
+}
+
+fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> MachineContext {
+    MachineContext {
+        file: "m.json".into(),
+        axes: Some(axes.chars().collect()),
+        reference,
+        work_offset,
+    }
+}
+
+#[test]
+fn g28_goes_via_the_intermediate_point() {
+    let refs = [
+        vec![-200.0],
+        vec![0.0],
+        vec![150.0],
+        vec![],
+        vec![0.0],
+        vec![0.0],
+    ];
+    let m = context("XYZBC", refs, [0.0, 0.0, 100.0]);
+    // G91 G28 Z10: via Z 5 + 10 = 15, then to the Z reference 150 (machine) = 50 (program).
+    let tp = parse_for(
+        Path::new("t.nc"),
+        "G90 G0 X10. Y10. Z5.\nG91 G28 Z10.\nG90 G28 X0. Y10. B0.\n",
+        Dialect::Fanuc.spec(),
+        Some(&m),
+    )
+    .unwrap();
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(p[1], v(10.0, 10.0, 15.0));
+    assert_eq!(p[2], v(10.0, 10.0, 50.0));
+    // Absolute G28 X0 Y10: via (0, 10), then X, Y to their references (−200, 0).
+    assert_eq!(p[3], v(0.0, 10.0, 50.0));
+    assert_eq!(p[4], v(-200.0, 0.0, 50.0));
+    assert!(tp.points[1..].iter().all(|p| p.feed == Feed::Rapid));
+    // Without a reference in the machine file: an error naming the field to add.
+    let m = context("XYZBC", Default::default(), [0.0; 3]);
+    let e = parse_for(
+        Path::new("t.nc"),
+        "G0 X0. Y0. Z0.\nG91 G28 Z0.\n",
+        Dialect::Fanuc.spec(),
+        Some(&m),
+    )
+    .unwrap_err();
+    let text = message(e);
+    assert!(
+        text.contains(":2:") && text.contains("axes.Z") && text.contains("reference"),
+        "{text}"
+    );
+}
+
+#[test]
+fn apt_circle_is_the_same_arc_as_g2() {
+    let a = apt_ok("FEDRAT/MMPM,100\nGOTO/10,0,0\nCIRCLE/0,0,0,0,0,-1,10\nGOTO/0,-10,0\n");
+    let g = gcode(Dialect::LinuxCnc, "G0 X10 Y0 Z0\nG2 X0 Y-10 I-10 J0 F100\n");
+    assert_eq!(a.points.len(), g.points.len());
+    assert!(a.points.len() > 50, "a quarter circle of r 10 within 1 µm");
+    for (p, q) in a.points.iter().zip(&g.points) {
+        assert_close(p.p, q.p, 1e-9);
+    }
+    assert!((feed_time(&a) - feed_time(&g)).abs() < 1e-12);
+    // A full circle: end = start.
+    let full = apt_ok("GOTO/10,0,0\nCIRCLE/0,0,0,0,0,1,10\nGOTO/10,0,0\n");
+    let len: f64 = full
+        .points
+        .windows(2)
+        .map(|w| (w[1].p - w[0].p).norm())
+        .sum();
+    // The chord polygon is shorter than the circle by a few µm (sagitta 1 µm).
+    assert!(
+        (len - 2.0 * std::f64::consts::PI * 10.0).abs() < 5e-3,
+        "{len}"
+    );
+}
+
+#[test]
+fn nurbs_is_followed_not_its_control_polygon() {
+    // A quadratic Bézier (0,0) (10,10) (20,0): B(t) = (20t, 20t(1 − t)); its length is
+    // (1/20)[10√800 + 200 ln((20 + √800)/20)] = 22.9559 mm; the control polygon is 28.284 mm.
+    let tp = apt_ok(
+        "FEDRAT/MMPM,60\nGOTO/0,0,0\nNURBS/\nKNOT/0,0,0,1,1,1\nCNTRL/0,0,0\nCNTRL/10,10,0\nCNTRL/20,0,0\nGOTO/20,0,5\n",
+    );
+    let exact = (10.0 * 800f64.sqrt() + 200.0 * ((20.0 + 800f64.sqrt()) / 20.0).ln()) / 20.0;
+    let curve: Vec<&feedopt::toolpath::ClPoint> =
+        tp.points.iter().filter(|p| p.p.z == 0.0).collect();
+    let len: f64 = curve.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
+    assert!((len - exact).abs() < 1e-3, "{len} vs {exact}");
+    assert!(
+        curve
+            .iter()
+            .any(|p| (p.p - v(10.0, 5.0, 0.0)).norm() < 1e-9)
+    );
+    // At 1 mm/s the curve takes its length in seconds, not the polygon's 28.28.
+    let t = feed_time(&tp) - 5.0;
+    assert!((t - exact).abs() < 1e-3, "{t}");
+}
+
+#[test]
+fn msys_rotates_points_and_tool_vectors() {
+    // X axis along world +Y, Y axis along world −X (90° about Z), origin (10, 0, 0).
+    let tp = apt_ok("MSYS/10,0,0,0,1,0,-1,0,0\nGOTO/1,0,0,1,0,0\nMSYS/\nGOTO/1,0,0,1,0,0\n");
+    assert_close(tp.points[0].p, v(10.0, 1.0, 0.0), 1e-12);
+    assert_close(tp.points[0].o, v(0.0, 1.0, 0.0), 1e-12);
+    assert_close(tp.points[1].p, v(1.0, 0.0, 0.0), 1e-12);
+    assert_close(tp.points[1].o, v(1.0, 0.0, 0.0), 1e-12);
+}
+
+#[test]
+fn cycle800_swivels_a_3_plus_2_plane() {
+    // _MODE 57: X, then Y, then Z; B = 90° about Y: program Z is world +X, and the tool
+    // points along it; CYCLE800() clears the plane.
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "CYCLE800(1,\"TC1\",0,57,0,0,0,0,90,0,0,0,0,-1,100,1)\nG0 X0 Y0 Z10\nX5\nCYCLE800()\nG0 X0 Y0 Z10\n",
+    );
+    assert_close(tp.points[0].p, v(10.0, 0.0, 0.0), 1e-12);
+    assert_close(tp.points[0].o, v(1.0, 0.0, 0.0), 1e-12);
+    assert_close(tp.points[1].p, v(10.0, 0.0, -5.0), 1e-12);
+    assert_eq!(tp.points[0].rotary, None);
+    assert_close(tp.points[2].p, v(0.0, 0.0, 10.0), 1e-12);
+    // TRANS and AROT: a programmable frame.
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "TRANS X100\nAROT Z90\nG0 X10 Y0 Z0\nTRANS\nG0 X10 Y0 Z0\n",
+    );
+    assert_close(tp.points[0].p, v(100.0, 10.0, 0.0), 1e-12);
+    assert_close(tp.points[1].p, v(10.0, 0.0, 0.0), 1e-12);
+}
+
+#[test]
+fn sinumerik_g70_feed_units() {
+    // G70 first: the program is in inches, F in inch/min (the basic system taken as inch).
+    let tp = gcode(Dialect::Sinumerik, "G70\nG0 X0 Y0 Z0\nG1 X1 F10\n");
+    assert_close(tp.points[1].p, v(25.4, 0.0, 0.0), 1e-12);
+    assert_eq!(tp.points[1].feed, Feed::Programmed(10.0 * 25.4 / 60.0));
+    // A metric basic system: G70 changes the geometry only, F stays mm/min.
+    let tp = gcode(Dialect::Sinumerik, "G71\nG70\nG0 X0 Y0 Z0\nG1 X1 F254\n");
+    assert_close(tp.points[1].p, v(25.4, 0.0, 0.0), 1e-12);
+    assert_eq!(tp.points[1].feed, Feed::Programmed(254.0 / 60.0));
+    // G700: F in inch/min too.
+    let tp = gcode(Dialect::Sinumerik, "G710\nG700\nG0 X0 Y0 Z0\nG1 X1 F10\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(10.0 * 25.4 / 60.0));
+}
+
+#[test]
+fn variables_and_expressions() {
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "DEF REAL _Z_HOME, _X=2\n_Z_HOME=50 R2=3\nR1=R2+5\nG0 X=R1*2 Y=_X Z=_Z_HOME\n",
+    );
+    assert_eq!(tp.points[0].p, v(16.0, 2.0, 50.0));
+    let tp = gcode(
+        Dialect::Fanuc,
+        "#100=5.\n#101=#100*2\nG0 X#101 Y[#100+1] Z-#100\n",
+    );
+    assert_eq!(tp.points[0].p, v(10.0, 6.0, -5.0));
+    // G10 L2 sets an offset and moves nothing.
+    let tp = gcode(Dialect::Fanuc, "G10 L2 P1 X0 Y0 Z0\nG0 X1. Y1. Z1.\n");
+    assert_eq!(tp.points.len(), 1);
+}
+
+#[test]
+fn an_ab_program_on_an_ac_machine_names_b() {
+    let m = context("XYZAC", Default::default(), [0.0; 3]);
+    let e = parse_for(
+        Path::new("t.nc"),
+        "G0 X0. Y0. Z0. A0.\nG0 A10. B20.\n",
+        Dialect::Fanuc.spec(),
+        Some(&m),
+    )
+    .unwrap_err();
+    let text = message(e);
+    assert!(text.contains(":2:") && text.contains("no B axis"), "{text}");
+}
+
+#[test]
+fn arc_turns_and_chords_are_bounded() {
+    // Turn counts and radii whose chords would be past MAX_ARC_CHORDS: errors up front.
+    let fails = |text: &str, dialect: Dialect| match parse(Path::new("t"), text, dialect) {
+        Ok(tp) => panic!("{} points from {text}", tp.points.len()),
+        Err(e) => message(e),
+    };
+    let e = fails(
+        "G0 X10 Y0 Z0\nG2 X10 Y0 I-10 J0 P1000000000 F100\n",
+        Dialect::LinuxCnc,
+    );
+    assert!(e.contains("chords"), "{e}");
+    let e = fails(
+        "G0 X10 Y0 Z0\nG2 X10 Y0 I-10 J0 TURN=100000000 F100\n",
+        Dialect::Sinumerik,
+    );
+    assert!(e.contains("chords"), "{e}");
+    let e = fails(
+        "G0 X10 Y0 Z0\nG2 X10 Y0 I-1000000000000 J0 F100\n",
+        Dialect::LinuxCnc,
+    );
+    assert!(e.contains("out of range") || e.contains("chords"), "{e}");
+}
