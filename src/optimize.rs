@@ -506,6 +506,38 @@ impl Plan<'_> {
         Ok(())
     }
 
+    /// The interval times of one span's profile (eq. 43); where the feed is zero over a whole
+    /// interval, an error naming span, u, the nearest CL line and the limit that allows no
+    /// motion there.
+    fn times(&self, si: usize, p: &SpanProblem, s: &SpanSolution) -> Result<Vec<f64>> {
+        interval_times(p, s).map_err(|e| {
+            let Some(k) = (0..p.intervals()).find(|&k| s.b[k] <= 0.0 && s.b[k + 1] <= 0.0) else {
+                return e;
+            };
+            let i = if p.b_max[k] <= p.b_max[k + 1] {
+                k
+            } else {
+                k + 1
+            };
+            let limit = match p.b_max_by[i] {
+                Bound::AxisVelocity(j) => format!("the {} velocity limit", self.axes[j]),
+                Bound::AxisAcceleration(j) => format!("the {} acceleration limit", self.axes[j]),
+                Bound::AxisJerk(j) => format!("the {} jerk limit", self.axes[j]),
+                Bound::Feed => "the programmed feed".to_string(),
+                Bound::Chord => "the chord tolerance".to_string(),
+                Bound::None => "the limits".to_string(),
+            };
+            Error::Infeasible(format!(
+                "span {si}, u = {:.6}, nearest CL line {}: {limit} leaves the tool no speed \
+                 here (at most {:.3e} mm/s), so the path cannot be traversed; check that value \
+                 in the program or the machine file",
+                p.u[k],
+                self.path.spans[si].nearest_line(p.u[k]),
+                p.b_max[i].max(0.0).sqrt() * p.tip_speed[i].max(1.0)
+            ))
+        })
+    }
+
     /// The reach pass on one span, its infeasibility in words.
     fn reach(&self, si: usize, p: &SpanProblem) -> Result<SpanSolution> {
         solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))
@@ -550,7 +582,7 @@ impl Plan<'_> {
         let span = &self.path.spans[si];
         let chord = options.verify.chord.as_ref();
         let g = self.reach(si, &p)?;
-        let t = interval_times(&p, &g)?;
+        let t = self.times(si, &p, &g)?;
         let n = p.intervals();
         let all: Vec<usize> = (0..n).collect();
         let pf = p.with_inserted(span, &self.kin, self.machine, chord, &all, |k| {
@@ -558,7 +590,7 @@ impl Plan<'_> {
         });
         self.check_travel(si, &pf)?;
         let gf = self.reach(si, &pf)?;
-        let tf = interval_times(&pf, &gf)?;
+        let tf = self.times(si, &pf, &gf)?;
         let time = tf.iter().sum();
         let e: Vec<f64> = (0..n)
             .map(|k| (t[k] - tf[2 * k] - tf[2 * k + 1]).abs())
@@ -757,7 +789,16 @@ impl Plan<'_> {
             iterations += s.iterations;
             solve_time += s.solve_time;
         }
-        let schedule = Schedule::build(&self.axes, &self.path.spans, &problems, &solutions)?;
+        let schedule = match Schedule::build(&self.axes, &self.path.spans, &problems, &solutions) {
+            Ok(s) => s,
+            Err(e) => {
+                // Name where (a zero feed over an interval), if that is the failure.
+                for (si, (p, s)) in problems.iter().zip(&solutions).enumerate() {
+                    self.times(si, p, s)?;
+                }
+                return Err(e);
+            }
+        };
         Ok(Level {
             problems,
             solutions,

@@ -29,6 +29,25 @@ use crate::motion::{Interval, Law, State};
 use crate::schedule::interval_times;
 use crate::solver::SpanSolution;
 
+/// Most servo instants a re-simulation checks (2e9: about 23 days of motion at 1 ms; on two
+/// cores about 10 min). A schedule that would need more is refused before the check starts.
+pub const MAX_SAMPLES: f64 = 2e9;
+
+/// A duration in the unit a person reads it in.
+fn human_duration(t: f64) -> String {
+    if !t.is_finite() {
+        "of unbounded length".to_string()
+    } else if t < 120.0 {
+        format!("{t:.3} s")
+    } else if t < 2.0 * 3600.0 {
+        format!("{:.1} min", t / 60.0)
+    } else if t < 2.0 * 86400.0 {
+        format!("{:.1} h", t / 3600.0)
+    } else {
+        format!("{:.3e} days", t / 86400.0)
+    }
+}
+
 /// Most violations kept in [`Verification::violations`] (the worst ones).
 pub const MAX_VIOLATIONS: usize = 1000;
 
@@ -203,6 +222,29 @@ pub fn verify(
         let span_start = t0;
         t0 = dt.iter().fold(t0, |t, d| t + d);
         times.push((span_start, dt));
+    }
+    // The work is the number of samples: refuse before starting where it is out of reach.
+    let samples = t0 / period;
+    if !(samples <= MAX_SAMPLES) {
+        // Where the time goes: the longest interval.
+        let (si, k, dt) = times
+            .iter()
+            .enumerate()
+            .flat_map(|(si, (_, dt))| dt.iter().enumerate().map(move |(k, &d)| (si, k, d)))
+            .fold(
+                (0, 0, f64::NEG_INFINITY),
+                |m, x| if x.2 > m.2 { x } else { m },
+            );
+        return Err(Error::Usage(format!(
+            "re-simulating the schedule ({}) every {} ms would take {samples:.3e} servo \
+             instants, more than the {MAX_SAMPLES:.0e} feedopt checks; the slowest stretch \
+             ({}) is near CL line {}: a feed or a limit there (program or machine file) is far \
+             too small, or the period (--period) too short",
+            human_duration(t0),
+            period * 1e3,
+            human_duration(dt),
+            spans[si].nearest_line(problems[si].u[k])
+        )));
     }
     // Chunks of CHUNK intervals, checked independently (in parallel) and merged in order: the
     // same samples, the same result, whatever the number of threads.

@@ -64,6 +64,9 @@ pub struct SolverSettings {
     pub window: usize,
     /// Threads for windows solved in parallel (0: as many as the machine has).
     pub threads: usize,
+    /// Longest a single cone program may run, s. Past it Clarabel stops (status MaxTime) and the
+    /// window keeps the feasible reach profile ([`optimal`]): a solve never hangs.
+    pub time_limit: f64,
 }
 
 impl Default for SolverSettings {
@@ -75,6 +78,7 @@ impl Default for SolverSettings {
             iterative_refinement: false,
             window: 2000,
             threads: 0,
+            time_limit: 60.0,
         }
     }
 }
@@ -98,6 +102,7 @@ impl SolverSettings {
             .tol_gap_abs(gap)
             .tol_feas(self.tol_feas)
             .iterative_refinement_enable(self.iterative_refinement)
+            .time_limit(self.time_limit)
             .build()
             .map_err(|e| crate::error::Error::Solver(format!("settings: {e:?}")))
     }
