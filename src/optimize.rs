@@ -5,9 +5,13 @@
 //!
 //! Every CL point is a station, and each CL segment is divided further (see
 //! [`constraints::stations`](crate::constraints::stations)). Unless a station count is given,
-//! the stations are refined automatically: every interval is halved until doubling the stations
-//! changes the cycle time by less than [`Options::convergence`] (0.01 %); the finer solution is
-//! returned.
+//! the stations are refined adaptively (`Plan::solve_adaptive`): each round compares every
+//! span's grid with its bisection by the O(N) reach pass, halves only the intervals whose time
+//! changes most, and puts a station where a ramp ends inside an interval, until the change
+//! summed over the path is below [`Options::convergence`] (1e-4) of the cycle time; that sum
+//! is returned as [`Solution::error_estimate`]. The final grid is then solved exactly
+//! ([`solver::optimal`]: the lattice relaxation where it is exact, Clarabel on the windows
+//! where it is not). Jerk-limited solves double every interval from level to level instead.
 //!
 //! Every schedule is then re-simulated at the servo period ([`crate::verify`]); one that exceeds
 //! any limit by more than the tolerance (0.1 %) between stations is not returned: the
@@ -122,9 +126,11 @@ pub struct Solution {
     /// Station counts tried and their cycle times.
     pub refinement: Vec<Refinement>,
     /// Estimated relative error of the cycle time against the continuous optimum (automatic
-    /// refinement only; see [`Plan::refine_span`]): the relative change of the time when every
-    /// interval of the returned grid's parent is halved, which bounds the returned grid's
-    /// remaining error wherever the error falls at least linearly with the interval length.
+    /// refinement only; `None` on a fixed grid). Acceleration-limited: the change of the time,
+    /// summed over intervals, when every interval of the returned grid's parent is halved,
+    /// which bounds the returned grid's remaining error wherever the error falls at least
+    /// linearly with the interval length (Richardson). Jerk-limited: the relative change of
+    /// the time from the last uniform level to the returned one.
     pub error_estimate: Option<f64>,
     /// The re-simulation of the returned schedule at the servo period.
     pub verification: Verification,

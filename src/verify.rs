@@ -225,7 +225,7 @@ pub fn verify(
     }
     // The work is the number of samples: refuse before starting where it is out of reach.
     let samples = t0 / period;
-    if !(samples <= MAX_SAMPLES) {
+    if samples.is_nan() || samples > MAX_SAMPLES {
         // Where the time goes: the longest interval.
         let (si, k, dt) = times
             .iter()
