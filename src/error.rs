@@ -74,3 +74,19 @@ impl Error {
         }
     }
 }
+
+/// A number as a message shows it: plain where that is short (`150`, `0.25`), in exponent
+/// notation where it is very large or small (`1e300`, `1e-12`), never hundreds of digits;
+/// `infinity` and `not a number` in words.
+pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if x.is_nan() {
+        "not a number".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "infinity" } else { "-infinity" }.into()
+    } else if x != 0.0 && !(1e-4..1e6).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}

@@ -116,12 +116,25 @@ pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> 
             _ => None,
         }
     };
-    match format.or_else(by_ext) {
-        Some(Format::Csv) => joint_csv::read(path).map(Input::Joint),
-        Some(Format::Gcode) => gcode::read(path, dialect).map(Input::Cl),
-        Some(Format::Apt) => apt::read(path).map(Input::Cl),
-        None => read(path).map(Input::Cl), // says what is wrong with the extension
+    let format = match format.or_else(by_ext) {
+        Some(f) => f,
+        None => return read(path).map(Input::Cl), // says what is wrong with the extension
+    };
+    let bytes = read_bytes(path)?;
+    match format {
+        Format::Csv => joint_csv::parse(path, &crate::files::utf8(path, bytes)?).map(Input::Joint),
+        // The CL readers replace bytes that are not UTF-8 (Latin-1 comments), as their `read`.
+        Format::Gcode => {
+            gcode::parse(path, &String::from_utf8_lossy(&bytes), dialect).map(Input::Cl)
+        }
+        Format::Apt => apt::parse(path, &String::from_utf8_lossy(&bytes)).map(Input::Cl),
     }
+}
+
+/// A toolpath file's bytes, at most [`crate::files::MAX_TOOLPATH_BYTES`] of them: a larger
+/// file, or a device that never ends (`/dev/zero`), is refused before it is read.
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    crate::files::read_bounded(path, crate::files::MAX_TOOLPATH_BYTES, "toolpath")
 }
 
 /// Reads a toolpath file, choosing the reader by extension (`.cls`, `.apt`: APT CL; `.ngc`,
@@ -133,8 +146,12 @@ pub fn read(path: &Path) -> Result<Toolpath> {
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "cls" | "apt" | "cl" => apt::read(path),
-        "ngc" | "nc" | "gcode" | "tap" => gcode::read(path, gcode::Dialect::default()),
+        "cls" | "apt" | "cl" => apt::parse(path, &String::from_utf8_lossy(&read_bytes(path)?)),
+        "ngc" | "nc" | "gcode" | "tap" => gcode::parse(
+            path,
+            &String::from_utf8_lossy(&read_bytes(path)?),
+            gcode::Dialect::default(),
+        ),
         "" => Err(crate::error::Error::Usage(format!(
             "{}: the toolpath file has no extension (expected .cls, .apt, .ngc, .nc, .gcode, \
              .tap or .csv)",
