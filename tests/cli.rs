@@ -935,3 +935,92 @@ fn a_machine_file_that_is_not_utf8_names_its_line() {
     w.write("line.cls", LINE);
     assert_error(&w.solve_line(&[]), &["machine.json:2:", "UTF-8", "save"]);
 }
+
+/// Two turns of the tool about the vertical on a 30° cone: C turns 720°, 45° per block.
+fn cone_turns() -> String {
+    let mut t = String::from("MULTAX/ON\nFEDRAT/MMPM,3000\n");
+    for k in 0..17 {
+        let a = (45.0 * k as f64).to_radians();
+        let (s, c) = 30f64.to_radians().sin_cos();
+        t.push_str(&format!(
+            "GOTO/{:.4},{:.4},0,{:.6},{:.6},{c:.6}\n",
+            50.0 * a.cos(),
+            50.0 * a.sin(),
+            s * a.cos(),
+            s * a.sin()
+        ));
+    }
+    t
+}
+
+#[test]
+fn gcode_block_count_is_bounded_before_writing() {
+    let w = Work::new();
+    w.write("head.json", HEAD_HEAD_MACHINE);
+    w.write("cone.cls", &cone_turns());
+    let gcode = |deg: &str| {
+        w.run(&[
+            "gcode",
+            "--solver",
+            "reach",
+            "-m",
+            "head.json",
+            "cone.cls",
+            "--stations",
+            "200",
+            "-o",
+            "cone.ngc",
+            "--max-rotation-deg",
+            deg,
+        ])
+    };
+    // 720° in steps of 0.001° is 720,000 pieces, 2^16 per 45° block: past 1,000,000 blocks.
+    refused_quickly(
+        &w,
+        &[
+            "gcode",
+            "--solver",
+            "reach",
+            "-m",
+            "head.json",
+            "cone.cls",
+            "--stations",
+            "200",
+            "-o",
+            "cone.ngc",
+            "--max-rotation-deg",
+            "0.001",
+        ],
+        &["cone.cls:", "1000000 blocks", "larger rotation"],
+    );
+    w.assert_listing(&["head.json", "cone.cls"]);
+    // Control: 1° per block is written.
+    let out = gcode("1");
+    assert_success(&out);
+    assert!(stdout(&out).contains("added by Δθ"), "{}", stdout(&out));
+    w.assert_listing(&["head.json", "cone.cls", "cone.ngc"]);
+}
+
+/// An output gets the permissions of any new file in its directory, not a temporary file's
+/// private 0600.
+#[cfg(unix)]
+#[test]
+fn outputs_have_the_permissions_of_a_new_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    assert_success(&w.solve_line(&["-o", "out.csv"]));
+    let mode = |name: &str| {
+        std::fs::metadata(w.path(name))
+            .expect("metadata")
+            .permissions()
+            .mode()
+            & 0o777
+    };
+    assert_eq!(
+        mode("out.csv"),
+        mode("line.cls"),
+        "written by std::fs::write"
+    );
+}

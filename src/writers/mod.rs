@@ -179,7 +179,15 @@ pub fn schedule_csv(schedule: &Schedule) -> String {
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     // The temporary file's own name stays out of messages: they name the target.
     let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
-    let mut tmp = tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(plain)?;
+    // A temporary file is private (0600); the output gets the mode any new file would get
+    // (0666 less the umask), as if written in place.
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(parent_dir(path)).map_err(plain)?;
     tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| plain(e.error))?;
