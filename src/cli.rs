@@ -107,7 +107,7 @@ pub struct SolveArgs {
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     #[arg(long, default_value_t = 0.01, value_name = "DEG")]
     pub tolerance_deg: f64,
-    /// Cap every programmed feed at this multiple of it (a feed override).
+    /// Cap every programmed feed at this multiple of it (a feed override), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
     /// Ignore the program's feeds: what do the machine's limits alone allow?
@@ -189,6 +189,11 @@ pub const MIN_CHORD_TOLERANCE_MM: f64 = 1e-6;
 
 /// The largest start or end feed (`--start-feed`, `--end-feed`): 1e6 mm/s (1 km/s).
 pub const MAX_END_FEED: f64 = 1e6;
+
+/// The range of `--feed-override`: a factor below 0.001 slows the feed to a crawl (and the
+/// re-simulation's work grows with the cycle time); above 1000 it caps nothing.
+pub const MIN_FEED_OVERRIDE: f64 = 1e-3;
+pub const MAX_FEED_OVERRIDE: f64 = 1e3;
 
 /// The smallest rotation per block (`gcode --max-rotation-deg`): 0.001°, a rotary axis's
 /// resolution; smaller steps only multiply the program's blocks.
@@ -290,10 +295,11 @@ impl SolveArgs {
                 "--tolerance and --tolerance-deg must be ≥ 0".into(),
             ));
         }
-        if !(self.feed_override.is_finite() && self.feed_override > 0.0) {
+        if !(MIN_FEED_OVERRIDE..=MAX_FEED_OVERRIDE).contains(&self.feed_override) {
             return Err(Error::Usage(format!(
-                "--feed-override must be a positive factor, got {}",
-                self.feed_override
+                "--feed-override {}: give a factor from {MIN_FEED_OVERRIDE} to \
+                 {MAX_FEED_OVERRIDE} (1: the programmed feeds)",
+                crate::error::number(self.feed_override)
             )));
         }
         o.geometry.feed_override = self.feed_override;
@@ -494,7 +500,7 @@ pub struct PlanArgs {
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     #[arg(long, default_value_t = 0.01, value_name = "DEG")]
     pub tolerance_deg: f64,
-    /// Cap every programmed feed at this multiple of it (a feed override).
+    /// Cap every programmed feed at this multiple of it (a feed override), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
     /// Ignore the program's feeds: only the machine's limits apply.

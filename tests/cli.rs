@@ -817,6 +817,11 @@ fn work_is_bounded_before_it_starts() {
         &["--start-feed", "1e300"],
     );
     refused_quickly(&w, &solve(&["--end-feed", "inf"]), &["--end-feed"]);
+    refused_quickly(
+        &w,
+        &solve(&["--feed-override", "1e-300"]),
+        &["--feed-override", "1e-300", "0.001 to 1000"],
+    );
     // Above the machine's feed.max (150 mm/s): no schedule can start there.
     refused_quickly(
         &w,
