@@ -1029,3 +1029,58 @@ fn outputs_have_the_permissions_of_a_new_file() {
         "written by std::fs::write"
     );
 }
+
+/// Found by the fuzzing harness: a coordinate of 1e308 made the spline's knots collapse (a
+/// panic), 1e12 ran the re-simulation for minutes. Implausible magnitudes in any CL toolpath
+/// are refused at the entry point, naming the line.
+#[test]
+fn implausible_toolpath_magnitudes_name_the_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    let cases = [
+        (
+            "big.cls",
+            "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/1e308,0,0\n",
+            "big.cls:3:",
+            "1e308",
+        ),
+        (
+            "far.cls",
+            "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/0,-1e12,0\n",
+            "far.cls:3:",
+            "Y",
+        ),
+        (
+            "slow.cls",
+            "FEDRAT/MMPM,0.000159\nGOTO/0,0,0\nGOTO/10,0,0\n",
+            "slow.cls:3:",
+            "1e-3 mm/min",
+        ),
+        (
+            "far.ngc",
+            "G21 G90 G94\nG1 X0 F100\nG1 X2000000\n",
+            "far.ngc:3:",
+            "2e6",
+        ),
+    ];
+    for (name, text, at, what) in cases {
+        w.write(name, text);
+        let out = w.run(&["solve", "-m", "machine.json", name, "--stations", "20"]);
+        assert_error(&out, &[at, what]);
+    }
+    // 1 km is still a toolpath (2,500 s at the X velocity limit: checked every 0.1 s).
+    w.write("km.cls", "FEDRAT/MMPM,600000\nGOTO/0,0,0\nGOTO/1e6,0,0\n");
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "km.cls",
+        "--stations",
+        "20",
+        "--solver",
+        "reach",
+        "--period",
+        "0.1",
+    ]);
+    assert_success(&out);
+}

@@ -124,11 +124,64 @@ pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> 
     match format {
         Format::Csv => joint_csv::parse(path, &crate::files::utf8(path, bytes)?).map(Input::Joint),
         // The CL readers replace bytes that are not UTF-8 (Latin-1 comments), as their `read`.
-        Format::Gcode => {
-            gcode::parse(path, &String::from_utf8_lossy(&bytes), dialect).map(Input::Cl)
-        }
-        Format::Apt => apt::parse(path, &String::from_utf8_lossy(&bytes)).map(Input::Cl),
+        Format::Gcode => gcode::parse(path, &String::from_utf8_lossy(&bytes), dialect)
+            .and_then(plausible)
+            .map(Input::Cl),
+        Format::Apt => apt::parse(path, &String::from_utf8_lossy(&bytes))
+            .and_then(plausible)
+            .map(Input::Cl),
     }
+}
+
+/// The largest tool-tip coordinate a toolpath may give, mm (1 km): beyond it a number is a
+/// typo or a wrong unit, and the path's length sets the work of every later stage.
+pub const MAX_COORDINATE_MM: f64 = 1e6;
+
+/// The smallest programmed feed, mm/s (1e-3 mm/min): below it the cycle time, and the work of
+/// the re-simulation, grow without bound.
+pub const MIN_FEED_MM_S: f64 = 1e-3 / 60.0;
+
+/// A CL toolpath as read, checked for implausible magnitudes at the entry point (whatever the
+/// reader): every tool-tip coordinate finite and within ±[`MAX_COORDINATE_MM`], every tool
+/// vector finite, every programmed feed at least [`MIN_FEED_MM_S`] (the first point's feed is
+/// unused). Errors name the line.
+pub fn plausible(t: Toolpath) -> Result<Toolpath> {
+    for (k, p) in t.points.iter().enumerate() {
+        for (axis, x) in ["X", "Y", "Z"].iter().zip(p.p.iter()) {
+            if !(x.abs() <= MAX_COORDINATE_MM) {
+                return Err(crate::error::Error::parse(
+                    &t.source,
+                    p.line,
+                    format!(
+                        "tool tip {axis} = {} mm is beyond ±{MAX_COORDINATE_MM:e} mm (1 km): \
+                         check the number and the units",
+                        crate::error::number(*x)
+                    ),
+                ));
+            }
+        }
+        if !p.o.iter().all(|x| x.is_finite()) {
+            return Err(crate::error::Error::parse(
+                &t.source,
+                p.line,
+                "the tool vector is not finite: give i, j, k as ordinary numbers",
+            ));
+        }
+        if let (Feed::Programmed(f), true) = (p.feed, k > 0) {
+            if !(f.is_finite() && f >= MIN_FEED_MM_S) {
+                return Err(crate::error::Error::parse(
+                    &t.source,
+                    p.line,
+                    format!(
+                        "a feed of {} mm/min is below 1e-3 mm/min: check the number and the \
+                         units",
+                        crate::error::number(f * 60.0)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(t)
 }
 
 /// A toolpath file's bytes, at most [`crate::files::MAX_TOOLPATH_BYTES`] of them: a larger
@@ -146,12 +199,15 @@ pub fn read(path: &Path) -> Result<Toolpath> {
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "cls" | "apt" | "cl" => apt::parse(path, &String::from_utf8_lossy(&read_bytes(path)?)),
+        "cls" | "apt" | "cl" => {
+            apt::parse(path, &String::from_utf8_lossy(&read_bytes(path)?)).and_then(plausible)
+        }
         "ngc" | "nc" | "gcode" | "tap" => gcode::parse(
             path,
             &String::from_utf8_lossy(&read_bytes(path)?),
             gcode::Dialect::default(),
-        ),
+        )
+        .and_then(plausible),
         "" => Err(crate::error::Error::Usage(format!(
             "{}: the toolpath file has no extension (expected .cls, .apt, .ngc, .nc, .gcode, \
              .tap or .csv)",
