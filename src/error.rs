@@ -26,7 +26,7 @@ pub enum Error {
         message: String,
     },
     /// A file could not be read or written.
-    #[error("{}: {source}", file.display())]
+    #[error("{}: {}", file.display(), io_reason(source))]
     Io {
         file: PathBuf,
         #[source]
@@ -88,5 +88,16 @@ pub fn number(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+/// What went wrong with a file, and what to do about the common cases.
+fn io_reason(e: &std::io::Error) -> String {
+    use std::io::ErrorKind;
+    match e.kind() {
+        ErrorKind::NotFound => "no such file: check the path".into(),
+        ErrorKind::PermissionDenied => "permission denied: check the file's permissions".into(),
+        ErrorKind::IsADirectory => "is a directory: name a file".into(),
+        _ => e.to_string(),
     }
 }

@@ -80,16 +80,19 @@ pub fn utf8(path: &Path, bytes: Vec<u8>) -> Result<String> {
     })
 }
 
-/// `text` with every control character (carriage return, newline, tab, escape, …) written as
-/// an escape (`\r`, `\n`, `\t`, `\u{1b}`), so that text from an input file cannot break a
-/// one-line message or drive the terminal.
+/// `text` with every control character (carriage return, newline, tab, escape, …) and every
+/// bidirectional override written as an escape (`\r`, `\n`, `\t`, `\u{1b}`, `\u{202e}`), so
+/// that text from an input file cannot break a one-line message, drive the terminal or reorder
+/// what is shown.
 pub fn escape_control(text: &str) -> String {
-    if !text.chars().any(char::is_control) {
+    let unsafe_char =
+        |c: char| c.is_control() || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    if !text.chars().any(unsafe_char) {
         return text.to_string();
     }
     text.chars()
         .map(|c| {
-            if c.is_control() {
+            if unsafe_char(c) {
                 c.escape_default().to_string()
             } else {
                 c.to_string()
@@ -111,7 +114,7 @@ mod tests {
         .unwrap_err();
         let text = e.to_string();
         assert!(
-            text.starts_with("m.json:2: byte 14 (column 13, 0xe9)"),
+            text.starts_with("m.json:2: byte 16 (column 14, 0xe9)"),
             "{text}"
         );
         assert!(text.contains("UTF-8"), "{text}");
@@ -120,6 +123,7 @@ mod tests {
     #[test]
     fn control_characters_are_escaped() {
         assert_eq!(escape_control("a\rb\n\t\u{1b}[2J"), "a\\rb\\n\\t\\u{1b}[2J");
+        assert_eq!(escape_control("x\u{202e}y"), "x\\u{202e}y");
         assert_eq!(escape_control("X1 Y° ok"), "X1 Y° ok");
     }
 

@@ -508,7 +508,7 @@ fn missing_toolpath_file() {
         "machine.json",
         "nowhere.cls",
         &["machine.json"],
-        &["nowhere.cls"],
+        &["nowhere.cls", "no such file: check the path"],
     );
 }
 

@@ -20,7 +20,9 @@
 //! ```
 //!
 //! It prints the figures per target and writes every failing input to
-//! `target/fuzz-failures/` (or `FEEDOPT_FUZZ_OUT`).
+//! `target/fuzz-failures/` (or `FEEDOPT_FUZZ_OUT`). A solve is bounded by 10 s in the long
+//! run (`FEEDOPT_FUZZ_BOUND_S`), 60 s in the short one (a hang, not a busy machine, should
+//! fail `cargo test`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -32,8 +34,13 @@ use feedopt::toolpath::{self, Input};
 
 /// Time bound of one in-process parse.
 const PARSE_BOUND: Duration = Duration::from_secs(5);
-/// Time bound of one solve (the issue's acceptance: within 10 s).
+/// Time bound of one solve in the long run (the issue's acceptance: within 10 s;
+/// `FEEDOPT_FUZZ_BOUND_S` changes it).
 const SOLVE_BOUND: Duration = Duration::from_secs(10);
+
+/// Time bound of one solve in the short run of every `cargo test`: generous, so that a
+/// machine busy with other builds does not fail it; a hang still does.
+const SHORT_SOLVE_BOUND: Duration = Duration::from_secs(60);
 
 // ---------------------------------------------------------------------------------------------
 // A small deterministic PRNG (SplitMix64): no dependency, the same cases on every machine.
@@ -469,7 +476,13 @@ fn nulls(v: &serde_json::Value, at: &str, out: &mut Vec<String>) {
 }
 
 /// Runs `feedopt solve` on a mutated problem as a child process, killed after the bound.
-fn solve_case(dir: &Path, ext: &str, machine: &[u8], toolpath: &[u8]) -> Result<(), String> {
+fn solve_case(
+    dir: &Path,
+    ext: &str,
+    machine: &[u8],
+    toolpath: &[u8],
+    bound: Duration,
+) -> Result<(), String> {
     std::fs::write(dir.join("machine.json"), machine).map_err(|e| e.to_string())?;
     let tp = format!("path.{ext}");
     std::fs::write(dir.join(&tp), toolpath).map_err(|e| e.to_string())?;
@@ -489,10 +502,10 @@ fn solve_case(dir: &Path, ext: &str, machine: &[u8], toolpath: &[u8]) -> Result<
         if let Some(s) = child.try_wait().map_err(|e| e.to_string())? {
             break s;
         }
-        if t0.elapsed() > SOLVE_BOUND {
+        if t0.elapsed() > bound {
             let _ = child.kill();
             let _ = child.wait();
-            return Err(format!("still running after {SOLVE_BOUND:?} (killed)"));
+            return Err(format!("still running after {bound:?} (killed)"));
         }
         std::thread::sleep(Duration::from_millis(2));
     };
@@ -568,6 +581,7 @@ struct Figures {
 
 struct Campaign {
     seed: u64,
+    solve_bound: Duration,
     deadline: Option<Instant>,
     failures: Vec<Failure>,
     figures: Vec<(&'static str, Figures)>,
@@ -672,7 +686,7 @@ impl Campaign {
             };
             let how = format!("{}: machine [{hm}] toolpath [{ht}]", p.name);
             let t0 = Instant::now();
-            let r = solve_case(dir.path(), p.ext, &m, &t);
+            let r = solve_case(dir.path(), p.ext, &m, &t, self.solve_bound);
             let res = match r {
                 Ok(()) => Ok(!dir.path().join("out.csv").exists()),
                 Err(what) => Err(Failure {
@@ -753,6 +767,7 @@ fn env_u64(name: &str) -> Option<u64> {
 fn fuzz_short() {
     let mut c = Campaign {
         seed: 1,
+        solve_bound: SHORT_SOLVE_BOUND,
         deadline: None,
         failures: Vec::new(),
         figures: Vec::new(),
@@ -782,6 +797,7 @@ fn fuzz_long() {
     let minutes = env_u64("FEEDOPT_FUZZ_MINUTES").unwrap_or(if cases.is_some() { 0 } else { 10 });
     let mut c = Campaign {
         seed: env_u64("FEEDOPT_FUZZ_SEED").unwrap_or(2),
+        solve_bound: env_u64("FEEDOPT_FUZZ_BOUND_S").map_or(SOLVE_BOUND, Duration::from_secs),
         deadline: (minutes > 0).then(|| Instant::now() + Duration::from_secs(60 * minutes)),
         failures: Vec::new(),
         figures: Vec::new(),
@@ -802,4 +818,58 @@ fn fuzz_long() {
     }
     c.report("long");
     c.assert_clean();
+}
+
+/// Solve case 20369 of the long run with seed 3 (the only failure of 25,224 solves, after the
+/// entry-point bounds): a 2 km excursion in Z (Z = 1e6 mm, the largest coordinate allowed) on
+/// the seed blade with two tool-vector components set to 1e-308 and one to 1e21. The cycle
+/// time is about 23,000 s, and the solve (reach, 50 stations) runs for minutes: its work grows
+/// with cycle time ÷ period in the re-simulation and refinement (the solve pipeline's part of
+/// issue 14). Kept as a reproducer.
+#[test]
+#[ignore = "known: the re-simulation's work grows with cycle time ÷ period (solve pipeline)"]
+fn fuzz_case_a_2_km_excursion_ends_within_10_s() {
+    let blade = String::from_utf8(head(
+        &file("problems/seed_head_head/impeller_blade.cls"),
+        60,
+    ))
+    .expect("UTF-8");
+    let edits = [
+        (
+            32,
+            "GOTO/0,-11.891693,49.323303,-0.101962182,1e-308,0.978129178",
+        ),
+        (
+            49,
+            "GOTO/35.152761,-11.628542,47.422336,-0.096668601,999999999999999999999,0.977877460",
+        ),
+        (
+            51,
+            "GOTO/35.351186,-11.593753,47.200314,1e-308,-0.186066750,0.977828453",
+        ),
+        (
+            52,
+            "GOTO/35.450490,-11.576055,1e6,-0.095782523,-0.186354897,0.977802414",
+        ),
+        (
+            54,
+            "GOTO/35.649280,0,46.867933,-0.095198905,-0.186942397,0.977747262",
+        ),
+    ];
+    let mut lines: Vec<String> = blade.lines().map(str::to_string).collect();
+    for (n, text) in edits {
+        lines[n - 1] = text.to_string();
+    }
+    let toolpath = lines.join("\n") + "\n";
+    let dir = tempfile::tempdir().expect("temp dir");
+    let machine = file("problems/seed_head_head/machine.json");
+    let t0 = Instant::now();
+    let r = solve_case(
+        dir.path(),
+        "cls",
+        &machine,
+        toolpath.as_bytes(),
+        SOLVE_BOUND,
+    );
+    assert!(r.is_ok(), "{r:?} after {:?}", t0.elapsed());
 }
