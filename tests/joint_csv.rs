@@ -106,9 +106,24 @@ fn derivatives_of_absurd_size_name_line_and_column() {
         &["column 5", "`dddq_a`", "1e300", "with respect to s"],
     );
     let text = "s,q_a,dq_a\n0,0,1e12\n1,1,1\n";
-    line_err(text, 2, &["column 3", "`dq_a`"]);
-    // The same derivative is fine where the rows are close enough for it to be plausible:
-    // dddq = 1e6 over Δs = 1e-3 moves the axis by 1e-3/6·1e-3… far less than a kilometre.
+    line_err(text, 2, &["column 3", "`dq_a`", "more than 1e7"]);
+    // A full-scale sine two rows per period is a path: its third derivative's term is
+    // π³/6 ≈ 5.2 times the amplitude, here 1e6.
+    let mut text = String::from("s,q_a,dq_a,ddq_a,dddq_a\n");
+    let w = std::f64::consts::PI; // period 2 in s, rows 1 apart
+    for i in 0..=4 {
+        let s = i as f64;
+        let q = 1e6 * (w * s + 0.3).sin();
+        let (d1, d2, d3) = (
+            1e6 * w * (w * s + 0.3).cos(),
+            -1e6 * w * w * (w * s + 0.3).sin(),
+            -1e6 * w * w * w * (w * s + 0.3).cos(),
+        );
+        text.push_str(&format!("{s},{q},{d1},{d2},{d3}\n"));
+    }
+    parse(&text).expect("a full-scale sine at two rows per period");
+    // The same kind of derivative is fine where the rows are close enough for it to be
+    // plausible: dddq = 1e6 over Δs = 1e-3 is a Taylor term of 1.7e-4.
     let mut text = String::from("s,q_a,dq_a,ddq_a,dddq_a\n");
     for i in 0..=10 {
         let s = i as f64 * 1e-3;

@@ -20,7 +20,7 @@
 //! infinite violations): every q within ±[`MAX_POSITION`]; s within ±[`MAX_S`] and rows at
 //! least [`MIN_S_STEP`] apart in s; some axis moving by more than [`MIN_MOTION`]; and every given
 //! derivative small enough that its Taylor term over one row step, |dᵏq/dsᵏ| hᵏ/k!, stays
-//! within [`MAX_POSITION`] (h the larger of the row's two steps in s).
+//! within [`MAX_TAYLOR_TERM`] (h the larger of the row's two steps in s).
 
 use std::path::{Path, PathBuf};
 
@@ -56,6 +56,13 @@ pub const MAX_S: f64 = 1e9;
 /// The smallest step in s between two rows: closer rows make the derivatives dq/ds (and with
 /// them the solver's numbers) overflow. s is unit-free: rescale it (0 to 1, or mm).
 pub const MIN_S_STEP: f64 = 1e-9;
+
+/// The largest Taylor term |dᵏq/dsᵏ| hᵏ/k! of a given derivative over one row step h, mm or
+/// degrees: ten times [`MAX_POSITION`]. A path sampled finely enough to follow (above two rows
+/// per oscillation) has terms of at most about 5 times its amplitude (π³/6 for the third
+/// derivative of a sine at two rows per period), so only derivatives of absurd size, or not
+/// with respect to s, are refused.
+pub const MAX_TAYLOR_TERM: f64 = 10.0 * MAX_POSITION;
 
 /// The least motion of the whole path, on some axis, mm or degrees (a picometre: below any
 /// machine's resolution).
@@ -289,7 +296,7 @@ fn check_motion(path: &JointPath, hline: usize) -> Result<()> {
 }
 
 /// Every given derivative's Taylor term over one row step, |dᵏq/dsᵏ| hᵏ/k!, within
-/// [`MAX_POSITION`] (module doc).
+/// [`MAX_TAYLOR_TERM`] (module doc).
 fn check_derivatives(path: &JointPath, names: &[&str], columns: &[Column]) -> Result<()> {
     let n = path.s.len();
     for (order, rows) in [(1, &path.dq), (2, &path.ddq), (3, &path.dddq)] {
@@ -309,7 +316,7 @@ fn check_derivatives(path: &JointPath, names: &[&str], columns: &[Column]) -> Re
             for a in 0..path.axes.len() {
                 let d = rows[i][a];
                 let term = d.abs() * h.powi(order as i32) / factorial;
-                if term > MAX_POSITION {
+                if term > MAX_TAYLOR_TERM {
                     let c = columns
                         .iter()
                         .position(|c| {
@@ -321,7 +328,7 @@ fn check_derivatives(path: &JointPath, names: &[&str], columns: &[Column]) -> Re
                         path.lines[i],
                         format!(
                             "column {} (`{}`): {} would move the axis by {} over one row step \
-                             (Δs = {h:e}), more than {MAX_POSITION:e}: derivatives are with \
+                             (Δs = {h:e}), more than {MAX_TAYLOR_TERM:e}: derivatives are with \
                              respect to s, in the axis's unit",
                             c + 1,
                             names[c],

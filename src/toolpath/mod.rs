@@ -148,7 +148,7 @@ pub const MIN_FEED_MM_S: f64 = 1e-3 / 60.0;
 pub fn plausible(t: Toolpath) -> Result<Toolpath> {
     for (k, p) in t.points.iter().enumerate() {
         for (axis, x) in ["X", "Y", "Z"].iter().zip(p.p.iter()) {
-            if !(x.abs() <= MAX_COORDINATE_MM) {
+            if !(x.is_finite() && x.abs() <= MAX_COORDINATE_MM) {
                 return Err(crate::error::Error::parse(
                     &t.source,
                     p.line,
