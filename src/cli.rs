@@ -58,13 +58,14 @@ pub struct SweepArgs {
     /// that its max is the value.
     #[arg(long, value_enum)]
     pub limit: crate::sweep::SweptLimit,
-    /// First limit value (mm/s, mm/s², deg/s or deg/s²).
+    /// First limit value (mm/s, mm/s², deg/s or deg/s²), within 1/1000 to 1000 times the
+    /// machine's own.
     #[arg(long)]
     pub from: f64,
     /// Last limit value.
     #[arg(long)]
     pub to: f64,
-    /// Number of values from --from to --to, evenly spaced.
+    /// Number of values from --from to --to, evenly spaced (at most 10,000).
     #[arg(long, default_value_t = 20)]
     pub steps: usize,
     /// Relative step of the central finite differences of the cycle time.
@@ -92,8 +93,8 @@ pub struct SolveArgs {
     /// sensitivity against the limit).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Total station count (default: refined automatically until doubling changes the cycle
-    /// time by less than 0.01 %).
+    /// Total station count, 2 to 4,000,000 (default: refined automatically until doubling
+    /// changes the cycle time by less than 0.01 %).
     #[arg(long)]
     pub stations: Option<usize>,
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
@@ -106,7 +107,7 @@ pub struct SolveArgs {
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     #[arg(long, default_value_t = 0.01, value_name = "DEG")]
     pub tolerance_deg: f64,
-    /// Cap every programmed feed at this multiple of it (a feed override).
+    /// Cap every programmed feed at this multiple of it (a feed override), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
     /// Ignore the program's feeds: what do the machine's limits alone allow?
@@ -122,21 +123,21 @@ pub struct SolveArgs {
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
     pub solver: SolverChoice,
-    /// Tool-tip feed at the start of the path, mm/s (default: at rest).
+    /// Tool-tip feed at the start of the path, mm/s (default: at rest); at most feed.max.
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub start_feed: f64,
-    /// Tool-tip feed at the end of the path, mm/s (default: at rest).
+    /// Tool-tip feed at the end of the path, mm/s (default: at rest); at most feed.max.
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub end_feed: f64,
     /// Bound the chord error of each interpolation period (`--period`) by this, mm (seed 004:
-    /// V² ≤ 8δ/(κT²) on a path of curvature κ), checked by the re-simulation.
+    /// V² ≤ 8δ/(κT²) on a path of curvature κ), checked by the re-simulation; ≥ 1e-6 mm.
     #[arg(long, value_name = "MM")]
     pub chord_tolerance: Option<f64>,
     /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
     #[arg(long)]
     pub no_jerk: bool,
     /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
-    /// (seconds).
+    /// (seconds); 1 µs to 1 s.
     #[arg(long, default_value = "1ms", value_parser = parse_period)]
     pub period: f64,
 }
@@ -176,7 +177,37 @@ pub enum SolverChoice {
     Reach,
 }
 
+/// The shortest servo period (`--period`) feedopt re-simulates at: 1 µs. The re-simulation's
+/// work is the cycle time divided by the period.
+pub const MIN_PERIOD_S: f64 = 1e-6;
+
+/// The longest servo period: 1 s.
+pub const MAX_PERIOD_S: f64 = 1.0;
+
+/// The smallest chord tolerance (`--chord-tolerance`): 1 nm, below any machine's resolution.
+pub const MIN_CHORD_TOLERANCE_MM: f64 = 1e-6;
+
+/// The largest start or end feed (`--start-feed`, `--end-feed`): 1e6 mm/s (1 km/s).
+pub const MAX_END_FEED: f64 = 1e6;
+
+/// The range of `--feed-override`: a factor below 0.001 slows the feed to a crawl (and the
+/// re-simulation's work grows with the cycle time); above 1000 it caps nothing.
+pub const MIN_FEED_OVERRIDE: f64 = 1e-3;
+pub const MAX_FEED_OVERRIDE: f64 = 1e3;
+
+/// The smallest rotation per block (`gcode --max-rotation-deg`): 0.001°, a rotary axis's
+/// resolution; smaller steps only multiply the program's blocks.
+pub const MIN_ROTATION_DEG: f64 = 1e-3;
+
 impl SolveArgs {
+    /// The inputs an output must not overwrite.
+    fn inputs(&self) -> [(&'static str, &std::path::Path); 2] {
+        [
+            ("machine file", self.machine.as_path()),
+            ("toolpath", self.toolpath.as_path()),
+        ]
+    }
+
     fn options(&self) -> Result<Options> {
         if !(self.corner_angle.is_finite() && self.corner_angle > 0.0 && self.corner_angle < 180.0)
         {
@@ -185,14 +216,46 @@ impl SolveArgs {
                 self.corner_angle
             )));
         }
-        if matches!(self.stations, Some(n) if n < 2) {
-            return Err(Error::Usage("--stations must be at least 2".into()));
+        let max_stations = Options::default().max_stations;
+        match self.stations {
+            Some(n) if n < 2 => {
+                return Err(Error::Usage("--stations must be at least 2".into()));
+            }
+            Some(n) if n > max_stations => {
+                return Err(Error::Usage(format!(
+                    "--stations {n} is more than the limit of {max_stations} (memory and time \
+                     grow with it): give at most {max_stations}, or leave it out to refine \
+                     automatically"
+                )));
+            }
+            _ => {}
+        }
+        if !(MIN_PERIOD_S..=MAX_PERIOD_S).contains(&self.period) {
+            return Err(Error::Usage(format!(
+                "--period {} s is outside {MIN_PERIOD_S:e} s to {MAX_PERIOD_S} s (1 µs to 1 s; \
+                 the re-simulation takes cycle time ÷ period steps): give e.g. 1ms or 250us",
+                crate::error::number(self.period)
+            )));
+        }
+        for (option, feed) in [
+            ("--start-feed", self.start_feed),
+            ("--end-feed", self.end_feed),
+        ] {
+            if !(feed.is_finite() && (0.0..=MAX_END_FEED).contains(&feed)) {
+                return Err(Error::Usage(format!(
+                    "{option} {} mm/s is outside 0 to {MAX_END_FEED:e} mm/s: give the \
+                     tool-tip feed in mm/s (0: at rest)",
+                    crate::error::number(feed)
+                )));
+            }
         }
         if let Some(out) = &self.output {
             writers::schedule_format(out)?;
+            writers::check_output("-o", out, &self.inputs())?;
         }
         if let Some(plot) = &self.plot {
             writers::plot::plot_format(plot)?;
+            writers::check_output("--plot", plot, &self.inputs())?;
         }
         let mut o = Options {
             stations: self.stations,
@@ -206,13 +269,18 @@ impl SolveArgs {
                 period: self.period,
                 chord: match self.chord_tolerance {
                     None => None,
-                    Some(d) if d.is_finite() && d > 0.0 => Some(crate::constraints::Chord {
-                        tolerance: d,
-                        period: self.period,
-                    }),
+                    Some(d) if d.is_finite() && d >= MIN_CHORD_TOLERANCE_MM => {
+                        Some(crate::constraints::Chord {
+                            tolerance: d,
+                            period: self.period,
+                        })
+                    }
                     Some(d) => {
                         return Err(Error::Usage(format!(
-                            "--chord-tolerance must be a positive number of mm, got {d}"
+                            "--chord-tolerance {} mm: give a chord tolerance of at least \
+                             {MIN_CHORD_TOLERANCE_MM:e} mm (1 nm; smaller ones only slow the \
+                             feed to a crawl)",
+                            crate::error::number(d)
                         )));
                     }
                 },
@@ -227,10 +295,11 @@ impl SolveArgs {
                 "--tolerance and --tolerance-deg must be ≥ 0".into(),
             ));
         }
-        if !(self.feed_override.is_finite() && self.feed_override > 0.0) {
+        if !(MIN_FEED_OVERRIDE..=MAX_FEED_OVERRIDE).contains(&self.feed_override) {
             return Err(Error::Usage(format!(
-                "--feed-override must be a positive factor, got {}",
-                self.feed_override
+                "--feed-override {}: give a factor from {MIN_FEED_OVERRIDE} to \
+                 {MAX_FEED_OVERRIDE} (1: the programmed feeds)",
+                crate::error::number(self.feed_override)
             )));
         }
         o.geometry.feed_override = self.feed_override;
@@ -238,6 +307,34 @@ impl SolveArgs {
         o.geometry.tolerance_mm = self.tolerance;
         o.geometry.tolerance_deg = self.tolerance_deg;
         Ok(o)
+    }
+
+    /// The start and end feeds against the machine's maximum feed (checked before solving).
+    fn check_feeds(&self, machine: &Machine) -> Result<()> {
+        let Some(max) = machine.feed_max else {
+            return Ok(());
+        };
+        for (option, feed) in [
+            ("--start-feed", self.start_feed),
+            ("--end-feed", self.end_feed),
+        ] {
+            if feed > max {
+                return Err(Error::Usage(format!(
+                    "{option} {} mm/s is more than the machine's maximum feed (feed.max = \
+                     {max} mm/s in {}): give at most {max} mm/s",
+                    crate::error::number(feed),
+                    self.machine.display()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The machine file, read and checked against these options.
+    fn machine(&self) -> Result<Machine> {
+        let machine = Machine::from_file(&self.machine)?;
+        self.check_feeds(&machine)?;
+        Ok(machine)
     }
 }
 
@@ -308,7 +405,7 @@ fn solve_with_progress(
 /// `feedopt solve`: returns what to print on stdout.
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
-    let machine = Machine::from_file(&args.machine)?;
+    let machine = args.machine()?;
     let (input, warnings) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     let (detected, dwell) = reader_used(args, &input)?;
@@ -356,7 +453,10 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
         toolpath::Input::Cl(t) => t
             .warnings
             .iter()
-            .map(|w| format!("{}:{}: {}", args.toolpath.display(), w.line, w.message))
+            .map(|w| {
+                let text = format!("{}:{}: {}", args.toolpath.display(), w.line, w.message);
+                crate::files::escape_control(&text)
+            })
             .collect(),
         toolpath::Input::Joint(_) => Vec::new(),
     };
@@ -404,7 +504,7 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
             options.junction_deviation
         )));
     }
-    let machine = Machine::from_file(&a.machine)?;
+    let machine = a.machine()?;
     let (input, _) = read_input(a)?;
     let name = a.toolpath.display().to_string();
     let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
@@ -441,7 +541,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     let solve = &args.solve;
     let options = solve.options()?;
     // `options()` has checked --plot (and -o) already.
-    let machine = Machine::from_file(&solve.machine)?;
+    let machine = solve.machine()?;
     let (input, _) = read_input(solve)?;
     let mut o =
         crate::sweep::SweepOptions::new(&args.axis, args.limit, args.from, args.to, args.steps);
@@ -481,7 +581,7 @@ pub struct PlanArgs {
     pub machine: PathBuf,
     /// Toolpath file (APT CL: .cls, .apt; G-code: .ngc, .nc, .gcode, .tap).
     pub toolpath: PathBuf,
-    /// Total station count (default: refined automatically).
+    /// Total station count, 2 to 4,000,000 (default: refined automatically).
     #[arg(long)]
     pub stations: Option<usize>,
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
@@ -493,7 +593,7 @@ pub struct PlanArgs {
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     #[arg(long, default_value_t = 0.01, value_name = "DEG")]
     pub tolerance_deg: f64,
-    /// Cap every programmed feed at this multiple of it (a feed override).
+    /// Cap every programmed feed at this multiple of it (a feed override), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
     /// Ignore the program's feeds: only the machine's limits apply.
@@ -505,10 +605,10 @@ pub struct PlanArgs {
     /// Solver: `clarabel` or `reach`.
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
     pub solver: SolverChoice,
-    /// Tool-tip feed at the start of the path, mm/s (default: at rest).
+    /// Tool-tip feed at the start of the path, mm/s (default: at rest); at most feed.max.
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub start_feed: f64,
-    /// Tool-tip feed at the end of the path, mm/s (default: at rest).
+    /// Tool-tip feed at the end of the path, mm/s (default: at rest); at most feed.max.
     #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
     pub end_feed: f64,
     /// Bound the chord error of each interpolation period (`--period`) by this, mm (seed 004:
@@ -521,6 +621,14 @@ pub struct PlanArgs {
 }
 
 impl PlanArgs {
+    /// The inputs an output must not overwrite.
+    fn inputs(&self) -> [(&'static str, &std::path::Path); 2] {
+        [
+            ("machine file", self.machine.as_path()),
+            ("toolpath", self.toolpath.as_path()),
+        ]
+    }
+
     /// The same solve as `feedopt solve` with these options (G-code input in `dialect`).
     fn solve_args(&self, dialect: crate::toolpath::gcode::Dialect, period: f64) -> SolveArgs {
         SolveArgs {
@@ -550,7 +658,7 @@ impl PlanArgs {
 /// Reads, solves; reader warnings go to stderr.
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
     let options = args.options()?;
-    let machine = Machine::from_file(&args.machine)?;
+    let machine = args.machine()?;
     let (input, _) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
@@ -571,14 +679,23 @@ pub struct GcodeArgs {
     #[arg(long)]
     pub input_dialect: Option<crate::toolpath::gcode::Dialect>,
     /// Largest turn of a rotary axis within one block (Δθ, degrees, seed 001): longer turns are
-    /// split by bisection (default: no limit).
+    /// split by bisection (default: no limit; at least 0.001°).
     #[arg(long, value_name = "DEG")]
     pub max_rotation_deg: Option<f64>,
 }
 
 /// `feedopt gcode`: returns what to print on stdout.
 pub fn gcode(args: &GcodeArgs) -> Result<String> {
-    writers::check_directory(&args.output)?;
+    writers::check_output("-o", &args.output, &args.plan.inputs())?;
+    if let Some(d) = args.max_rotation_deg {
+        if !(d.is_finite() && d >= MIN_ROTATION_DEG) {
+            return Err(Error::Usage(format!(
+                "--max-rotation-deg {}: give at least {MIN_ROTATION_DEG}° (a rotary axis's \
+                 resolution; smaller steps only multiply the blocks)",
+                crate::error::number(d)
+            )));
+        }
+    }
     let solve_args = args.plan.solve_args(
         args.input_dialect.unwrap_or(args.dialect),
         crate::verify::VerifyOptions::default().period,
@@ -619,8 +736,8 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
 pub struct InterpolateArgs {
     #[command(flatten)]
     pub plan: PlanArgs,
-    /// Interpolation period: `1ms`, `500us`, `0.002` (seconds). Also the servo period of the
-    /// schedule's verification.
+    /// Interpolation period: `1ms`, `500us`, `0.002` (seconds); 1 µs to 1 s. Also the servo
+    /// period of the schedule's verification.
     #[arg(long, default_value = "1ms", value_parser = parse_period)]
     pub period: f64,
     /// The setpoints to write: FILE.csv or FILE.bin (layout in `feedopt::interpolate`).
@@ -634,6 +751,7 @@ pub struct InterpolateArgs {
 /// `feedopt interpolate`: returns what to print on stdout.
 pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
     crate::interpolate::setpoint_format(&args.output)?;
+    writers::check_output("-o", &args.output, &args.plan.inputs())?;
     let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, args.period))?;
     let sp = crate::interpolate::sample(&machine, &solution, args.period)?;
     crate::interpolate::write_setpoints(&args.output, &sp)?;

@@ -26,7 +26,7 @@ pub enum Error {
         message: String,
     },
     /// A file could not be read or written.
-    #[error("{}: {source}", file.display())]
+    #[error("{}: {}", file.display(), io_reason(source))]
     Io {
         file: PathBuf,
         #[source]
@@ -72,5 +72,32 @@ impl Error {
             file: file.into(),
             source,
         }
+    }
+}
+
+/// A number as a message shows it: plain where that is short (`150`, `0.25`), in exponent
+/// notation where it is very large or small (`1e300`, `1e-12`), never hundreds of digits;
+/// `infinity` and `not a number` in words.
+pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if x.is_nan() {
+        "not a number".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "infinity" } else { "-infinity" }.into()
+    } else if x != 0.0 && !(1e-4..1e6).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// What went wrong with a file, and what to do about the common cases.
+fn io_reason(e: &std::io::Error) -> String {
+    use std::io::ErrorKind;
+    match e.kind() {
+        ErrorKind::NotFound => "no such file: check the path".into(),
+        ErrorKind::PermissionDenied => "permission denied: check the file's permissions".into(),
+        ErrorKind::IsADirectory => "is a directory: name a file".into(),
+        _ => e.to_string(),
     }
 }

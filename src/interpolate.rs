@@ -161,6 +161,10 @@ pub struct Setpoints {
     pub samples: Vec<Sample>,
 }
 
+/// The most setpoints [`sample`] takes (216 bytes each in memory, about 1 GB; 66 minutes of
+/// motion at 1 ms), checked before sampling.
+pub const MAX_SAMPLES: usize = 4_000_000;
+
 /// Samples the solution's motion at period `period` (s): see the module doc.
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
     if !(period.is_finite() && period > 0.0) {
@@ -171,9 +175,13 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
     let timeline = Timeline::new(solution)?;
     let cycle = timeline.cycle_time;
     let count = (cycle / period).ceil();
-    if !(count.is_finite() && count < 5e8) {
+    if !(count.is_finite() && count < MAX_SAMPLES as f64) {
         return Err(Error::Usage(format!(
-            "{cycle} s at a period of {period} s is too many samples"
+            "the schedule takes {} s: at a period of {} s that is more than {MAX_SAMPLES} \
+             setpoints (about 1 GB): give a period of at least {} s",
+            crate::error::number(cycle),
+            crate::error::number(period),
+            crate::error::number(cycle / MAX_SAMPLES as f64)
         )));
     }
     let kin = &solution.kinematics;

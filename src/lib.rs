@@ -58,6 +58,7 @@ pub mod cli;
 pub mod compare;
 pub mod constraints;
 pub mod error;
+pub mod files;
 pub mod geometry;
 pub mod interpolate;
 pub mod kinematics;

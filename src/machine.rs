@@ -12,8 +12,10 @@
 //! in mm/s and mm/s², rotary axes in °/s and °/s². An optional `"jerk"` (number or `[min, max]`,
 //! mm/s³ or °/s³) makes the schedule jerk-limited. An axis may also give its travel, `"min"` and
 //! `"max"` (mm or degrees, both or neither, `min < max`). `feed.max` (mm/s) caps the tool-tip
-//! feed V; the `feed` section is optional. Unknown fields, missing axes or limits and
-//! non-positive limits are errors that name the field.
+//! feed V; the `feed` section is optional. Unknown fields, missing axes or limits,
+//! non-positive limits and keys given twice in one object are errors that name the field; so
+//! are implausible magnitudes: limits outside [`MIN_LIMIT`]…[`MAX_LIMIT`] of their unit (jerk
+//! up to [`MAX_JERK_LIMIT`]) and lengths beyond ±[`MAX_LENGTH`] mm.
 //!
 //! An axis may give its **reference position**, `"reference": 0.0` (mm or degrees, machine
 //! coordinates), or several, `"reference": [0.0, -250.0]`: the first is the point `G28`
@@ -208,8 +210,9 @@ impl Machine {
 
     /// Reads and validates a machine file.
     pub fn from_file(path: &Path) -> Result<Machine> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Machine::from_json(path, &text)
+        let bytes =
+            crate::files::read_bounded(path, crate::files::MAX_MACHINE_FILE_BYTES, "machine file")?;
+        Machine::from_json(path, &crate::files::utf8(path, bytes)?)
     }
 
     /// Parses and validates machine JSON; `source` names the file in errors.
@@ -219,6 +222,17 @@ impl Machine {
             line: e.line(),
             message: format!("invalid JSON: {e}"),
         })?;
+        // A JSON object keeps only one value per key (the last); a key given twice is a
+        // mistake feedopt does not guess about.
+        if let Some((field, line)) = duplicate_key(text) {
+            return Err(Error::field(
+                source,
+                field,
+                format!(
+                    "given twice in one object (the second time on line {line}): remove one of                      them"
+                ),
+            ));
+        }
         Parser {
             file: source.to_path_buf(),
         }
@@ -238,7 +252,9 @@ pub struct References {
 impl Machine {
     /// Reads a machine file and the axes' optional `reference` positions.
     pub fn references_from_file(path: &Path) -> Result<(Machine, References)> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let bytes =
+            crate::files::read_bounded(path, crate::files::MAX_MACHINE_FILE_BYTES, "machine file")?;
+        let text = crate::files::utf8(path, bytes)?;
         let machine = Machine::from_json(path, &text)?;
         let references = references_from_json(path, &text, &machine)?;
         Ok((machine, references))
@@ -282,6 +298,111 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         file: source.to_path_buf(),
         axes,
     })
+}
+
+/// The smallest limit a machine file may give, in its unit (mm/s, mm/s², mm/s³, °/s, …, or
+/// mm/s for `feed.max`): below it a schedule would take ages, and the value is more likely a
+/// wrong unit than a machine.
+pub const MIN_LIMIT: f64 = 1e-6;
+
+/// The largest velocity or acceleration limit (and `feed.max`) a machine file may give.
+pub const MAX_LIMIT: f64 = 1e9;
+
+/// The largest jerk limit a machine file may give.
+pub const MAX_JERK_LIMIT: f64 = 1e12;
+
+/// The largest length a machine file may give (tool and pivot lengths, trunnion offsets, work
+/// offsets, travel), in mm or degrees: 1 km.
+pub const MAX_LENGTH: f64 = 1e6;
+
+/// The dotted path and line of the first key that appears twice in one JSON object of `text`
+/// (already known to be valid JSON), if any.
+fn duplicate_key(text: &str) -> Option<(String, usize)> {
+    use serde::de::{self, DeserializeSeed, Deserializer, MapAccess, SeqAccess, Visitor};
+    use std::cell::RefCell;
+    use std::collections::HashSet;
+
+    /// Walks any JSON value; `found` receives the path of a repeated key.
+    struct Walk<'a> {
+        path: String,
+        found: &'a RefCell<Option<String>>,
+    }
+
+    impl<'de> DeserializeSeed<'de> for Walk<'_> {
+        type Value = ();
+        fn deserialize<D: Deserializer<'de>>(self, d: D) -> std::result::Result<(), D::Error> {
+            d.deserialize_any(self)
+        }
+    }
+
+    impl<'de> Visitor<'de> for Walk<'_> {
+        type Value = ();
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("any JSON value")
+        }
+        fn visit_bool<E>(self, _: bool) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_i64<E>(self, _: i64) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_u64<E>(self, _: u64) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_f64<E>(self, _: f64) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_str<E>(self, _: &str) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_unit<E>(self) -> std::result::Result<(), E> {
+            Ok(())
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<(), A::Error> {
+            let mut i = 0;
+            while seq
+                .next_element_seed(Walk {
+                    path: format!("{}[{i}]", self.path),
+                    found: self.found,
+                })?
+                .is_some()
+            {
+                i += 1;
+            }
+            Ok(())
+        }
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> std::result::Result<(), A::Error> {
+            let mut seen = HashSet::new();
+            while let Some(key) = map.next_key::<String>()? {
+                let path = if self.path.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{}.{key}", self.path)
+                };
+                if !seen.insert(key) {
+                    *self.found.borrow_mut() = Some(path);
+                    return Err(de::Error::custom("duplicate key"));
+                }
+                map.next_value_seed(Walk {
+                    path,
+                    found: self.found,
+                })?;
+            }
+            Ok(())
+        }
+    }
+
+    let found = RefCell::new(None);
+    let mut de = serde_json::Deserializer::from_str(text);
+    let result = Walk {
+        path: String::new(),
+        found: &found,
+    }
+    .deserialize(&mut de);
+    match (result, found.into_inner()) {
+        (Err(e), Some(path)) => Some((path, e.line())),
+        _ => None,
+    }
 }
 
 struct Parser {
@@ -345,23 +466,64 @@ impl Parser {
         Ok(x)
     }
 
-    fn limit(&self, v: Option<&Value>, field: &str) -> Result<Limit> {
+    /// A limit's size `x` (> 0) must lie within [[`MIN_LIMIT`], `max`] of its `unit`.
+    fn plausible_limit(&self, x: f64, field: &str, unit: &str, max: f64) -> Result<()> {
+        if x < MIN_LIMIT {
+            return Err(self.err(
+                field,
+                format!(
+                    "{x} {unit} is implausibly small (at least {MIN_LIMIT:e} {unit}): check the                      unit (mm, degrees, seconds)"
+                ),
+            ));
+        }
+        if x > max {
+            return Err(self.err(
+                field,
+                format!(
+                    "{x} {unit} is implausibly large (at most {max:e} {unit}): check the unit                      (mm, degrees, seconds)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A length (mm, or degrees for a rotary travel) within ±[`MAX_LENGTH`].
+    fn plausible_length(&self, x: f64, field: &str) -> Result<f64> {
+        if x.abs() > MAX_LENGTH {
+            return Err(self.err(
+                field,
+                format!(
+                    "{x} is implausibly large (at most {MAX_LENGTH:e} mm or degrees in size):                      check the unit (mm)"
+                ),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// A limit in `unit`, each side's size within [[`MIN_LIMIT`], `max`].
+    fn limit(&self, v: Option<&Value>, field: &str, unit: &str, max: f64) -> Result<Limit> {
         match v {
             Some(Value::Array(items)) => {
                 let nums: Vec<f64> = items.iter().filter_map(Value::as_f64).collect();
                 if items.len() != 2 || nums.len() != 2 {
                     return Err(self.err(field, "expected a number or [min, max]"));
                 }
-                let (min, max) = (nums[0], nums[1]);
-                if !(min.is_finite() && max.is_finite() && min < 0.0 && max > 0.0) {
+                let (lo, hi) = (nums[0], nums[1]);
+                if !(lo.is_finite() && hi.is_finite() && lo < 0.0 && hi > 0.0) {
                     return Err(self.err(
                         field,
-                        format!("[min, max] must have min < 0 < max, found [{min}, {max}]"),
+                        format!("[min, max] must have min < 0 < max, found [{lo}, {hi}]"),
                     ));
                 }
-                Ok(Limit { min, max })
+                self.plausible_limit(-lo, field, unit, max)?;
+                self.plausible_limit(hi, field, unit, max)?;
+                Ok(Limit { min: lo, max: hi })
             }
-            other => Ok(Limit::symmetric(self.positive(other, field)?)),
+            other => {
+                let x = self.positive(other, field)?;
+                self.plausible_limit(x, field, unit, max)?;
+                Ok(Limit::symmetric(x))
+            }
         }
     }
 
@@ -386,7 +548,9 @@ impl Parser {
             Some(f) => {
                 let f = self.object(f, "feed")?;
                 self.only_known(f, "feed", &["max"])?;
-                Some(self.positive(f.get("max"), "feed.max")?)
+                let max = self.positive(f.get("max"), "feed.max")?;
+                self.plausible_limit(max, "feed.max", "mm/s", MAX_LIMIT)?;
+                Some(max)
             }
         };
         Ok(Machine {
@@ -416,6 +580,7 @@ impl Parser {
                 self.only_known(obj, "kinematics", &["type", "tool_length"])?;
                 let tool_length =
                     self.positive(obj.get("tool_length"), "kinematics.tool_length")?;
+                self.plausible_length(tool_length, "kinematics.tool_length")?;
                 Ok(KinematicsSpec::HeadHead { tool_length })
             }
             Some("table_table_ac") => self.trunnion(obj, TrunnionTilt::A),
@@ -424,12 +589,14 @@ impl Parser {
                 self.only_known(obj, "kinematics", &["type", "pivot_length"])?;
                 let pivot_length =
                     self.non_negative(obj.get("pivot_length"), "kinematics.pivot_length")?;
+                self.plausible_length(pivot_length, "kinematics.pivot_length")?;
                 Ok(KinematicsSpec::HeadTable { pivot_length })
             }
             Some("dresser") => {
                 self.only_known(obj, "kinematics", &["type", "tool_length"])?;
                 let tool_length =
                     self.non_negative(obj.get("tool_length"), "kinematics.tool_length")?;
+                self.plausible_length(tool_length, "kinematics.tool_length")?;
                 Ok(KinematicsSpec::Dresser { tool_length })
             }
             _ => Err(self.err(
@@ -473,7 +640,10 @@ impl Parser {
                 "work-offset",
             ],
         )?;
-        let num = |name: &str| self.number(obj.get(name), &format!("kinematics.{name}"));
+        let num = |name: &str| {
+            let field = format!("kinematics.{name}");
+            self.plausible_length(self.number(obj.get(name), &field)?, &field)
+        };
         let rot_point = [
             num("x-rot-point")?,
             num("y-rot-point")?,
@@ -483,7 +653,7 @@ impl Parser {
         let z_offset = num("z-offset")?;
         let tool_offset = match obj.get("tool-offset") {
             None => 0.0,
-            v => self.number(v, "kinematics.tool-offset")?,
+            Some(_) => num("tool-offset")?,
         };
         let conventional_directions = match obj.get("conventional-directions") {
             None => false,
@@ -499,14 +669,19 @@ impl Parser {
             None => [0.0; 3],
             Some(Value::Array(items))
                 if items.len() == 3
-                    && items.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)) =>
+                    && items
+                        .iter()
+                        .all(|x| x.as_f64().is_some_and(|x| x.abs() <= MAX_LENGTH)) =>
             {
                 std::array::from_fn(|i| items[i].as_f64().unwrap_or(0.0))
             }
             Some(v) => {
                 return Err(self.err(
                     "kinematics.work-offset",
-                    format!("expected [x, y, z] (three numbers, mm), found {v}"),
+                    format!(
+                        "expected [x, y, z] (three numbers, mm, each within ±{MAX_LENGTH:e}), \
+                         found {v}"
+                    ),
                 ));
             }
         };
@@ -531,7 +706,8 @@ impl Parser {
             (Some(_), None) => Err(self.err(&max_f, "missing (travel needs both min and max)")),
             (None, Some(_)) => Err(self.err(&min_f, "missing (travel needs both min and max)")),
             (lo, hi) => {
-                let (min, max) = (self.number(lo, &min_f)?, self.number(hi, &max_f)?);
+                let min = self.plausible_length(self.number(lo, &min_f)?, &min_f)?;
+                let max = self.plausible_length(self.number(hi, &max_f)?, &max_f)?;
                 if min >= max {
                     return Err(self.err(
                         &min_f,
@@ -587,19 +763,39 @@ impl Parser {
                         "reference",
                     ],
                 )?;
+                let kind = if *kin == KinematicsSpec::Joint {
+                    AxisKind::Linear
+                } else {
+                    KinematicsSpec::axis_kind(name)
+                };
+                let unit = match (kin, kind) {
+                    (KinematicsSpec::Joint, _) => "units/s",
+                    (_, AxisKind::Linear) => "mm/s",
+                    (_, AxisKind::Rotary) => "°/s",
+                };
                 Ok(Axis {
                     name: name.to_string(),
-                    kind: if *kin == KinematicsSpec::Joint {
-                        AxisKind::Linear
-                    } else {
-                        KinematicsSpec::axis_kind(name)
-                    },
-                    velocity: self.limit(a.get("velocity"), &format!("{field}.velocity"))?,
-                    acceleration: self
-                        .limit(a.get("acceleration"), &format!("{field}.acceleration"))?,
+                    kind,
+                    velocity: self.limit(
+                        a.get("velocity"),
+                        &format!("{field}.velocity"),
+                        unit,
+                        MAX_LIMIT,
+                    )?,
+                    acceleration: self.limit(
+                        a.get("acceleration"),
+                        &format!("{field}.acceleration"),
+                        &format!("{unit}²"),
+                        MAX_LIMIT,
+                    )?,
                     jerk: match a.get("jerk") {
                         None => None,
-                        Some(j) => Some(self.limit(Some(j), &format!("{field}.jerk"))?),
+                        Some(j) => Some(self.limit(
+                            Some(j),
+                            &format!("{field}.jerk"),
+                            &format!("{unit}³"),
+                            MAX_JERK_LIMIT,
+                        )?),
                     },
                     travel: self.travel(a, &field)?,
                 })

@@ -10,7 +10,9 @@ fn main() -> std::process::ExitCode {
             std::process::ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("feedopt: error: {e}");
+            // Text from an input file never breaks the line or drives the terminal.
+            let message = feedopt::files::escape_control(&e.to_string());
+            eprintln!("feedopt: error: {message}");
             std::process::ExitCode::from(2)
         }
     }

@@ -456,9 +456,10 @@ fn span_weights(path: &Path) -> Vec<f64> {
 
 /// b at an end station for a tool-tip feed (mm/s); an error where the tip cannot move.
 fn end_speed(span: &Span, p: &SpanProblem, i: usize, feed: f64, which: &str) -> Result<f64> {
-    if !(feed.is_finite() && feed >= 0.0) {
+    if !(feed.is_finite() && (0.0..=1e6).contains(&feed)) {
         return Err(Error::Usage(format!(
-            "the {which} feed must be ≥ 0 mm/s, got {feed}"
+            "the {which} feed must be between 0 and 1e6 mm/s, got {} mm/s",
+            crate::error::number(feed)
         )));
     }
     if feed == 0.0 {
@@ -474,7 +475,14 @@ fn end_speed(span: &Span, p: &SpanProblem, i: usize, feed: f64, which: &str) -> 
              feed must be 0, got {feed} mm/s"
         )));
     }
-    Ok((feed / speed).powi(2))
+    let b = (feed / speed).powi(2);
+    if !b.is_finite() {
+        return Err(Error::Infeasible(format!(
+            "the path's {which} barely moves the tool tip ({speed:.3e} mm per unit of path): a \
+             {which} feed of {feed} mm/s there is out of reach; give 0"
+        )));
+    }
+    Ok(b)
 }
 
 /// What stays fixed while the stations are refined.

@@ -155,11 +155,19 @@ impl SweepOptions {
         if !(self.from.is_finite() && self.to.is_finite() && self.from > 0.0 && self.to > 0.0) {
             return Err(Error::Usage(format!(
                 "--from and --to must be positive limits, got {} and {}",
-                self.from, self.to
+                crate::error::number(self.from),
+                crate::error::number(self.to)
             )));
         }
         if self.steps == 0 {
             return Err(Error::Usage("--steps must be at least 1".into()));
+        }
+        if self.steps > MAX_STEPS {
+            return Err(Error::Usage(format!(
+                "--steps {} is more than {MAX_STEPS} (each step is three solves): give at most \
+                 {MAX_STEPS}",
+                self.steps
+            )));
         }
         if self.steps > 1 && self.to <= self.from {
             return Err(Error::Usage(format!(
@@ -176,6 +184,14 @@ impl SweepOptions {
         Ok(())
     }
 }
+
+/// The most steps a sweep takes (each is three solves: the value and its finite differences).
+pub const MAX_STEPS: usize = 10_000;
+
+/// How far from the machine's own limit a sweep may go: from 1/`MAX_SWEEP_FACTOR` to
+/// `MAX_SWEEP_FACTOR` times it. The cycle time, and with it the re-simulation's work, grows as
+/// the limit shrinks; a study beyond this range is no longer about that machine.
+pub const MAX_SWEEP_FACTOR: f64 = 1e3;
 
 /// One step of the sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -421,6 +437,23 @@ pub fn sweep(
         })?;
     let which = options.limit;
     let nominal = machine_limit(machine, axis, which);
+    let (lo, hi) = (
+        nominal.max / MAX_SWEEP_FACTOR,
+        nominal.max * MAX_SWEEP_FACTOR,
+    );
+    for (option, v) in [("--from", options.from), ("--to", options.to)] {
+        if !(lo..=hi).contains(&v) {
+            return Err(Error::Usage(format!(
+                "{option} {} is outside {} to {}, 1/{MAX_SWEEP_FACTOR} to {MAX_SWEEP_FACTOR} \
+                 times the machine's {} {which} limit ({}): sweep within that range",
+                crate::error::number(v),
+                crate::error::number(lo),
+                crate::error::number(hi),
+                machine.axes[axis].name,
+                nominal.max
+            )));
+        }
+    }
     // The stations: one reach solve at the nominal limits, as `solve` would refine them.
     let base = optimize_input(
         machine,

@@ -508,7 +508,7 @@ fn missing_toolpath_file() {
         "machine.json",
         "nowhere.cls",
         &["machine.json"],
-        &["nowhere.cls"],
+        &["nowhere.cls", "no such file: check the path"],
     );
 }
 
@@ -611,4 +611,486 @@ fn absolute_paths() {
 fn command_line_definition_is_consistent() {
     use clap::CommandFactory;
     feedopt::cli::Cli::command().debug_assert();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 14: outputs never overwrite inputs, fail before the solve, work bounded up front
+// ---------------------------------------------------------------------------------------------
+
+/// Two 1 m/s² joint axes along s ∈ [0, 1] (for `interpolate` onto a CSV input).
+const JOINT_MACHINE: &str = r#"{"kinematics": {"type": "joint"},
+  "axes": {"a": {"velocity": 1, "acceleration": 1}, "b": {"velocity": 1, "acceleration": 1}}}"#;
+const JOINT_PATH: &str = "s,q_a,q_b\n0,0,0\n0.5,0.5,0.25\n1,1,0.5\n";
+
+/// Asserts that `name` still holds `text`.
+fn assert_unchanged(w: &Work, name: &str, text: &str) {
+    assert_eq!(w.read(name), text, "{name} was changed");
+}
+
+#[test]
+fn output_onto_an_input_is_refused_and_the_input_unchanged() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    w.write("line.ngc", "G21 G90 G94\nF6000\nG0 X0 Y0 Z0\nG1 X100\nM2\n");
+    w.write("jm.json", JOINT_MACHINE);
+    w.write("joint.csv", JOINT_PATH);
+    // solve -o onto the machine file, by its name and by another spelling.
+    for out in ["machine.json", "./machine.json"] {
+        let line = assert_error(
+            &w.solve_line(&["-o", out]),
+            &["-o", "machine file", "overwrite"],
+        );
+        assert!(line.contains(out), "{line}");
+    }
+    // A symbolic link and a hard link to an input are the input.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("machine.json", w.path("link.json")).unwrap();
+        assert_error(
+            &w.solve_line(&["-o", "link.json"]),
+            &["link.json", "overwrite"],
+        );
+        std::fs::hard_link(w.path("machine.json"), w.path("hard.json")).unwrap();
+        assert_error(
+            &w.solve_line(&["-o", "hard.json"]),
+            &["hard.json", "overwrite"],
+        );
+    }
+    // solve -o onto a CSV toolpath; --plot onto a toolpath read with --format.
+    let joint = |cmd: &str, extra: &[&str]| {
+        let mut args = vec![cmd, "-m", "jm.json", "joint.csv", "--stations", "20"];
+        args.extend_from_slice(extra);
+        w.run(&args)
+    };
+    assert_error(
+        &joint("solve", &["-o", "joint.csv"]),
+        &["toolpath", "joint.csv"],
+    );
+    // interpolate -o onto the CSV toolpath.
+    assert_error(
+        &joint("interpolate", &["-o", "joint.csv"]),
+        &["toolpath", "joint.csv"],
+    );
+    // sweep -o onto the machine file.
+    assert_error(
+        &joint(
+            "sweep",
+            &[
+                "--axis", "a", "--limit", "velocity", "--from", "0.5", "--to", "1", "--steps", "2",
+                "-o", "jm.json",
+            ],
+        ),
+        &["machine file", "jm.json"],
+    );
+    // gcode -o onto its .ngc input.
+    assert_error(
+        &w.run(&[
+            "gcode",
+            "-m",
+            "machine.json",
+            "line.ngc",
+            "--stations",
+            "20",
+            "-o",
+            "line.ngc",
+        ]),
+        &["toolpath", "line.ngc", "overwrite"],
+    );
+    // --plot onto the toolpath (read as APT whatever its name).
+    w.write("path.svg", LINE);
+    assert_error(
+        &w.run(&[
+            "solve",
+            "-m",
+            "machine.json",
+            "path.svg",
+            "--format",
+            "apt",
+            "--stations",
+            "20",
+            "--plot",
+            "path.svg",
+        ]),
+        &["--plot", "toolpath", "path.svg"],
+    );
+    assert_unchanged(&w, "machine.json", XYZ_MACHINE);
+    assert_unchanged(&w, "jm.json", JOINT_MACHINE);
+    assert_unchanged(&w, "joint.csv", JOINT_PATH);
+    assert_unchanged(&w, "line.cls", LINE);
+    assert_unchanged(&w, "path.svg", LINE);
+    assert!(w.read("line.ngc").starts_with("G21 G90 G94\n"));
+}
+
+#[test]
+fn an_unwritable_output_fails_before_the_solve_naming_the_path() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    // The toolpath does not exist: an error about it would mean the output was checked late.
+    let out = w.run(&[
+        "interpolate",
+        "-m",
+        "machine.json",
+        "nowhere.cls",
+        "-o",
+        "missing/set.csv",
+    ]);
+    assert_error(&out, &["missing/set.csv", "does not exist"]);
+    w.write("line.cls", LINE);
+    for cmd in ["solve", "interpolate"] {
+        let out = w.run(&[
+            cmd,
+            "-m",
+            "machine.json",
+            "line.cls",
+            "--stations",
+            "20",
+            "-o",
+            "missing/x.csv",
+        ]);
+        assert_error(&out, &["missing/x.csv", "does not exist"]);
+    }
+    // An existing directory as the output.
+    std::fs::create_dir(w.path("dir.csv")).unwrap();
+    let out = w.solve_line(&["-o", "dir.csv"]);
+    assert_error(&out, &["dir.csv", "not a regular file"]);
+    w.assert_listing(&["machine.json", "line.cls", "dir.csv"]);
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn an_output_in_a_directory_that_takes_no_files_fails_before_the_solve() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    for cmd in ["solve", "interpolate"] {
+        let out = w.run(&[
+            cmd,
+            "-m",
+            "machine.json",
+            "nowhere.cls",
+            "-o",
+            "/proc/version.csv",
+        ]);
+        assert_error(
+            &out,
+            &["/proc/version.csv", "cannot create a file in /proc"],
+        );
+    }
+}
+
+/// Runs `feedopt ARGS` on the straight line and asserts a quick one-line error mentioning
+/// `needles` and no `inf`/`NaN`.
+fn refused_quickly(w: &Work, args: &[&str], needles: &[&str]) {
+    let t0 = std::time::Instant::now();
+    let out = w.run(args);
+    let line = assert_error(&out, needles);
+    assert!(
+        t0.elapsed().as_secs_f64() < 10.0,
+        "{args:?} took {:?}",
+        t0.elapsed()
+    );
+    assert!(
+        !line.contains("inf ") && !line.contains("NaN"),
+        "not in words: {line}"
+    );
+}
+
+#[test]
+fn work_is_bounded_before_it_starts() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    fn solve<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        let mut a = vec!["solve", "-m", "machine.json", "line.cls"];
+        a.extend_from_slice(extra);
+        a
+    }
+    refused_quickly(
+        &w,
+        &solve(&["--stations", "100000000"]),
+        &["--stations", "4000000"],
+    );
+    refused_quickly(
+        &w,
+        &solve(&["--period", "1e-12"]),
+        &["--period", "1 µs to 1 s"],
+    );
+    refused_quickly(&w, &solve(&["--period", "10s"]), &["--period"]);
+    refused_quickly(
+        &w,
+        &solve(&["--chord-tolerance", "1e-300"]),
+        &["--chord-tolerance", "1e-6 mm"],
+    );
+    refused_quickly(
+        &w,
+        &solve(&["--start-feed", "1e300"]),
+        &["--start-feed", "1e300"],
+    );
+    refused_quickly(&w, &solve(&["--end-feed", "inf"]), &["--end-feed"]);
+    refused_quickly(
+        &w,
+        &solve(&["--feed-override", "1e-300"]),
+        &["--feed-override", "1e-300", "0.001 to 1000"],
+    );
+    // Above the machine's feed.max (150 mm/s): no schedule can start there.
+    refused_quickly(
+        &w,
+        &solve(&["--start-feed", "151"]),
+        &["--start-feed", "feed.max = 150"],
+    );
+    fn sweep<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        let mut a = vec![
+            "sweep",
+            "-m",
+            "machine.json",
+            "line.cls",
+            "--stations",
+            "20",
+            "--axis",
+            "X",
+            "--limit",
+            "acceleration",
+        ];
+        a.extend_from_slice(extra);
+        a
+    }
+    refused_quickly(
+        &w,
+        &sweep(&["--from", "100", "--to", "200", "--steps", "1000000000"]),
+        &["--steps", "10000"],
+    );
+    refused_quickly(
+        &w,
+        &sweep(&["--from", "1e-300", "--to", "200"]),
+        &["--from", "X acceleration", "2000"],
+    );
+    refused_quickly(
+        &w,
+        &sweep(&["--from", "100", "--to", "1e12"]),
+        &["--to", "1/1000 to 1000 times"],
+    );
+    w.write("head.json", HEAD_HEAD_MACHINE);
+    w.write(
+        "turn.cls",
+        "MULTAX/ON\nFEDRAT/MMPM,3000\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0.5,0,0.866025\n",
+    );
+    refused_quickly(
+        &w,
+        &[
+            "gcode",
+            "-m",
+            "head.json",
+            "turn.cls",
+            "--stations",
+            "20",
+            "-o",
+            "out.ngc",
+            "--max-rotation-deg",
+            "1e-6",
+        ],
+        &["--max-rotation-deg", "0.001"],
+    );
+    w.assert_listing(&["machine.json", "line.cls", "head.json", "turn.cls"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn an_endless_input_is_refused() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    refused_quickly(
+        &w,
+        &[
+            "solve",
+            "-m",
+            "machine.json",
+            "/dev/zero",
+            "--format",
+            "apt",
+        ],
+        &["/dev/zero", "larger than 64 MiB", "toolpath"],
+    );
+    refused_quickly(
+        &w,
+        &["solve", "-m", "/dev/zero", "line.cls"],
+        &["/dev/zero", "larger than 1 MiB", "machine file"],
+    );
+}
+
+#[test]
+fn input_text_is_escaped_in_messages() {
+    let w = Work::new();
+    // An escape sequence in a key (valid JSON) and a carriage return in a toolpath value.
+    w.write(
+        "machine.json",
+        &XYZ_MACHINE.replace(
+            r#""Z": {"#,
+            r#""Z\u001b[2J": {"velocity": 1, "acceleration": 1}, "Z": {"#,
+        ),
+    );
+    w.write("line.cls", LINE);
+    let out = w.solve_line(&[]);
+    let line = assert_error(&out, &["machine.json", "axes.Z\\u{1b}[2J"]);
+    assert!(!line.contains('\u{1b}'), "raw escape echoed: {line:?}");
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("bad.cls", "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/1,2\r3x,0\n");
+    let out = w.run(&["solve", "-m", "machine.json", "bad.cls", "--stations", "20"]);
+    let line = assert_error(&out, &["bad.cls:3:"]);
+    assert!(!line.contains('\r'), "raw carriage return echoed: {line:?}");
+}
+
+#[test]
+fn a_machine_file_that_is_not_utf8_names_its_line() {
+    let w = Work::new();
+    let mut bytes = XYZ_MACHINE.replace("test router", "fr@se").into_bytes();
+    let at = bytes.iter().position(|&b| b == b'@').unwrap();
+    bytes[at] = 0xe4; // ä in Latin-1
+    std::fs::write(w.path("machine.json"), bytes).unwrap();
+    w.write("line.cls", LINE);
+    assert_error(&w.solve_line(&[]), &["machine.json:2:", "UTF-8", "save"]);
+}
+
+/// Two turns of the tool about the vertical on a 30° cone: C turns 720°, 45° per block.
+fn cone_turns() -> String {
+    let mut t = String::from("MULTAX/ON\nFEDRAT/MMPM,3000\n");
+    for k in 0..17 {
+        let a = (45.0 * k as f64).to_radians();
+        let (s, c) = 30f64.to_radians().sin_cos();
+        t.push_str(&format!(
+            "GOTO/{:.4},{:.4},0,{:.6},{:.6},{c:.6}\n",
+            50.0 * a.cos(),
+            50.0 * a.sin(),
+            s * a.cos(),
+            s * a.sin()
+        ));
+    }
+    t
+}
+
+#[test]
+fn gcode_block_count_is_bounded_before_writing() {
+    let w = Work::new();
+    w.write("head.json", HEAD_HEAD_MACHINE);
+    w.write("cone.cls", &cone_turns());
+    let gcode = |deg: &str| {
+        w.run(&[
+            "gcode",
+            "--solver",
+            "reach",
+            "-m",
+            "head.json",
+            "cone.cls",
+            "--stations",
+            "200",
+            "-o",
+            "cone.ngc",
+            "--max-rotation-deg",
+            deg,
+        ])
+    };
+    // 720° in steps of 0.001° is 720,000 pieces, 2^16 per 45° block: past 1,000,000 blocks.
+    refused_quickly(
+        &w,
+        &[
+            "gcode",
+            "--solver",
+            "reach",
+            "-m",
+            "head.json",
+            "cone.cls",
+            "--stations",
+            "200",
+            "-o",
+            "cone.ngc",
+            "--max-rotation-deg",
+            "0.001",
+        ],
+        &["cone.cls:", "1000000 blocks", "larger rotation"],
+    );
+    w.assert_listing(&["head.json", "cone.cls"]);
+    // Control: 1° per block is written.
+    let out = gcode("1");
+    assert_success(&out);
+    assert!(stdout(&out).contains("added by Δθ"), "{}", stdout(&out));
+    w.assert_listing(&["head.json", "cone.cls", "cone.ngc"]);
+}
+
+/// An output gets the permissions of any new file in its directory, not a temporary file's
+/// private 0600.
+#[cfg(unix)]
+#[test]
+fn outputs_have_the_permissions_of_a_new_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    assert_success(&w.solve_line(&["-o", "out.csv"]));
+    let mode = |name: &str| {
+        std::fs::metadata(w.path(name))
+            .expect("metadata")
+            .permissions()
+            .mode()
+            & 0o777
+    };
+    assert_eq!(
+        mode("out.csv"),
+        mode("line.cls"),
+        "written by std::fs::write"
+    );
+}
+
+/// Found by the fuzzing harness: a coordinate of 1e308 made the spline's knots collapse (a
+/// panic), 1e12 ran the re-simulation for minutes. Implausible magnitudes in any CL toolpath
+/// are refused at the entry point, naming the line.
+#[test]
+fn implausible_toolpath_magnitudes_name_the_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    let cases = [
+        (
+            "big.cls",
+            "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/1e308,0,0\n",
+            "big.cls:3:",
+            "1e308",
+        ),
+        (
+            "far.cls",
+            "FEDRAT/MMPM,6000\nGOTO/0,0,0\nGOTO/0,-1e12,0\n",
+            "far.cls:3:",
+            "Y",
+        ),
+        (
+            "slow.cls",
+            "FEDRAT/MMPM,0.000159\nGOTO/0,0,0\nGOTO/10,0,0\n",
+            "slow.cls:3:",
+            "1e-3 mm/min",
+        ),
+        (
+            "far.ngc",
+            "G21 G90 G94\nG1 X0 F100\nG1 X2000000\n",
+            "far.ngc:3:",
+            "2e6",
+        ),
+    ];
+    for (name, text, at, what) in cases {
+        w.write(name, text);
+        let out = w.run(&["solve", "-m", "machine.json", name, "--stations", "20"]);
+        assert_error(&out, &[at, what]);
+    }
+    // 1 km is still a toolpath (2,500 s at the X velocity limit: checked every 0.1 s).
+    w.write("km.cls", "FEDRAT/MMPM,600000\nGOTO/0,0,0\nGOTO/1e6,0,0\n");
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "km.cls",
+        "--stations",
+        "20",
+        "--solver",
+        "reach",
+        "--period",
+        "0.1",
+    ]);
+    assert_success(&out);
 }

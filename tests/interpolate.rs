@@ -225,3 +225,38 @@ fn the_cli_writes_csv_and_binary_setpoints() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// More setpoints than [`feedopt::interpolate::MAX_SAMPLES`] are refused before sampling, with
+/// the period that would do.
+#[test]
+fn too_many_setpoints_are_refused_before_sampling() {
+    let m = common::machine(
+        r#"{"name": "line", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 10, "acceleration": 100},
+                     "Y": {"velocity": 10, "acceleration": 100},
+                     "Z": {"velocity": 10, "acceleration": 100}}}"#,
+    );
+    let t = common::toolpath(
+        &[
+            (Vector3::new(0.0, 0.0, 0.0), common::UP),
+            (Vector3::new(100.0, 0.0, 0.0), common::UP),
+        ],
+        None,
+    );
+    let options = Options {
+        solver_kind: SolverKind::Reach,
+        stations: Some(100),
+        ..Options::default()
+    };
+    let sol = optimize(&m, &t, &options).unwrap();
+    // 10.1 s: 10,100 setpoints at 1 ms, 10.1 million at 1 µs.
+    assert!(sample(&m, &sol, 1e-3).is_ok());
+    let t0 = std::time::Instant::now();
+    let e = sample(&m, &sol, 1e-6).expect_err("too many setpoints");
+    assert!(t0.elapsed().as_secs_f64() < 0.5, "{:?}", t0.elapsed());
+    let text = e.to_string();
+    assert!(
+        text.contains("4000000 setpoints") && text.contains("at least 2.5"),
+        "{text}"
+    );
+}

@@ -880,3 +880,150 @@ fn bad_jerk_limit_names_its_field() {
         &["positive"],
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 14: duplicate keys, implausible magnitudes, bounded reads, UTF-8
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_duplicate_axis_names_the_key_and_its_line() {
+    // serde_json would keep the second X silently.
+    let text = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+ "axes": {"X": {"velocity": 400, "acceleration": 2000},
+          "Y": {"velocity": 300, "acceleration": 1500},
+          "X": {"velocity": 1, "acceleration": 1},
+          "Z": {"velocity": 200, "acceleration": 1000}}}"#;
+    field_err(text, "axes.X", &["twice", "line 4", "remove one"]);
+}
+
+#[test]
+fn a_duplicate_field_anywhere_names_its_path() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "velocity": 4}"#),
+        "axes.X.velocity",
+        &["twice"],
+    );
+    field_err(
+        &format!(
+            r#"{{"name": "a", "name": "b", "kinematics": {{"type": "xyz"}}, "axes": {XYZ_AXES}}}"#
+        ),
+        "name",
+        &["twice"],
+    );
+    field_err(
+        &head_head(
+            r#"{"type": "head_head", "tool_length": 200, "tool_length": 2}"#,
+            "",
+        ),
+        "kinematics.tool_length",
+        &["twice"],
+    );
+    // The same key in two different objects is no duplicate.
+    ok(&xyz_with_x(r#"{"velocity": 400, "acceleration": 2000}"#));
+}
+
+#[test]
+fn implausibly_small_or_large_limits_name_the_field() {
+    field_err(
+        &xyz_with_x(r#"{"velocity": 1e-300, "acceleration": 2000}"#),
+        "axes.X.velocity",
+        &["implausibly small", "1e-6", "mm/s", "unit"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 1e300}"#),
+        "axes.X.acceleration",
+        &["implausibly large", "1e9", "mm/s²"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": [-1e-9, 400], "acceleration": 2000}"#),
+        "axes.X.velocity",
+        &["implausibly small"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "jerk": 1e15}"#),
+        "axes.X.jerk",
+        &["implausibly large", "1e12", "mm/s³"],
+    );
+    let hh = r#"{"type": "head_head", "tool_length": 200}"#;
+    field_err(
+        &head_head(hh, r#", "feed": {"max": 1e-300}"#),
+        "feed.max",
+        &["implausibly small"],
+    );
+    // A rotary axis's limits are in degrees.
+    let axes = HEAD_HEAD_AXES.replace(r#""C": {"velocity": 120"#, r#""C": {"velocity": 1e10"#);
+    field_err(
+        &format!(r#"{{"kinematics": {hh}, "axes": {axes}}}"#),
+        "axes.C.velocity",
+        &["°/s"],
+    );
+    // The bounds themselves are accepted.
+    ok(&xyz_with_x(
+        r#"{"velocity": 1e-6, "acceleration": 1e9, "jerk": 1e12}"#,
+    ));
+}
+
+#[test]
+fn implausible_lengths_name_the_field() {
+    field_err(
+        &head_head(r#"{"type": "head_head", "tool_length": 1e300}"#, ""),
+        "kinematics.tool_length",
+        &["implausibly large", "1e6"],
+    );
+    field_err(
+        &with_kinematics(
+            &AC_FULL.replace(r#""z-offset": 10.0"#, r#""z-offset": -1e7"#),
+            &five_axes("A"),
+        ),
+        "kinematics.z-offset",
+        &["implausibly large"],
+    );
+    field_err(
+        &with_kinematics(
+            &AC_FULL.replace("[0.5, -0.25, 13.25]", "[0.5, -0.25, 1e300]"),
+            &five_axes("A"),
+        ),
+        "kinematics.work-offset",
+        &["three numbers"],
+    );
+    field_err(
+        &xyz_with_x(r#"{"velocity": 400, "acceleration": 2000, "min": -1e12, "max": 5}"#),
+        "axes.X.min",
+        &["implausibly large"],
+    );
+}
+
+#[test]
+fn not_utf8_names_the_line_and_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("latin1.json");
+    let mut bytes = b"{\"kinematics\": {\"type\": \"xyz\"},\n \"name\": \"fr".to_vec();
+    bytes.push(0xe4); // ä in Latin-1
+    bytes.extend_from_slice(format!("se\",\n \"axes\": {XYZ_AXES}}}").as_bytes());
+    std::fs::write(&path, bytes).unwrap();
+    let e = Machine::from_file(&path).expect_err("not UTF-8");
+    let text = e.to_string();
+    assert!(
+        text.contains("latin1.json:2:") && text.contains("UTF-8") && text.contains("save"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_file_that_never_ends_is_refused() {
+    // Bigger than any machine file: refused before it is read, not read to its end.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.json");
+    let f = std::fs::File::create(&path).unwrap();
+    f.set_len(2 << 20).unwrap(); // sparse: no disk used
+    let e = Machine::from_file(&path).expect_err("too large");
+    assert!(e.to_string().contains("larger than 1 MiB"), "{e}");
+    #[cfg(unix)]
+    {
+        let e = Machine::from_file(Path::new("/dev/zero")).expect_err("endless");
+        assert!(
+            e.to_string().contains("/dev/zero: larger than 1 MiB"),
+            "{e}"
+        );
+    }
+}

@@ -167,7 +167,7 @@ pub const NURBS_MAX_POINTS: usize = 1_000_000;
 /// Reads an APT CL file. Bytes that are not valid UTF-8 (e.g. Latin-1 in `PPRINT` text) are
 /// replaced, not rejected.
 pub fn read(path: &Path) -> Result<Toolpath> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::toolpath::read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);
     parse(path, &text)
 }

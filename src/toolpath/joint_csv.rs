@@ -15,6 +15,12 @@
 //! derivatives are given they are used as given (the path between rows is the Hermite
 //! interpolant that takes them); when absent a cubic spline is fitted. Units are the axes' own
 //! (mm or degrees); s is unit-free. Errors name the file, the line and the column.
+//!
+//! Degenerate paths are refused (they would otherwise be refined to millions of stations on
+//! infinite violations): every q within ±[`MAX_POSITION`]; s within ±[`MAX_S`] and rows at
+//! least [`MIN_S_STEP`] apart in s; some axis moving by more than [`MIN_MOTION`]; and every given
+//! derivative small enough that its Taylor term over one row step, |dᵏq/dsᵏ| hᵏ/k!, stays
+//! within [`MAX_TAYLOR_TERM`] (h the larger of the row's two steps in s).
 
 use std::path::{Path, PathBuf};
 
@@ -41,9 +47,30 @@ pub struct JointPath {
     pub lines: Vec<usize>,
 }
 
+/// The largest axis position a joint-space path may give, mm or degrees (1 km).
+pub const MAX_POSITION: f64 = crate::machine::MAX_LENGTH;
+
+/// The largest |s|: s is unit-free, but beyond this it is not a path parameter.
+pub const MAX_S: f64 = 1e9;
+
+/// The smallest step in s between two rows: closer rows make the derivatives dq/ds (and with
+/// them the solver's numbers) overflow. s is unit-free: rescale it (0 to 1, or mm).
+pub const MIN_S_STEP: f64 = 1e-9;
+
+/// The largest Taylor term |dᵏq/dsᵏ| hᵏ/k! of a given derivative over one row step h, mm or
+/// degrees: ten times [`MAX_POSITION`]. A path sampled finely enough to follow (above two rows
+/// per oscillation) has terms of at most about 5 times its amplitude (π³/6 for the third
+/// derivative of a sine at two rows per period), so only derivatives of absurd size, or not
+/// with respect to s, are refused.
+pub const MAX_TAYLOR_TERM: f64 = 10.0 * MAX_POSITION;
+
+/// The least motion of the whole path, on some axis, mm or degrees (a picometre: below any
+/// machine's resolution).
+pub const MIN_MOTION: f64 = 1e-9;
+
 /// Reads a joint-space CSV file.
 pub fn read(path: &Path) -> Result<JointPath> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::files::utf8(path, super::read_bytes(path)?)?;
     parse(path, &text)
 }
 
@@ -57,6 +84,7 @@ enum Column {
 /// Parses joint-space CSV text; `source` names the file in errors.
 pub fn parse(source: &Path, text: &str) -> Result<JointPath> {
     let err = |line: usize, msg: String| Error::parse(source, line, msg);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -172,8 +200,23 @@ pub fn parse(source: &Path, text: &str) -> Result<JointPath> {
                         ),
                     )
                 })?;
+            let too_large = |max: f64| {
+                err(
+                    line,
+                    format!(
+                        "column {} (`{}`): {} is implausibly large (at most {max:e} in size)",
+                        c + 1,
+                        names[c],
+                        crate::error::number(v)
+                    ),
+                )
+            };
             match *col {
+                Column::S if v.abs() > MAX_S => return Err(too_large(MAX_S)),
                 Column::S => s = v,
+                Column::Axis { order: 0, .. } if v.abs() > MAX_POSITION => {
+                    return Err(too_large(MAX_POSITION));
+                }
                 Column::Axis { order, axis } => rows[order][axis] = v,
             }
         }
@@ -181,7 +224,24 @@ pub fn parse(source: &Path, text: &str) -> Result<JointPath> {
             if s <= prev {
                 return Err(err(
                     line,
-                    format!("s must increase strictly: {s} after {prev}"),
+                    format!(
+                        "column 1 (`s`): s must increase strictly: {} after {}",
+                        crate::error::number(s),
+                        crate::error::number(prev)
+                    ),
+                ));
+            }
+            if s - prev < MIN_S_STEP {
+                return Err(err(
+                    line,
+                    format!(
+                        "column 1 (`s`): {} is only {:e} after the row before ({}); rows \
+                         must be at least {MIN_S_STEP:e} apart in s: rescale s (it is \
+                         unit-free: e.g. 0 to 1, or the path length in mm)",
+                        crate::error::number(s),
+                        s - prev,
+                        crate::error::number(prev)
+                    ),
                 ));
             }
         }
@@ -203,5 +263,86 @@ pub fn parse(source: &Path, text: &str) -> Result<JointPath> {
             "a joint-space path needs at least two rows".into(),
         ));
     }
+    check_motion(&out, hline)?;
+    check_derivatives(&out, &names, &columns)?;
     Ok(out)
+}
+
+/// Some axis must move by more than [`MIN_MOTION`] over the path.
+fn check_motion(path: &JointPath, hline: usize) -> Result<()> {
+    let na = path.axes.len();
+    let moves = (0..na).any(|a| {
+        let (lo, hi) = path
+            .q
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+                (lo.min(r[a]), hi.max(r[a]))
+            });
+        hi - lo > MIN_MOTION
+    });
+    if moves {
+        return Ok(());
+    }
+    let first = path.lines[0];
+    let last = path.lines[path.lines.len() - 1];
+    Err(Error::parse(
+        &path.source,
+        hline,
+        format!(
+            "no `q_` column changes by more than {MIN_MOTION:e} from line {first} to line \
+             {last}: the path does not move; give the axis positions along s"
+        ),
+    ))
+}
+
+/// Every given derivative's Taylor term over one row step, |dᵏq/dsᵏ| hᵏ/k!, within
+/// [`MAX_TAYLOR_TERM`] (module doc).
+fn check_derivatives(path: &JointPath, names: &[&str], columns: &[Column]) -> Result<()> {
+    let n = path.s.len();
+    for (order, rows) in [(1, &path.dq), (2, &path.ddq), (3, &path.dddq)] {
+        let Some(rows) = rows else { continue };
+        let factorial = [1.0, 1.0, 2.0, 6.0][order];
+        for i in 0..n {
+            let h = (if i > 0 {
+                path.s[i] - path.s[i - 1]
+            } else {
+                0.0
+            })
+            .max(if i + 1 < n {
+                path.s[i + 1] - path.s[i]
+            } else {
+                0.0
+            });
+            for a in 0..path.axes.len() {
+                let d = rows[i][a];
+                let term = d.abs() * h.powi(order as i32) / factorial;
+                if term > MAX_TAYLOR_TERM {
+                    let c = columns
+                        .iter()
+                        .position(|c| {
+                            matches!(*c, Column::Axis { order: o, axis } if o == order && axis == a)
+                        })
+                        .unwrap_or(0);
+                    return Err(Error::parse(
+                        &path.source,
+                        path.lines[i],
+                        format!(
+                            "column {} (`{}`): {} would move the axis by {} over one row step \
+                             (Δs = {h:e}), more than {MAX_TAYLOR_TERM:e}: derivatives are with \
+                             respect to s, in the axis's unit",
+                            c + 1,
+                            names[c],
+                            crate::error::number(d),
+                            if term.is_finite() {
+                                crate::error::number(term)
+                            } else {
+                                "more than f64 can hold".to_string()
+                            }
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }

@@ -289,20 +289,85 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
 
 /// Reads any input with `options`, detecting what they leave open; says what was used.
 pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);
     let detected = detect(path, &text, options)?;
     let input = match detected.format {
-        Format::Csv => Input::Joint(joint_csv::read(path)?),
-        Format::Apt => Input::Cl(apt::parse_for(path, &text, options.machine.as_ref())?),
-        Format::Gcode => Input::Cl(gcode::parse_for(
+        Format::Csv => Input::Joint(joint_csv::parse(
+            path,
+            &crate::files::utf8(path, bytes.clone())?,
+        )?),
+        // The CL readers replace bytes that are not UTF-8 (Latin-1 comments).
+        Format::Apt => Input::Cl(plausible(apt::parse_for(
+            path,
+            &text,
+            options.machine.as_ref(),
+        )?)?),
+        Format::Gcode => Input::Cl(plausible(gcode::parse_for(
             path,
             &text,
             detected.dialect.unwrap_or_default().spec(),
             options.machine.as_ref(),
-        )?),
+        )?)?),
     };
     Ok((input, detected))
+}
+
+/// The largest tool-tip coordinate a toolpath may give, mm (1 km): beyond it a number is a
+/// typo or a wrong unit, and the path's length sets the work of every later stage.
+pub const MAX_COORDINATE_MM: f64 = 1e6;
+
+/// The smallest programmed feed, mm/s (1e-3 mm/min): below it the cycle time, and the work of
+/// the re-simulation, grow without bound.
+pub const MIN_FEED_MM_S: f64 = 1e-3 / 60.0;
+
+/// A CL toolpath as read, checked for implausible magnitudes at the entry point (whatever the
+/// reader): every tool-tip coordinate finite and within ±[`MAX_COORDINATE_MM`], every tool
+/// vector finite, every programmed feed at least [`MIN_FEED_MM_S`] (the first point's feed is
+/// unused). Errors name the line.
+pub fn plausible(t: Toolpath) -> Result<Toolpath> {
+    for (k, p) in t.points.iter().enumerate() {
+        for (axis, x) in ["X", "Y", "Z"].iter().zip(p.p.iter()) {
+            if !(x.is_finite() && x.abs() <= MAX_COORDINATE_MM) {
+                return Err(crate::error::Error::parse(
+                    &t.source,
+                    p.line,
+                    format!(
+                        "tool tip {axis} = {} mm is beyond ±{MAX_COORDINATE_MM:e} mm (1 km): \
+                         check the number and the units",
+                        crate::error::number(*x)
+                    ),
+                ));
+            }
+        }
+        if !p.o.iter().all(|x| x.is_finite()) {
+            return Err(crate::error::Error::parse(
+                &t.source,
+                p.line,
+                "the tool vector is not finite: give i, j, k as ordinary numbers",
+            ));
+        }
+        if let (Feed::Programmed(f), true) = (p.feed, k > 0) {
+            if !(f.is_finite() && f >= MIN_FEED_MM_S) {
+                return Err(crate::error::Error::parse(
+                    &t.source,
+                    p.line,
+                    format!(
+                        "a feed of {} mm/min is below 1e-3 mm/min: check the number and the \
+                         units",
+                        crate::error::number(f * 60.0)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(t)
+}
+
+/// A toolpath file's bytes, at most [`crate::files::MAX_TOOLPATH_BYTES`] of them: a larger
+/// file, or a device that never ends (`/dev/zero`), is refused before it is read.
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    crate::files::read_bounded(path, crate::files::MAX_TOOLPATH_BYTES, "toolpath")
 }
 
 /// Any input path: cutter locations or joint positions.

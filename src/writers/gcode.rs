@@ -85,6 +85,11 @@ pub const MIN_BLOCK_TIME_S: f64 = 1e-5;
 /// Most halvings of one block under the Δθ rule (as `limit_rotation`).
 const MAX_HALVINGS: u32 = 20;
 
+/// The most blocks a written program may have (about 60 MB of G-code): `--max-rotation-deg`
+/// splits blocks, and the count is checked while the splits are computed, before anything is
+/// written.
+pub const MAX_BLOCKS: usize = 1_000_000;
+
 /// Significant digits of F.
 const F_DIGITS: i32 = 7;
 
@@ -249,6 +254,18 @@ fn nodes(
                     })
                 };
                 let parts = halvings(&at, ua, ub, step);
+                if out.len() + parts > MAX_BLOCKS {
+                    return Err(Error::parse(
+                        &toolpath.source,
+                        pts[idx[k]].line,
+                        format!(
+                            "splitting this move into {parts} blocks of at most {:.3e}° \
+                             (--max-rotation-deg) makes the program longer than {MAX_BLOCKS} \
+                             blocks: give a larger rotation per block",
+                            step.to_degrees()
+                        ),
+                    ));
+                }
                 for j in 1..parts {
                     let u = ua + (ub - ua) * j as f64 / parts as f64;
                     let w = at(u);
@@ -263,6 +280,13 @@ fn nodes(
             }
             out.push(node(k, ub));
         }
+    }
+    if out.len() > MAX_BLOCKS + 1 {
+        return Err(Error::Usage(format!(
+            "{}: the program would have {} blocks, more than {MAX_BLOCKS}: write it in parts",
+            toolpath.source.display(),
+            out.len() - 1
+        )));
     }
     Ok((out, split))
 }

@@ -37,18 +37,72 @@ pub fn schedule_format(path: &Path) -> Result<ScheduleFormat> {
     Ok(format)
 }
 
-/// An output path's directory must exist (checked before any work is done).
+/// An output path must be writable (checked before any work is done, so that a long solve
+/// never ends in "cannot write"): its directory exists and a file can be created in it (a
+/// temporary file is created and removed at once), and the path is not a directory or a
+/// device.
 pub fn check_directory(path: &Path) -> Result<()> {
     let dir = parent_dir(path);
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(Error::Usage(format!(
-            "{}: the directory {} does not exist",
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: the directory {} does not exist: create it or write elsewhere",
             path.display(),
             dir.display()
-        )))
+        )));
     }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            return Err(Error::Usage(format!(
+                "{}: exists and is not a regular file (a directory or a device): name a file",
+                path.display()
+            )));
+        }
+    }
+    tempfile::NamedTempFile::new_in(dir).map_err(|e| {
+        Error::Usage(format!(
+            "{}: cannot create a file in {} ({}): write elsewhere",
+            path.display(),
+            dir.display(),
+            std::io::Error::from(e.kind())
+        ))
+    })?;
+    Ok(())
+}
+
+/// Checks an output path given by `option` (`-o`, `--plot`) before any work is done: it must
+/// not be any of `inputs` (what each is, and its path) — compared as files, so a different
+/// spelling, a symbolic link or (on Unix) a hard link to an input counts as the input — and
+/// it must be writable ([`check_directory`]).
+pub fn check_output(option: &str, path: &Path, inputs: &[(&str, &Path)]) -> Result<()> {
+    for (what, input) in inputs {
+        if same_file(path, input) {
+            return Err(Error::Usage(format!(
+                "{option} {}: is the {what} {} itself; writing it would overwrite the input: \
+                 name another file",
+                path.display(),
+                input.display()
+            )));
+        }
+    }
+    check_directory(path)
+}
+
+/// Whether `a` and `b` name the same existing file: the same canonical path (symbolic links
+/// resolved) or, on Unix, the same device and inode (hard links).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    if let (Ok(ca), Ok(cb)) = (a.canonicalize(), b.canonicalize()) {
+        if ca == cb {
+            return true;
+        }
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return ma.dev() == mb.dev() && ma.ino() == mb.ino();
+        }
+    }
+    false
 }
 
 /// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).
@@ -125,7 +179,15 @@ pub fn schedule_csv(schedule: &Schedule) -> String {
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     // The temporary file's own name stays out of messages: they name the target.
     let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
-    let mut tmp = tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(plain)?;
+    // A temporary file is private (0600); the output gets the mode any new file would get
+    // (0666 less the umask), as if written in place.
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(parent_dir(path)).map_err(plain)?;
     tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| plain(e.error))?;

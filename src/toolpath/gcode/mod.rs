@@ -174,7 +174,7 @@ pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap"];
 /// Reads a G-code file. Bytes that are not valid UTF-8 (e.g. Latin-1 in comments) are replaced,
 /// not rejected.
 pub fn read(path: &Path, dialect: Dialect) -> Result<Toolpath> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::toolpath::read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);
     parse(path, &text, dialect)
 }
