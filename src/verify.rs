@@ -16,7 +16,9 @@
 //!   `1 + tolerance` is a [`Violation`].
 //!
 //! Samples are the instants `t = j · period` of one global clock (time accumulates over the
-//! spans, run one after the other) plus the last instant of each span. In addition, both ends
+//! spans, run one after the other) plus the last instant of each span; inside an interval that
+//! lasts more than [`MAX_INTERVAL_SAMPLES`] periods, every k-th of them, evenly spread, so the
+//! work is bounded by the stations, not by cycle time ÷ period. In addition, both ends
 //! of every station interval are checked with that interval's own ü (q̈ jumps at stations), so
 //! the check is at least as strict as the solver's own rows.
 
@@ -32,6 +34,25 @@ use crate::solver::SpanSolution;
 /// Most servo instants a re-simulation checks (2e9: about 23 days of motion at 1 ms; on two
 /// cores about 10 min). A schedule that would need more is refused before the check starts.
 pub const MAX_SAMPLES: f64 = 2e9;
+
+/// Most servo instants checked inside one station interval. An interval lasting longer (a slow
+/// feed over a long CL move) is checked at this many of its instants, every k-th, evenly
+/// spread: within an interval the motion follows a closed-form law on one cubic piece of the
+/// path spline, which 4,096 samples resolve far below the tolerance, so the work grows with
+/// the stations rather than with cycle time ÷ period.
+pub const MAX_INTERVAL_SAMPLES: u64 = 4096;
+
+/// The first instant `j · period` of the global clock at or after `t`.
+fn first_instant(t: f64, period: f64) -> u64 {
+    let mut j = (t / period).ceil().max(0.0) as u64;
+    while j > 0 && (j - 1) as f64 * period >= t {
+        j -= 1;
+    }
+    while (j as f64) * period < t {
+        j += 1;
+    }
+    j
+}
 
 /// A duration in the unit a person reads it in.
 fn human_duration(t: f64) -> String {
@@ -134,8 +155,8 @@ pub struct Violation {
 pub struct Verification {
     /// No sample exceeds any limit by more than the tolerance.
     pub verified: bool,
-    /// Servo instants checked: every `j · period` within the schedule and the last instant of
-    /// each span.
+    /// Servo instants checked: every `j · period` within the schedule (every k-th inside an
+    /// interval longer than [`MAX_INTERVAL_SAMPLES`] periods) and the last instant of each span.
     pub samples: usize,
     /// Additional checks at station instants: both ends of every station interval, each with
     /// that interval's ü (the last instant of a span is among them and among `samples`).
@@ -355,13 +376,7 @@ fn check_intervals(
     let mut ta = dt[..i0].iter().fold(*span_start, |t, d| t + d);
     // The first instant of the global clock at or after ta (an interval's samples lie in
     // [ta, tb): its end belongs to the next interval; a span's last instant is counted apart).
-    let mut j = (ta / period).ceil().max(0.0) as u64;
-    while j > 0 && (j - 1) as f64 * period >= ta {
-        j -= 1;
-    }
-    while (j as f64) * period < ta {
-        j += 1;
-    }
+    let mut j = first_instant(ta, period);
     // The spline segment at the chunk's first station: at a span's start the one starting
     // there (a station on a knot starts the next segment), else the one the previous interval
     // ended in (the left side of a knot), as when walking the span from its start.
@@ -401,7 +416,10 @@ fn check_intervals(
         }
         udd_before = s1.udd;
         station_checks += 1;
-        // Servo instants strictly inside the interval (and at its start).
+        // Servo instants strictly inside the interval (and at its start); past
+        // MAX_INTERVAL_SAMPLES of them, every k-th, evenly spread.
+        let inside = ((tb / period).ceil() - j as f64).max(0.0);
+        let stride = (inside / MAX_INTERVAL_SAMPLES as f64).ceil().max(1.0) as u64;
         loop {
             let t = j as f64 * period;
             if t >= tb {
@@ -417,7 +435,10 @@ fn check_intervals(
             let pt = Point::new(span, kin, seg, u, moving, jerk);
             acc.check(&pt, &st, cap, u, t, si, i);
             samples += 1;
-            j += 1;
+            j += stride;
+        }
+        if stride > 1 {
+            j = first_instant(tb, period);
         }
         // The interval's end, with this interval's ü.
         while seg < last_seg && knots[seg + 1] < ub {
@@ -705,6 +726,41 @@ mod tests {
         // T = 2√(L/a) = 63.2 ms: instants 0 … 63 ms and the end.
         assert_eq!(v.samples, 65);
         assert_eq!(v.station_checks, 16);
+    }
+
+    #[test]
+    fn a_long_slow_interval_costs_a_bounded_number_of_samples_and_is_still_checked() {
+        // 1 m at about 0.11 mm/s: some 9,000 s, 9 million instants at 1 ms, on 4 intervals.
+        let (len, a) = (1000.0, 2000.0);
+        let m = xyz(a, 1e4, None);
+        let kin = Kinematics::new(&m);
+        let span = line(len, 0.1);
+        let grid = Grid {
+            spacing: len / 4.0,
+            min_parts: 1,
+        };
+        let p = SpanProblem::build(&span, &kin, &m, grid);
+        let n = p.intervals();
+        let b: Vec<f64> = (0..=n)
+            .map(|i| {
+                if i == 0 || i == n {
+                    0.0
+                } else {
+                    0.11f64.powi(2)
+                }
+            })
+            .collect();
+        let v = verify(&m, &kin, &[span], &[p], &[solution(b)], &Default::default()).unwrap();
+        assert!(
+            v.samples <= n * MAX_INTERVAL_SAMPLES as usize + 1,
+            "{}",
+            v.samples
+        );
+        assert!(v.samples >= n * (MAX_INTERVAL_SAMPLES as usize - 1));
+        // The feed 10 % over its cap is found inside the long intervals.
+        assert!(!v.verified);
+        assert!((v.worst_feed - 1.1).abs() < 1e-9, "{}", v.worst_feed);
+        assert!(v.violations.iter().any(|x| x.kind == Quantity::Feed));
     }
 
     #[test]

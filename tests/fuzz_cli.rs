@@ -457,9 +457,18 @@ fn toolpath_case(dir: &Path, ext: &str, bytes: Vec<u8>) -> Result<bool, String> 
     }
 }
 
+/// Fields of the summary that are `null` by design: no estimate on a fixed grid, no dialect
+/// for an APT or CSV input.
+const OPTIONAL: [&str; 3] = [
+    "summary.error_estimate",
+    "summary.dialect",
+    "summary.dialect_by",
+];
+
 /// Checks a JSON summary for NaN (serde_json writes NaN and infinities as null).
 fn nulls(v: &serde_json::Value, at: &str, out: &mut Vec<String>) {
     match v {
+        serde_json::Value::Null if OPTIONAL.contains(&at) => {}
         serde_json::Value::Null => out.push(at.to_string()),
         serde_json::Value::Array(a) => {
             for (i, x) in a.iter().enumerate() {
@@ -823,11 +832,10 @@ fn fuzz_long() {
 /// Solve case 20369 of the long run with seed 3 (the only failure of 25,224 solves, after the
 /// entry-point bounds): a 2 km excursion in Z (Z = 1e6 mm, the largest coordinate allowed) on
 /// the seed blade with two tool-vector components set to 1e-308 and one to 1e21. The cycle
-/// time is about 23,000 s, and the solve (reach, 50 stations) runs for minutes: its work grows
-/// with cycle time ÷ period in the re-simulation and refinement (the solve pipeline's part of
-/// issue 14). Kept as a reproducer.
+/// time is about 23,000 s, and the solve (reach, 50 stations) ran for minutes while the
+/// re-simulation's work grew with cycle time ÷ period; with at most
+/// `verify::MAX_INTERVAL_SAMPLES` instants per interval it ends in well under a second.
 #[test]
-#[ignore = "known: the re-simulation's work grows with cycle time ÷ period (solve pipeline)"]
 fn fuzz_case_a_2_km_excursion_ends_within_10_s() {
     let blade = String::from_utf8(head(
         &file("problems/seed_head_head/impeller_blade.cls"),

@@ -501,7 +501,7 @@ fn malformed_numbers_are_errors_naming_the_line() {
         &["C1E12", "exponent"],
     );
     // Coordinates beyond 1e6 mm are an error naming the word.
-    err("G0 X0 Y0 Z0\nG1 X2000000 F100\n", 2, &["X", "1000000"]);
+    err("G0 X0 Y0 Z0\nG1 X2000000 F100\n", 2, &["X", "2e6", "1e6"]);
     err_in(
         Dialect::Sinumerik,
         "G0 X0 Y0 Z0\nG1 A3=0..5 X1\n",

@@ -401,15 +401,18 @@ impl<'a> Reader<'a> {
 
         let p =
             self.world(Vector3::new(values[0], values[1], values[2]) * self.units.mm_per_unit());
-        if !p
-            .iter()
-            .all(|c| c.is_finite() && c.abs() <= crate::toolpath::gcode::MAX_COORDINATE_MM)
+        if let Some((axis, c)) = ["X", "Y", "Z"]
+            .into_iter()
+            .zip(p.iter())
+            .find(|(_, c)| !(c.is_finite() && c.abs() <= crate::toolpath::MAX_COORDINATE_MM))
         {
             return Err(self.error(
                 line,
                 format!(
-                    "{word}: position is out of range (beyond ±{} mm)",
-                    crate::toolpath::gcode::MAX_COORDINATE_MM
+                    "{word}: {axis} = {} mm is beyond ±{:e} mm (1 km): check the number and \
+                     the units",
+                    crate::error::number(*c),
+                    crate::toolpath::MAX_COORDINATE_MM
                 ),
             ));
         }

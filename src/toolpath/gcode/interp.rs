@@ -68,8 +68,9 @@ struct ModalCall {
 const AXIS_NAMES: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
 
 /// Largest coordinate a program may use, mm (and degrees of rotary travel, ×1000): past it a
-/// word is an error naming it, so that arc chord counts and cycle pecks stay bounded.
-pub const MAX_COORDINATE_MM: f64 = 1e6;
+/// word is an error naming it, so that arc chord counts and cycle pecks stay bounded. The
+/// same bound as every reader's ([`crate::toolpath::MAX_COORDINATE_MM`]).
+pub use crate::toolpath::MAX_COORDINATE_MM;
 /// Most chords one arc block may become (full turns included).
 pub const MAX_ARC_CHORDS: usize = 1_000_000;
 
@@ -973,8 +974,10 @@ impl<'a> Interpreter<'a> {
                 return Err(self.error(
                     line,
                     format!(
-                        "{}: {value} is beyond ±{MAX_COORDINATE_MM} mm (or °)",
-                        AXIS_NAMES[i]
+                        "{}: {} is beyond ±{MAX_COORDINATE_MM:e} mm (or °): check the number \
+                         and the units",
+                        AXIS_NAMES[i],
+                        crate::error::number(value)
                     ),
                 ));
             }
