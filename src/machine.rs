@@ -34,6 +34,7 @@
 //! | `head_head` | X Y Z C A | `tool_length` (> 0) |
 //! | `table_table_ac` | X Y Z A C | LinuxCNC xyzac-trt: `x-rot-point`, `y-rot-point`, `z-rot-point`, `y-offset`, `z-offset` (required); `tool-offset` (0), `conventional-directions` (false), `work-offset` ([0, 0, 0]) |
 //! | `table_table_bc` | X Y Z B C | LinuxCNC xyzbc-trt: the same with `x-offset` instead of `y-offset` |
+//! | `table_table_ab` | X Y Z A B | a Haas TR-series A/B trunnion: A tilts about X, B turns the platter (machine +Z at A = 0); `table_table_ac`'s parameters, the rot-point being B's centre |
 //! | `head_table` | X Y Z B C | `pivot_length` (≥ 0) |
 //! | `dresser` | X Z B | `tool_length` (≥ 0) |
 //! | `joint` | as the file names them | – |
@@ -96,24 +97,44 @@ impl Axis {
     }
 }
 
-/// Which table tilts in a LinuxCNC trunnion ("table-rotary-tilting") machine.
+/// Which table tilts in a trunnion ("table-rotary-tilting") machine, and the platter's letter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TrunnionTilt {
-    /// xyzac-trt: the tilt axis A is parallel to X.
+    /// xyzac-trt: the tilt axis A is parallel to X; the platter is C.
     A,
-    /// xyzbc-trt: the tilt axis B is parallel to Y.
+    /// xyzbc-trt: the tilt axis B is parallel to Y; the platter is C.
     B,
+    /// `table_table_ab`, a Haas TR-series table: the tilt axis A is parallel to X as in
+    /// xyzac-trt, and the platter, which turns about the table's normal (machine +Z at A = 0),
+    /// is lettered B (Haas names a trunnion's fifth axis B, not by ISO's about-Y rule).
+    AB,
+}
+
+impl TrunnionTilt {
+    /// Whether the tilt axis is parallel to X (A) rather than Y (B).
+    pub fn about_x(self) -> bool {
+        matches!(self, TrunnionTilt::A | TrunnionTilt::AB)
+    }
+
+    /// The letters of the tilt and the platter axes.
+    pub fn letters(self) -> [&'static str; 2] {
+        match self {
+            TrunnionTilt::A => ["A", "C"],
+            TrunnionTilt::B => ["B", "C"],
+            TrunnionTilt::AB => ["A", "B"],
+        }
+    }
 }
 
 /// The parameters of LinuxCNC's xyzac-trt / xyzbc-trt kinematics (HAL pin names in the
 /// machine file), plus the work offset (G54) added to the program coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrunnionParams {
-    /// `x-rot-point`, `y-rot-point`, `z-rot-point`: the C rotary's centre in machine
-    /// coordinates, mm.
+    /// `x-rot-point`, `y-rot-point`, `z-rot-point`: the platter's (C, or B for AB) centre in
+    /// machine coordinates, mm.
     pub rot_point: [f64; 3],
-    /// The tilt axis's offset from the C centre across it: `y-offset` for AC, `x-offset` for BC,
-    /// mm.
+    /// The tilt axis's offset from the platter centre across it: `y-offset` for AC and AB,
+    /// `x-offset` for BC, mm.
     pub tilt_offset: f64,
     /// `z-offset`: the tilt axis's height above the C centre, mm.
     pub z_offset: f64,
@@ -136,7 +157,8 @@ pub enum KinematicsSpec {
     /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
     HeadHead { tool_length: f64 },
     /// LinuxCNC's xyzac-trt (`tilt` A, axes X Y Z A C) or xyzbc-trt (`tilt` B, axes
-    /// X Y Z B C) table-rotary-tilting machine.
+    /// X Y Z B C) table-rotary-tilting machine, or a Haas TR-series A/B table (`tilt` AB, axes
+    /// X Y Z A B: xyzac-trt with the platter lettered B).
     TableTable {
         tilt: TrunnionTilt,
         params: TrunnionParams,
@@ -159,14 +181,11 @@ impl KinematicsSpec {
         match self {
             KinematicsSpec::Xyz => &["X", "Y", "Z"],
             KinematicsSpec::HeadHead { .. } => &["X", "Y", "Z", "C", "A"],
-            KinematicsSpec::TableTable {
-                tilt: TrunnionTilt::A,
-                ..
-            } => &["X", "Y", "Z", "A", "C"],
-            KinematicsSpec::TableTable {
-                tilt: TrunnionTilt::B,
-                ..
-            } => &["X", "Y", "Z", "B", "C"],
+            KinematicsSpec::TableTable { tilt, .. } => match tilt {
+                TrunnionTilt::A => &["X", "Y", "Z", "A", "C"],
+                TrunnionTilt::B => &["X", "Y", "Z", "B", "C"],
+                TrunnionTilt::AB => &["X", "Y", "Z", "A", "B"],
+            },
             KinematicsSpec::HeadTable { .. } => &["X", "Y", "Z", "B", "C"],
             KinematicsSpec::Dresser { .. } => &["X", "Z", "B"],
             KinematicsSpec::Joint => &[],
@@ -585,6 +604,7 @@ impl Parser {
             }
             Some("table_table_ac") => self.trunnion(obj, TrunnionTilt::A),
             Some("table_table_bc") => self.trunnion(obj, TrunnionTilt::B),
+            Some("table_table_ab") => self.trunnion(obj, TrunnionTilt::AB),
             Some("head_table") => {
                 self.only_known(obj, "kinematics", &["type", "pivot_length"])?;
                 let pivot_length =
@@ -603,18 +623,20 @@ impl Parser {
                 "kinematics.type",
                 format!(
                     "unknown kinematics {ty} (expected \"xyz\", \"head_head\", \
-                     \"table_table_ac\", \"table_table_bc\", \"head_table\", \"dresser\" \
-                     or \"joint\")"
+                     \"table_table_ac\", \"table_table_bc\", \"table_table_ab\", \
+                     \"head_table\", \"dresser\" or \"joint\")"
                 ),
             )),
         }
     }
 
-    /// The parameters of LinuxCNC's xyzac-trt / xyzbc-trt under their HAL pin names.
+    /// The parameters of LinuxCNC's xyzac-trt / xyzbc-trt under their HAL pin names (the A/B
+    /// table takes xyzac-trt's).
     fn trunnion(&self, obj: &Map<String, Value>, tilt: TrunnionTilt) -> Result<KinematicsSpec> {
         let (offset, other, module) = match tilt {
             TrunnionTilt::A => ("y-offset", "x-offset", "xyzac-trt"),
             TrunnionTilt::B => ("x-offset", "y-offset", "xyzbc-trt"),
+            TrunnionTilt::AB => ("y-offset", "x-offset", "table_table_ab"),
         };
         if obj.contains_key(other) {
             return Err(self.err(

@@ -61,8 +61,8 @@ fn trunnion(tilt: TrunnionTilt, conventional: bool) -> Kinematics {
         tilt,
         params: TrunnionParams {
             rot_point: [12.5, -7.25, 3.0],
-            tilt_offset: if tilt == TrunnionTilt::A { 20.0 } else { -20.0 },
-            z_offset: if tilt == TrunnionTilt::A { 10.0 } else { -15.0 },
+            tilt_offset: if tilt.about_x() { 20.0 } else { -20.0 },
+            z_offset: if tilt.about_x() { 10.0 } else { -15.0 },
             tool_offset: 42.0,
             conventional_directions: conventional,
             work_offset: [-3.0, 4.5, 13.25],
@@ -76,8 +76,8 @@ fn sim(tilt: TrunnionTilt) -> Trunnion {
         tilt,
         params: TrunnionParams {
             rot_point: [0.0; 3],
-            tilt_offset: if tilt == TrunnionTilt::A { 20.0 } else { -20.0 },
-            z_offset: if tilt == TrunnionTilt::A { 10.0 } else { -15.0 },
+            tilt_offset: if tilt.about_x() { 20.0 } else { -20.0 },
+            z_offset: if tilt.about_x() { 10.0 } else { -15.0 },
             tool_offset: 0.0,
             conventional_directions: false,
             work_offset: [0.0; 3],
@@ -99,6 +99,11 @@ fn all() -> Vec<(&'static str, Kinematics)> {
         (
             "table_table_bc conventional",
             trunnion(TrunnionTilt::B, true),
+        ),
+        ("table_table_ab", trunnion(TrunnionTilt::AB, false)),
+        (
+            "table_table_ab conventional",
+            trunnion(TrunnionTilt::AB, true),
         ),
         (
             "head_table",
@@ -651,6 +656,7 @@ fn programmed_rotary_words_are_taken_as_they_are() {
         (Kinematics::HeadHead { d2: 100.0 }, [c, a]),
         (trunnion(TrunnionTilt::A, false), [a, c]),
         (trunnion(TrunnionTilt::B, false), [b, c]),
+        (trunnion(TrunnionTilt::AB, false), [a, b]),
         (
             Kinematics::HeadTable(HeadTable { pivot_length: 50.0 }),
             [b, c],
@@ -665,6 +671,103 @@ fn programmed_rotary_words_are_taken_as_they_are() {
         assert_eq!(got, vec![want], "{kin:?}");
         assert_eq!(kin.angles_from_rotary(rotary), want);
     }
+}
+
+#[test]
+fn table_table_ab_is_the_ac_table_with_its_platter_lettered_b() {
+    // The same trunnion with the platter lettered B instead of C: forward, inverse and tool
+    // vectors agree with the AC machine's once B is read as C.
+    let mut rng = Rng(0x5EED_AB00_0000_0001);
+    for conventional in [false, true] {
+        let (ab, ac) = (
+            trunnion(TrunnionTilt::AB, conventional),
+            trunnion(TrunnionTilt::A, conventional),
+        );
+        for _ in 0..200 {
+            let q: Vec<f64> = (0..5)
+                .map(|i| match i {
+                    3 => rng.uniform(-120.0, 120.0),
+                    4 => rng.uniform(-720.0, 720.0),
+                    _ => rng.uniform(-200.0, 200.0),
+                })
+                .collect();
+            assert_eq!(ab.forward(&q), ac.forward(&q));
+            let angles = [q[3].to_radians(), q[4].to_radians()];
+            let w = path_w(&ab, Vector3::new(q[0], q[1], q[2]), angles);
+            assert_eq!(ik(&ab, w), ik(&ac, w));
+            let o = rng.unit();
+            let p = [cl(Vector3::zeros(), o, None, 1)];
+            assert_eq!(
+                ab.rotary_angles(&p, &[]).unwrap(),
+                ac.rotary_angles(&p, &[]).unwrap()
+            );
+        }
+        // Programmed words: A and B here are A and C there.
+        assert_eq!(
+            ab.angles_from_rotary([30.0, 75.0, 0.0]),
+            ac.angles_from_rotary([30.0, 0.0, 75.0])
+        );
+    }
+    // Hand-computed tool axes (σ = +1): k = (sin A sin B, sin A cos B, cos A).
+    let ab = trunnion(TrunnionTilt::AB, false);
+    let deg = |a: f64, b: f64| [a.to_radians(), b.to_radians()];
+    assert_vec(ab.tool_axis(deg(0.0, 37.0)), Vector3::z(), 1e-15, "A0");
+    assert_vec(ab.tool_axis(deg(90.0, 0.0)), Vector3::y(), 1e-15, "A90 B0");
+    assert_vec(
+        ab.tool_axis(deg(90.0, 90.0)),
+        Vector3::x(),
+        1e-15,
+        "A90 B90",
+    );
+    let h = 0.5f64.sqrt();
+    assert_vec(
+        ab.tool_axis(deg(45.0, 180.0)),
+        Vector3::new(0.0, -h, h),
+        1e-15,
+        "A45 B180",
+    );
+    // At A = 0 the platter turns about machine Z through the rot-point: a tip at the centre
+    // stays put whatever B, one 10 mm off it in X circles it.
+    let Kinematics::TableTable(t) = &ab else {
+        unreachable!()
+    };
+    let centre = Vector3::from(t.params.rot_point)
+        - Vector3::from(t.params.work_offset)
+        - Vector3::new(0.0, 0.0, t.params.tool_offset);
+    let off = centre + Vector3::new(10.0, 0.0, 0.0);
+    for b in [0.0, 33.0, 90.0, 250.0] {
+        let q0 = ik(&ab, path_w(&ab, centre, deg(0.0, b)));
+        let q1 = ik(&ab, path_w(&ab, off, deg(0.0, b)));
+        assert_vec(
+            Vector3::new(q0[0], q0[1], q0[2]),
+            Vector3::from(t.params.rot_point),
+            1e-9,
+            "platter centre",
+        );
+        let r = Vector3::new(q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]);
+        assert_vec(
+            r,
+            Vector3::new(
+                10.0 * b.to_radians().cos(),
+                10.0 * b.to_radians().sin(),
+                0.0,
+            ),
+            1e-9,
+            &format!("B = {b}"),
+        );
+    }
+}
+
+#[test]
+fn table_table_ab_names_its_b_axis_outside_travel() {
+    let kin = trunnion(TrunnionTilt::AB, false);
+    let axes = axes5(["A", "B"], [Some((-120.0, 120.0)), Some((-90.0, 90.0))]);
+    let pts = [
+        cl(Vector3::zeros(), Vector3::z(), Some([10.0, 45.0, 0.0]), 3),
+        cl(Vector3::zeros(), Vector3::z(), Some([10.0, 135.0, 0.0]), 4),
+    ];
+    let msg = kin.rotary_angles(&pts, &axes).unwrap_err().to_string();
+    assert!(msg.contains("line 4") && msg.contains("B = 135"), "{msg}");
 }
 
 #[test]

@@ -630,6 +630,41 @@ fn valid_table_table_bc_defaults_the_optional_parameters() {
 }
 
 #[test]
+fn valid_table_table_ab_takes_the_ac_parameters_and_axes_x_y_z_a_b() {
+    let ab_axes = five_axes("A").replace("\"C\":", "\"B\":");
+    let ab = AC_FULL.replace("table_table_ac", "table_table_ab");
+    let m = ok(&with_kinematics(&ab, &ab_axes));
+    let KinematicsSpec::TableTable { tilt, params } = m.kinematics else {
+        panic!("{:?}", m.kinematics)
+    };
+    assert_eq!(tilt, TrunnionTilt::AB);
+    let ac = ok(&with_kinematics(AC_FULL, &five_axes("A")));
+    assert_eq!(
+        ac.kinematics,
+        KinematicsSpec::TableTable {
+            tilt: TrunnionTilt::A,
+            params
+        }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "A", "B"]);
+    assert!(m.axes[3..].iter().all(|a| a.kind == AxisKind::Rotary));
+    assert_eq!(m.axes[4].travel, Some((-36000.0, 36000.0)));
+    // Its tilt axis is placed by y-offset, as xyzac-trt's; an A/C axis set is the wrong machine.
+    let with_x = ab.replace("\"y-offset\": 20.0", "\"x-offset\": 20.0");
+    field_err(
+        &with_kinematics(&with_x, &ab_axes),
+        "kinematics.x-offset",
+        &["unknown field", "y-offset"],
+    );
+    field_err(
+        &with_kinematics(&ab, &five_axes("A")),
+        "axes.C",
+        &["unknown field", "B"],
+    );
+}
+
+#[test]
 fn valid_head_table_and_dresser() {
     let m = ok(&with_kinematics(
         r#"{"type": "head_table", "pivot_length": 150}"#,
@@ -663,9 +698,10 @@ fn valid_head_table_and_dresser() {
 #[test]
 fn unknown_kinematics_type_lists_the_new_types() {
     field_err(
-        &with_kinematics(r#"{"type": "table_table_ab"}"#, &five_axes("A")),
+        &with_kinematics(r#"{"type": "table_table_ca"}"#, &five_axes("A")),
         "kinematics.type",
         &[
+            "table_table_ca",
             "table_table_ab",
             "table_table_ac",
             "table_table_bc",

@@ -165,3 +165,66 @@ fn reader_warnings_reach_the_user_with_their_line() {
         "{w:?}"
     );
 }
+
+const TRUNNION_AB: &str = r#"{"name": "haas-tr-like", "kinematics": {"type": "table_table_ab",
+      "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0, "y-offset": 20, "z-offset": 10},
+    "axes": {"X": {"velocity": 400, "acceleration": 2000}, "Y": {"velocity": 400, "acceleration": 2000},
+             "Z": {"velocity": 400, "acceleration": 2000},
+             "A": {"velocity": 45, "acceleration": 300, "min": -120, "max": 120},
+             "B": {"velocity": 90, "acceleration": 450}}, "feed": {"max": 100}}"#;
+
+/// A Fanuc/Haas program in tool-tip mode with A and B words, read for the A/B machine.
+fn ab_program(machine: &Machine, text: &str) -> feedopt::error::Result<Toolpath> {
+    use feedopt::machine::references_from_json;
+    use feedopt::toolpath::MachineContext;
+    use feedopt::toolpath::gcode::{Dialect, parse_for};
+    let refs = references_from_json(Path::new("m.json"), TRUNNION_AB, machine)?;
+    let ctx = MachineContext::new(machine, &refs);
+    parse_for(Path::new("ab.nc"), text, Dialect::Fanuc.spec(), Some(&ctx))
+}
+
+#[test]
+fn an_a_b_program_solves_on_an_a_b_trunnion() {
+    let m = machine(TRUNNION_AB);
+    let tp = ab_program(
+        &m,
+        "G21 G90 G94 G17\nG43.4 H1\nG0 X0. Y0. Z20. A0. B0.\nG1 Z5. F600.\n\
+         G1 X20. Y0. A15. B45.\nG1 X30. Y10. A30. B90.\nG49\nM30\n",
+    )
+    .unwrap();
+    assert_eq!(tp.points.len(), 4);
+    assert_eq!(tp.points[3].rotary, Some([30.0, 90.0, 0.0]));
+    let sol = optimize(&m, &tp, &Options::default()).unwrap();
+    assert!(sol.verification.verified);
+    assert!(sol.schedule.cycle_time.is_finite() && sol.schedule.cycle_time > 0.0);
+    // The last station: A = 30°, B = 90° as programmed, and X Y Z by hand from the module
+    // doc's inverse (r = 0, D = (0, 20, 10), L = 0, σ = +1) at P = (30, 10, 5):
+    // R_z(90°)P − D = (−10, 10, −5); R_x(30°) of it = (−10, 10 cos30° + 5 sin30°,
+    // 10 sin30° − 5 cos30°); + D.
+    let last = sol.schedule.stations.last().unwrap();
+    let (s30, c30) = 30f64.to_radians().sin_cos();
+    let want = [
+        -10.0,
+        10.0 * c30 + 5.0 * s30 + 20.0,
+        10.0 * s30 - 5.0 * c30 + 10.0,
+        30.0,
+        90.0,
+    ];
+    for (i, w) in want.iter().enumerate() {
+        assert!(
+            (last.q[i] - w).abs() < 1e-6,
+            "axis {i}: {} vs {w}",
+            last.q[i]
+        );
+    }
+    // B turned through 90° at most 90 °/s: at least a second.
+    assert!(sol.schedule.cycle_time > 1.0, "{}", sol.schedule.cycle_time);
+}
+
+#[test]
+fn a_c_word_on_an_a_b_trunnion_is_an_error_naming_c() {
+    let m = machine(TRUNNION_AB);
+    let e = ab_program(&m, "G43.4 H1\nG0 X0. Y0. Z20. A0. B0.\nG1 X5. C10. F600.\n").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains(":3:") && msg.contains("no C axis"), "{msg}");
+}

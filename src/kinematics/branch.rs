@@ -1,10 +1,10 @@
 //! Rotary angles along a path on one continuous branch within the rotary axes' travel.
 //!
-//! Every two-rotary kinematics here (head_head, table_table_ac/bc, head_table) turns the tool
-//! by a *tilt* angle t and a *spin* angle s about the C axis, and its tool-vector inverse
-//! kinematics has exactly two solutions, (t, s) with t ≥ 0 and (−t, s + π), each defined up to
-//! 2π in either angle. Where the tool is parallel to the C axis (sin t = 0, the singular pose,
-//! "the pole") s is free.
+//! Every two-rotary kinematics here (head_head, table_table_ac/bc/ab, head_table) turns the
+//! tool by a *tilt* angle t and a *spin* angle s about the C axis (table_table_ab's platter
+//! B), and its tool-vector inverse kinematics has exactly two solutions, (t, s) with t ≥ 0 and
+//! (−t, s + π), each defined up to 2π in either angle. Where the tool is parallel to the C
+//! axis (sin t = 0, the singular pose, "the pole") s is free.
 //!
 //! [`follow`] walks the CL points in order:
 //!

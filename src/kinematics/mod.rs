@@ -18,6 +18,7 @@
 //! | xyz | X Y Z | (Px, Py, Pz) | – |
 //! | head_head (seed 000) | X Y Z C A | (Px, Py, Pz, θ1 = C, θ2 = A) | [`head_head`] |
 //! | table_table_ac / _bc (LinuxCNC xyzac-trt / xyzbc-trt) | X Y Z A C / X Y Z B C | (Px, Py, Pz, T, C) | [`trunnion`] |
+//! | table_table_ab (Haas TR-series: xyzac-trt, platter lettered B) | X Y Z A B | (Px, Py, Pz, A, B) | [`trunnion`] |
 //! | head_table (like LinuxCNC maxkins) | X Y Z B C | (Px, Py, Pz, B, C) | [`head_table`] |
 //! | dresser (seed 001) | X Z B | (Px, ·, Pz, θ) | [`dresser`] |
 //! | joint | as named | the axis positions | – |
@@ -86,7 +87,7 @@ pub enum Kinematics {
     HeadHead {
         d2: f64,
     },
-    /// LinuxCNC's xyzac-trt / xyzbc-trt.
+    /// LinuxCNC's xyzac-trt / xyzbc-trt, and the Haas A/B trunnion.
     TableTable(trunnion::Trunnion),
     /// Tilting head B, rotary table C.
     HeadTable(head_table::HeadTable),
@@ -145,8 +146,8 @@ impl Kinematics {
 
     /// The path angles (radians) of rotary axis positions `[A, B, C]` in degrees as a program
     /// gives them (never reduced modulo 360°): (C, A) for head_head, (A, C) for
-    /// table_table_ac, (B, C) for table_table_bc and head_table, (B, 0) for the dresser, zero
-    /// for xyz and joint.
+    /// table_table_ac, (B, C) for table_table_bc and head_table, (A, B) for table_table_ab,
+    /// (B, 0) for the dresser, zero for xyz and joint.
     pub fn angles_from_rotary(&self, rotary: [f64; 3]) -> [f64; 2] {
         let [a, b, c] = rotary.map(f64::to_radians);
         match self {
@@ -155,6 +156,7 @@ impl Kinematics {
             Kinematics::TableTable(t) => match t.tilt {
                 TrunnionTilt::A => [a, c],
                 TrunnionTilt::B => [b, c],
+                TrunnionTilt::AB => [a, b],
             },
             Kinematics::HeadTable(_) => [b, c],
             Kinematics::Dresser(_) => [b, 0.0],
@@ -219,10 +221,7 @@ impl Kinematics {
             Kinematics::HeadHead { .. } => {
                 return self.follow(points, &lines, head_head::layout(travel));
             }
-            Kinematics::TableTable(t) => match t.tilt {
-                TrunnionTilt::A => ["A", "C"],
-                TrunnionTilt::B => ["B", "C"],
-            },
+            Kinematics::TableTable(t) => t.tilt.letters(),
             Kinematics::HeadTable(_) => ["B", "C"],
         };
         self.follow(

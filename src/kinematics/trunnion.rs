@@ -3,7 +3,8 @@
 //! fixed along machine +Z and X, Y, Z move the tool relative to the machine frame.
 //!
 //! The maths is LinuxCNC's (`src/emc/kinematics/trtfuncs.c`, as stated in the shared
-//! realworld/linuxcnc README). Notation: R_x, R_y, R_z are right-handed rotations; σ = +1, or −1
+//! realworld/linuxcnc README); a Haas A/B table is the AC machine with C lettered B (below).
+//! Notation: R_x, R_y, R_z are right-handed rotations; σ = +1, or −1
 //! when `conventional-directions` is true; p = (Px, Py, Pz) is the tool tip in program
 //! coordinates, w the work offset, L the tool length (`tool-offset`), r the C centre
 //! (`x/y/z-rot-point`) and D the tilt axis relative to it:
@@ -20,6 +21,28 @@
 //!
 //! with R_tilt = R_x for AC and R_y for BC. The path coordinates are w = (Px, Py, Pz, T, C) with
 //! the angles in radians; the axes are X Y Z A C (AC) or X Y Z B C (BC), rotary in degrees.
+//!
+//! # The A/B table (`table_table_ab`, Haas TR-series)
+//!
+//! A Haas TR160/TR210-style trunnion is the AC machine with its platter lettered B: A tilts the
+//! trunnion about an axis parallel to machine X (placed by `y-offset`, `z-offset` from the
+//! platter centre r), and B turns the platter about the platter's own normal, which is machine
+//! +Z at A = 0 and R_x(−σA)·ẑ in the machine frame after the tilt (Haas letters the fifth axis
+//! B; it does not turn about Y). With C renamed B every formula above holds unchanged:
+//!
+//! ```text
+//! inverse:   J = r + D + R_x(σA) · ( R_z(σB) · (P − r) − D ),   D = (0, y-offset, z-offset + L)
+//! forward:   P = r + R_z(−σB) · ( R_x(−σA) · (J − r − D) + D )
+//! tool axis: k = (sin A sin B,  σ sin A cos B,  cos A)
+//! ```
+//!
+//! so A = 90°, B = 0 puts the tool along +σY of the workpiece and A = 90°, B = 90° along +X.
+//! The path coordinates are w = (Px, Py, Pz, A, B), the axes X Y Z A B. The tool-vector inverse
+//! and its branch rule are the AC ones: A = atan2(√(k_x² + k_y²), k_z) ≥ 0 and
+//! B = atan2(k_x, σ k_y), the other solution (−A, B + π), B undefined where k ∥ ẑ; [`branch`]
+//! then picks the solution nearest the previous point within travel.
+//!
+//! [`branch`]: super::branch
 
 use nalgebra::Vector3;
 
@@ -27,7 +50,7 @@ use super::dual::Real;
 use super::{MAX_AXES, PATH_DIM, ToolPose, rad_to_deg};
 use crate::machine::{TrunnionParams, TrunnionTilt};
 
-/// A trunnion machine: which table tilts, and LinuxCNC's parameters.
+/// A trunnion machine: which table tilts (and the platter's letter), and LinuxCNC's parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Trunnion {
     pub tilt: TrunnionTilt,
@@ -48,9 +71,10 @@ impl Trunnion {
     pub fn d(&self) -> Vector3<f64> {
         let p = &self.params;
         let dz = p.z_offset + p.tool_offset;
-        match self.tilt {
-            TrunnionTilt::A => Vector3::new(0.0, p.tilt_offset, dz),
-            TrunnionTilt::B => Vector3::new(p.tilt_offset, 0.0, dz),
+        if self.tilt.about_x() {
+            Vector3::new(0.0, p.tilt_offset, dz)
+        } else {
+            Vector3::new(p.tilt_offset, 0.0, dz)
         }
     }
 
@@ -84,9 +108,10 @@ impl Trunnion {
             q[2] - T::cst(d.z),
         ];
         // V = R_tilt(σT) U.
-        let v = match self.tilt {
-            TrunnionTilt::A => [u[0], ct * u[1] - st * u[2], st * u[1] + ct * u[2]],
-            TrunnionTilt::B => [ct * u[0] + st * u[2], u[1], ct * u[2] - st * u[0]],
+        let v = if self.tilt.about_x() {
+            [u[0], ct * u[1] - st * u[2], st * u[1] + ct * u[2]]
+        } else {
+            [ct * u[0] + st * u[2], u[1], ct * u[2] - st * u[0]]
         };
         out[0] = v[0] + T::cst(r.x + d.x);
         out[1] = v[1] + T::cst(r.y + d.y);
@@ -105,9 +130,10 @@ impl Trunnion {
         let (sc, cc) = (sigma * spin.sin(), spin.cos());
         let v = Vector3::new(q[0], q[1], q[2]) - r - d;
         // U = R_tilt(−σT) V + D.
-        let u = match self.tilt {
-            TrunnionTilt::A => Vector3::new(v.x, ct * v.y + st * v.z, ct * v.z - st * v.y),
-            TrunnionTilt::B => Vector3::new(ct * v.x - st * v.z, v.y, st * v.x + ct * v.z),
+        let u = if self.tilt.about_x() {
+            Vector3::new(v.x, ct * v.y + st * v.z, ct * v.z - st * v.y)
+        } else {
+            Vector3::new(ct * v.x - st * v.z, v.y, st * v.x + ct * v.z)
         } + d;
         // P = r + R_z(−σC) U, p = P − w − L ẑ.
         let big_p = r + Vector3::new(cc * u.x + sc * u.y, cc * u.y - sc * u.x, u.z);
@@ -124,9 +150,10 @@ impl Trunnion {
         let sigma = self.sigma();
         let (st, ct) = tilt.sin_cos();
         let (sc, cc) = spin.sin_cos();
-        match self.tilt {
-            TrunnionTilt::A => Vector3::new(st * sc, sigma * st * cc, ct),
-            TrunnionTilt::B => Vector3::new(-sigma * st * cc, st * sc, ct),
+        if self.tilt.about_x() {
+            Vector3::new(st * sc, sigma * st * cc, ct)
+        } else {
+            Vector3::new(-sigma * st * cc, st * sc, ct)
         }
     }
 
@@ -139,9 +166,10 @@ impl Trunnion {
         if h < super::branch::SINGULAR {
             return (tilt, None);
         }
-        let spin = match self.tilt {
-            TrunnionTilt::A => k.x.atan2(sigma * k.y),
-            TrunnionTilt::B => k.y.atan2(-sigma * k.x),
+        let spin = if self.tilt.about_x() {
+            k.x.atan2(sigma * k.y)
+        } else {
+            k.y.atan2(-sigma * k.x)
         };
         (tilt, Some(spin))
     }

@@ -111,8 +111,11 @@ pub enum Address {
     Ignored,
     /// Accepted but not modelled: skipped with this warning (U V W axes).
     Unmodelled(&'static str),
-    /// Rejected with this error (LinuxCNC O-words, Sinumerik `L` subprogram calls).
+    /// Rejected with this error (LinuxCNC O-words other than subroutines).
     Unsupported(&'static str),
+    /// A subprogram call by number, the word as written naming it (Sinumerik `L123`; `P`
+    /// in the same block is the repeat count).
+    Call,
 }
 
 /// Motion modes (modal group 1).
@@ -202,6 +205,12 @@ pub enum Action {
     NoMotion(&'static str),
     /// Stop reading (M2, M30).
     ProgramEnd,
+    /// The end of a subprogram (Fanuc `M99`, Sinumerik `M17`, `RET`): back to the caller; in
+    /// the main program, stop reading.
+    Return,
+    /// Fanuc/Haas `M98`: call program `O<P>` of this file `L` times (see
+    /// [`super::subprograms`]).
+    Call,
     /// A Fanuc/LinuxCNC canned cycle (73, 74, 76, 81–89): modal until `G80` or a motion code.
     Cycle(u32),
     /// `G80` (Fanuc): cancels the canned cycle; the motion mode stays.
@@ -242,6 +251,18 @@ pub enum FrameOp {
     ARot,
 }
 
+/// How a dialect's files hold subprograms (see [`super::subprograms`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Subprograms {
+    /// LinuxCNC: `o100 sub` … `o100 endsub` anywhere in the file, called by `o100 call`.
+    OWordSub,
+    /// Fanuc/Haas: programs `O2000` … `M99` after the main program, called by `M98 P2000`.
+    OPrograms,
+    /// Sinumerik: `PROC NAME` (or a `%_N_NAME_SPF` header) … `RET`/`M17` after the main
+    /// program, called by name (`NAME`, `L123`).
+    Procs,
+}
+
 /// Numbers without a decimal point count least input increments (Fanuc's default).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IntegerIncrements {
@@ -277,11 +298,13 @@ pub struct DialectSpec {
     /// Every `G94` sets F to 0 (LinuxCNC); otherwise only leaving G93 forgets F.
     pub g94_clears_feed: bool,
     pub integer_increments: Option<IntegerIncrements>,
+    /// How subprograms are written.
+    pub subprograms: Subprograms,
 }
 
 use Action::{
     ArcDistance, Distance as Dist, FeedMode as Fm, MachineCoordinates, Motion as Mo, MotionCancel,
-    NoMotion, Note, ProgramEnd, Unsupported as Unsup,
+    NoMotion, Note, ProgramEnd, Return, Unsupported as Unsup,
 };
 use Address::{ArcCentre, Axis, Unmodelled};
 
@@ -333,7 +356,10 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ('W', Unmodelled(UVW)),
         (
             'O',
-            Address::Unsupported("O-word subroutines and control flow are not supported"),
+            Address::Unsupported(
+                "O-word control flow (if, while, do, repeat) is not supported; O-word \
+                 subroutines (sub, endsub, call, return) are",
+            ),
         ),
     ],
     named: &[],
@@ -450,6 +476,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     initial_motion: None,
     g94_clears_feed: true,
     integer_increments: None,
+    subprograms: Subprograms::OWordSub,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -587,8 +614,15 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("19", Action::Ignored),
         ("29", Action::Ignored),
         ("30", ProgramEnd),
-        ("98", Unsup("subprogram calls (M98) are not supported")),
-        ("99", ProgramEnd),
+        (
+            "97",
+            Unsup(
+                "local subprogram calls (Haas M97 P<label>) are not supported: post the \
+                 program with M98 and O-numbered subprograms, or without subprograms",
+            ),
+        ),
+        ("98", Action::Call),
+        ("99", Return),
     ],
     keywords: &[],
     initial_motion: Some(Motion::Rapid),
@@ -598,6 +632,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         inch: 0.0001,
         deg: 0.001,
     }),
+    subprograms: Subprograms::OPrograms,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -626,10 +661,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ('D', Address::Ignored),
         ('H', Address::Ignored),
         ('P', Address::Ignored),
-        (
-            'L',
-            Address::Unsupported("subprogram calls (L…) are not supported"),
-        ),
+        ('L', Address::Call),
     ],
     named: &[
         ("A3", Address::ToolVector(0)),
@@ -730,7 +762,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("1", Action::Ignored),
         ("2", ProgramEnd),
         ("3..9", Action::Ignored),
-        ("17", ProgramEnd),
+        ("17", Return),
         ("19", Action::Ignored),
         ("30", ProgramEnd),
         ("40..45", Action::Ignored),
@@ -772,7 +804,13 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("CYCLE89", Action::SinumerikCycle(89)),
         ("MCALL", Action::ModalCall),
         ("FNORM", Action::Ignored),
-        ("CALL", Unsup("subprogram calls are not supported")),
+        (
+            "CALL",
+            Unsup(
+                "indirect subprogram calls (CALL \"NAME\") are not supported: call the \
+                 subprogram by its name (NAME, with PROC NAME … RET in this file)",
+            ),
+        ),
         ("GOTOF", Unsup("control flow is not supported")),
         ("GOTOB", Unsup("control flow is not supported")),
         ("GOTO", Unsup("control flow is not supported")),
@@ -781,7 +819,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("FOR", Unsup("control flow is not supported")),
         ("REPEAT", Unsup("control flow is not supported")),
         ("LOOP", Unsup("control flow is not supported")),
-        ("RET", ProgramEnd),
+        ("RET", Return),
         ("SOFT", Action::Ignored),
         ("BRISK", Action::Ignored),
         ("FFWON", Action::Ignored),
@@ -808,6 +846,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     initial_motion: Some(Motion::Rapid),
     g94_clears_feed: false,
     integer_increments: None,
+    subprograms: Subprograms::Procs,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

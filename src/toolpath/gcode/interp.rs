@@ -65,6 +65,17 @@ struct ModalCall {
     args: Vec<Option<f64>>,
 }
 
+/// A subprogram call a block makes, run after the block's own words.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Call {
+    /// The call as written (`M98 P2000 L3`, `L123 P2`, `MYSUB`), for messages.
+    pub(super) text: String,
+    /// The subprogram's name and the repeat count, in order of preference: the first whose
+    /// name is in the file is called (Fanuc's packed `M98 P32000`: O32000 once, else
+    /// O2000 three times).
+    pub(super) targets: Vec<(String, u64)>,
+}
+
 const AXIS_NAMES: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
 
 /// Largest coordinate a program may use, mm (and degrees of rotary travel, ×1000): past it a
@@ -105,8 +116,16 @@ pub(super) struct Interpreter<'a> {
     mcall: Option<ModalCall>,
     programmable: Frame,
     swivel: Option<Frame>,
+    /// A program end or subprogram return was read; `end_of_program`: it ends the whole
+    /// program (M2, M30), not just a subprogram (M99, M17, RET).
     pub(super) ended: bool,
-    points: Vec<ClPoint>,
+    pub(super) end_of_program: bool,
+    /// The call the last block made, taken by the driver.
+    pub(super) call: Option<Call>,
+    /// Names of the file's named subprograms (Sinumerik `PROC NAME`): a bare word with one of
+    /// these names is a call.
+    pub(super) procs: Vec<String>,
+    pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
     dwells: Vec<Dwell>,
 }
@@ -144,6 +163,9 @@ impl<'a> Interpreter<'a> {
             programmable: Frame::IDENTITY,
             swivel: None,
             ended: false,
+            end_of_program: false,
+            call: None,
+            procs: Vec::new(),
             points: Vec::new(),
             warnings: Vec::new(),
             dwells: Vec::new(),
@@ -181,6 +203,7 @@ impl<'a> Interpreter<'a> {
     /// Sorts a block's words, warning about unknown ones.
     fn collect(&mut self, line: usize, items: Vec<Item>) -> Result<Block> {
         let mut block = Block::default();
+        let mut call_word: Option<String> = None;
         let name = self.spec.name;
         for item in items {
             let (text, address, num) = match item {
@@ -190,6 +213,15 @@ impl<'a> Interpreter<'a> {
                     continue;
                 }
                 Item::Skipped => continue,
+                Item::Unknown { text } if self.procs.contains(&text) => {
+                    if let Some(first) = call_word.replace(text.clone()) {
+                        return Err(self.error(
+                            line,
+                            format!("`{first}`, `{text}`: two subprogram calls in one block"),
+                        ));
+                    }
+                    continue;
+                }
                 Item::Unknown { text } => {
                     self.warn(
                         line,
@@ -289,13 +321,83 @@ impl<'a> Interpreter<'a> {
                     }
                 }
                 Address::Ignored => {}
+                Address::Call => {
+                    if let Some(first) = call_word.replace(text.clone()) {
+                        return Err(self.error(
+                            line,
+                            format!("`{first}`, `{text}`: two subprogram calls in one block"),
+                        ));
+                    }
+                }
                 Address::Unmodelled(message) => self.warn(line, format!("`{text}`: {message}")),
                 Address::Unsupported(message) => {
                     return Err(self.error(line, format!("{text}: {message}")));
                 }
             }
         }
+        if let Some(name) = call_word {
+            // Sinumerik `L123`, `MYSUB`: the name is the word as written (L0123 is another
+            // program than L123); P is the repeat count.
+            self.set_call(line, name, block.letter('P'))?;
+        }
         Ok(block)
+    }
+
+    /// Records a call of subprogram `name` repeated `count` times (P).
+    fn set_call(&mut self, line: usize, name: String, count: Option<Num>) -> Result<()> {
+        let (text, repeats) = match count {
+            None => (name.clone(), 1),
+            Some(p) => (
+                format!("{name} P{}", p.value),
+                self.count(line, &format!("{name} P"), p.value)?,
+            ),
+        };
+        self.call = Some(Call {
+            text,
+            targets: vec![(name, repeats)],
+        });
+        Ok(())
+    }
+
+    /// A whole, non-negative number (a program number or repeat count).
+    fn count(&self, line: usize, what: &str, value: f64) -> Result<u64> {
+        if value < 0.0 || value.fract() != 0.0 || value > 1e12 {
+            return Err(self.error(
+                line,
+                format!("`{what}{value}`: expected a whole number of at least 0"),
+            ));
+        }
+        Ok(value as u64)
+    }
+
+    /// Fanuc/Haas `M98 P<program> [L<count>]`; without L, a P of more than four digits may
+    /// pack the count before a four-digit program number (`P32000`: O2000 three times).
+    fn fanuc_call(&mut self, line: usize, block: &Block) -> Result<()> {
+        let Some(p) = block.letter('P') else {
+            return Err(self.error(
+                line,
+                "M98 without P (the program number to call): add P<program number>",
+            ));
+        };
+        let number = self.count(line, "M98 P", p.value)?;
+        let mut text = format!("M98 P{number}");
+        let targets = match block.letter('L') {
+            Some(l) => {
+                let count = self.count(line, "M98 L", l.value)?;
+                text.push_str(&format!(" L{count}"));
+                vec![(format!("O{number}"), count)]
+            }
+            None if number > 9999 => vec![
+                (format!("O{number}"), 1),
+                (format!("O{}", number % 10000), number / 10000),
+            ],
+            None => vec![(format!("O{number}"), 1)],
+        };
+        if self.call.is_some() {
+            return Err(self.error(line, format!("`{text}`: two subprogram calls in one block")));
+        }
+        self.call = Some(Call { text, targets });
+        Ok(())
     }
 
     /// Scale of a length word (mm per written unit), honouring integer increments.
@@ -345,6 +447,8 @@ impl<'a> Interpreter<'a> {
         let mut machine = false;
         let mut no_motion: Option<&str> = None;
         let mut end = false;
+        let mut end_of_program = false;
+        let mut fanuc_call = false;
         let mut reference: Option<u8> = None;
         let mut dwell = false;
         let mut frame_op: Option<(&str, FrameOp)> = None;
@@ -445,7 +549,12 @@ impl<'a> Interpreter<'a> {
                     no_motion = Some(message);
                     self.warn(line, format!("{text}: {message}"));
                 }
-                Action::ProgramEnd => end = true,
+                Action::ProgramEnd => {
+                    end = true;
+                    end_of_program = true;
+                }
+                Action::Return => end = true,
+                Action::Call => fanuc_call = true,
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -453,6 +562,17 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
+        if fanuc_call {
+            self.fanuc_call(line, &block)?;
+        }
+        if end && self.call.is_some() {
+            return Err(self.error(
+                line,
+                "a subprogram call and a program end or return in one block: put them in \
+                 blocks of their own",
+            ));
+        }
+        self.end_of_program = end_of_program;
         if let Some(f) = block.feed {
             if f < 0.0 {
                 return Err(self.error(line, format!("F{f}: a feed cannot be negative")));

@@ -87,6 +87,9 @@
 //! * **Bounds**: an axis word beyond ±[`MAX_COORDINATE_MM`] is an error naming it; an arc needs
 //!   at most [`MAX_ARC_CHORDS`] chords (so `P1000000000` turns or `TURN=100000000` are errors
 //!   before any work); exponent notation (`X1e309`) is an error naming the word.
+//! * **Subprograms in the file**: see [`subprograms`] (Fanuc/Haas `M98 P L` with `O<n> … M99`,
+//!   Sinumerik `PROC NAME … RET` and `L123`, LinuxCNC `o100 sub` / `o100 call`): expanded
+//!   where called, nesting and expansion bounded; a call of one not in the file is an error.
 //! * **The machine**: with [`parse_for`] and a [`MachineContext`], an axis word for an axis the
 //!   machine lacks is an error naming the axis.
 //!
@@ -97,8 +100,8 @@
 //! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (`.1 .2 .3`), path control
 //! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
 //! coordinates either way; `G234` is TCP on); `%` lines; blank lines; nested `(( ))` comments. Program
-//! end (`M2`, `M30`, Sinumerik `M17`, `RET`, Fanuc `M99`) stops reading: later lines are not
-//! parsed. These codes are accepted with a warning because the toolpath does not carry them:
+//! end (`M2`, `M30`; in the main program also Sinumerik `M17`, `RET`, Fanuc `M99`) stops
+//! reading: later lines are not parsed. These codes are accepted with a warning because the toolpath does not carry them:
 //! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
 //! moves nothing: its axis words are not a move). A block starting with `/` (block delete) is skipped with a
 //! warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
@@ -111,11 +114,11 @@
 //!   [`Warning`] naming the word and its line, never silently.
 //! * Errors ([`Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
 //!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
-//!   LinuxCNC O-word control flow, the same word twice in a block, two motion codes in one
+//!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
 //!   silently: `G92`/`G52` offsets, splines, threading, probing, polar coordinates, scaling,
-//!   mirroring, feed per revolution, subprogram calls (`M98`, Sinumerik `L…`), Sinumerik
+//!   mirroring, feed per revolution, calls of subprograms not in the file, Haas `M97`, Sinumerik
 //!   `CYCLE76`/`CYCLE77` (spigot milling).
 
 pub mod cycles;
@@ -124,6 +127,7 @@ pub mod expr;
 pub mod frames;
 mod interp;
 mod lexer;
+pub mod subprograms;
 
 use std::path::Path;
 
@@ -135,7 +139,7 @@ use crate::toolpath::{MachineContext, Toolpath};
 pub use dialect::*;
 use interp::Interpreter;
 pub use interp::{MAX_ARC_CHORDS, MAX_COORDINATE_MM};
-use lexer::{lex, split_blocks};
+use subprograms::Program;
 
 /// Largest distance between an arc and the chords that replace it (the sagitta), mm: 1 µm.
 ///
@@ -197,38 +201,12 @@ pub fn parse_for(
     spec: &DialectSpec,
     machine: Option<&MachineContext>,
 ) -> Result<Toolpath> {
-    let mut interp = Interpreter::new(spec, source, machine);
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut last_line = 0;
-    for (index, raw) in text.lines().enumerate() {
-        let line = index + 1;
-        last_line = line;
-        let trimmed = raw.trim();
-        if trimmed.is_empty() || trimmed.starts_with('%') {
-            continue;
-        }
-        let blocks = split_blocks(spec, raw).map_err(|m| Error::parse(source, line, m))?;
-        for block in blocks {
-            let block = block.trim();
-            if block.is_empty() {
-                continue;
-            }
-            if block.starts_with('/') {
-                interp.warn(line, "block delete `/`: block skipped");
-                continue;
-            }
-            let items =
-                lex(spec, block, &mut interp.vars).map_err(|m| Error::parse(source, line, m))?;
-            interp.block(line, items)?;
-            if interp.ended {
-                break;
-            }
-        }
-        if interp.ended {
-            break;
-        }
-    }
-    interp.finish(last_line)
+    let program = Program::scan(spec, source, text)?;
+    let mut interp = Interpreter::new(spec, source, machine);
+    interp.procs = program.proc_names();
+    program.run(spec, &mut interp, source)?;
+    interp.finish(program.last_line())
 }
 
 /// The dialect a program's text (upper-cased) shows, if any: Sinumerik (`TRAORI`, `TRAFOOF`,

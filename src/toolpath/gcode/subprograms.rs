@@ -1,0 +1,583 @@
+//! Subprograms defined in the same file, expanded where they are called.
+//!
+//! # What a file holds
+//!
+//! * **Fanuc / Haas** ([`Subprograms::OPrograms`]): programs headed `O2000` (a block starting
+//!   with `O` and a number). The first program is the main one: everything before the first
+//!   `O` header that follows a block of code, its own `O` header included. Every later
+//!   `O<n>` header starts subprogram `O<n>` (leading zeros do not count: `M98 P100` calls
+//!   `O0100`), which runs to `M99` or the next header. `M98 P<n> L<count>` calls it `count`
+//!   times (`L0`: not at all); without L a P of more than four digits that names no program
+//!   in the file packs the count before a four-digit number (`M98 P32000`: O2000 three
+//!   times, Fanuc's form).
+//! * **Sinumerik** ([`Subprograms::Procs`]): `PROC NAME …` or `%_N_NAME_SPF` (with or
+//!   without a `PROC NAME` line after it) starts subprogram NAME, which runs to `RET`, `M17`
+//!   or the next header. A header before any code starts the main program. A block with the
+//!   word `NAME` (or `L123` for `PROC L123`, the name as written: `L0123` is another program)
+//!   calls it, `P<count>` in the same block repeating it. `EXTERN` declarations are skipped.
+//!   PROC parameters are not passed: a body that reads one is an error naming it.
+//! * **LinuxCNC** ([`Subprograms::OWordSub`]): `o100 sub` … `o100 endsub` (or `o<name>`)
+//!   anywhere in the file; those lines are not part of the main program. `o100 call` runs the
+//!   body once, `o100 return` returns early. Call arguments are not passed (a body that reads
+//!   `#1` is an error naming it); other O-words (`if`, `while`, …) are errors.
+//!
+//! # How a call runs
+//!
+//! The block's own words run first (a move in the same block is made), then the body's blocks
+//! with the caller's modal state, which they may change as on the control (units, feed, G90/91,
+//! motion mode, TCP); every point keeps the line of the block in the body that made it. A call
+//! of a subprogram that is not in the file is an error naming the line, the call and what to
+//! do; so are calls nested more than [`MAX_CALL_DEPTH`] deep and calls that expand to more than
+//! [`MAX_EXPANDED_BLOCKS`] blocks, before the work is done. A program end (`M2`, `M30`) in a
+//! subprogram ends the whole program; a return (`M99`, `M17`, `RET`, `endsub`) in the main
+//! program ends it.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::dialect::{DialectSpec, Subprograms};
+use super::interp::{Call, Interpreter};
+use super::lexer::{lex, split_blocks};
+use crate::error::{Error, Result};
+
+/// Deepest nesting of subprogram calls (the main program is depth 0).
+pub const MAX_CALL_DEPTH: usize = 8;
+
+/// Most blocks that subprogram calls may run in all (repeats and nesting multiplied out).
+pub const MAX_EXPANDED_BLOCKS: usize = 1_000_000;
+
+/// One line of the file: its 1-based number and its blocks with comments removed (or the
+/// message of an unclosed comment, reported if the line is ever run).
+struct Line {
+    number: usize,
+    blocks: std::result::Result<Vec<String>, String>,
+}
+
+/// A program or subprogram: its name and header line, and the indices of its lines.
+struct Section {
+    name: String,
+    header: usize,
+    lines: Vec<usize>,
+}
+
+/// Where a running program or subprogram stands.
+struct Frame {
+    section: usize,
+    /// Next line (index into the section's lines) and block within it.
+    pos: usize,
+    block: usize,
+    /// Runs still to make, this one included.
+    runs: u64,
+    /// The call as written and its line (none for the main program).
+    call: Option<(String, usize)>,
+}
+
+/// A LinuxCNC O-word subroutine line: `o100 sub`, `o<name> call [..]`, …
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum OWord {
+    Sub,
+    EndSub,
+    Call,
+    Return,
+}
+
+/// The name and keyword of a LinuxCNC O-word subroutine block (`None`: not one).
+fn oword(block: &str) -> Option<(String, OWord)> {
+    let compact: String = block
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_lowercase();
+    let rest = strip_block_number(&compact);
+    let rest = rest.strip_prefix('o')?;
+    let name_end = if rest.starts_with('<') {
+        rest.find('>')? + 1
+    } else {
+        rest.find(|c: char| !c.is_ascii_digit())?
+    };
+    if name_end == 0 {
+        return None;
+    }
+    let (name, tail) = rest.split_at(name_end);
+    let name = if name.starts_with('<') {
+        format!("O{name}")
+    } else {
+        format!("O{}", name.trim_start_matches('0'))
+    };
+    let word = |kw: &str| {
+        tail.strip_prefix(kw)
+            .is_some_and(|t| t.is_empty() || t.starts_with('['))
+    };
+    // `endsub` before `sub`: no keyword is a prefix of another that comes first.
+    [
+        ("endsub", OWord::EndSub),
+        ("sub", OWord::Sub),
+        ("call", OWord::Call),
+        ("return", OWord::Return),
+    ]
+    .into_iter()
+    .find(|(kw, _)| word(kw))
+    .map(|(_, k)| (name, k))
+}
+
+/// `N10 …` → `…` (lower or upper case).
+fn strip_block_number(text: &str) -> &str {
+    let t = text.trim_start();
+    match t.strip_prefix(['n', 'N']) {
+        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) => rest
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start(),
+        _ => t,
+    }
+}
+
+/// The first word of a block, upper-cased, after any block number.
+fn first_word(block: &str) -> String {
+    strip_block_number(block)
+        .split(|c: char| c.is_whitespace() || c == '(')
+        .next()
+        .unwrap_or("")
+        .to_ascii_uppercase()
+}
+
+/// A Fanuc `O2000` header's program name (`O` and the number without leading zeros).
+fn fanuc_header(block: &str) -> Option<String> {
+    let compact: String = block.chars().filter(|c| !c.is_whitespace()).collect();
+    let rest = strip_block_number(&compact).strip_prefix(['O', 'o'])?;
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    if digits.is_empty() {
+        return None;
+    }
+    let n: u64 = digits.parse().ok()?;
+    Some(format!("O{n}"))
+}
+
+/// A Sinumerik header: `PROC NAME(…)` → (NAME, false), `%_N_NAME_SPF` → (NAME, false),
+/// `%_N_NAME_MPF` → (NAME, true: a main program).
+fn sinumerik_header(block: &str) -> Option<(String, bool)> {
+    let t = block.trim();
+    if let Some(rest) = t.strip_prefix("%_N_") {
+        let upper = rest.to_ascii_uppercase();
+        let (name, main) = if let Some(n) = upper.strip_suffix("_SPF") {
+            (n, false)
+        } else if let Some(n) = upper.strip_suffix("_MPF") {
+            (n, true)
+        } else {
+            return None;
+        };
+        return Some((name.to_string(), main));
+    }
+    if first_word(t) != "PROC" {
+        return None;
+    }
+    let after = strip_block_number(t)[4..].trim_start();
+    let name: String = after
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect::<String>()
+        .to_ascii_uppercase();
+    (!name.is_empty()).then_some((name, false))
+}
+
+/// The file split into its main program and subprograms.
+pub(super) struct Program {
+    lines: Vec<Line>,
+    sections: Vec<Section>,
+    by_name: HashMap<String, usize>,
+    style: Subprograms,
+}
+
+impl Program {
+    /// Reads the file's structure (headers only; no block is interpreted).
+    pub(super) fn scan(spec: &DialectSpec, source: &Path, text: &str) -> Result<Program> {
+        let lines: Vec<Line> = text
+            .lines()
+            .enumerate()
+            .map(|(i, raw)| Line {
+                number: i + 1,
+                blocks: split_blocks(spec, raw),
+            })
+            .collect();
+        let mut program = Program {
+            lines,
+            sections: vec![Section {
+                name: "the main program".into(),
+                header: 0,
+                lines: Vec::new(),
+            }],
+            by_name: HashMap::new(),
+            style: spec.subprograms,
+        };
+        match spec.subprograms {
+            Subprograms::OWordSub => program.scan_owords(source)?,
+            Subprograms::OPrograms | Subprograms::Procs => program.scan_headers(source)?,
+        }
+        Ok(program)
+    }
+
+    /// The first block of line `i`, trimmed (empty when it has none or an unclosed comment).
+    fn first_block(&self, i: usize) -> &str {
+        match &self.lines[i].blocks {
+            Ok(b) => b.first().map_or("", |s| s.trim()),
+            Err(_) => "",
+        }
+    }
+
+    fn add_section(&mut self, source: &Path, name: String, line: usize) -> Result<usize> {
+        if let Some(&k) = self.by_name.get(&name) {
+            return Err(Error::parse(
+                source,
+                line,
+                format!(
+                    "subprogram {name} is defined twice (lines {} and {line}): rename one",
+                    self.sections[k].header
+                ),
+            ));
+        }
+        self.sections.push(Section {
+            name: name.clone(),
+            header: line,
+            lines: Vec::new(),
+        });
+        let k = self.sections.len() - 1;
+        self.by_name.insert(name, k);
+        Ok(k)
+    }
+
+    /// LinuxCNC: `oN sub` … `oN endsub` regions are subroutines (the `endsub` line is their
+    /// last line: it returns); every other line is the main program.
+    fn scan_owords(&mut self, source: &Path) -> Result<()> {
+        let mut open: Option<(usize, String)> = None;
+        for i in 0..self.lines.len() {
+            let number = self.lines[i].number;
+            let word = oword(self.first_block(i));
+            match (&open, word) {
+                (None, Some((name, OWord::Sub))) => {
+                    let k = self.add_section(source, name.clone(), number)?;
+                    open = Some((k, name));
+                }
+                (Some((_, outer)), Some((name, OWord::Sub))) => {
+                    return Err(Error::parse(
+                        source,
+                        number,
+                        format!(
+                            "O-word {name} sub inside {outer} sub: subroutines cannot be \
+                             defined inside one another"
+                        ),
+                    ));
+                }
+                (Some((k, open_name)), Some((name, OWord::EndSub))) if *open_name == name => {
+                    self.sections[*k].lines.push(i);
+                    open = None;
+                }
+                (None, Some((name, OWord::EndSub))) => {
+                    return Err(Error::parse(
+                        source,
+                        number,
+                        format!("O-word {name} endsub without {name} sub"),
+                    ));
+                }
+                (Some((k, _)), _) => self.sections[*k].lines.push(i),
+                (None, _) => self.sections[0].lines.push(i),
+            }
+        }
+        if let Some((k, name)) = open {
+            return Err(Error::parse(
+                source,
+                self.sections[k].header,
+                format!("O-word {name} sub has no {name} endsub: close the subroutine"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Fanuc and Sinumerik: headers start sections; the first section is the main program.
+    fn scan_headers(&mut self, source: &Path) -> Result<()> {
+        let mut current = 0usize;
+        // The current section has a block of code (a header after code starts a new one).
+        let mut has_code = false;
+        for i in 0..self.lines.len() {
+            let number = self.lines[i].number;
+            let block = self.first_block(i);
+            let header = match self.style {
+                Subprograms::OPrograms => fanuc_header(block).map(|n| (n, false)),
+                _ => sinumerik_header(block),
+            };
+            match header {
+                Some((name, main)) => {
+                    let same_proc = self.sections[current].name == name;
+                    if !has_code && (current == 0 || same_proc) {
+                        // The main program's own header, or `PROC NAME` after `%_N_NAME_SPF`.
+                        if current == 0 && self.sections[0].header == 0 {
+                            self.sections[0].header = number;
+                        }
+                        self.sections[current].lines.push(i);
+                        continue;
+                    }
+                    if main {
+                        return Err(Error::parse(
+                            source,
+                            number,
+                            format!("a second main program ({name}) in one file: split the file"),
+                        ));
+                    }
+                    current = self.add_section(source, name, number)?;
+                    has_code = false;
+                    self.sections[current].lines.push(i);
+                }
+                None => {
+                    let t = block.trim();
+                    if !t.is_empty() && !t.starts_with('%') {
+                        has_code = true;
+                    }
+                    self.sections[current].lines.push(i);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The names a bare word may call (Sinumerik `PROC` names).
+    pub(super) fn proc_names(&self) -> Vec<String> {
+        if self.style == Subprograms::Procs {
+            self.sections[1..].iter().map(|s| s.name.clone()).collect()
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// The last line number (for "no motion blocks").
+    pub(super) fn last_line(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Runs the main program through `interp`, expanding calls.
+    pub(super) fn run(
+        &self,
+        spec: &DialectSpec,
+        interp: &mut Interpreter,
+        source: &Path,
+    ) -> Result<()> {
+        let mut stack = vec![Frame {
+            section: 0,
+            pos: 0,
+            block: 0,
+            runs: 1,
+            call: None,
+        }];
+        let mut expanded = 0usize;
+        while let Some(&Frame {
+            section,
+            pos,
+            block,
+            ..
+        }) = stack.last()
+        {
+            let Some(&index) = self.sections[section].lines.get(pos) else {
+                // The section ran out: a return.
+                if !self.ret(&mut stack) {
+                    return Ok(());
+                }
+                continue;
+            };
+            let line = &self.lines[index];
+            let number = line.number;
+            let blocks = match &line.blocks {
+                Ok(b) => b,
+                Err(m) => {
+                    return Err(self.located(Error::parse(source, number, m.clone()), &stack));
+                }
+            };
+            if let Some(top) = stack.last_mut() {
+                if block + 1 >= blocks.len() {
+                    top.pos += 1;
+                    top.block = 0;
+                } else {
+                    top.block += 1;
+                }
+            }
+            let Some(text) = blocks.get(block) else {
+                continue;
+            };
+            let text = text.trim();
+            if text.is_empty() || text.starts_with('%') {
+                continue;
+            }
+            if stack.len() > 1 {
+                expanded += 1;
+                if expanded > MAX_EXPANDED_BLOCKS {
+                    return Err(self.too_many(source, number, &stack));
+                }
+            }
+            if text.starts_with('/') {
+                interp.warn(number, "block delete `/`: block skipped");
+                continue;
+            }
+            if self.style == Subprograms::OWordSub
+                && let Some((name, kind)) = oword(text)
+            {
+                match kind {
+                    OWord::Call => {
+                        let call = Call {
+                            text: format!("{name} call"),
+                            targets: vec![(name, 1)],
+                        };
+                        self.enter(&mut stack, call, number, source)?;
+                    }
+                    OWord::Return | OWord::EndSub => {
+                        if !self.ret(&mut stack) {
+                            return Ok(());
+                        }
+                    }
+                    // Definitions were taken apart by the scan.
+                    OWord::Sub => {}
+                }
+                continue;
+            }
+            if self.style == Subprograms::Procs
+                && (matches!(first_word(text).as_str(), "PROC" | "EXTERN")
+                    || sinumerik_header(text).is_some())
+            {
+                continue;
+            }
+            let items = lex(spec, text, &mut interp.vars)
+                .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+            interp
+                .block(number, items)
+                .map_err(|e| self.located(e, &stack))?;
+            if let Some(call) = interp.call.take() {
+                self.enter(&mut stack, call, number, source)?;
+            } else if interp.ended {
+                interp.ended = false;
+                if interp.end_of_program || !self.ret(&mut stack) {
+                    return Ok(());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Returns from the running (sub)program: runs it again while repeats remain, else pops
+    /// it. `false`: the main program has ended.
+    fn ret(&self, stack: &mut Vec<Frame>) -> bool {
+        if stack.len() <= 1 {
+            return false;
+        }
+        let Some(top) = stack.last_mut() else {
+            return false;
+        };
+        if top.runs > 1 {
+            top.runs -= 1;
+            top.pos = 0;
+            top.block = 0;
+        } else {
+            stack.pop();
+        }
+        true
+    }
+
+    /// Starts a call made at line `number`.
+    fn enter(
+        &self,
+        stack: &mut Vec<Frame>,
+        call: Call,
+        number: usize,
+        source: &Path,
+    ) -> Result<()> {
+        let found = call
+            .targets
+            .iter()
+            .find_map(|(name, runs)| self.by_name.get(name).map(|&k| (k, *runs)));
+        let Some((section, runs)) = found else {
+            let name = &call.targets[0].0;
+            let how = match self.style {
+                Subprograms::OPrograms => format!("{name} … M99"),
+                Subprograms::Procs => format!("PROC {name} … RET"),
+                Subprograms::OWordSub => format!("{name} sub … {name} endsub"),
+            };
+            return Err(self.located(
+                Error::parse(
+                    source,
+                    number,
+                    format!(
+                        "`{}`: subprogram {name} is not in this file; feedopt expands only \
+                         subprograms defined in the same file: add {how} to it, or post the \
+                         program without subprogram calls",
+                        call.text
+                    ),
+                ),
+                stack,
+            ));
+        };
+        if runs == 0 {
+            return Ok(());
+        }
+        if stack.len() > MAX_CALL_DEPTH {
+            return Err(self.located(
+                Error::parse(
+                    source,
+                    number,
+                    format!(
+                        "`{}`: subprogram calls nested more than {MAX_CALL_DEPTH} deep (does a \
+                         subprogram call itself?)",
+                        call.text
+                    ),
+                ),
+                stack,
+            ));
+        }
+        // Every run costs at least one block: a huge repeat count of an empty body is bounded.
+        if runs > MAX_EXPANDED_BLOCKS as u64 {
+            return Err(self.too_many(source, number, stack));
+        }
+        stack.push(Frame {
+            section,
+            pos: 0,
+            block: 0,
+            runs,
+            call: Some((call.text, number)),
+        });
+        Ok(())
+    }
+
+    fn too_many(&self, source: &Path, number: usize, stack: &[Frame]) -> Error {
+        self.located(
+            Error::parse(
+                source,
+                number,
+                format!(
+                    "subprogram calls expand to more than {MAX_EXPANDED_BLOCKS} blocks: lower \
+                     the repeat counts or post the program without subprogram calls"
+                ),
+            ),
+            stack,
+        )
+    }
+
+    /// Adds to a parse error inside a subprogram where it was called from.
+    fn located(&self, e: Error, stack: &[Frame]) -> Error {
+        let Some(Frame {
+            section,
+            call: Some((text, line)),
+            ..
+        }) = stack.last()
+        else {
+            return e;
+        };
+        match e {
+            Error::Parse {
+                file,
+                line: at,
+                message,
+            } => Error::Parse {
+                file,
+                line: at,
+                message: format!(
+                    "{message} (in subprogram {}, called by `{text}` at line {line})",
+                    self.sections[*section].name
+                ),
+            },
+            other => other,
+        }
+    }
+}
