@@ -131,7 +131,7 @@ pub mod subprograms;
 
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 pub use crate::toolpath::Units;
 #[allow(unused_imports)] // named by the module docs
 use crate::toolpath::{ClPoint, Feed, Warning};
