@@ -4,9 +4,11 @@
 //! `cargo bench --bench copp` measures, on COPP's own grid (every one of the 1,001 CSV rows a
 //! station):
 //!
-//! - `copp20_solver/{reach,clarabel}`: the solver alone, all 20 paths per iteration (the span
-//!   problems are built outside the timed loop); divide by 20 for the time per path (the
-//!   throughput line says paths/s);
+//! - `copp20_solver/{reach,clarabel,optimal}`: the solver alone, all 20 paths per iteration
+//!   (the span problems are built outside the timed loop); divide by 20 for the time per path
+//!   (the throughput line says paths/s). `clarabel` is one cone program per path; `optimal` is
+//!   what the default solve runs: the reach pass, then the lattice relaxation where it is the
+//!   exact optimum and Clarabel only on the windows where it is not;
 //! - `copp20_optimize_joint/{reach,clarabel}`: the whole `optimize_joint` with default options
 //!   (path, problem, the reachability pass that always runs first, the solver, the schedule,
 //!   the re-simulation at the servo period and the stations it adds), all 20 paths per
@@ -109,6 +111,18 @@ fn bench_copp(c: &mut Criterion) {
         b.iter(|| {
             for p in &problems {
                 black_box(solver::clarabel::solve(p, &settings).expect("solves"));
+            }
+        })
+    });
+    // What the default solve runs on a span: the reach pass (always first), then the optimum
+    // of the discretisation — the lattice relaxation where it is exact, Clarabel on the windows
+    // where it is not (`solver::optimal`).
+    g.bench_function("optimal", |b| {
+        let settings = Default::default();
+        b.iter(|| {
+            for p in &problems {
+                let greedy = solver::reach::solve(p).expect("feasible");
+                black_box(solver::optimal(p, &greedy, &settings).expect("solves"));
             }
         })
     });
