@@ -103,9 +103,6 @@ use crate::toolpath::gcode::{
 };
 use crate::toolpath::{ClPoint, Dwell, Feed, MachineContext, Toolpath, Units};
 
-/// Tool vectors shorter than this are rejected as having no direction.
-const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
-
 /// Known major words that do not affect the motion and are skipped.
 ///
 /// Unknown words are skipped too (see the module documentation); this list documents what is
@@ -418,14 +415,7 @@ impl<'a> Reader<'a> {
         }
         if fields.len() == 6 && self.multax != Some(false) {
             let v = Vector3::new(values[3], values[4], values[5]);
-            // Scale by the largest component first so that huge vectors cannot overflow.
-            let largest = v.amax();
-            let scaled_norm = if largest > 0.0 {
-                (v / largest).norm()
-            } else {
-                0.0
-            };
-            if largest * scaled_norm < MIN_TOOL_VECTOR_NORM {
+            let Some(v) = crate::toolpath::unit_tool_vector(v) else {
                 return Err(self.error(
                     line,
                     format!(
@@ -433,8 +423,7 @@ impl<'a> Reader<'a> {
                         v.x, v.y, v.z
                     ),
                 ));
-            }
-            let v = v / largest / scaled_norm;
+            };
             self.orientation = match self.msys {
                 Some((_, r)) => r * v,
                 None => v,

@@ -370,6 +370,22 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
     crate::files::read_bounded(path, crate::files::MAX_TOOLPATH_BYTES, "toolpath")
 }
 
+/// A tool vector shorter than this (after scaling) has no direction.
+const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
+
+/// The unit tool vector along `v`, or `None` when `v` has no direction (zero length). Scaled
+/// by its largest component first, so that huge components cannot overflow and tiny ones
+/// cannot underflow; the one normalisation of every reader.
+pub fn unit_tool_vector(v: nalgebra::Vector3<f64>) -> Option<nalgebra::Vector3<f64>> {
+    let largest = v.amax();
+    let scaled_norm = if largest > 0.0 {
+        (v / largest).norm()
+    } else {
+        0.0
+    };
+    (largest * scaled_norm >= MIN_TOOL_VECTOR_NORM).then(|| v / largest / scaled_norm)
+}
+
 /// Any input path: cutter locations or joint positions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Input {

@@ -1159,19 +1159,13 @@ impl<'a> Interpreter<'a> {
                 vector_words[1].unwrap_or(0.0),
                 vector_words[2].unwrap_or(0.0),
             );
-            let largest = v.amax();
-            let scaled_norm = if largest > 0.0 {
-                (v / largest).norm()
-            } else {
-                0.0
-            };
-            if largest * scaled_norm < MIN_TOOL_VECTOR_NORM {
+            let Some(unit) = crate::toolpath::unit_tool_vector(v) else {
                 return Err(self.error(
                     line,
                     format!("tool vector ({}, {}, {}) has no direction", v.x, v.y, v.z),
                 ));
-            }
-            self.vector = v / largest / scaled_norm;
+            };
+            self.vector = unit;
         } else if !is_arc {
             let stray: Vec<&str> = ["I", "J", "K"]
                 .iter()

@@ -165,9 +165,6 @@ pub const R_ARC_TOLERANCE_MM: f64 = 0.00127;
 /// An I J K arc whose end is this close to its start (in the plane, mm) is a full circle.
 const FULL_CIRCLE_MM: f64 = 1e-9;
 
-/// Tool vectors shorter than this are rejected as having no direction.
-const MIN_TOOL_VECTOR_NORM: f64 = 1e-12;
-
 /// File extensions read as G-code.
 pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap"];
 
