@@ -1,7 +1,8 @@
 //! Solve time of the whole pipeline at a fixed station count on a 5-axis path (seed 000's
 //! double swivel head): 1,000 / 10,000 / 100,000 stations.
 //!
-//! `cargo bench --bench solve` (add `-- 1000` to run one size). Reports medians; the target is
+//! `cargo bench --bench solve` (add `-- 1000` to run one size); `verify/seed_head_head_1ms`
+//! times the re-simulation alone on the bundled blade. Reports medians; the target is
 //! 1,000 stations in ≤ 45 ms with cost linear in stations.
 
 use std::hint::black_box;
@@ -80,5 +81,30 @@ fn bench_solve(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_solve);
+/// The re-simulation alone (`verify`, 1 ms) of the bundled seed blade's default schedule: what
+/// every solve pays after the solver.
+fn bench_verify(c: &mut Criterion) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
+    let m = Machine::from_file(&root.join("machine.json")).expect("machine");
+    let t = feedopt::toolpath::read(&root.join("impeller_blade.cls")).expect("toolpath");
+    let sol = optimize(&m, &t, &Options::default()).expect("solves");
+    let mut group = c.benchmark_group("verify");
+    group.bench_function("seed_head_head_1ms", |b| {
+        b.iter(|| {
+            let v = feedopt::verify::verify(
+                &m,
+                &sol.kinematics,
+                &sol.path.spans,
+                &sol.problems,
+                &sol.solutions,
+                &Default::default(),
+            )
+            .expect("re-simulates");
+            black_box(v.samples)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_solve, bench_verify);
 criterion_main!(benches);

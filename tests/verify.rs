@@ -1,12 +1,9 @@
 //! Re-simulation at the servo period: real schedules pass, tampered or under-resolved ones fail.
 
-use std::path::Path;
-use std::time::Instant;
-
 use feedopt::geometry::GeometryOptions;
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize};
-use feedopt::toolpath::{self, Toolpath};
+use feedopt::toolpath::Toolpath;
 use feedopt::verify::{Quantity, Verification, VerifyOptions, verify};
 use nalgebra::Vector3;
 
@@ -348,75 +345,6 @@ fn halving_the_period_doubles_the_samples() {
     assert_eq!(coarse.station_checks, fine.station_checks);
     // The schedule is verified at either period.
     assert!(fine.verified && coarse.verified);
-}
-
-fn load(dir: &Path, machine: &str, cls: &str) -> (Machine, Toolpath) {
-    (
-        Machine::from_file(&dir.join(machine)).unwrap(),
-        toolpath::read(&dir.join(cls)).unwrap(),
-    )
-}
-
-/// Timing and worst ratios on the bundled problem and the public cases:
-/// `cargo test --release --test verify -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn timing_on_the_bundled_problems() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut cases = vec![(
-        "seed_head_head".to_string(),
-        load(
-            &root.join("problems/seed_head_head"),
-            "machine.json",
-            "impeller_blade.cls",
-        ),
-    )];
-    let shared = root.join("../shared/cases");
-    for name in ["p1_spiral_tilt", "p2_xyz_rounded_square", "p3_s_curve_lean"] {
-        if shared.join(format!("{name}.cls")).exists() {
-            cases.push((
-                name.to_string(),
-                load(
-                    &shared,
-                    &format!("{name}.machine.json"),
-                    &format!("{name}.cls"),
-                ),
-            ));
-        }
-    }
-    for (name, (m, t)) in &cases {
-        let sol = solve(m, t, &Options::default());
-        let opts = VerifyOptions::default();
-        let runs = 20;
-        let start = Instant::now();
-        let mut v = check(m, &sol, &opts);
-        for _ in 1..runs {
-            v = check(m, &sol, &opts);
-        }
-        let per = start.elapsed().as_secs_f64() / runs as f64;
-        eprintln!(
-            "{name}: T {:.4} s, {} stations, {} samples + {} station checks, verify {:.3} ms; \
-             verified {}, worst {:.6} (feed {:.6}), violating intervals {}",
-            sol.schedule.cycle_time,
-            sol.stations(),
-            v.samples,
-            v.station_checks,
-            1e3 * per,
-            v.verified,
-            v.worst_ratio(),
-            v.worst_feed,
-            v.violating_intervals
-        );
-        for w in &v.worst {
-            eprintln!(
-                "    {:<2} velocity {:.6}  acceleration {:.6}",
-                w.name, w.velocity, w.acceleration
-            );
-        }
-        for x in v.violations.iter().take(3) {
-            eprintln!("    {x:?}");
-        }
-    }
 }
 
 #[test]
