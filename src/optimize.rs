@@ -654,6 +654,8 @@ impl Plan<'_> {
     }
 
     /// Every span refined adaptively, then solved on its final grid by the chosen solver.
+    /// Spans run in parallel; where several fail, the first along the path is reported (the
+    /// same error whatever the threads).
     ///
     /// Each round takes every span's grid G and its bisection F ([`Plan::bisect`], spans in
     /// parallel: rest stops decouple them exactly). When Σ e_k over the whole path is at most
@@ -678,6 +680,8 @@ impl Plan<'_> {
                     self.uniform_problem(si, options.initial_stations, 0, options)?,
                 )
             })
+            .collect::<Vec<Result<_>>>()
+            .into_iter()
             .collect::<Result<_>>()?;
         let mut refinement = Vec::new();
         loop {
@@ -725,6 +729,8 @@ impl Plan<'_> {
                     let p = self.refined_grid(si, options, r, threshold);
                     self.bisect(si, options, p).map(Some)
                 })
+                .collect::<Vec<Result<_>>>()
+                .into_iter()
                 .collect::<Result<_>>()?;
             for (r, n) in rounds.iter_mut().zip(next) {
                 if let Some(n) = n {
@@ -745,6 +751,8 @@ impl Plan<'_> {
                 let s = self.solve_span(si, &p, options, None)?;
                 Ok((p, s))
             })
+            .collect::<Vec<Result<_>>>()
+            .into_iter()
             .collect::<Result<_>>()?;
         let (problems, solutions): (Vec<_>, Vec<_>) = solved.into_iter().unzip();
         let lv = self.level(problems, solutions)?;
