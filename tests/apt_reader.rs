@@ -391,11 +391,10 @@ fn read_reports_io_error() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn shared_cases_parse() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cases");
-    if !dir.is_dir() {
-        return;
-    }
+    assert!(dir.is_dir(), "../shared is present (cfg shared_data)");
     let expected = [
         ("p1_spiral_tilt.cls", 801),
         ("p2_xyz_rounded_square.cls", 6001),

@@ -1,7 +1,7 @@
 //! Tests of the G-code reader (`feedopt::toolpath::gcode`).
 //!
 //! The LinuxCNC programs are third-party test data read from `../shared/realworld/linuxcnc`
-//! when that folder exists (skipped otherwise); they are never copied into the crate.
+//! when that folder exists (reported as ignored otherwise); they are never copied into the crate.
 
 use feedopt::error::Error;
 use feedopt::toolpath::gcode::{Dialect, MAX_CHORD_ERROR_MM, parse};
@@ -670,27 +670,23 @@ fn sinumerik_units_radius_and_spaces() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The LinuxCNC demo programs (GPL-2.0 test data in ../shared; skipped when absent)
+// The LinuxCNC demo programs (GPL-2.0 test data in ../shared; ignored when absent)
 // ---------------------------------------------------------------------------------------------
 
-fn linuxcnc_dir() -> Option<PathBuf> {
+fn linuxcnc_dir() -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/linuxcnc");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipped: {} not present", dir.display());
-        None
-    }
+    assert!(dir.is_dir(), "../shared is present (cfg shared_data)");
+    dir
 }
 
-fn read_demo(name: &str) -> Option<(Toolpath, String)> {
-    let path = linuxcnc_dir()?.join(name);
+fn read_demo(name: &str) -> (Toolpath, String) {
+    let path = linuxcnc_dir().join(name);
     let text = std::fs::read_to_string(&path).unwrap();
     let tp = feedopt::toolpath::gcode::read(&path, Dialect::LinuxCnc)
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     // The extension chooses the same reader.
     assert_eq!(feedopt::toolpath::read(&path).unwrap(), tp);
-    Some((tp, text))
+    (tp, text)
 }
 
 /// Programmed feed time: Σ BlockTime + Σ chord length / programmed feed.
@@ -755,10 +751,9 @@ fn lines_starting(text: &str, code: &str) -> Vec<usize> {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn linuxcnc_impeller() {
-    let Some((tp, text)) = read_demo("impeller-7bl-xyzac.ngc") else {
-        return;
-    };
+    let (tp, text) = read_demo("impeller-7bl-xyzac.ngc");
     report_warnings("impeller-7bl-xyzac", &tp);
     let counts = blocks_by_feed(&tp);
     assert_eq!(counts.get("block time"), Some(&4306), "{counts:?}");
@@ -788,10 +783,9 @@ fn linuxcnc_impeller() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn linuxcnc_boat_xyzac() {
-    let Some((tp, _)) = read_demo("boat-xyzac.ngc") else {
-        return;
-    };
+    let (tp, _) = read_demo("boat-xyzac.ngc");
     report_warnings("boat-xyzac", &tp);
     let (inverse, per_minute) = programmed_feed_time(&tp);
     eprintln!(
@@ -817,10 +811,9 @@ fn linuxcnc_boat_xyzac() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn linuxcnc_boat_xyzbc() {
-    let Some((tp, _)) = read_demo("boat-xyzbc.ngc") else {
-        return;
-    };
+    let (tp, _) = read_demo("boat-xyzbc.ngc");
     report_warnings("boat-xyzbc", &tp);
     let (inverse, per_minute) = programmed_feed_time(&tp);
     eprintln!(
