@@ -152,27 +152,7 @@ impl SpanProblem {
             SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
             SpanKind::Reorientation | SpanKind::Joint => 0.0,
         };
-        let mut best = (f64::INFINITY, Bound::None);
-        for (j, axis) in machine.axes.iter().enumerate().take(na) {
-            let d = jet.dq[j];
-            if d != 0.0 {
-                let v = if d > 0.0 {
-                    axis.velocity.max
-                } else {
-                    axis.velocity.min
-                };
-                let b = (v / d).powi(2);
-                if b < best.0 {
-                    best = (b, Bound::AxisVelocity(j));
-                }
-            }
-        }
-        if tip_speed > 0.0 && cap.is_finite() {
-            let b = (cap / tip_speed).powi(2);
-            if b < best.0 {
-                best = (b, Bound::Feed);
-            }
-        }
+        let mut best = velocity_bound(machine, na, &jet, tip_speed, cap);
         let (rows, b_star, by) = essential_rows(&jet, &self.acceleration, best.0);
         // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
         if b_star < best.0 {
@@ -302,6 +282,22 @@ impl SpanProblem {
         self.u[k + 1] - self.u[k]
     }
 
+    /// The range of ü that every axis's acceleration row allows at station `i` with b there
+    /// (`q'' b + q' ü` within its limits, solved for ü).
+    pub fn udd_range(&self, i: usize, b: f64) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        let jet = &self.jets[i];
+        for (j, lim) in self.acceleration.iter().enumerate() {
+            let (d, dd) = (jet.dq[j], jet.ddq[j]);
+            if d != 0.0 {
+                let (x, y) = ((lim.max - dd * b) / d, (lim.min - dd * b) / d);
+                lo = lo.max(x.min(y));
+                hi = hi.min(x.max(y));
+            }
+        }
+        (lo, hi)
+    }
+
     /// ü on interval k: (b_{k+1} − b_k) / (2Δu_k).
     pub fn path_acceleration(&self, b: &[f64], k: usize) -> f64 {
         (b[k + 1] - b[k]) / (2.0 * self.du(k))
@@ -312,6 +308,40 @@ impl SpanProblem {
     pub fn axis_acceleration(&self, b: &[f64], k: usize, i: usize, j: usize) -> f64 {
         self.jets[i].ddq[j] * b[i] + self.jets[i].dq[j] * self.path_acceleration(b, k)
     }
+}
+
+/// The tightest bound on b from every axis's velocity limit (q'² b ≤ v², on the side of q')
+/// and the feed cap (|P'|² b ≤ F², where the tip moves: `tip_speed` = |P'| > 0), with the
+/// limit that sets it: the velocity rows of one point of the path merged into one.
+pub fn velocity_bound(
+    machine: &Machine,
+    n_axes: usize,
+    jet: &AxisJets,
+    tip_speed: f64,
+    cap: f64,
+) -> (f64, Bound) {
+    let mut best = (f64::INFINITY, Bound::None);
+    for (j, axis) in machine.axes.iter().enumerate().take(n_axes) {
+        let d = jet.dq[j];
+        if d != 0.0 {
+            let v = if d > 0.0 {
+                axis.velocity.max
+            } else {
+                axis.velocity.min
+            };
+            let b = (v / d).powi(2);
+            if b < best.0 {
+                best = (b, Bound::AxisVelocity(j));
+            }
+        }
+    }
+    if tip_speed > 0.0 && cap.is_finite() {
+        let b = (cap / tip_speed).powi(2);
+        if b < best.0 {
+            best = (b, Bound::Feed);
+        }
+    }
+    best
 }
 
 /// The acceleration limit of each axis the kinematics drives.

@@ -187,12 +187,6 @@ pub fn optimize_observed(
 /// Computes the time-optimal schedule of a joint-space path (axis positions along s) on a
 /// machine of kinematics `joint`. The feed options are path speeds ds/dt there.
 pub fn optimize_joint(machine: &Machine, path: &JointPath, options: &Options) -> Result<Solution> {
-    if machine.kinematics != KinematicsSpec::Joint {
-        return Err(Error::Usage(format!(
-            "{}: a joint-space path needs a machine file with \"kinematics\": {{\"type\": \"joint\"}}",
-            path.source.display()
-        )));
-    }
     optimize_joint_observed(machine, path, options, &Silent)
 }
 
@@ -204,7 +198,10 @@ pub fn optimize_joint_observed(
     progress: &dyn Progress,
 ) -> Result<Solution> {
     if machine.kinematics != KinematicsSpec::Joint {
-        return optimize_joint(machine, path, options);
+        return Err(Error::Usage(format!(
+            "{}: a joint-space path needs a machine file with \"kinematics\": {{\"type\": \"joint\"}}",
+            path.source.display()
+        )));
     }
     optimize_path(machine, Path::from_joint(path, machine)?, options, progress)
 }
@@ -328,22 +325,6 @@ fn optimize_path(
 /// Geometric grading of the stations into a rest end of a jerk-limited span (levels).
 const GRADING: usize = 4;
 
-/// The range of ü that every axis's acceleration allows at station `i` at b (the rows of
-/// [`SpanProblem`], written for ü).
-fn udd_range(p: &SpanProblem, i: usize, b: f64) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-    let jet = &p.jets[i];
-    for (j, lim) in p.acceleration.iter().enumerate() {
-        let (d, dd) = (jet.dq[j], jet.ddq[j]);
-        if d != 0.0 {
-            let (x, y) = ((lim.max - dd * b) / d, (lim.min - dd * b) / d);
-            lo = lo.max(x.min(y));
-            hi = hi.min(x.max(y));
-        }
-    }
-    (lo, hi)
-}
-
 /// Where a full-rate ramp inside interval `k` meets the plateau the interval ends on (or
 /// starts from), if it does so inside the interval.
 ///
@@ -361,10 +342,10 @@ fn ramp_end(p: &SpanProblem, b: &[f64], k: usize) -> Option<f64> {
     let slope = (b[k + 1] - b[k]) / (2.0 * du);
     let on_bound = |i: usize| b[i] >= p.b_max[i] * (1.0 - 1e-9);
     let at = if slope > 0.0 && on_bound(k + 1) {
-        let hi = udd_range(p, k, b[k]).1;
+        let hi = p.udd_range(k, b[k]).1;
         (hi > slope * (1.0 + 1e-6)).then(|| u0 + (b[k + 1] - b[k]) / (2.0 * hi))
     } else if slope < 0.0 && on_bound(k) {
-        let lo = udd_range(p, k + 1, b[k + 1]).0;
+        let lo = p.udd_range(k + 1, b[k + 1]).0;
         (lo < slope * (1.0 + 1e-6)).then(|| u1 - (b[k] - b[k + 1]) / (2.0 * -lo))
     } else {
         None
@@ -747,9 +728,9 @@ impl Plan<'_> {
             .into_par_iter()
             .enumerate()
             .map(|(si, r)| {
-                let p = self.final_grid(si, r.fine, options);
-                let s = self.solve_span(si, &p, options, None)?;
-                Ok((p, s))
+                // (Acceleration-limited only: jerk-limited solves take `solve_uniform`.)
+                let s = self.solve_span(si, &r.fine, options, None, Some(r.greedy))?;
+                Ok((r.fine, s))
             })
             .collect::<Vec<Result<_>>>()
             .into_iter()
@@ -901,7 +882,7 @@ impl Plan<'_> {
             }
             self.check_travel(si, &p)?;
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
-            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])))?;
+            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None)?;
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
@@ -920,10 +901,15 @@ impl Plan<'_> {
         p: &SpanProblem,
         options: &Options,
         previous: Option<(&SpanProblem, &SpanSolution)>,
+        greedy: Option<SpanSolution>,
     ) -> Result<SpanSolution> {
-        // The O(N) pass runs first whatever the solver: it finds an impossible request and
-        // says where, which a convex solver's infeasibility certificate cannot.
-        let greedy = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
+        // The O(N) pass runs first whatever the solver (unless the caller has its profile on
+        // these stations already): it finds an impossible request and says where, which a
+        // convex solver's infeasibility certificate cannot.
+        let greedy = match greedy {
+            Some(g) => g,
+            None => self.reach(si, p)?,
+        };
         if self.machine.has_jerk() {
             if options.solver_kind == SolverKind::Reach {
                 return Err(Error::Usage(
@@ -997,7 +983,7 @@ impl Plan<'_> {
                 options,
             );
             let warm = previous.map(|lv| (&lv.problems[si], &lv.solutions[si]));
-            solutions.push(self.solve_span(si, &p, options, warm)?);
+            solutions.push(self.solve_span(si, &p, options, warm, None)?);
             problems.push(p);
         }
         self.level(problems, solutions)

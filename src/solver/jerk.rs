@@ -249,27 +249,15 @@ impl JerkData {
             let seg = span.spline.segment(um);
             let w = span.spline.eval_in(seg, um);
             let jets = kin.axis_jets(&w);
-            let mut b_max = f64::INFINITY;
-            for (j, axis) in machine.axes.iter().enumerate().take(na) {
-                let d = jets.dq[j];
-                if d != 0.0 {
-                    let v = if d > 0.0 {
-                        axis.velocity.max
-                    } else {
-                        axis.velocity.min
-                    };
-                    b_max = b_max.min((v / d).powi(2));
-                }
-            }
+            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            let speed = if moving {
+                (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt()
+            } else {
+                0.0
+            };
+            let mut b_max = crate::constraints::velocity_bound(machine, na, &jets, speed, cap).0;
             if let (true, Some(c)) = (moving, chord) {
                 b_max = b_max.min(c.b_max(&w));
-            }
-            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
-            if moving && cap.is_finite() {
-                let speed = (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt();
-                if speed > 0.0 {
-                    b_max = b_max.min((cap / speed).powi(2));
-                }
             }
             let (essential, b_star, _) = essential_rows(&jets, &p.acceleration, b_max);
             Midpoint {
