@@ -363,3 +363,45 @@ fn a_linuxcnc_program_with_jerk_limits_solves_without_stalls_or_cycles() {
     assert!(most.is_some_and(|k| (2..=12).contains(&k)), "{most:?}");
     assert!(tj.is_finite() && tj >= ta * (1.0 - 1e-4), "{tj} vs {ta}");
 }
+
+/// The default (adaptive) jerk-limited refinement on the rest-to-rest line of
+/// `straight_line_with_only_jerk_binding_matches_the_closed_form`: the cycle time comes within
+/// the returned estimate of the closed form, the estimate is within the tolerance (1e-3, ten
+/// times the SCP's own), and the stations stay where the jerk binds (few of them).
+#[test]
+fn adaptive_jerk_refinement_meets_its_estimate_on_the_closed_form() {
+    let (len, jerk) = (20.0, 5000.0);
+    let m = common::machine(&format!(
+        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{
+        "X": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
+        "Y": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
+        "Z": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}}}}}}"#
+    ));
+    let pts: Vec<_> = (0..=4)
+        .map(|k| (Vector3::new(len * k as f64 / 4.0, 0.0, 0.0), UP))
+        .collect();
+    let sol = optimize(&m, &common::toolpath(&pts, None), &Options::default()).expect("solve");
+    let exact = 4.0 * (len / (2.0 * jerk)).cbrt();
+    let t = sol.schedule.cycle_time;
+    let estimate = sol
+        .error_estimate
+        .expect("an adaptive solve has an estimate");
+    eprintln!(
+        "adaptive jerk line: {t:.6} s vs {exact:.6} s exact ({:.2e}), estimate {estimate:.2e}, \
+         {} stations, rounds {:?}",
+        t / exact - 1.0,
+        sol.schedule.stations.len(),
+        sol.refinement
+    );
+    assert!(
+        t >= exact * (1.0 - 1e-6),
+        "faster than possible: {t} < {exact}"
+    );
+    assert!(estimate <= 1e-3, "estimate {estimate}");
+    assert!(
+        t / exact - 1.0 <= estimate,
+        "true error {} > estimate {estimate}",
+        t / exact - 1.0
+    );
+    assert_verified_with_jerk(&sol, "adaptive line");
+}

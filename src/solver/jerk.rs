@@ -472,10 +472,12 @@ pub fn solve(
         Some(w) => Start {
             b: &w.b,
             a: Some(&w.a),
+            fresh: Some(&w.fresh),
         },
         None => Start {
             b: &greedy.b,
             a: None,
+            fresh: None,
         },
     };
     let threads = settings.worker_threads();
@@ -511,6 +513,7 @@ pub fn solve(
             let ws = Start {
                 b: &start.b[a..=b],
                 a: start.a.map(|x| &x[a..=b]),
+                fresh: start.fresh.map(|x| &x[a..=b]),
             };
             solve_piece(&wp, &wjd, &ws, (aa, ab), settings, options)
         });
@@ -538,6 +541,9 @@ pub fn solve(
 struct Start<'a> {
     b: &'a [f64],
     a: Option<&'a [f64]>,
+    /// Stations where a warm start's profile is interpolated, not solved: no window ends
+    /// there (its b and ü need not be feasible on the new stations).
+    fresh: Option<&'a [bool]>,
 }
 
 impl Start<'_> {
@@ -590,6 +596,7 @@ fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<us
                     p.b_max[i].is_finite()
                         && p.b_max_by[i] == p.b_max_by[m]
                         && start.b[i] >= (1.0 - 1e-4) * p.b_max[i]
+                        && !start.fresh.is_some_and(|f| f[i])
                 })
         };
         let len = n / windows;
