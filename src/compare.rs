@@ -321,6 +321,12 @@ pub fn compare(
     toolpath_name: &str,
     options: &CompareOptions,
 ) -> Result<Comparison> {
+    options.validate()?;
+    machine.validate()?;
+    options
+        .solve
+        .validate_for(machine)
+        .map_err(|e| e.within("solve"))?;
     // The reference (c) is acceleration-limited; (d) adds the jerk limits.
     let accel_only = Options {
         jerk_limited: false,

@@ -41,6 +41,25 @@ pub enum Error {
     /// A bad option or argument combination.
     #[error("{0}")]
     Usage(String),
+    /// An option of a library call is out of its range (checked where it enters the library:
+    /// see [`crate::validate`]).
+    #[error("option `{field}`: {reason}")]
+    InvalidOption {
+        /// Dotted path of the option in its struct, e.g. `verify.period` of
+        /// [`Options`](crate::optimize::Options), or the argument's name (`period`).
+        field: String,
+        /// What is wrong with the value and what to give instead.
+        reason: String,
+    },
+    /// A [`Machine`](crate::machine::Machine) (built in code; a machine file's errors are
+    /// [`Error::Field`]) has an invalid field ([`Machine::validate`](crate::machine::Machine::validate)).
+    #[error("machine: field `{field}`: {reason}")]
+    InvalidMachine {
+        /// Dotted path of the field as a machine file names it, e.g. `axes.C.velocity`.
+        field: String,
+        /// What is wrong with the value and what to give instead.
+        reason: String,
+    },
 }
 
 /// Result alias used throughout the crate.
@@ -64,6 +83,26 @@ impl Error {
             file: file.into(),
             field: field.into(),
             message: message.into(),
+        }
+    }
+
+    /// An [`Error::InvalidOption`] for `field`.
+    pub(crate) fn option(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::InvalidOption {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The same error with `prefix.` before an [`Error::InvalidOption`]'s field (an option of
+    /// a nested struct); any other error unchanged.
+    pub(crate) fn within(self, prefix: &str) -> Self {
+        match self {
+            Error::InvalidOption { field, reason } => Error::InvalidOption {
+                field: format!("{prefix}.{field}"),
+                reason,
+            },
+            e => e,
         }
     }
 

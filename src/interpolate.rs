@@ -167,11 +167,7 @@ pub const MAX_SAMPLES: usize = 4_000_000;
 
 /// Samples the solution's motion at period `period` (s): see the module doc.
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
-    if !(period.is_finite() && period > 0.0) {
-        return Err(Error::Usage(format!(
-            "the interpolation period must be a positive number of seconds, got {period}"
-        )));
-    }
+    crate::validate::period("period", period)?;
     let timeline = Timeline::new(solution)?;
     let cycle = timeline.cycle_time;
     let count = (cycle / period).ceil();

@@ -54,6 +54,7 @@
 //! Units: mm, degrees, seconds in every file; feeds in machine files in mm/s; APT feeds per
 //! minute as the format defines.
 
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod compare;
 pub mod constraints;
@@ -65,10 +66,13 @@ pub mod kinematics;
 pub mod machine;
 pub mod motion;
 pub mod optimize;
+#[cfg(feature = "progress")]
+pub mod progress;
 pub mod report;
 pub mod schedule;
 pub mod solver;
 pub mod sweep;
 pub mod toolpath;
+pub mod validate;
 pub mod verify;
 pub mod writers;

@@ -88,7 +88,8 @@ use crate::verify::verify;
 use crate::writers::write_atomically;
 
 /// Which limit of the axis is swept.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum SweptLimit {
     Velocity,
@@ -121,7 +122,8 @@ pub struct SweepOptions {
     /// threads and the re-simulation's threads are overridden (one window, one thread: see
     /// the module doc).
     pub solve: Options,
-    /// Draw a progress bar on stderr.
+    /// Draw a progress bar on stderr (with the cargo feature `progress`; without it, nothing
+    /// is drawn).
     pub progress: bool,
 }
 
@@ -149,39 +151,6 @@ impl SweepOptions {
         (0..=n)
             .map(|k| self.from + (self.to - self.from) * k as f64 / n as f64)
             .collect()
-    }
-
-    fn check(&self) -> Result<()> {
-        if !(self.from.is_finite() && self.to.is_finite() && self.from > 0.0 && self.to > 0.0) {
-            return Err(Error::Usage(format!(
-                "--from and --to must be positive limits, got {} and {}",
-                crate::error::number(self.from),
-                crate::error::number(self.to)
-            )));
-        }
-        if self.steps == 0 {
-            return Err(Error::Usage("--steps must be at least 1".into()));
-        }
-        if self.steps > MAX_STEPS {
-            return Err(Error::Usage(format!(
-                "--steps {} is more than {MAX_STEPS} (each step is three solves): give at most \
-                 {MAX_STEPS}",
-                self.steps
-            )));
-        }
-        if self.steps > 1 && self.to <= self.from {
-            return Err(Error::Usage(format!(
-                "--to ({}) must be greater than --from ({}) for more than one step",
-                self.to, self.from
-            )));
-        }
-        if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 0.5) {
-            return Err(Error::Usage(format!(
-                "--fd-step must be a relative step in (0, 0.5), got {}",
-                self.fd_step
-            )));
-        }
-        Ok(())
     }
 }
 
@@ -421,19 +390,27 @@ pub fn sweep(
     toolpath: &str,
     options: &SweepOptions,
 ) -> Result<Sweep> {
-    options.check()?;
+    options.validate()?;
+    machine.validate()?;
+    options
+        .solve
+        .validate_for(machine)
+        .map_err(|e| e.within("solve"))?;
     let axis = machine
         .axes
         .iter()
         .position(|a| a.name.eq_ignore_ascii_case(&options.axis))
         .ok_or_else(|| {
             let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
-            Error::Usage(format!(
-                "--axis {}: the machine {} has no such axis (axes: {})",
-                options.axis,
-                machine.name,
-                names.join(", ")
-            ))
+            Error::option(
+                "axis",
+                format!(
+                    "{}: the machine {} has no such axis (axes: {})",
+                    options.axis,
+                    machine.name,
+                    names.join(", ")
+                ),
+            )
         })?;
     let which = options.limit;
     let nominal = machine_limit(machine, axis, which);
@@ -441,17 +418,20 @@ pub fn sweep(
         nominal.max / MAX_SWEEP_FACTOR,
         nominal.max * MAX_SWEEP_FACTOR,
     );
-    for (option, v) in [("--from", options.from), ("--to", options.to)] {
+    for (field, v) in [("from", options.from), ("to", options.to)] {
         if !(lo..=hi).contains(&v) {
-            return Err(Error::Usage(format!(
-                "{option} {} is outside {} to {}, 1/{MAX_SWEEP_FACTOR} to {MAX_SWEEP_FACTOR} \
-                 times the machine's {} {which} limit ({}): sweep within that range",
-                crate::error::number(v),
-                crate::error::number(lo),
-                crate::error::number(hi),
-                machine.axes[axis].name,
-                nominal.max
-            )));
+            return Err(Error::option(
+                field,
+                format!(
+                    "{} is outside {} to {}, 1/{MAX_SWEEP_FACTOR} to {MAX_SWEEP_FACTOR} times the \
+                     machine's {} {which} limit ({}): sweep within that range",
+                    crate::error::number(v),
+                    crate::error::number(lo),
+                    crate::error::number(hi),
+                    machine.axes[axis].name,
+                    nominal.max
+                ),
+            ));
         }
     }
     // The stations: one reach solve at the nominal limits, as `solve` would refine them.
@@ -482,27 +462,26 @@ pub fn sweep(
         .enumerate()
         .flat_map(|(k, &v)| [(k, 0, v * (1.0 - h)), (k, 1, v), (k, 2, v * (1.0 + h))])
         .collect();
+    #[cfg(feature = "progress")]
     let bar = options.progress.then(|| {
-        let bar = indicatif::ProgressBar::with_draw_target(
-            Some(jobs.len() as u64),
-            indicatif::ProgressDrawTarget::stderr(),
-        );
-        bar.set_message(format!("{} {} sweep", machine.axes[axis].name, which));
-        bar
+        crate::progress::Counter::new(
+            jobs.len(),
+            format!("{} {} sweep", machine.axes[axis].name, which),
+        )
     });
     let evals: Vec<Result<Eval>> = jobs
         .par_iter()
         .map(|&(_, _, v)| {
             let e = study.evaluate(v);
+            #[cfg(feature = "progress")]
             if let Some(b) = &bar {
-                b.inc(1);
+                b.inc();
             }
             e
         })
         .collect();
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    #[cfg(feature = "progress")]
+    drop(bar);
     let mut evals = evals.into_iter();
     let mut points = Vec::with_capacity(values.len());
     for &v in &values {
@@ -666,8 +645,9 @@ impl Sweep {
         write_atomically(path, &bytes)
     }
 
-    /// An SVG plot: cycle time against the limit (top) and the sensitivity, dual and finite
+    /// An SVG plot (cargo feature `plot`): cycle time against the limit (top) and the sensitivity, dual and finite
     /// differences (bottom); axes labelled with units, legends.
+    #[cfg(feature = "plot")]
     pub fn plot_svg(&self) -> Result<String> {
         use plotters::prelude::*;
         let fail = |e: &dyn fmt::Display| Error::Solver(format!("plot: {e}"));
@@ -781,11 +761,13 @@ impl Sweep {
     }
 
     /// Writes [`Sweep::plot_svg`] to `path`, atomically.
+    #[cfg(feature = "plot")]
     pub fn write_plot(&self, path: &Path) -> Result<()> {
         write_atomically(path, self.plot_svg()?.as_bytes())
     }
 }
 
+#[cfg(feature = "plot")]
 /// A plotting range around `values` with 5 % margins (never empty).
 fn pad_range(values: &[f64]) -> (f64, f64) {
     let lo = values.iter().copied().fold(f64::INFINITY, f64::min);

@@ -2,6 +2,7 @@
 //! target's directory and renamed into place, so no half-written output is ever left behind.
 
 pub mod gcode;
+#[cfg(feature = "plot")]
 pub mod plot;
 
 use std::io::Write;
