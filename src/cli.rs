@@ -47,6 +47,7 @@ pub fn init_logging(verbose: u8) {
 }
 
 #[derive(Debug, Subcommand)]
+/// The subcommands.
 pub enum Command {
     /// Compute the time-optimal feed profile of a toolpath on a machine.
     Solve(SolveArgs),
@@ -62,8 +63,10 @@ pub enum Command {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt compare`.
 pub struct CompareArgs {
     #[command(flatten)]
+    /// Machine, toolpath, --json, --plot and the solve options.
     pub solve: SolveArgs,
     /// Junction deviation δ of the controller baseline, mm (grbl's `$11`): how far the
     /// virtual arc through a corner may pass from the corner point.
@@ -72,6 +75,7 @@ pub struct CompareArgs {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt sweep`.
 pub struct SweepArgs {
     /// Machine, toolpath, --json, -o (here: the sweep table as FILE.csv or FILE.json) and the
     /// solve options. `--stations N` fixes the stations of every step; without it they are
@@ -101,6 +105,7 @@ pub struct SweepArgs {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt solve`, and the solve options every subcommand shares.
 pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
@@ -192,15 +197,20 @@ fn parse_period(text: &str) -> std::result::Result<f64, String> {
 /// `--format` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum FormatChoice {
+    /// APT CL (`.cls`, `.apt`).
     Apt,
+    /// G-code (`.ngc`, `.nc`, `.gcode`, `.tap`).
     Gcode,
+    /// A joint-space CSV (`s,q_<axis>,…`).
     Csv,
 }
 
 /// `--solver` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum SolverChoice {
+    /// The convex solve (Clarabel).
     Clarabel,
+    /// The O(N) reachability pass.
     Reach,
 }
 
@@ -587,8 +597,10 @@ fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt gcode`.
 pub struct GcodeArgs {
     #[command(flatten)]
+    /// Machine, toolpath and the solve options.
     pub plan: PlanArgs,
     /// The G-code program to write (.ngc, .nc, …).
     #[arg(long, short, value_name = "FILE")]
@@ -648,8 +660,10 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt interpolate`.
 pub struct InterpolateArgs {
     #[command(flatten)]
+    /// Machine, toolpath and the solve options.
     pub plan: PlanArgs,
     /// Interpolation period: `1ms`, `500us`, `0.002` (seconds); 1 µs to 1 s. Also the servo
     /// period of the schedule's verification.

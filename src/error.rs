@@ -12,24 +12,30 @@ pub enum Error {
     /// A toolpath (or other line-oriented) input file has a bad record.
     #[error("{}:{line}: {message}", file.display())]
     Parse {
+        /// The file.
         file: PathBuf,
         /// 1-based line number of the record (its first line when `$`-continued).
         line: usize,
+        /// What is wrong with the record and what to do.
         message: String,
     },
     /// A machine file has a missing, unknown or invalid field.
     #[error("{}: field `{field}`: {message}", file.display())]
     Field {
+        /// The machine file.
         file: PathBuf,
         /// Dotted path of the field, e.g. `axes.C.velocity`.
         field: String,
+        /// What is wrong with the field and what to do.
         message: String,
     },
     /// A file could not be read or written.
     #[error("{}: {}", file.display(), io_reason(source))]
     Io {
+        /// The file.
         file: PathBuf,
         #[source]
+        /// What the operating system said.
         source: std::io::Error,
     },
     /// The request cannot be met by any schedule (names where on the path).

@@ -47,7 +47,9 @@ use crate::error::{Error, Result};
 /// A two-sided limit on an axis quantity: `min < 0 < max`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limit {
+    /// The negative side.
     pub min: f64,
+    /// The positive side.
     pub max: f64,
 }
 
@@ -70,16 +72,22 @@ impl Limit {
 /// Linear (mm) or rotary (degrees) axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AxisKind {
+    /// Millimetres.
     Linear,
+    /// Degrees.
     Rotary,
 }
 
 /// One machine axis with its velocity and acceleration limits (file units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
+    /// Axis name (`X`, `C`, or a joint-space machine's own).
     pub name: String,
+    /// Linear or rotary.
     pub kind: AxisKind,
+    /// Velocity limit, mm/s or °/s.
     pub velocity: Limit,
+    /// Acceleration limit, mm/s² or °/s².
     pub acceleration: Limit,
     /// Jerk limit (mm/s³ or °/s³), `None` when the file gives none: the schedule is then
     /// acceleration-limited (issue 6).
@@ -155,20 +163,31 @@ pub enum KinematicsSpec {
     Xyz,
     /// Seed 000's fixed-bed double swivel head: θ1 = axis C about z, θ2 = axis A,
     /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
-    HeadHead { tool_length: f64 },
+    HeadHead {
+        /// Pivot to tool tip (d2), mm.
+        tool_length: f64,
+    },
     /// LinuxCNC's xyzac-trt (`tilt` A, axes X Y Z A C) or xyzbc-trt (`tilt` B, axes
     /// X Y Z B C) table-rotary-tilting machine, or a Haas TR-series A/B table (`tilt` AB, axes
     /// X Y Z A B: xyzac-trt with the platter lettered B).
     TableTable {
+        /// Which table tilts.
         tilt: TrunnionTilt,
+        /// The LinuxCNC parameters.
         params: TrunnionParams,
     },
     /// A tilting head B (about Y) on a fixed bed with a rotary table C; `pivot_length` (mm)
     /// from the B pivot to the tool tip. Axes X Y Z B C.
-    HeadTable { pivot_length: f64 },
+    HeadTable {
+        /// B pivot to tool tip, mm.
+        pivot_length: f64,
+    },
     /// Seed 001's dresser: planar X–Z slides and a rotary axis B that keeps the dressing tool
     /// on the profile normal; `tool_length` (mm) from the B axis to the tool tip. Axes X Z B.
-    Dresser { tool_length: f64 },
+    Dresser {
+        /// B axis to tool tip, mm.
+        tool_length: f64,
+    },
     /// A joint-space path (CSV of axis positions along a parameter s): any axes, named as in
     /// the CSV's `q_<axis>` columns, in the file's order; no feed limit applies.
     Joint,
@@ -205,8 +224,11 @@ impl KinematicsSpec {
 /// A machine: kinematics, axes (in the kinematics' order) and the feed cap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
+    /// The machine's name (for reports).
     pub name: String,
+    /// The kinematic structure.
     pub kinematics: KinematicsSpec,
+    /// The axes, in the kinematics' order.
     pub axes: Vec<Axis>,
     /// Maximum tool-tip feed, mm/s (`None`: only the axes limit the feed).
     pub feed_max: Option<f64>,
@@ -265,6 +287,7 @@ impl Machine {
 pub struct References {
     /// The machine file (for messages naming the field to add).
     pub file: PathBuf,
+    /// Per axis: its name and reference positions.
     pub axes: Vec<(String, Vec<f64>)>,
 }
 

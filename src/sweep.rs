@@ -92,7 +92,9 @@ use crate::writers::write_atomically;
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum SweptLimit {
+    /// The velocity limit.
     Velocity,
+    /// The acceleration limit.
     Acceleration,
 }
 
@@ -110,9 +112,11 @@ impl fmt::Display for SweptLimit {
 pub struct SweepOptions {
     /// Axis name, as in the machine file (e.g. `"C"`).
     pub axis: String,
+    /// Which of its limits.
     pub limit: SweptLimit,
-    /// First and last limit value (the max side; mm/s, mm/s², °/s or °/s²).
+    /// First limit value (the max side; mm/s, mm/s², °/s or °/s²).
     pub from: f64,
+    /// The last value.
     pub to: f64,
     /// Number of values, evenly spaced from `from` to `to` (1: `from` only).
     pub steps: usize,
@@ -167,16 +171,19 @@ pub const MAX_SWEEP_FACTOR: f64 = 1e3;
 pub struct SweepPoint {
     /// The swept limit's max side at this step.
     pub limit: f64,
+    /// Cycle time T at `limit`, s.
     pub cycle_time_s: f64,
     /// dT/dv from the dual variables, s per unit of the limit (`None` with the reach solver).
     pub sensitivity_dual: Option<f64>,
     /// dT/dv by central differences (T₊ − T₋)/(2hv).
     pub sensitivity_fd: f64,
-    /// T at v(1 − h) and v(1 + h), s.
+    /// T at v(1 − h), s.
     pub cycle_time_minus_s: f64,
+    /// T at v(1 + h), s.
     pub cycle_time_plus_s: f64,
-    /// The dual sensitivity at v(1 − h) and v(1 + h).
+    /// The dual sensitivity at v(1 − h).
     pub sensitivity_dual_minus: Option<f64>,
+    /// The dual sensitivity at v(1 + h).
     pub sensitivity_dual_plus: Option<f64>,
     /// The swept limit holds the feed down somewhere at this step (its share of the path in
     /// [`binding`](Self::binding) is not 0). Where it does not, dT/dv = 0 and both estimates
@@ -189,6 +196,7 @@ pub struct SweepPoint {
     pub relative_difference: Option<f64>,
     /// Which limit holds the feed down over what share of the path and of the time.
     pub binding: Vec<BindingShare>,
+    /// The worst status over the step's spans.
     pub status: Status,
     /// The step's schedule re-simulated at the servo period keeps every limit.
     pub verified: bool,
@@ -201,22 +209,29 @@ pub struct SweepPoint {
 /// A whole sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Sweep {
+    /// The machine's name.
     pub machine: String,
+    /// The toolpath as named by the caller.
     pub toolpath: String,
+    /// The swept axis.
     pub axis: String,
+    /// Which of its limits.
     pub limit: SweptLimit,
     /// Unit of the limit values (`mm/s²`, `deg/s`, …); sensitivities are in s per this unit.
     pub unit: String,
     /// The machine's own limit (min, max) before scaling.
     pub nominal_min: f64,
+    /// The machine's own limit, max side.
     pub nominal_max: f64,
     /// Stations (fixed for every step) and spans.
     pub stations: usize,
+    /// Rest-to-rest spans.
     pub spans: usize,
     /// Relative finite-difference step h.
     pub fd_step: f64,
     /// The solver of the steps: `"clarabel"` or `"reach"`.
     pub solver: String,
+    /// The steps, in order of the limit.
     pub points: Vec<SweepPoint>,
 }
 

@@ -105,6 +105,7 @@ pub struct GcodeOptions {
 /// A written program and what it contains.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Program {
+    /// The program, as written to the file.
     pub text: String,
     /// Motion blocks after the first point (each with its F).
     pub blocks: usize,

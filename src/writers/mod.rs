@@ -14,7 +14,9 @@ use crate::schedule::Schedule;
 /// Formats a schedule can be written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ScheduleFormat {
+    /// `.json`: [`schedule_json`].
     Json,
+    /// `.csv`: [`schedule_csv`].
     Csv,
 }
 
