@@ -24,7 +24,7 @@
 //! | `solver.max_iter` | at least 1 |
 //! | `solver.tol_gap`, `solver.tol_feas` | finite, > 0 |
 //! | `solver.window`, `jerk.window` | at least 2 stations |
-//! | `solver.time_limit` | > 0 s (may be infinite) |
+//! | `solver.time_limit` | ≥ 0 s (may be infinite) |
 //! | `jerk.convergence` | finite, > 0 |
 //! | `jerk.max_iterations` | at least 1 |
 //! | compare: `junction_deviation` | finite, ≥ 0 mm |
@@ -188,11 +188,12 @@ impl SolverSettings {
         positive("tol_gap", self.tol_gap)?;
         positive("tol_feas", self.tol_feas)?;
         at_least("window", self.window, 2, "stations per window")?;
-        if self.time_limit.is_nan() || self.time_limit <= 0.0 {
+        // 0 is allowed: Clarabel stops at once and every window keeps the reach profile.
+        if self.time_limit.is_nan() || self.time_limit < 0.0 {
             return Err(Error::option(
                 "time_limit",
                 format!(
-                    "must be more than 0 s (infinite: no limit), got {}",
+                    "must be 0 s or more (0: the reach profile; infinite: no limit), got {}",
                     number(self.time_limit)
                 ),
             ));
