@@ -15,11 +15,39 @@ use crate::{toolpath, writers};
 #[derive(Debug, Parser)]
 #[command(version, about)]
 pub struct Cli {
+    /// The subcommand and its arguments.
     #[command(subcommand)]
     pub command: Command,
+    /// Diagnostics on stderr: `-v` each solver stage's details (refinement rounds, SCP
+    /// iterates), `-vv` also Clarabel's own log. `RUST_LOG` (e.g. `feedopt=debug`), when set,
+    /// decides instead.
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    pub verbose: u8,
+}
+
+/// Installs the diagnostics subscriber: the library's `tracing` events on stderr, filtered by
+/// `RUST_LOG` when it is set, else by `verbose` (0: warnings, 1: `feedopt=debug`, 2 or more:
+/// `feedopt=trace`). Call once, before [`run`].
+pub fn init_logging(verbose: u8) {
+    use tracing_subscriber::EnvFilter;
+    let filter = match std::env::var("RUST_LOG") {
+        Ok(spec) if !spec.trim().is_empty() => EnvFilter::new(spec),
+        _ => EnvFilter::new(match verbose {
+            0 => "warn",
+            1 => "warn,feedopt=debug",
+            _ => "warn,feedopt=trace",
+        }),
+    };
+    // A second call (in a test, say) keeps the first subscriber.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .without_time()
+        .try_init();
 }
 
 #[derive(Debug, Subcommand)]
+/// The subcommands.
 pub enum Command {
     /// Compute the time-optimal feed profile of a toolpath on a machine.
     Solve(SolveArgs),
@@ -35,8 +63,10 @@ pub enum Command {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt compare`.
 pub struct CompareArgs {
     #[command(flatten)]
+    /// Machine, toolpath, --json, --plot and the solve options.
     pub solve: SolveArgs,
     /// Junction deviation δ of the controller baseline, mm (grbl's `$11`): how far the
     /// virtual arc through a corner may pass from the corner point.
@@ -45,6 +75,7 @@ pub struct CompareArgs {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt sweep`.
 pub struct SweepArgs {
     /// Machine, toolpath, --json, -o (here: the sweep table as FILE.csv or FILE.json) and the
     /// solve options. `--stations N` fixes the stations of every step; without it they are
@@ -74,6 +105,7 @@ pub struct SweepArgs {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt solve`, and the solve options every subcommand shares.
 pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
@@ -165,39 +197,72 @@ fn parse_period(text: &str) -> std::result::Result<f64, String> {
 /// `--format` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum FormatChoice {
+    /// APT CL (`.cls`, `.apt`).
     Apt,
+    /// G-code (`.ngc`, `.nc`, `.gcode`, `.tap`).
     Gcode,
+    /// A joint-space CSV (`s,q_<axis>,…`).
     Csv,
 }
 
 /// `--solver` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum SolverChoice {
+    /// The convex solve (Clarabel).
     Clarabel,
+    /// The O(N) reachability pass.
     Reach,
 }
 
-/// The shortest servo period (`--period`) feedopt re-simulates at: 1 µs. The re-simulation's
-/// work is the cycle time divided by the period.
-pub const MIN_PERIOD_S: f64 = 1e-6;
+/// The command-line flag of each option field the library names in an
+/// [`Error::InvalidOption`] (a nested struct's prefix `solve.` dropped).
+const FLAGS: &[(&str, &str)] = &[
+    ("geometry.corner_angle_deg", "--corner-angle"),
+    ("geometry.tolerance_mm", "--tolerance"),
+    ("geometry.tolerance_deg", "--tolerance-deg"),
+    ("geometry.feed_override", "--feed-override"),
+    ("stations", "--stations"),
+    ("start_feed", "--start-feed"),
+    ("end_feed", "--end-feed"),
+    ("verify.period", "--period"),
+    ("verify.chord.tolerance", "--chord-tolerance"),
+    ("verify.chord.period", "--period"),
+    ("period", "--period"),
+    ("junction_deviation", "--junction-deviation"),
+    ("axis", "--axis"),
+    ("from", "--from"),
+    ("to", "--to"),
+    ("steps", "--steps"),
+    ("fd_step", "--fd-step"),
+    ("max_rotation_deg", "--max-rotation-deg"),
+];
 
-/// The longest servo period: 1 s.
-pub const MAX_PERIOD_S: f64 = 1.0;
+/// The library's [`Error::InvalidOption`] as the command line says it: naming the flag
+/// (`--period 1e-12 s is outside …`) instead of the field; every other error unchanged.
+pub fn name_flag(e: Error) -> Error {
+    match e {
+        Error::InvalidOption { field, reason } => {
+            let key = field.strip_prefix("solve.").unwrap_or(&field);
+            match FLAGS.iter().find(|(f, _)| *f == key) {
+                Some((_, flag)) => Error::Usage(format!("{flag} {reason}")),
+                None => Error::InvalidOption { field, reason },
+            }
+        }
+        e => e,
+    }
+}
 
-/// The smallest chord tolerance (`--chord-tolerance`): 1 nm, below any machine's resolution.
-pub const MIN_CHORD_TOLERANCE_MM: f64 = 1e-6;
-
-/// The largest start or end feed (`--start-feed`, `--end-feed`): 1e6 mm/s (1 km/s).
-pub const MAX_END_FEED: f64 = 1e6;
-
-/// The range of `--feed-override`: a factor below 0.001 slows the feed to a crawl (and the
-/// re-simulation's work grows with the cycle time); above 1000 it caps nothing.
-pub const MIN_FEED_OVERRIDE: f64 = 1e-3;
-pub const MAX_FEED_OVERRIDE: f64 = 1e3;
-
-/// The smallest rotation per block (`gcode --max-rotation-deg`): 0.001°, a rotary axis's
-/// resolution; smaller steps only multiply the program's blocks.
-pub const MIN_ROTATION_DEG: f64 = 1e-3;
+/// `--plot FILE`: a format the plot writer knows (the build has plots).
+fn plot_format(path: &std::path::Path) -> Result<()> {
+    #[cfg(feature = "plot")]
+    return writers::plot::plot_format(path).map(|_| ());
+    #[cfg(not(feature = "plot"))]
+    return Err(Error::Usage(format!(
+        "--plot {}: this feedopt was built without plots (cargo feature `plot`): rebuild with \
+         it, or leave --plot out",
+        path.display()
+    )));
+}
 
 impl SolveArgs {
     /// The inputs an output must not overwrite.
@@ -208,55 +273,9 @@ impl SolveArgs {
         ]
     }
 
+    /// The options these arguments give, checked by the library ([`Options::validate`]), and
+    /// the outputs checked before any work.
     fn options(&self) -> Result<Options> {
-        if !(self.corner_angle.is_finite() && self.corner_angle > 0.0 && self.corner_angle < 180.0)
-        {
-            return Err(Error::Usage(format!(
-                "--corner-angle must be between 0 and 180 degrees, got {}",
-                self.corner_angle
-            )));
-        }
-        let max_stations = Options::default().max_stations;
-        match self.stations {
-            Some(n) if n < 2 => {
-                return Err(Error::Usage("--stations must be at least 2".into()));
-            }
-            Some(n) if n > max_stations => {
-                return Err(Error::Usage(format!(
-                    "--stations {n} is more than the limit of {max_stations} (memory and time \
-                     grow with it): give at most {max_stations}, or leave it out to refine \
-                     automatically"
-                )));
-            }
-            _ => {}
-        }
-        if !(MIN_PERIOD_S..=MAX_PERIOD_S).contains(&self.period) {
-            return Err(Error::Usage(format!(
-                "--period {} s is outside {MIN_PERIOD_S:e} s to {MAX_PERIOD_S} s (1 µs to 1 s; \
-                 the re-simulation takes cycle time ÷ period steps): give e.g. 1ms or 250us",
-                crate::error::number(self.period)
-            )));
-        }
-        for (option, feed) in [
-            ("--start-feed", self.start_feed),
-            ("--end-feed", self.end_feed),
-        ] {
-            if !(feed.is_finite() && (0.0..=MAX_END_FEED).contains(&feed)) {
-                return Err(Error::Usage(format!(
-                    "{option} {} mm/s is outside 0 to {MAX_END_FEED:e} mm/s: give the \
-                     tool-tip feed in mm/s (0: at rest)",
-                    crate::error::number(feed)
-                )));
-            }
-        }
-        if let Some(out) = &self.output {
-            writers::schedule_format(out)?;
-            writers::check_output("-o", out, &self.inputs())?;
-        }
-        if let Some(plot) = &self.plot {
-            writers::plot::plot_format(plot)?;
-            writers::check_output("--plot", plot, &self.inputs())?;
-        }
         let mut o = Options {
             stations: self.stations,
             solver_kind: match self.solver {
@@ -267,128 +286,37 @@ impl SolveArgs {
             end_feed: self.end_feed,
             verify: crate::verify::VerifyOptions {
                 period: self.period,
-                chord: match self.chord_tolerance {
-                    None => None,
-                    Some(d) if d.is_finite() && d >= MIN_CHORD_TOLERANCE_MM => {
-                        Some(crate::constraints::Chord {
-                            tolerance: d,
-                            period: self.period,
-                        })
-                    }
-                    Some(d) => {
-                        return Err(Error::Usage(format!(
-                            "--chord-tolerance {} mm: give a chord tolerance of at least \
-                             {MIN_CHORD_TOLERANCE_MM:e} mm (1 nm; smaller ones only slow the \
-                             feed to a crawl)",
-                            crate::error::number(d)
-                        )));
-                    }
-                },
+                chord: self.chord_tolerance.map(|d| crate::constraints::Chord {
+                    tolerance: d,
+                    period: self.period,
+                }),
                 ..Default::default()
             },
             jerk_limited: !self.no_jerk,
             ..Options::default()
         };
         o.geometry.corner_angle_deg = self.corner_angle;
-        if !(self.tolerance >= 0.0 && self.tolerance_deg >= 0.0) {
-            return Err(Error::Usage(
-                "--tolerance and --tolerance-deg must be ≥ 0".into(),
-            ));
-        }
-        if !(MIN_FEED_OVERRIDE..=MAX_FEED_OVERRIDE).contains(&self.feed_override) {
-            return Err(Error::Usage(format!(
-                "--feed-override {}: give a factor from {MIN_FEED_OVERRIDE} to \
-                 {MAX_FEED_OVERRIDE} (1: the programmed feeds)",
-                crate::error::number(self.feed_override)
-            )));
-        }
         o.geometry.feed_override = self.feed_override;
         o.geometry.ignore_programmed_feed = self.ignore_programmed_feed;
         o.geometry.tolerance_mm = self.tolerance;
         o.geometry.tolerance_deg = self.tolerance_deg;
+        o.validate()?;
+        if let Some(out) = &self.output {
+            writers::schedule_format(out)?;
+            writers::check_output("-o", out, &self.inputs())?;
+        }
+        if let Some(plot) = &self.plot {
+            plot_format(plot)?;
+            writers::check_output("--plot", plot, &self.inputs())?;
+        }
         Ok(o)
     }
 
-    /// The start and end feeds against the machine's maximum feed (checked before solving).
-    fn check_feeds(&self, machine: &Machine) -> Result<()> {
-        let Some(max) = machine.feed_max else {
-            return Ok(());
-        };
-        for (option, feed) in [
-            ("--start-feed", self.start_feed),
-            ("--end-feed", self.end_feed),
-        ] {
-            if feed > max {
-                return Err(Error::Usage(format!(
-                    "{option} {} mm/s is more than the machine's maximum feed (feed.max = \
-                     {max} mm/s in {}): give at most {max} mm/s",
-                    crate::error::number(feed),
-                    self.machine.display()
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// The machine file, read and checked against these options.
-    fn machine(&self) -> Result<Machine> {
+    /// The machine file, read and checked against `options` ([`Options::validate_for`]).
+    fn machine(&self, options: &Options) -> Result<Machine> {
         let machine = Machine::from_file(&self.machine)?;
-        self.check_feeds(&machine)?;
+        options.validate_for(&machine)?;
         Ok(machine)
-    }
-}
-
-/// A spinner on stderr with the solve's stage and refinement rounds: drawn only when stderr is
-/// a terminal, and only once the solve has run for a second (short solves print nothing).
-struct Bar {
-    bar: indicatif::ProgressBar,
-    start: std::time::Instant,
-    shown: std::sync::atomic::AtomicBool,
-}
-
-impl Bar {
-    fn new() -> Bar {
-        let bar = indicatif::ProgressBar::hidden();
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-        );
-        Bar {
-            bar,
-            start: std::time::Instant::now(),
-            shown: std::sync::atomic::AtomicBool::new(false),
-        }
-    }
-
-    fn show(&self, msg: String) {
-        use std::io::IsTerminal;
-        self.bar.set_message(msg);
-        if self.start.elapsed().as_secs_f64() >= 1.0
-            && std::io::stderr().is_terminal()
-            && !self.shown.swap(true, std::sync::atomic::Ordering::Relaxed)
-        {
-            self.bar
-                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            self.bar
-                .enable_steady_tick(std::time::Duration::from_millis(120));
-        }
-    }
-}
-
-impl optimize::Progress for Bar {
-    fn stage(&self, what: &str) {
-        self.show(what.to_string());
-    }
-    fn round(&self, stations: usize, estimate: f64, target: f64) {
-        self.show(format!(
-            "refining stations: {stations}, estimated error {estimate:.1e} (target {target:.0e})"
-        ));
-    }
-}
-
-impl Drop for Bar {
-    fn drop(&mut self) {
-        self.bar.finish_and_clear();
     }
 }
 
@@ -398,20 +326,24 @@ fn solve_with_progress(
     input: &toolpath::Input,
     options: &Options,
 ) -> Result<optimize::Solution> {
-    let bar = Bar::new();
+    #[cfg(feature = "progress")]
+    let bar = crate::progress::Spinner::new();
+    #[cfg(not(feature = "progress"))]
+    let bar = optimize::Silent;
     optimize::optimize_input_observed(machine, input, options, &bar)
 }
 
 /// `feedopt solve`: returns what to print on stdout.
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
-    let machine = args.machine()?;
+    let machine = args.machine(&options)?;
     let (input, warnings) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     let (detected, dwell) = reader_used(args, &input)?;
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
+    #[cfg(feature = "plot")]
     if let Some(plot) = &args.plot {
         writers::plot::write_solution_plot(
             plot,
@@ -498,16 +430,12 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
         solve: a.options()?,
         junction_deviation: args.junction_deviation,
     };
-    if !(options.junction_deviation.is_finite() && options.junction_deviation >= 0.0) {
-        return Err(Error::Usage(format!(
-            "--junction-deviation must be ≥ 0 mm, got {}",
-            options.junction_deviation
-        )));
-    }
-    let machine = a.machine()?;
+    options.validate()?;
+    let machine = a.machine(&options.solve)?;
     let (input, _) = read_input(a)?;
     let name = a.toolpath.display().to_string();
     let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
+    #[cfg(feature = "plot")]
     if let Some(plot) = &a.plot {
         let curves: Vec<writers::plot::ProfileCurve> = cmp
             .schedules
@@ -541,17 +469,19 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     let solve = &args.solve;
     let options = solve.options()?;
     // `options()` has checked --plot (and -o) already.
-    let machine = solve.machine()?;
-    let (input, _) = read_input(solve)?;
     let mut o =
         crate::sweep::SweepOptions::new(&args.axis, args.limit, args.from, args.to, args.steps);
     o.fd_step = args.fd_step;
     o.solve = options;
     o.progress = !solve.json && std::io::stderr().is_terminal();
+    o.validate()?;
+    let machine = solve.machine(&o.solve)?;
+    let (input, _) = read_input(solve)?;
     let result = crate::sweep::sweep(&machine, &input, &solve.toolpath.display().to_string(), &o)?;
     if let Some(out) = &solve.output {
         result.write(out)?;
     }
+    #[cfg(feature = "plot")]
     if let Some(plot) = &args.solve.plot {
         result.write_plot(plot)?;
     }
@@ -562,7 +492,8 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     }
 }
 
-/// Runs a parsed command line; returns what to print on stdout.
+/// Runs a parsed command line; returns what to print on stdout. An option the library refuses
+/// is named by its flag ([`name_flag`]).
 pub fn run(cli: &Cli) -> Result<String> {
     match &cli.command {
         Command::Solve(args) => solve(args),
@@ -571,6 +502,7 @@ pub fn run(cli: &Cli) -> Result<String> {
         Command::Compare(args) => compare(args),
         Command::Sweep(args) => sweep(args),
     }
+    .map_err(name_flag)
 }
 
 /// The solve options of `feedopt gcode` and `feedopt interpolate` (as `feedopt solve`'s).
@@ -658,15 +590,17 @@ impl PlanArgs {
 /// Reads, solves; reader warnings go to stderr.
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
     let options = args.options()?;
-    let machine = args.machine()?;
+    let machine = args.machine(&options)?;
     let (input, _) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt gcode`.
 pub struct GcodeArgs {
     #[command(flatten)]
+    /// Machine, toolpath and the solve options.
     pub plan: PlanArgs,
     /// The G-code program to write (.ngc, .nc, …).
     #[arg(long, short, value_name = "FILE")]
@@ -687,15 +621,11 @@ pub struct GcodeArgs {
 /// `feedopt gcode`: returns what to print on stdout.
 pub fn gcode(args: &GcodeArgs) -> Result<String> {
     writers::check_output("-o", &args.output, &args.plan.inputs())?;
-    if let Some(d) = args.max_rotation_deg {
-        if !(d.is_finite() && d >= MIN_ROTATION_DEG) {
-            return Err(Error::Usage(format!(
-                "--max-rotation-deg {}: give at least {MIN_ROTATION_DEG}° (a rotary axis's \
-                 resolution; smaller steps only multiply the blocks)",
-                crate::error::number(d)
-            )));
-        }
-    }
+    let gcode_options = writers::gcode::GcodeOptions {
+        dialect: args.dialect,
+        max_rotation_deg: args.max_rotation_deg,
+    };
+    gcode_options.validate()?;
     let solve_args = args.plan.solve_args(
         args.input_dialect.unwrap_or(args.dialect),
         crate::verify::VerifyOptions::default().period,
@@ -713,10 +643,7 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
         path,
         &solution,
         &options.geometry,
-        &writers::gcode::GcodeOptions {
-            dialect: args.dialect,
-            max_rotation_deg: args.max_rotation_deg,
-        },
+        &gcode_options,
     )?;
     Ok(format!(
         "wrote {} ({} dialect): {} blocks ({} under G93), {} merged, {} added by Δθ\n\
@@ -733,8 +660,10 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
 }
 
 #[derive(Debug, Args)]
+/// Arguments of `feedopt interpolate`.
 pub struct InterpolateArgs {
     #[command(flatten)]
+    /// Machine, toolpath and the solve options.
     pub plan: PlanArgs,
     /// Interpolation period: `1ms`, `500us`, `0.002` (seconds); 1 µs to 1 s. Also the servo
     /// period of the schedule's verification.

@@ -70,16 +70,22 @@ impl Default for CompareOptions {
 /// What every planner sees: the inputs and feedopt's solution (whose path is the common
 /// geometry).
 pub struct Context<'a> {
+    /// The machine.
     pub machine: &'a Machine,
+    /// The toolpath or joint-space path.
     pub input: &'a Input,
+    /// The comparison's options.
     pub options: &'a CompareOptions,
+    /// feedopt's acceleration-limited solution, whose path is the common geometry.
     pub reference: &'a Solution,
 }
 
 /// A schedule to evaluate: b = u̇² at the stations of every span of the reference path.
 #[derive(Debug, Clone)]
 pub struct Candidate {
+    /// The reference path's span problems (stations) the schedule is given on.
     pub problems: Vec<SpanProblem>,
+    /// b (and ü) at those stations, per span.
     pub solutions: Vec<SpanSolution>,
     /// Figures of the planner worth printing (e.g. a closed-form time).
     pub notes: Vec<String>,
@@ -94,6 +100,7 @@ pub struct Entry {
     pub key: &'static str,
     /// What it is.
     pub label: &'static str,
+    /// Computes the schedule.
     pub plan: Planner,
 }
 
@@ -250,6 +257,7 @@ fn realize(ctx: &Context, profile: &Profile, notes: Vec<String>) -> Candidate {
 /// One axis's worst use of its limits in one schedule.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct AxisRow {
+    /// Axis name.
     pub name: String,
     /// Worst |q̇| / limit.
     pub velocity: f64,
@@ -264,21 +272,27 @@ pub struct AxisRow {
 /// One schedule's figures.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Row {
+    /// Short key (JSON, column heading).
     pub key: String,
+    /// What the schedule is.
     pub label: String,
+    /// Cycle time, s.
     pub cycle_time_s: f64,
     /// Every ratio ≤ 1 + tolerance (1.001).
     pub verified: bool,
     /// The largest ratio to any limit, and which limit.
     pub worst_ratio: f64,
+    /// The limit of `worst_ratio` (e.g. `X acceleration`).
     pub worst_limit: String,
     /// Largest V / feed cap.
     pub worst_feed_ratio: f64,
+    /// Every axis's worst use of its limits.
     pub axes: Vec<AxisRow>,
     /// Corners between spans passed at speed (velocity jumps executed in one servo period).
     pub corners_at_speed: usize,
     /// The largest ratio of such a jump's acceleration Δq̇ / T to an axis's limit (0: none).
     pub worst_corner_ratio: f64,
+    /// Figures of the planner worth printing.
     pub notes: Vec<String>,
     /// The schedule itself (stations with s, t, V, every axis's motion).
     #[serde(skip)]
@@ -288,21 +302,28 @@ pub struct Row {
 /// A schedule that does not apply to the input, and why.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Omitted {
+    /// The schedule's key.
     pub key: String,
+    /// Why it does not apply.
     pub reason: String,
 }
 
 /// The comparison: what `feedopt compare` prints.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Comparison {
+    /// The machine's name.
     pub machine: String,
+    /// The toolpath as named on the command line.
     pub toolpath: String,
     /// Servo period of the re-simulation, s.
     pub period_s: f64,
+    /// Junction deviation δ of the controller baseline, mm.
     pub junction_deviation_mm: f64,
     /// Whether lengths and feeds are in the joint-space path's parameter s.
     pub joint_space: bool,
+    /// The schedules compared, in table order.
     pub schedules: Vec<Row>,
+    /// The schedules that do not apply to this input.
     pub omitted: Vec<Omitted>,
 }
 
@@ -321,6 +342,12 @@ pub fn compare(
     toolpath_name: &str,
     options: &CompareOptions,
 ) -> Result<Comparison> {
+    options.validate()?;
+    machine.validate()?;
+    options
+        .solve
+        .validate_for(machine)
+        .map_err(|e| e.within("solve"))?;
     // The reference (c) is acceleration-limited; (d) adds the jerk limits.
     let accel_only = Options {
         jerk_limited: false,

@@ -12,24 +12,30 @@ pub enum Error {
     /// A toolpath (or other line-oriented) input file has a bad record.
     #[error("{}:{line}: {message}", file.display())]
     Parse {
+        /// The file.
         file: PathBuf,
         /// 1-based line number of the record (its first line when `$`-continued).
         line: usize,
+        /// What is wrong with the record and what to do.
         message: String,
     },
     /// A machine file has a missing, unknown or invalid field.
     #[error("{}: field `{field}`: {message}", file.display())]
     Field {
+        /// The machine file.
         file: PathBuf,
         /// Dotted path of the field, e.g. `axes.C.velocity`.
         field: String,
+        /// What is wrong with the field and what to do.
         message: String,
     },
     /// A file could not be read or written.
     #[error("{}: {}", file.display(), io_reason(source))]
     Io {
+        /// The file.
         file: PathBuf,
         #[source]
+        /// What the operating system said.
         source: std::io::Error,
     },
     /// The request cannot be met by any schedule (names where on the path).
@@ -41,6 +47,25 @@ pub enum Error {
     /// A bad option or argument combination.
     #[error("{0}")]
     Usage(String),
+    /// An option of a library call is out of its range (checked where it enters the library:
+    /// see [`crate::validate`]).
+    #[error("option `{field}`: {reason}")]
+    InvalidOption {
+        /// Dotted path of the option in its struct, e.g. `verify.period` of
+        /// [`Options`](crate::optimize::Options), or the argument's name (`period`).
+        field: String,
+        /// What is wrong with the value and what to give instead.
+        reason: String,
+    },
+    /// A [`Machine`](crate::machine::Machine) (built in code; a machine file's errors are
+    /// [`Error::Field`]) has an invalid field ([`Machine::validate`](crate::machine::Machine::validate)).
+    #[error("machine: field `{field}`: {reason}")]
+    InvalidMachine {
+        /// Dotted path of the field as a machine file names it, e.g. `axes.C.velocity`.
+        field: String,
+        /// What is wrong with the value and what to give instead.
+        reason: String,
+    },
 }
 
 /// Result alias used throughout the crate.
@@ -64,6 +89,26 @@ impl Error {
             file: file.into(),
             field: field.into(),
             message: message.into(),
+        }
+    }
+
+    /// An [`Error::InvalidOption`] for `field`.
+    pub(crate) fn option(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::InvalidOption {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The same error with `prefix.` before an [`Error::InvalidOption`]'s field (an option of
+    /// a nested struct); any other error unchanged.
+    pub(crate) fn within(self, prefix: &str) -> Self {
+        match self {
+            Error::InvalidOption { field, reason } => Error::InvalidOption {
+                field: format!("{prefix}.{field}"),
+                reason,
+            },
+            e => e,
         }
     }
 

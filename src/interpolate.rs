@@ -53,13 +53,16 @@ use crate::schedule::interval_times;
 pub struct Timeline {
     /// Per span: its stations' u, start times t (s) and arc lengths s, and b.
     pub spans: Vec<SpanTimeline>,
+    /// The schedule's cycle time, s.
     pub cycle_time: f64,
 }
 
 /// One span's stations on the global clock.
 #[derive(Debug, Clone)]
 pub struct SpanTimeline {
+    /// The stations' u.
     pub u: Vec<f64>,
+    /// b = u̇² at the stations.
     pub b: Vec<f64>,
     /// ü at the stations of a jerk-limited profile.
     pub a: Option<Vec<f64>>,
@@ -158,6 +161,7 @@ pub struct Setpoints {
     pub joint: bool,
     /// Interpolation period T, s.
     pub period: f64,
+    /// The setpoints, at t = 0, T, 2T, … and at the cycle time.
     pub samples: Vec<Sample>,
 }
 
@@ -167,11 +171,7 @@ pub const MAX_SAMPLES: usize = 4_000_000;
 
 /// Samples the solution's motion at period `period` (s): see the module doc.
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
-    if !(period.is_finite() && period > 0.0) {
-        return Err(Error::Usage(format!(
-            "the interpolation period must be a positive number of seconds, got {period}"
-        )));
-    }
+    crate::validate::period("period", period)?;
     let timeline = Timeline::new(solution)?;
     let cycle = timeline.cycle_time;
     let count = (cycle / period).ceil();
@@ -424,7 +424,9 @@ pub fn read_setpoints_bin(source: &Path, bytes: &[u8]) -> Result<Setpoints> {
 /// Output formats of the setpoints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SetpointFormat {
+    /// Comma-separated text.
     Csv,
+    /// The compact binary layout of the module doc.
     Bin,
 }
 

@@ -47,7 +47,9 @@ use crate::error::{Error, Result};
 /// A two-sided limit on an axis quantity: `min < 0 < max`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limit {
+    /// The negative side.
     pub min: f64,
+    /// The positive side.
     pub max: f64,
 }
 
@@ -70,16 +72,22 @@ impl Limit {
 /// Linear (mm) or rotary (degrees) axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AxisKind {
+    /// Millimetres.
     Linear,
+    /// Degrees.
     Rotary,
 }
 
 /// One machine axis with its velocity and acceleration limits (file units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
+    /// Axis name (`X`, `C`, or a joint-space machine's own).
     pub name: String,
+    /// Linear or rotary.
     pub kind: AxisKind,
+    /// Velocity limit, mm/s or °/s.
     pub velocity: Limit,
+    /// Acceleration limit, mm/s² or °/s².
     pub acceleration: Limit,
     /// Jerk limit (mm/s³ or °/s³), `None` when the file gives none: the schedule is then
     /// acceleration-limited (issue 6).
@@ -155,20 +163,31 @@ pub enum KinematicsSpec {
     Xyz,
     /// Seed 000's fixed-bed double swivel head: θ1 = axis C about z, θ2 = axis A,
     /// `tool_length` = d2 (pivot to tool tip, mm). Eq. 15–16 and 27.
-    HeadHead { tool_length: f64 },
+    HeadHead {
+        /// Pivot to tool tip (d2), mm.
+        tool_length: f64,
+    },
     /// LinuxCNC's xyzac-trt (`tilt` A, axes X Y Z A C) or xyzbc-trt (`tilt` B, axes
     /// X Y Z B C) table-rotary-tilting machine, or a Haas TR-series A/B table (`tilt` AB, axes
     /// X Y Z A B: xyzac-trt with the platter lettered B).
     TableTable {
+        /// Which table tilts.
         tilt: TrunnionTilt,
+        /// The LinuxCNC parameters.
         params: TrunnionParams,
     },
     /// A tilting head B (about Y) on a fixed bed with a rotary table C; `pivot_length` (mm)
     /// from the B pivot to the tool tip. Axes X Y Z B C.
-    HeadTable { pivot_length: f64 },
+    HeadTable {
+        /// B pivot to tool tip, mm.
+        pivot_length: f64,
+    },
     /// Seed 001's dresser: planar X–Z slides and a rotary axis B that keeps the dressing tool
     /// on the profile normal; `tool_length` (mm) from the B axis to the tool tip. Axes X Z B.
-    Dresser { tool_length: f64 },
+    Dresser {
+        /// B axis to tool tip, mm.
+        tool_length: f64,
+    },
     /// A joint-space path (CSV of axis positions along a parameter s): any axes, named as in
     /// the CSV's `q_<axis>` columns, in the file's order; no feed limit applies.
     Joint,
@@ -205,8 +224,11 @@ impl KinematicsSpec {
 /// A machine: kinematics, axes (in the kinematics' order) and the feed cap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
+    /// The machine's name (for reports).
     pub name: String,
+    /// The kinematic structure.
     pub kinematics: KinematicsSpec,
+    /// The axes, in the kinematics' order.
     pub axes: Vec<Axis>,
     /// Maximum tool-tip feed, mm/s (`None`: only the axes limit the feed).
     pub feed_max: Option<f64>,
@@ -248,7 +270,7 @@ impl Machine {
                 source,
                 field,
                 format!(
-                    "given twice in one object (the second time on line {line}): remove one of                      them"
+                    "given twice in one object (the second time on line {line}): remove one of them"
                 ),
             ));
         }
@@ -265,6 +287,7 @@ impl Machine {
 pub struct References {
     /// The machine file (for messages naming the field to add).
     pub file: PathBuf,
+    /// Per axis: its name and reference positions.
     pub axes: Vec<(String, Vec<f64>)>,
 }
 
@@ -487,35 +510,12 @@ impl Parser {
 
     /// A limit's size `x` (> 0) must lie within [[`MIN_LIMIT`], `max`] of its `unit`.
     fn plausible_limit(&self, x: f64, field: &str, unit: &str, max: f64) -> Result<()> {
-        if x < MIN_LIMIT {
-            return Err(self.err(
-                field,
-                format!(
-                    "{x} {unit} is implausibly small (at least {MIN_LIMIT:e} {unit}): check the                      unit (mm, degrees, seconds)"
-                ),
-            ));
-        }
-        if x > max {
-            return Err(self.err(
-                field,
-                format!(
-                    "{x} {unit} is implausibly large (at most {max:e} {unit}): check the unit                      (mm, degrees, seconds)"
-                ),
-            ));
-        }
-        Ok(())
+        plausible_limit(x, unit, max).map_err(|reason| self.err(field, reason))
     }
 
     /// A length (mm, or degrees for a rotary travel) within ±[`MAX_LENGTH`].
     fn plausible_length(&self, x: f64, field: &str) -> Result<f64> {
-        if x.abs() > MAX_LENGTH {
-            return Err(self.err(
-                field,
-                format!(
-                    "{x} is implausibly large (at most {MAX_LENGTH:e} mm or degrees in size):                      check the unit (mm)"
-                ),
-            ));
-        }
+        plausible_length(x).map_err(|reason| self.err(field, reason))?;
         Ok(x)
     }
 
@@ -527,16 +527,12 @@ impl Parser {
                 if items.len() != 2 || nums.len() != 2 {
                     return Err(self.err(field, "expected a number or [min, max]"));
                 }
-                let (lo, hi) = (nums[0], nums[1]);
-                if !(lo.is_finite() && hi.is_finite() && lo < 0.0 && hi > 0.0) {
-                    return Err(self.err(
-                        field,
-                        format!("[min, max] must have min < 0 < max, found [{lo}, {hi}]"),
-                    ));
-                }
-                self.plausible_limit(-lo, field, unit, max)?;
-                self.plausible_limit(hi, field, unit, max)?;
-                Ok(Limit { min: lo, max: hi })
+                let limit = Limit {
+                    min: nums[0],
+                    max: nums[1],
+                };
+                check_limit(limit, unit, max).map_err(|reason| self.err(field, reason))?;
+                Ok(limit)
             }
             other => {
                 let x = self.positive(other, field)?;
@@ -790,11 +786,7 @@ impl Parser {
                 } else {
                     KinematicsSpec::axis_kind(name)
                 };
-                let unit = match (kin, kind) {
-                    (KinematicsSpec::Joint, _) => "units/s",
-                    (_, AxisKind::Linear) => "mm/s",
-                    (_, AxisKind::Rotary) => "°/s",
-                };
+                let unit = velocity_unit(kin, kind);
                 Ok(Axis {
                     name: name.to_string(),
                     kind,
@@ -823,5 +815,214 @@ impl Parser {
                 })
             })
             .collect()
+    }
+}
+
+/// The velocity unit of an axis of kind `kind` under kinematics `kin`, for messages.
+fn velocity_unit(kin: &KinematicsSpec, kind: AxisKind) -> &'static str {
+    match (kin, kind) {
+        (KinematicsSpec::Joint, _) => "units/s",
+        (_, AxisKind::Linear) => "mm/s",
+        (_, AxisKind::Rotary) => "°/s",
+    }
+}
+
+/// A limit's size `x` (> 0) lies within [[`MIN_LIMIT`], `max`] of its `unit`; else what to do.
+fn plausible_limit(x: f64, unit: &str, max: f64) -> std::result::Result<(), String> {
+    if x < MIN_LIMIT {
+        return Err(format!(
+            "{x} {unit} is implausibly small (at least {MIN_LIMIT:e} {unit}): check the unit \
+             (mm, degrees, seconds)"
+        ));
+    }
+    if x > max {
+        return Err(format!(
+            "{x} {unit} is implausibly large (at most {max:e} {unit}): check the unit (mm, \
+             degrees, seconds)"
+        ));
+    }
+    Ok(())
+}
+
+/// A two-sided limit: finite, `min < 0 < max`, each side's size plausible
+/// ([`plausible_limit`]); else what to do.
+fn check_limit(limit: Limit, unit: &str, max: f64) -> std::result::Result<(), String> {
+    let Limit { min: lo, max: hi } = limit;
+    if !(lo.is_finite() && hi.is_finite() && lo < 0.0 && hi > 0.0) {
+        return Err(format!(
+            "[min, max] must have min < 0 < max, found [{lo}, {hi}]"
+        ));
+    }
+    plausible_limit(-lo, unit, max)?;
+    plausible_limit(hi, unit, max)
+}
+
+/// A length (mm, or degrees for a rotary travel) is finite and within ±[`MAX_LENGTH`]; else
+/// what to do.
+fn plausible_length(x: f64) -> std::result::Result<(), String> {
+    if !x.is_finite() {
+        return Err(format!("must be a finite number, found {x}"));
+    }
+    if x.abs() > MAX_LENGTH {
+        return Err(format!(
+            "{x} is implausibly large (at most {MAX_LENGTH:e} mm or degrees in size): check the \
+             unit (mm)"
+        ));
+    }
+    Ok(())
+}
+
+impl Machine {
+    /// Checks what [`Machine::from_json`] checks of a file, for a machine built in code: the
+    /// kinematics' parameters (finite, plausible lengths; `tool_length` > 0 on a double swivel
+    /// head, ≥ 0 on a head-table or dresser), the axes the kinematics needs in its order (a
+    /// joint-space machine: 1 to [`MAX_AXES`](crate::kinematics::MAX_AXES) axes with distinct,
+    /// non-empty names), every limit finite with `min < 0 < max` and each side within
+    /// [`MIN_LIMIT`]…[`MAX_LIMIT`] ([`MAX_JERK_LIMIT`] for jerk), travel `min < max` within
+    /// ±[`MAX_LENGTH`], and `feed_max` a plausible limit (none on a joint-space machine).
+    /// [`optimize`](crate::optimize::optimize) calls it before any work. The error
+    /// ([`Error::InvalidMachine`]) names the field as a machine file would (`axes.C.velocity`).
+    pub fn validate(&self) -> Result<()> {
+        let bad = |field: &str, reason: String| Error::InvalidMachine {
+            field: field.to_string(),
+            reason,
+        };
+        let length = |field: &str, x: f64| plausible_length(x).map_err(|r| bad(field, r));
+        let kin = &self.kinematics;
+        match kin {
+            KinematicsSpec::Xyz | KinematicsSpec::Joint => {}
+            KinematicsSpec::HeadHead { tool_length } => {
+                length("kinematics.tool_length", *tool_length)?;
+                if *tool_length <= 0.0 {
+                    return Err(bad(
+                        "kinematics.tool_length",
+                        format!("must be a positive number, found {tool_length}"),
+                    ));
+                }
+            }
+            KinematicsSpec::HeadTable { pivot_length: x }
+            | KinematicsSpec::Dresser { tool_length: x } => {
+                let field = match kin {
+                    KinematicsSpec::HeadTable { .. } => "kinematics.pivot_length",
+                    _ => "kinematics.tool_length",
+                };
+                length(field, *x)?;
+                if *x < 0.0 {
+                    return Err(bad(field, format!("must be zero or positive, found {x}")));
+                }
+            }
+            KinematicsSpec::TableTable { tilt, params } => {
+                let offset = if *tilt == TrunnionTilt::B {
+                    "kinematics.x-offset"
+                } else {
+                    "kinematics.y-offset"
+                };
+                let [x, y, z] = params.rot_point;
+                let [wx, wy, wz] = params.work_offset;
+                for (field, v) in [
+                    ("kinematics.x-rot-point", x),
+                    ("kinematics.y-rot-point", y),
+                    ("kinematics.z-rot-point", z),
+                    (offset, params.tilt_offset),
+                    ("kinematics.z-offset", params.z_offset),
+                    ("kinematics.tool-offset", params.tool_offset),
+                    ("kinematics.work-offset[0]", wx),
+                    ("kinematics.work-offset[1]", wy),
+                    ("kinematics.work-offset[2]", wz),
+                ] {
+                    length(field, v)?;
+                }
+            }
+        }
+        if *kin == KinematicsSpec::Joint {
+            let max = crate::kinematics::MAX_AXES;
+            if self.axes.is_empty() || self.axes.len() > max {
+                return Err(bad(
+                    "axes",
+                    format!(
+                        "a joint-space machine needs 1 to {max} axes, found {}",
+                        self.axes.len()
+                    ),
+                ));
+            }
+            for (k, a) in self.axes.iter().enumerate() {
+                if a.name.is_empty() || self.axes[..k].iter().any(|b| b.name == a.name) {
+                    return Err(bad(
+                        &format!("axes[{k}].name"),
+                        format!(
+                            "`{}`: every axis needs a name of its own (not empty, not repeated)",
+                            a.name
+                        ),
+                    ));
+                }
+            }
+        } else {
+            let names: Vec<&str> = self.axes.iter().map(|a| a.name.as_str()).collect();
+            if names != kin.axis_names() {
+                return Err(bad(
+                    "axes",
+                    format!(
+                        "this kinematics needs the axes {} in that order, found {}",
+                        kin.axis_names().join(" "),
+                        if names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            names.join(" ")
+                        }
+                    ),
+                ));
+            }
+            for a in &self.axes {
+                let kind = KinematicsSpec::axis_kind(&a.name);
+                if a.kind != kind {
+                    return Err(bad(
+                        &format!("axes.{}.kind", a.name),
+                        format!(
+                            "axis {} is {kind:?} in this kinematics, not {:?}",
+                            a.name, a.kind
+                        ),
+                    ));
+                }
+            }
+        }
+        for a in &self.axes {
+            let field = format!("axes.{}", a.name);
+            let unit = velocity_unit(kin, a.kind);
+            let limit = |which: &str, limit: Limit, unit: &str, max: f64| {
+                check_limit(limit, unit, max).map_err(|r| bad(&format!("{field}.{which}"), r))
+            };
+            limit("velocity", a.velocity, unit, MAX_LIMIT)?;
+            limit(
+                "acceleration",
+                a.acceleration,
+                &format!("{unit}²"),
+                MAX_LIMIT,
+            )?;
+            if let Some(j) = a.jerk {
+                limit("jerk", j, &format!("{unit}³"), MAX_JERK_LIMIT)?;
+            }
+            if let Some((min, max)) = a.travel {
+                length(&format!("{field}.min"), min)?;
+                length(&format!("{field}.max"), max)?;
+                if min >= max {
+                    return Err(bad(
+                        &format!("{field}.min"),
+                        format!("travel min must be less than max, found min {min}, max {max}"),
+                    ));
+                }
+            }
+        }
+        match self.feed_max {
+            None => Ok(()),
+            Some(_) if *kin == KinematicsSpec::Joint => Err(bad(
+                "feed.max",
+                "a joint-space machine has no tool-tip feed limit: leave it out (None)".into(),
+            )),
+            Some(max) if !(max.is_finite() && max > 0.0) => Err(bad(
+                "feed.max",
+                format!("must be a positive number, found {max}"),
+            )),
+            Some(max) => plausible_limit(max, "mm/s", MAX_LIMIT).map_err(|r| bad("feed.max", r)),
+        }
     }
 }

@@ -4,6 +4,7 @@ use clap::Parser;
 
 fn main() -> std::process::ExitCode {
     let cli = feedopt::cli::Cli::parse();
+    feedopt::cli::init_logging(cli.verbose);
     match feedopt::cli::run(&cli) {
         Ok(out) => {
             print!("{out}");

@@ -26,20 +26,30 @@ use crate::error::{Error, Result};
 /// How u moves between two stations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Law {
+    /// b linear in u (module doc).
     Linear,
+    /// ü linear in u, b quadratic (module doc).
     Quadratic,
+    /// From rest at constant path jerk (module doc).
     RestStart,
+    /// To rest at constant path jerk (module doc).
     RestEnd,
 }
 
 /// One station interval: its length in u, b and ü at both ends, and its law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Interval {
+    /// Length in u.
     pub du: f64,
+    /// b at the start.
     pub b0: f64,
+    /// b at the end.
     pub b1: f64,
+    /// ü at the start.
     pub a0: f64,
+    /// ü at the end.
     pub a1: f64,
+    /// How u moves in between.
     pub law: Law,
 }
 

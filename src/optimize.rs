@@ -158,6 +158,7 @@ pub fn optimize_observed(
     options: &Options,
     progress: &dyn Progress,
 ) -> Result<Solution> {
+    crate::validate::inputs(machine, options)?;
     if machine.kinematics == KinematicsSpec::Joint {
         return Err(Error::Usage(format!(
             "{}: a CL toolpath needs a machine with kinematics (xyz, head_head), not a \
@@ -198,6 +199,7 @@ pub fn optimize_joint_observed(
     options: &Options,
     progress: &dyn Progress,
 ) -> Result<Solution> {
+    crate::validate::inputs(machine, options)?;
     if machine.kinematics != KinematicsSpec::Joint {
         return Err(Error::Usage(format!(
             "{}: a joint-space path needs a machine file with \"kinematics\": {{\"type\": \"joint\"}}",
@@ -277,13 +279,11 @@ fn optimize_path(
     let mut v = plan.verify(&lv, options)?;
     let mut round = 0;
     while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
-        if std::env::var_os("FEEDOPT_VERIFY_TRACE").is_some() {
-            eprintln!(
-                "verify: {} intervals, worst {:?}",
-                v.violating_intervals,
-                v.violations.first()
-            );
-        }
+        tracing::debug!(
+            "verify: {} intervals, worst {:?}",
+            v.violating_intervals,
+            v.violations.first()
+        );
         plan.progress
             .stage("adding stations where the re-simulation found a limit exceeded");
         plan.refine_where_violated(&mut lv, &v, options)?;

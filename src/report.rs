@@ -146,13 +146,21 @@ pub struct BindingShare {
 /// The summary of a solve (what `feedopt solve --json` prints).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Summary {
+    /// The machine's name.
     pub machine: String,
+    /// The toolpath as named by the caller.
     pub toolpath: String,
+    /// Cycle time, s (dwells included).
     pub cycle_time_s: f64,
+    /// Stations in all.
     pub stations: usize,
+    /// Rest-to-rest spans.
     pub spans: usize,
+    /// The worst status over all spans.
     pub status: Status,
+    /// Interior-point iterations, summed over spans.
     pub iterations: u32,
+    /// Solver time, summed over spans, s.
     pub solve_time_s: f64,
     /// Tool-tip path length, mm (joint-space path: the length of its parameter s).
     pub path_length_mm: f64,
@@ -161,11 +169,14 @@ pub struct Summary {
     /// Largest distance of the fitted path from a programmed point (smoothing within
     /// `--tolerance`): tool tip, mm; rotary angles, degrees.
     pub max_deviation_mm: f64,
+    /// The same for the rotary angles, degrees.
     pub max_deviation_deg: f64,
     /// Per axis, in the machine's order (a JSON object keyed by axis name).
     #[serde(serialize_with = "as_map")]
     pub axes: Vec<(String, AxisPeaks)>,
+    /// Which limit holds the feed down over what share of the path and of the time.
     pub binding: Vec<BindingShare>,
+    /// Station counts tried and their cycle times.
     pub refinement: Vec<Refinement>,
     /// Estimated relative error of `cycle_time_s` against the continuous optimum (automatic
     /// refinement; `null` on a fixed grid): see [`Solution::error_estimate`].
@@ -188,10 +199,12 @@ pub struct Summary {
     /// The input format read (`apt`, `gcode`, `csv`) and how it was chosen (`option`,
     /// `extension`, `content`).
     pub format: String,
+    /// How the format was chosen.
     pub format_by: String,
     /// The G-code dialect read (G-code only) and how it was chosen (`option`, `content`,
     /// `extension`, `default`).
     pub dialect: Option<String>,
+    /// How the dialect was chosen.
     pub dialect_by: Option<String>,
     /// Dwells of the program (G4, cycle dwells), s: part of `cycle_time_s`.
     pub dwell_time_s: f64,
@@ -200,7 +213,9 @@ pub struct Summary {
 /// Worst use of one axis's limits in the re-simulation.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WorstRatio {
+    /// Worst |q̇| / limit.
     pub velocity: f64,
+    /// Worst |q̈| / limit.
     pub acceleration: f64,
     /// 0 where the axis has no jerk limit.
     pub jerk: f64,
@@ -211,6 +226,7 @@ fn worst_as_map<S: serde::Serializer>(v: &[(String, WorstRatio)], s: S) -> Resul
 }
 
 impl Summary {
+    /// The summary of `sol`, a solve of `toolpath` (as named in reports) on `machine`.
     pub fn new(machine: &Machine, toolpath: &str, sol: &Solution) -> Summary {
         let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
         let na = names.len();

@@ -46,6 +46,7 @@ pub struct Station {
 pub struct Schedule {
     /// Names of the axes, in the order of `Station::q`.
     pub axes: Vec<String>,
+    /// Every station of every span, in path order.
     pub stations: Vec<Station>,
     /// Total time, s.
     pub cycle_time: f64,

@@ -88,10 +88,13 @@ use crate::verify::verify;
 use crate::writers::write_atomically;
 
 /// Which limit of the axis is swept.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum SweptLimit {
+    /// The velocity limit.
     Velocity,
+    /// The acceleration limit.
     Acceleration,
 }
 
@@ -109,9 +112,11 @@ impl fmt::Display for SweptLimit {
 pub struct SweepOptions {
     /// Axis name, as in the machine file (e.g. `"C"`).
     pub axis: String,
+    /// Which of its limits.
     pub limit: SweptLimit,
-    /// First and last limit value (the max side; mm/s, mm/s², °/s or °/s²).
+    /// First limit value (the max side; mm/s, mm/s², °/s or °/s²).
     pub from: f64,
+    /// The last value.
     pub to: f64,
     /// Number of values, evenly spaced from `from` to `to` (1: `from` only).
     pub steps: usize,
@@ -121,7 +126,8 @@ pub struct SweepOptions {
     /// threads and the re-simulation's threads are overridden (one window, one thread: see
     /// the module doc).
     pub solve: Options,
-    /// Draw a progress bar on stderr.
+    /// Draw a progress bar on stderr (with the cargo feature `progress`; without it, nothing
+    /// is drawn).
     pub progress: bool,
 }
 
@@ -150,39 +156,6 @@ impl SweepOptions {
             .map(|k| self.from + (self.to - self.from) * k as f64 / n as f64)
             .collect()
     }
-
-    fn check(&self) -> Result<()> {
-        if !(self.from.is_finite() && self.to.is_finite() && self.from > 0.0 && self.to > 0.0) {
-            return Err(Error::Usage(format!(
-                "--from and --to must be positive limits, got {} and {}",
-                crate::error::number(self.from),
-                crate::error::number(self.to)
-            )));
-        }
-        if self.steps == 0 {
-            return Err(Error::Usage("--steps must be at least 1".into()));
-        }
-        if self.steps > MAX_STEPS {
-            return Err(Error::Usage(format!(
-                "--steps {} is more than {MAX_STEPS} (each step is three solves): give at most \
-                 {MAX_STEPS}",
-                self.steps
-            )));
-        }
-        if self.steps > 1 && self.to <= self.from {
-            return Err(Error::Usage(format!(
-                "--to ({}) must be greater than --from ({}) for more than one step",
-                self.to, self.from
-            )));
-        }
-        if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 0.5) {
-            return Err(Error::Usage(format!(
-                "--fd-step must be a relative step in (0, 0.5), got {}",
-                self.fd_step
-            )));
-        }
-        Ok(())
-    }
 }
 
 /// The most steps a sweep takes (each is three solves: the value and its finite differences).
@@ -198,16 +171,19 @@ pub const MAX_SWEEP_FACTOR: f64 = 1e3;
 pub struct SweepPoint {
     /// The swept limit's max side at this step.
     pub limit: f64,
+    /// Cycle time T at `limit`, s.
     pub cycle_time_s: f64,
     /// dT/dv from the dual variables, s per unit of the limit (`None` with the reach solver).
     pub sensitivity_dual: Option<f64>,
     /// dT/dv by central differences (T₊ − T₋)/(2hv).
     pub sensitivity_fd: f64,
-    /// T at v(1 − h) and v(1 + h), s.
+    /// T at v(1 − h), s.
     pub cycle_time_minus_s: f64,
+    /// T at v(1 + h), s.
     pub cycle_time_plus_s: f64,
-    /// The dual sensitivity at v(1 − h) and v(1 + h).
+    /// The dual sensitivity at v(1 − h).
     pub sensitivity_dual_minus: Option<f64>,
+    /// The dual sensitivity at v(1 + h).
     pub sensitivity_dual_plus: Option<f64>,
     /// The swept limit holds the feed down somewhere at this step (its share of the path in
     /// [`binding`](Self::binding) is not 0). Where it does not, dT/dv = 0 and both estimates
@@ -220,6 +196,7 @@ pub struct SweepPoint {
     pub relative_difference: Option<f64>,
     /// Which limit holds the feed down over what share of the path and of the time.
     pub binding: Vec<BindingShare>,
+    /// The worst status over the step's spans.
     pub status: Status,
     /// The step's schedule re-simulated at the servo period keeps every limit.
     pub verified: bool,
@@ -232,22 +209,29 @@ pub struct SweepPoint {
 /// A whole sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Sweep {
+    /// The machine's name.
     pub machine: String,
+    /// The toolpath as named by the caller.
     pub toolpath: String,
+    /// The swept axis.
     pub axis: String,
+    /// Which of its limits.
     pub limit: SweptLimit,
     /// Unit of the limit values (`mm/s²`, `deg/s`, …); sensitivities are in s per this unit.
     pub unit: String,
     /// The machine's own limit (min, max) before scaling.
     pub nominal_min: f64,
+    /// The machine's own limit, max side.
     pub nominal_max: f64,
     /// Stations (fixed for every step) and spans.
     pub stations: usize,
+    /// Rest-to-rest spans.
     pub spans: usize,
     /// Relative finite-difference step h.
     pub fd_step: f64,
     /// The solver of the steps: `"clarabel"` or `"reach"`.
     pub solver: String,
+    /// The steps, in order of the limit.
     pub points: Vec<SweepPoint>,
 }
 
@@ -421,19 +405,27 @@ pub fn sweep(
     toolpath: &str,
     options: &SweepOptions,
 ) -> Result<Sweep> {
-    options.check()?;
+    options.validate()?;
+    machine.validate()?;
+    options
+        .solve
+        .validate_for(machine)
+        .map_err(|e| e.within("solve"))?;
     let axis = machine
         .axes
         .iter()
         .position(|a| a.name.eq_ignore_ascii_case(&options.axis))
         .ok_or_else(|| {
             let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
-            Error::Usage(format!(
-                "--axis {}: the machine {} has no such axis (axes: {})",
-                options.axis,
-                machine.name,
-                names.join(", ")
-            ))
+            Error::option(
+                "axis",
+                format!(
+                    "{}: the machine {} has no such axis (axes: {})",
+                    options.axis,
+                    machine.name,
+                    names.join(", ")
+                ),
+            )
         })?;
     let which = options.limit;
     let nominal = machine_limit(machine, axis, which);
@@ -441,17 +433,20 @@ pub fn sweep(
         nominal.max / MAX_SWEEP_FACTOR,
         nominal.max * MAX_SWEEP_FACTOR,
     );
-    for (option, v) in [("--from", options.from), ("--to", options.to)] {
+    for (field, v) in [("from", options.from), ("to", options.to)] {
         if !(lo..=hi).contains(&v) {
-            return Err(Error::Usage(format!(
-                "{option} {} is outside {} to {}, 1/{MAX_SWEEP_FACTOR} to {MAX_SWEEP_FACTOR} \
-                 times the machine's {} {which} limit ({}): sweep within that range",
-                crate::error::number(v),
-                crate::error::number(lo),
-                crate::error::number(hi),
-                machine.axes[axis].name,
-                nominal.max
-            )));
+            return Err(Error::option(
+                field,
+                format!(
+                    "{} is outside {} to {}, 1/{MAX_SWEEP_FACTOR} to {MAX_SWEEP_FACTOR} times the \
+                     machine's {} {which} limit ({}): sweep within that range",
+                    crate::error::number(v),
+                    crate::error::number(lo),
+                    crate::error::number(hi),
+                    machine.axes[axis].name,
+                    nominal.max
+                ),
+            ));
         }
     }
     // The stations: one reach solve at the nominal limits, as `solve` would refine them.
@@ -482,27 +477,26 @@ pub fn sweep(
         .enumerate()
         .flat_map(|(k, &v)| [(k, 0, v * (1.0 - h)), (k, 1, v), (k, 2, v * (1.0 + h))])
         .collect();
+    #[cfg(feature = "progress")]
     let bar = options.progress.then(|| {
-        let bar = indicatif::ProgressBar::with_draw_target(
-            Some(jobs.len() as u64),
-            indicatif::ProgressDrawTarget::stderr(),
-        );
-        bar.set_message(format!("{} {} sweep", machine.axes[axis].name, which));
-        bar
+        crate::progress::Counter::new(
+            jobs.len(),
+            format!("{} {} sweep", machine.axes[axis].name, which),
+        )
     });
     let evals: Vec<Result<Eval>> = jobs
         .par_iter()
         .map(|&(_, _, v)| {
             let e = study.evaluate(v);
+            #[cfg(feature = "progress")]
             if let Some(b) = &bar {
-                b.inc(1);
+                b.inc();
             }
             e
         })
         .collect();
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    #[cfg(feature = "progress")]
+    drop(bar);
     let mut evals = evals.into_iter();
     let mut points = Vec::with_capacity(values.len());
     for &v in &values {
@@ -666,8 +660,9 @@ impl Sweep {
         write_atomically(path, &bytes)
     }
 
-    /// An SVG plot: cycle time against the limit (top) and the sensitivity, dual and finite
+    /// An SVG plot (cargo feature `plot`): cycle time against the limit (top) and the sensitivity, dual and finite
     /// differences (bottom); axes labelled with units, legends.
+    #[cfg(feature = "plot")]
     pub fn plot_svg(&self) -> Result<String> {
         use plotters::prelude::*;
         let fail = |e: &dyn fmt::Display| Error::Solver(format!("plot: {e}"));
@@ -781,11 +776,13 @@ impl Sweep {
     }
 
     /// Writes [`Sweep::plot_svg`] to `path`, atomically.
+    #[cfg(feature = "plot")]
     pub fn write_plot(&self, path: &Path) -> Result<()> {
         write_atomically(path, self.plot_svg()?.as_bytes())
     }
 }
 
+#[cfg(feature = "plot")]
 /// A plotting range around `values` with 5 % margins (never empty).
 fn pad_range(values: &[f64]) -> (f64, f64) {
     let lo = values.iter().copied().fold(f64::INFINITY, f64::min);

@@ -893,6 +893,80 @@ fn work_is_bounded_before_it_starts() {
     w.assert_listing(&["machine.json", "line.cls", "head.json", "turn.cls"]);
 }
 
+/// The library checks the options (`feedopt::validate`); the command line names its own flag
+/// for the field the library names, in one line.
+#[test]
+fn an_option_the_library_refuses_is_named_by_its_flag() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write("line.cls", LINE);
+    fn solve<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        let mut a = vec!["solve", "-m", "machine.json", "line.cls"];
+        a.extend_from_slice(extra);
+        a
+    }
+    for (args, needles) in [
+        (
+            solve(&["--corner-angle", "200"]),
+            &["--corner-angle", "180"][..],
+        ),
+        (solve(&["--tolerance=-1"]), &["--tolerance ", "≥ 0 mm"]),
+        (
+            solve(&["--tolerance-deg=-1"]),
+            &["--tolerance-deg", "≥ 0 degrees"],
+        ),
+        (
+            vec![
+                "compare",
+                "-m",
+                "machine.json",
+                "line.cls",
+                "--junction-deviation=-1",
+            ],
+            &["--junction-deviation", "≥ 0 mm"],
+        ),
+        (
+            vec![
+                "sweep",
+                "-m",
+                "machine.json",
+                "line.cls",
+                "--axis",
+                "Q",
+                "--limit",
+                "velocity",
+                "--from",
+                "1",
+                "--to",
+                "2",
+            ],
+            &["--axis Q", "no such axis"],
+        ),
+        (
+            vec![
+                "sweep",
+                "-m",
+                "machine.json",
+                "line.cls",
+                "--axis",
+                "X",
+                "--limit",
+                "velocity",
+                "--from",
+                "100",
+                "--to",
+                "200",
+                "--fd-step",
+                "0.7",
+            ],
+            &["--fd-step", "(0, 0.5)"],
+        ),
+    ] {
+        refused_quickly(&w, &args, needles);
+    }
+    w.assert_listing(&["machine.json", "line.cls"]);
+}
+
 #[cfg(unix)]
 #[test]
 fn an_endless_input_is_refused() {

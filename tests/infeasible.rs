@@ -55,6 +55,15 @@ fn line() -> Toolpath {
     }
 }
 
+/// [`line`] programmed at `feed` mm/s.
+fn line_at(feed: f64) -> Toolpath {
+    let mut t = line();
+    for p in &mut t.points {
+        p.feed = Feed::Programmed(feed);
+    }
+    t
+}
+
 fn options(start_feed: f64, end_feed: f64, kind: SolverKind) -> Options {
     Options {
         stations: Some(200),
@@ -155,10 +164,16 @@ fn an_end_feed_limited_by_x_acceleration_names_x_not_y() {
 
 #[test]
 fn an_end_feed_above_the_feed_cap_names_the_last_station() {
-    // 200 mm/s > the 150 mm/s cap: impossible at the last station itself.
+    // 200 mm/s > the programmed 150 mm/s: impossible at the last station itself. (Above the
+    // machine's cap, feed.max, the option itself is refused before any work.)
     let m = machine(XYZ_CAP_150);
+    assert!(matches!(
+        optimize(&m, &line(), &options(0.0, 200.0, SolverKind::Reach)),
+        Err(Error::InvalidOption { ref field, .. }) if field == "end_feed"
+    ));
+    let m = machine(XYZ_NO_CAP);
     for kind in BOTH {
-        let msg = infeasible(optimize(&m, &line(), &options(0.0, 200.0, kind)));
+        let msg = infeasible(optimize(&m, &line_at(150.0), &options(0.0, 200.0, kind)));
         names_where(&msg);
         assert!(msg.contains("station 200 of 200"), "{msg}");
         assert!(msg.contains("u = 2.000000"), "{msg}");
@@ -184,8 +199,13 @@ fn a_start_feed_beyond_what_x_can_brake_from_names_x() {
 #[test]
 fn a_start_feed_above_the_feed_cap_names_the_first_station() {
     let m = machine(XYZ_CAP_150);
+    assert!(matches!(
+        optimize(&m, &line(), &options(200.0, 0.0, SolverKind::Reach)),
+        Err(Error::InvalidOption { ref field, .. }) if field == "start_feed"
+    ));
+    let m = machine(XYZ_NO_CAP);
     for kind in BOTH {
-        let msg = infeasible(optimize(&m, &line(), &options(200.0, 0.0, kind)));
+        let msg = infeasible(optimize(&m, &line_at(150.0), &options(200.0, 0.0, kind)));
         names_where(&msg);
         assert!(msg.contains("station 0 of 200"), "{msg}");
         assert!(msg.contains("CL line 1"), "{msg}");

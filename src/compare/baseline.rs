@@ -37,6 +37,7 @@ pub const DEFAULT_JUNCTION_DEVIATION_MM: f64 = 0.01;
 /// of the path: `spans[i]` runs from u = 0 to the span's length, u strictly increasing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Profile {
+    /// Per span: (u, b) breakpoints.
     pub spans: Vec<Vec<(f64, f64)>>,
 }
 
@@ -45,15 +46,18 @@ pub struct Profile {
 pub struct Block {
     /// Span of the path and knot interval within it.
     pub span: usize,
+    /// Knot interval within the span.
     pub index: usize,
     /// Where it starts and ends in the span's u.
     pub u0: f64,
+    /// Where the block ends in the span's u.
     pub u1: f64,
     /// Δq / Δu per axis (mm or degrees per unit of u).
     pub joint_direction: [f64; MAX_AXES],
     /// Unit direction used for the corner angle: the tool tip's chord on a moving span, the
     /// normalised joint direction elsewhere.
     pub direction: [f64; MAX_AXES],
+    /// What moves along the block.
     pub kind: SpanKind,
     /// Source line of the CL point the block ends at.
     pub line: usize,
@@ -237,6 +241,7 @@ pub fn programmed_feed(
 /// One block as the controller planned it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlannedBlock {
+    /// The programmed move.
     pub block: Block,
     /// Nominal speed: the programmed feed and every axis's velocity limit along the block
     /// (u̇; mm/s of tool tip on a moving span).
@@ -247,6 +252,7 @@ pub struct PlannedBlock {
     pub junction_limit: f64,
     /// Planned speeds at the block's start and end after the backward and forward passes.
     pub entry: f64,
+    /// Planned speed at the block's end.
     pub exit: f64,
 }
 
@@ -275,6 +281,7 @@ impl PlannedBlock {
 /// The controller's plan of the whole path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ControllerPlan {
+    /// Every block, in path order.
     pub blocks: Vec<PlannedBlock>,
     /// Junction deviation δ used, mm.
     pub junction_deviation: f64,

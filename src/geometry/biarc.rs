@@ -97,27 +97,36 @@ fn dist(a: P, b: P) -> f64 {
 /// One piece of a fitted profile.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Piece {
+    /// A straight segment from `from` to `to`.
     Line {
+        /// Start point (x, z).
         from: [f64; 2],
+        /// End point (x, z).
         to: [f64; 2],
     },
     /// A circular arc of less than a full turn from `from` to `to` about `center`; `ccw`: it
     /// turns from +X towards +Z. The radius is `|from − center|`.
     Arc {
+        /// Start point (x, z).
         from: [f64; 2],
+        /// End point (x, z).
         to: [f64; 2],
+        /// Centre (x, z).
         center: [f64; 2],
+        /// Whether it turns from +X towards +Z.
         ccw: bool,
     },
 }
 
 impl Piece {
+    /// Where the piece starts.
     pub fn start(&self) -> [f64; 2] {
         match *self {
             Piece::Line { from, .. } | Piece::Arc { from, .. } => from,
         }
     }
 
+    /// Where the piece ends.
     pub fn end(&self) -> [f64; 2] {
         match *self {
             Piece::Line { to, .. } | Piece::Arc { to, .. } => to,

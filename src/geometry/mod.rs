@@ -74,6 +74,7 @@ pub struct Span {
     /// Largest distance of a fitted point from its programmed position: mm (tool tip) and
     /// radians (rotary angles).
     pub deviation: (f64, f64),
+    /// What moves in the span.
     pub kind: SpanKind,
     /// w(u) = (Px, Py, Pz, θ1, θ2); its knots are the CL points of the span.
     pub spline: CubicSpline<PATH_DIM>,
@@ -109,6 +110,7 @@ impl Span {
 /// The whole path: spans in program order.
 #[derive(Debug, Clone)]
 pub struct Path {
+    /// The rest-to-rest spans, in path order.
     pub spans: Vec<Span>,
 }
 

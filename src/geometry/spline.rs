@@ -13,8 +13,11 @@
 /// Value and first two derivatives of every coordinate at one parameter value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Jet<const D: usize> {
+    /// The value.
     pub value: [f64; D],
+    /// The first derivative.
     pub d1: [f64; D],
+    /// The second derivative.
     pub d2: [f64; D],
 }
 

@@ -55,8 +55,11 @@ pub enum Target {
     Programmed([f64; 2]),
     /// A unit tool vector `k`, solved: tilt t ≥ 0 and spin s (`None` at the singular pose).
     Vector {
+        /// The unit tool vector.
         k: Vector3<f64>,
+        /// Tilt t ≥ 0, radians.
         tilt: f64,
+        /// Spin s, radians (`None` at the singular pose).
         spin: Option<f64>,
     },
 }

@@ -25,6 +25,7 @@ use super::{MAX_AXES, PATH_DIM, ToolPose, rad_to_deg};
 /// A dresser: the distance from the B axis to the dressing tool's tip, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dresser {
+    /// From the B axis to the tool tip, mm.
     pub tool_length: f64,
 }
 

@@ -10,12 +10,16 @@ use std::ops::{Add, Mul, Neg, Sub};
 /// `v + d·ε + ½·dd·ε²` truncated after second order: value, first and second derivative.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dual2 {
+    /// Value.
     pub v: f64,
+    /// First derivative.
     pub d: f64,
+    /// Second derivative.
     pub dd: f64,
 }
 
 impl Dual2 {
+    /// `v + d·ε + ½·dd·ε²`.
     pub fn new(v: f64, d: f64, dd: f64) -> Self {
         Dual2 { v, d, dd }
     }
@@ -25,9 +29,13 @@ impl Dual2 {
 pub trait Real:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
 {
+    /// The constant `x`.
     fn cst(x: f64) -> Self;
+    /// The sine.
     fn sin(self) -> Self;
+    /// The cosine.
     fn cos(self) -> Self;
+    /// Multiplied by the constant `k`.
     fn scale(self, k: f64) -> Self;
 }
 
@@ -99,13 +107,18 @@ impl Real for Dual2 {
 /// jerk limits (issue 6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dual3 {
+    /// Value.
     pub v: f64,
+    /// First derivative.
     pub d: f64,
+    /// Second derivative.
     pub dd: f64,
+    /// Third derivative.
     pub ddd: f64,
 }
 
 impl Dual3 {
+    /// `v + d·ε + ½·dd·ε² + ⅙·ddd·ε³`.
     pub fn new(v: f64, d: f64, dd: f64, ddd: f64) -> Self {
         Dual3 { v, d, dd, ddd }
     }

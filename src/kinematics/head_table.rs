@@ -30,6 +30,7 @@ use super::{MAX_AXES, PATH_DIM, ToolPose, rad_to_deg};
 /// A head–table machine: the distance from the B pivot to the tool tip, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeadTable {
+    /// From the B pivot to the tool tip, mm.
     pub pivot_length: f64,
 }
 

@@ -65,8 +65,11 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// Position and u-derivatives of every axis at one station (file units: mm or degrees).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AxisJets {
+    /// Axis positions, mm or degrees.
     pub q: [f64; MAX_AXES],
+    /// dq/du.
     pub dq: [f64; MAX_AXES],
+    /// d²q/du².
     pub ddq: [f64; MAX_AXES],
 }
 
@@ -75,16 +78,22 @@ pub struct AxisJets {
 /// kinematics gives.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ToolPose {
+    /// The tool tip, program coordinates, mm.
     pub p: Vector3<f64>,
+    /// The unit tool axis.
     pub k: Vector3<f64>,
+    /// The path angles, radians.
     pub angles: [f64; 2],
 }
 
 /// A machine's kinematics, ready to evaluate.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Kinematics {
+    /// Three linear axes follow the tool tip.
     Xyz,
+    /// Seed 000's double swivel head.
     HeadHead {
+        /// Pivot to tool tip, mm.
         d2: f64,
     },
     /// LinuxCNC's xyzac-trt / xyzbc-trt, and the Haas A/B trunnion.
@@ -95,11 +104,13 @@ pub enum Kinematics {
     Dresser(dresser::Dresser),
     /// A joint-space path: the path coordinates are the `n` axis positions.
     Joint {
+        /// Number of axes.
         n: usize,
     },
 }
 
 impl Kinematics {
+    /// The kinematics of `machine`.
     pub fn new(machine: &Machine) -> Self {
         match machine.kinematics {
             KinematicsSpec::Xyz => Kinematics::Xyz,
@@ -319,7 +330,9 @@ impl Kinematics {
 /// axis at one point of a moving path (eq. 28–39; rotary axes in degrees).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Effective {
+    /// Effective tangents t_q = dq/ds.
     pub t: [f64; MAX_AXES],
+    /// Effective curvatures K_q = d²q/ds².
     pub k: [f64; MAX_AXES],
 }
 

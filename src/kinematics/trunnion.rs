@@ -53,7 +53,9 @@ use crate::machine::{TrunnionParams, TrunnionTilt};
 /// A trunnion machine: which table tilts (and the platter's letter), and LinuxCNC's parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Trunnion {
+    /// Which table tilts, and the platter's letter.
     pub tilt: TrunnionTilt,
+    /// The machine file's parameters.
     pub params: TrunnionParams,
 }
 

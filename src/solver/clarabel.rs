@@ -46,7 +46,7 @@
 //! so only [`solve_with_sensitivity`] (one window) returns sensitivities.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{DefaultSolver, SolverStatus, SupportedConeT};
 
 use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::SpanProblem;
@@ -241,7 +241,7 @@ pub fn solve_with_sensitivity(
     let s = settings.clarabel(settings.tol_gap)?;
     let mut solver = DefaultSolver::new(&pmat, &q, &a, &h, &cones, s)
         .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
-    solver.solve();
+    super::run_clarabel(&mut solver);
     let sol = &solver.solution;
     let status = match sol.status {
         SolverStatus::Solved => Status::Optimal,

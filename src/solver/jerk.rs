@@ -65,7 +65,7 @@
 //! interval).
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{DefaultSolver, SolverStatus, SupportedConeT};
 
 use super::{Rows, SolverSettings, SpanSolution, Status};
 use crate::constraints::{Chord, SpanProblem, essential_rows};
@@ -482,7 +482,6 @@ pub fn solve(
     };
     let threads = settings.worker_threads();
     let cuts = cuts(p, &start, threads, options.window);
-    let trace = std::env::var_os("FEEDOPT_JERK_TRACE").is_some();
     if cuts.len() > 2 {
         let t0 = std::time::Instant::now();
         let windows: Vec<(usize, usize)> = cuts.windows(2).map(|c| (c[0], c[1])).collect();
@@ -524,13 +523,10 @@ pub fn solve(
         match stitch(&windows, results) {
             Ok(mut sol) => {
                 sol.solve_time = t0.elapsed().as_secs_f64();
-                if trace {
-                    eprintln!("SCP in {} windows: {:?}", windows.len(), windows);
-                }
+                tracing::debug!("SCP in {} windows: {:?}", windows.len(), windows);
                 return Ok(sol);
             }
-            Err(e) if trace => eprintln!("SCP windows failed ({e}); one piece"),
-            Err(_) => {}
+            Err(e) => tracing::debug!("SCP windows failed ({e}); one piece"),
         }
     }
     solve_piece(p, jd, &start, (0.0, 0.0), settings, options)
@@ -713,14 +709,12 @@ fn solve_piece(
                 }
             }
         }
-        if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
-            eprintln!(
-                "SCP {it}: T = {time:.6}, {} IP iterations, {:.1} ms, {:?}, step {step}",
-                sol.iterations,
-                sol.solve_time * 1e3,
-                sol.status
-            );
-        }
+        tracing::debug!(
+            "SCP {it}: T = {time:.6}, {} IP iterations, {:.1} ms, {:?}, step {step}",
+            sol.iterations,
+            sol.solve_time * 1e3,
+            sol.status
+        );
         from_iterate = true;
         let done = last_time.is_some_and(|t| (t - time).abs() <= options.convergence * time);
         last_time = Some(time);
@@ -1273,7 +1267,7 @@ impl<'a> Program<'a> {
             let s = settings.clarabel(gap)?;
             let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
                 .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
-            solver.solve();
+            super::run_clarabel(&mut solver);
             let sol = &solver.solution;
             iterations += sol.iterations;
             solve_time += sol.solve_time;
@@ -1303,12 +1297,10 @@ impl<'a> Program<'a> {
                     }
                 }
             }
-            if std::env::var_os("FEEDOPT_JERK_TRACE").is_some() {
-                eprintln!(
-                    "  active rows {n_rows} of {} candidates, {added} added",
-                    self.cands.len()
-                );
-            }
+            tracing::debug!(
+                "  active rows {n_rows} of {} candidates, {added} added",
+                self.cands.len()
+            );
             if added == 0 {
                 *carried = std::mem::take(&mut active);
                 break (sol.x.clone(), status);

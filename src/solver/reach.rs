@@ -172,9 +172,13 @@ impl IntervalRows {
 /// A controllable set [lo, hi] of b at one station, and the limits that set its ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Set {
+    /// The least b reachable at the station.
     pub lo: f64,
+    /// The greatest b at the station from which the span can still be completed.
     pub hi: f64,
+    /// The limit that sets `lo`.
     pub lo_by: Bound,
+    /// The limit that sets `hi`.
     pub hi_by: Bound,
 }
 

@@ -96,6 +96,7 @@ const F_DIGITS: i32 = 7;
 /// Options of the writer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GcodeOptions {
+    /// The controller the program is written for (header, TCP switch, comments).
     pub dialect: Dialect,
     /// Δθ: the largest turn of any rotary axis within one block, degrees (`None`: no limit).
     pub max_rotation_deg: Option<f64>,
@@ -104,6 +105,7 @@ pub struct GcodeOptions {
 /// A written program and what it contains.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Program {
+    /// The program, as written to the file.
     pub text: String,
     /// Motion blocks after the first point (each with its F).
     pub blocks: usize,
@@ -378,15 +380,8 @@ pub fn program(
             "a joint-space path has no tool tip to write as G-code".into(),
         ));
     }
-    let step = match options.max_rotation_deg {
-        None => None,
-        Some(d) if d.is_finite() && d > 0.0 => Some(d.to_radians()),
-        Some(d) => {
-            return Err(Error::Usage(format!(
-                "the largest rotation per block must be a positive number of degrees, got {d}"
-            )));
-        }
-    };
+    options.validate()?;
+    let step = options.max_rotation_deg.map(f64::to_radians);
     // Rotary words: (letter, path angle index) in the machine's axis order.
     let mut rotary: Vec<(String, usize)> = Vec::new();
     for (a, axis) in kin.rotary_axes().iter().enumerate() {

@@ -2,6 +2,7 @@
 //! target's directory and renamed into place, so no half-written output is ever left behind.
 
 pub mod gcode;
+#[cfg(feature = "plot")]
 pub mod plot;
 
 use std::io::Write;
@@ -13,7 +14,9 @@ use crate::schedule::Schedule;
 /// Formats a schedule can be written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ScheduleFormat {
+    /// `.json`: [`schedule_json`].
     Json,
+    /// `.csv`: [`schedule_csv`].
     Csv,
 }
 

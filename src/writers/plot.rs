@@ -34,6 +34,7 @@ use crate::schedule::Schedule;
 /// Formats a plot can be written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlotFormat {
+    /// Scalable vector graphics (`.svg`).
     Svg,
 }
 
@@ -542,7 +543,9 @@ fn axis_ratios(
 
 /// One feed profile of [`write_profiles_plot`].
 pub struct ProfileCurve<'a> {
+    /// The legend's text.
     pub label: String,
+    /// The schedule drawn.
     pub schedule: &'a Schedule,
 }
 
