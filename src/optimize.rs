@@ -259,11 +259,7 @@ fn optimize_path(
             (lv, vec![r], None)
         }
         None if plan.machine.has_jerk() => {
-            let (lv, refinement, estimate) = if std::env::var_os("FEEDOPT_JERK_UNIFORM").is_some() {
-                plan.solve_uniform(options)?
-            } else {
-                plan.solve_adaptive_jerk(options)?
-            };
+            let (lv, refinement, estimate) = plan.solve_adaptive_jerk(options)?;
             (lv, refinement, Some(estimate))
         }
         None => {
@@ -758,7 +754,7 @@ impl Plan<'_> {
             .into_par_iter()
             .enumerate()
             .map(|(si, r)| {
-                // (Acceleration-limited only: jerk-limited solves take `solve_uniform`.)
+                // (Acceleration-limited only: jerk-limited solves take `solve_adaptive_jerk`.)
                 let s = self.solve_span(si, &r.fine, options, None, Some(r.greedy))?;
                 Ok((r.fine, s))
             })
@@ -775,44 +771,6 @@ impl Plan<'_> {
         Ok((lv, refinement, estimate))
     }
 
-    /// Jerk-limited solves: every interval halved until doubling the stations changes the
-    /// cycle time by less than the tolerance (at least 10 × the SCP's own), each level's SCP
-    /// started from the level before. The estimate is that last relative change.
-    ///
-    /// The adaptive refinement of [`Plan::solve_adaptive`] places stations for the
-    /// acceleration-limited profile; the jerk-limited one leaves and rejoins its plateaus over
-    /// a distance the jerk sets, where that grid can be coarse, and the SCP's windows need
-    /// plateaus several stations long to cut at.
-    fn solve_uniform(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
-        let tol = options.convergence.max(10.0 * options.jerk.convergence);
-        let mut refinement = Vec::new();
-        let mut previous: Option<Level> = None;
-        for level in 0.. {
-            let lv = self.solve_at(options.initial_stations, level, options, previous.as_ref())?;
-            let (time, stations) = (lv.schedule.cycle_time, lv.schedule.stations.len());
-            refinement.push(Refinement {
-                stations,
-                cycle_time_s: time,
-            });
-            if let Some(prev) = &previous {
-                let change = (prev.schedule.cycle_time - time).abs() / time;
-                self.progress.round(stations, change, tol);
-                if change <= tol {
-                    return Ok((lv, refinement, change));
-                }
-            }
-            if 2 * stations > options.max_stations {
-                return Err(Error::Solver(format!(
-                    "the jerk-limited cycle time has not converged to {tol:e} within {} \
-                     stations (last: {stations} stations, {time:.4} s); try --stations N for a \
-                     fixed grid, or --no-jerk",
-                    options.max_stations
-                )));
-            }
-            previous = Some(lv);
-        }
-        unreachable!("the refinement loop returns")
-    }
 
     /// Jerk-limited solves, refined adaptively as [`Plan::solve_adaptive`] refines the
     /// acceleration-limited ones, with the SCP itself as the solver.
@@ -847,7 +805,6 @@ impl Plan<'_> {
         use rayon::prelude::*;
         let ns = self.path.spans.len();
         let tol = options.convergence.max(10.0 * options.jerk.convergence);
-        let trace = std::env::var_os("FEEDOPT_JERK_TRACE").is_some();
         self.progress.stage("refining stations (jerk-limited)");
         let t0 = std::time::Instant::now();
         let mut rounds: Vec<JerkRound> = (0..ns)
@@ -882,14 +839,12 @@ impl Plan<'_> {
             estimate_s = raw * rho / (1.0 - rho);
             let estimate = estimate_s;
             let stations: usize = rounds.iter().map(|r| r.fine.u.len()).sum();
-            if trace {
-                eprintln!(
-                    "jerk round {}: {stations} stations, T = {time:.6}, estimate {:.2e}, {:.2} s",
-                    refinement.len(),
-                    estimate / time,
-                    t0.elapsed().as_secs_f64()
-                );
-            }
+            tracing::debug!(
+                "jerk round {}: {stations} stations, T = {time:.6}, estimate {:.2e}, {:.2} s",
+                refinement.len(),
+                estimate / time,
+                t0.elapsed().as_secs_f64()
+            );
             refinement.push(Refinement {
                 stations,
                 cycle_time_s: time,
