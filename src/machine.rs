@@ -548,7 +548,19 @@ impl Parser {
 
     fn machine(&self, root: &Value) -> Result<Machine> {
         let obj = self.object(root, "(top level)")?;
-        self.only_known(obj, "", &["name", "kinematics", "axes", "feed"])?;
+        self.only_known(
+            obj,
+            "",
+            &[
+                "name",
+                "kinematics",
+                "axes",
+                "feed",
+                "stock",
+                "tool",
+                "process",
+            ],
+        )?;
         let name = match obj.get("name") {
             None => String::new(),
             Some(Value::String(s)) => s.clone(),

@@ -65,6 +65,9 @@ pub struct Options {
     pub jerk_limited: bool,
     /// The sequential convex programme of a jerk-limited solve.
     pub jerk: JerkOptions,
+    /// Process feed caps from the material stage ([`crate::material::FeedLimits`], computed
+    /// on the same toolpath): attached to the spans before the constraints are built.
+    pub process: Option<std::sync::Arc<crate::material::FeedLimits>>,
 }
 
 impl Default for Options {
@@ -83,6 +86,7 @@ impl Default for Options {
             refine_until_verified: true,
             jerk_limited: true,
             jerk: JerkOptions::default(),
+            process: None,
         }
     }
 }
@@ -166,7 +170,7 @@ pub fn optimize_observed(
     }
     let kin = Kinematics::new(machine);
     let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
-    let path = Path::build(
+    let mut path = Path::build(
         toolpath,
         &angles,
         machine.feed_max,
@@ -180,6 +184,9 @@ pub fn optimize_observed(
             toolpath.points.first().map_or(1, |p| p.line),
             "no motion: every CL point is at the same position",
         ));
+    }
+    if let Some(limits) = &options.process {
+        limits.attach(&mut path, toolpath, machine.feed_max)?;
     }
     optimize_path(machine, path, options, progress)
 }
@@ -520,6 +527,7 @@ impl Plan<'_> {
                 Bound::AxisJerk(j) => format!("the {} jerk limit", self.axes[j]),
                 Bound::Feed => "the programmed feed".to_string(),
                 Bound::Chord => "the chord tolerance".to_string(),
+                Bound::Process(l) => format!("the {} limit", l.label()),
                 Bound::None => "the limits".to_string(),
             };
             Error::Infeasible(format!(
@@ -948,6 +956,7 @@ impl Plan<'_> {
                 Bound::AxisJerk(j) => Some(format!("{} jerk", self.axes[j])),
                 Bound::Feed => Some("the feed cap".to_string()),
                 Bound::Chord => Some("the chord tolerance".to_string()),
+                Bound::Process(l) => Some(format!("the {} limit", l.label())),
                 Bound::None => None,
             })
             .collect();
