@@ -393,3 +393,245 @@ fn chip_thinning_follows_its_formula() {
     assert_eq!(by, ProcessLimit::ChipLoad);
     assert!((v - 15.0 * 10.0 / 6.0).abs() < 1e-9);
 }
+
+/// Seed 003's tool-breakage detection: two blocks 30 % over the chip load and one rapid through
+/// the stock are exactly the three findings, with their lines.
+#[test]
+fn the_overload_check_lists_exactly_the_overloads_and_the_rapid_through_stock() {
+    use feedopt::material::check::{Severity, overloads};
+    let mut tp = path(&[
+        [20.0, 20.0, 10.0],
+        [20.0, 20.0, 1.0],
+        [20.0, 20.0, -3.0],
+        [40.0, 20.0, -3.0],
+        [60.0, 20.0, -3.0],
+        [80.0, 20.0, -3.0],
+        [80.0, 20.0, 10.0],
+        [90.0, 20.0, 10.0],
+        [90.0, 20.0, -2.0],
+    ]);
+    let feeds = [5.0, 19.5, 10.0, 19.5, 10.0];
+    for (k, f) in (2..=6).zip(feeds) {
+        tp.points[k].feed = Feed::Programmed(f);
+    }
+    tp.points[7].feed = Feed::Rapid;
+    tp.points[8].feed = Feed::Rapid;
+    let m = material(
+        flat10(),
+        0.2,
+        ProcessLimits {
+            chip_load: Some(0.05),
+            spindle_speed: Some(6000.0), // 15 mm/s with 3 flutes
+            ..Default::default()
+        },
+    );
+    let sim = material::simulate(&tp, &m).unwrap();
+    let found = overloads(&sim, &m, 1.0);
+    let lines: Vec<(usize, Severity)> = found.iter().map(|f| (f.line, f.severity)).collect();
+    assert_eq!(
+        lines,
+        vec![
+            (4, Severity::Warning),
+            (6, Severity::Warning),
+            (9, Severity::Error)
+        ],
+        "{found:#?}"
+    );
+    for f in &found[..2] {
+        assert_eq!(f.limit, Some(ProcessLimit::ChipLoad));
+        assert!((f.excess - 0.3).abs() < 1e-9, "{}", f.excess);
+    }
+    // The rapid plunges 2 mm into the stock: a disc of the tool's area.
+    let disc = PI * 25.0 * 2.0;
+    assert!(
+        (found[2].removed - disc).abs() < 0.01 * disc,
+        "{}",
+        found[2].removed
+    );
+    // At a feed override of 0.5 nothing but the rapid is left.
+    assert_eq!(overloads(&sim, &m, 0.5).len(), 1);
+}
+
+/// A second identical pass cuts air: it runs at the air feed (or the machine's limits), the
+/// first at the chip load.
+#[test]
+fn a_repeated_pass_runs_at_the_air_feed() {
+    let m = material(
+        flat10(),
+        0.2,
+        ProcessLimits {
+            chip_load: Some(0.05),
+            spindle_speed: Some(6000.0),
+            air_feed: Some(100.0),
+            ..Default::default()
+        },
+    );
+    let tp = path(&[
+        [20.0, 20.0, 10.0],
+        [20.0, 20.0, -3.0],
+        [80.0, 20.0, -3.0],
+        [20.0, 20.0, -3.0],
+    ]);
+    let sim = material::simulate(&tp, &m).unwrap();
+    let options = Options {
+        process: Some(Arc::new(FeedLimits::new(&sim, &m, tp.points.len()))),
+        solver_kind: feedopt::solver::SolverKind::Reach,
+        ..Options::default()
+    };
+    let sol = optimize(&machine(XYZ), &tp, &options).unwrap();
+    assert!(sol.verification.verified);
+    let at = |span: usize| {
+        let st = sol
+            .schedule
+            .stations
+            .iter()
+            .find(|s| s.span == span && (s.q[0] - 50.0).abs() < 0.5)
+            .unwrap();
+        let p = &sol.problems[span];
+        let i = p.u.iter().position(|&u| u == st.u).unwrap();
+        (st.v, p.b_max_by[i])
+    };
+    let (v1, by1) = at(1);
+    assert_eq!(by1, Bound::Process(ProcessLimit::ChipLoad));
+    assert!((v1 - 15.0).abs() < 1e-6, "{v1}");
+    let (v2, by2) = at(2);
+    assert_eq!(by2, Bound::Process(ProcessLimit::Air));
+    assert!((v2 - 100.0).abs() < 1e-6, "{v2}");
+}
+
+fn feedopt(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+const POCKET: [&str; 3] = [
+    "--machine",
+    "problems/material_pocket/machine.json",
+    "problems/material_pocket/pocket.cls",
+];
+
+/// The bundled pocket: the removed volume is the pocket's analytic volume (a 32 × 12 mm
+/// rectangle of tool centres swept by a disc of radius 4, 3 mm deep) within 1 %, the solve
+/// verifies with process limits binding, and it is faster than the programmed feeds but slower
+/// than the axes alone allow.
+#[test]
+fn the_bundled_pocket_removes_its_volume_and_solves_under_process_limits() {
+    let out = feedopt(&[&["solve", "--json", "--solver", "reach"], &POCKET[..]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let m = &v["material"];
+    let exact = (32.0 * 12.0 + 8.0 * 44.0 + PI * 16.0) * 3.0;
+    let removed = m["removed_volume_mm3"].as_f64().unwrap();
+    assert!(
+        (removed - exact).abs() < 0.01 * exact,
+        "{removed} vs {exact}"
+    );
+    let lost = m["initial_volume_mm3"].as_f64().unwrap() - m["final_volume_mm3"].as_f64().unwrap();
+    assert!((lost - removed).abs() < 1e-6 * removed);
+    assert_eq!(v["verified"], true);
+    let limits: Vec<&str> = v["binding"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["limit"].as_str().unwrap())
+        .collect();
+    for l in ["chip load", "power", "air"] {
+        assert!(limits.contains(&l), "{limits:?}");
+    }
+    let t = v["cycle_time_s"].as_f64().unwrap();
+    let time_of = |extra: &[&str]| {
+        let out = feedopt(
+            &[
+                &["solve", "--json", "--solver", "reach"],
+                &POCKET[..],
+                extra,
+            ]
+            .concat(),
+        );
+        assert!(out.status.success());
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(v.get("material").is_none());
+        v["cycle_time_s"].as_f64().unwrap()
+    };
+    let programmed = time_of(&["--no-material"]);
+    let axes_only = time_of(&["--no-material", "--ignore-programmed-feed"]);
+    assert!(
+        axes_only < t && t < programmed,
+        "{axes_only} {t} {programmed}"
+    );
+}
+
+/// `feedopt check` lists the pocket's overloads with file and line; without a stock it says
+/// what to add.
+#[test]
+fn check_prints_findings_and_needs_a_stock() {
+    let out = feedopt(&[&["check"], &POCKET[..]].concat());
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("problems/material_pocket/pocket.cls:14: warning")
+            && text.contains("power limit"),
+        "{text}"
+    );
+    let out = feedopt(&[
+        "check",
+        "--machine",
+        "problems/xyz_pocket/machine.json",
+        "problems/xyz_pocket/pocket_contour.cls",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("needs a stock") && err.lines().count() == 1,
+        "{err}"
+    );
+}
+
+/// Bad material sections are one error naming the field.
+#[test]
+fn bad_material_sections_name_the_field() {
+    use feedopt::material::MaterialSpec;
+    let f = std::path::Path::new("m.json");
+    let err = |json: &str| MaterialSpec::from_json(f, json).unwrap_err().to_string();
+    let e = err(r#"{"stock": {"box": {"min": [0, 0, 0], "max": [10, 10, -1]}}}"#);
+    assert!(
+        e.contains("field `stock`") && e.contains("must exceed"),
+        "{e}"
+    );
+    let e =
+        err(r#"{"stock": {"cylinder": {"center": [0, 0], "radius": 5, "z": [0, 1]}, "box": {}}}"#);
+    assert!(e.contains("exactly one"), "{e}");
+    let e = err(r#"{"process": {"chip_lode": 0.05}}"#);
+    assert!(
+        e.contains("process.chip_lode") && e.contains("unknown field"),
+        "{e}"
+    );
+    let e = err(r#"{"process": {"power": 800}}"#);
+    assert!(e.contains("kc"), "{e}");
+    let e = err(r#"{"tool": {"diameter": -8}}"#);
+    assert!(e.contains("tool.diameter"), "{e}");
+    // Process limits without a stock: resolve says what to add.
+    let spec = MaterialSpec::from_json(f, r#"{"process": {"mrr_max": 100}}"#).unwrap();
+    let e = feedopt::material::Material::resolve(f, spec, &Default::default(), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("field `stock`"), "{e}");
+    // A chip load without flutes or spindle speed.
+    let spec = MaterialSpec::from_json(
+        f,
+        r#"{"stock": {"box": {"min": [0, 0, 0], "max": [1, 1, 1]}}, "tool": {"diameter": 6},
+            "process": {"chip_load": 0.05}}"#,
+    )
+    .unwrap();
+    let e = feedopt::material::Material::resolve(f, spec, &Default::default(), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("flutes"), "{e}");
+}

@@ -21,6 +21,7 @@
 //! and [`MAX_WORK`] dexel updates (the dexels under each step's tool, times the poses of a
 //! tilted step), estimated from the path before any material is cut.
 
+pub mod check;
 pub mod cut;
 pub mod dexel;
 pub mod process;
@@ -565,5 +566,196 @@ impl MaterialSpec {
             (spec.stock.is_some() || spec.process.any() || spec.tool.diameter.is_some())
                 .then_some(spec),
         )
+    }
+}
+
+/// Where the material model's inputs come from besides the machine file.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Overrides {
+    /// The tool as the options give it (first choice).
+    pub tool: ToolSpec,
+    /// The spindle speed option, rpm (first choice).
+    pub spindle_speed: Option<f64>,
+    /// Resolution.
+    pub options: CutOptions,
+}
+
+impl Material {
+    /// The material model of a run: the machine file's sections (`spec`, `None` without any),
+    /// the program's `CUTTER/` and spindle speed (`program`), and the options (`o`), which win
+    /// over the program, which wins over the machine file. `None` when there is no stock; an
+    /// error naming what is missing when process limits are given without a stock, a tool or
+    /// the spindle speed the chip load needs.
+    pub fn resolve(
+        file: &Path,
+        spec: Option<MaterialSpec>,
+        program: &program::ProgramProcess,
+        o: &Overrides,
+    ) -> Result<Option<Material>> {
+        let spec = spec.unwrap_or_default();
+        let field = |f: &str, m: String| Error::field(file, f, m);
+        let Some(stock) = spec.stock else {
+            if spec.process.any() {
+                return Err(field(
+                    "stock",
+                    "process limits need a stock: add `stock` {\"box\": {\"min\": [x, y, z], \
+                     \"max\": [x, y, z]}} or {\"cylinder\": …}"
+                        .into(),
+                ));
+            }
+            return Ok(None);
+        };
+        let from_program = ToolSpec {
+            diameter: program.cutter.map(|c| c.0),
+            corner_radius: program.cutter.map(|c| c.1),
+            ..ToolSpec::default()
+        };
+        let mut process = spec.process;
+        let tool = o
+            .tool
+            .or(from_program)
+            .or(spec.tool)
+            .build(process.chip_load.is_some())
+            .map_err(|e| field("tool", e))?;
+        process.spindle_speed = o
+            .spindle_speed
+            .or(program.spindle_speed.map(|s| s.0))
+            .or(process.spindle_speed);
+        if let Some(n) = process.spindle_speed {
+            if !(n.is_finite() && n > 0.0 && n <= 1e6) {
+                return Err(Error::Usage(format!(
+                    "spindle speed {n} rpm: give a speed from 0 to 1e6 rpm"
+                )));
+            }
+        }
+        if process.chip_load.is_some() && process.spindle_speed.is_none() {
+            return Err(field(
+                "process.spindle_speed",
+                "the chip load needs the spindle speed: program S / SPINDL/, give \
+                 `process.spindle_speed` or --spindle-speed"
+                    .into(),
+            ));
+        }
+        Ok(Some(Material {
+            stock,
+            tool,
+            process,
+            options: o.options,
+        }))
+    }
+}
+
+/// What a person reads about the material model after a run (`--json`: the `material`
+/// object).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MaterialReport {
+    pub stock: Stock,
+    pub tool: Tool,
+    pub tool_kind: tool::ToolKind,
+    pub process: ProcessLimits,
+    /// Dexel cells along X and Y, and their size (mm).
+    pub dexels: [usize; 2],
+    pub cell_mm: [f64; 2],
+    pub sample_step_mm: f64,
+    pub samples: usize,
+    /// Stock volume before, removed by the samples, and after, mm³.
+    pub initial_volume_mm3: f64,
+    pub removed_volume_mm3: f64,
+    pub final_volume_mm3: f64,
+    /// Largest A (mm²), a_p and a_e (mm) over the samples.
+    pub peak_area_mm2: f64,
+    pub peak_axial_depth_mm: f64,
+    pub peak_radial_engagement_mm: f64,
+    /// Share of the path length (samples) cutting air.
+    pub air_share: f64,
+    /// Dexel updates done.
+    pub work: f64,
+    /// How many different spindle speeds the program gives (the lowest is used).
+    pub program_spindle_speeds: usize,
+    /// The overload check's findings.
+    pub findings: Vec<check::Finding>,
+}
+
+impl MaterialReport {
+    /// The report of `sim` under `m`.
+    pub fn new(
+        m: &Material,
+        sim: &Simulation,
+        program: &program::ProgramProcess,
+        findings: Vec<check::Finding>,
+    ) -> MaterialReport {
+        let peak = |f: fn(&Sample) -> f64| sim.samples.iter().map(f).fold(0.0, f64::max);
+        let total: f64 = sim.samples.iter().map(|s| s.length).sum();
+        let air: f64 = sim
+            .samples
+            .iter()
+            .filter(|s| s.removed <= 0.0)
+            .map(|s| s.length)
+            .sum();
+        MaterialReport {
+            stock: m.stock,
+            tool: m.tool,
+            tool_kind: m.tool.kind(),
+            process: m.process,
+            dexels: [sim.dexels.nx, sim.dexels.ny],
+            cell_mm: [sim.cell.0, sim.cell.1],
+            sample_step_mm: sim.step,
+            samples: sim.samples.len(),
+            initial_volume_mm3: sim.initial_volume,
+            removed_volume_mm3: sim.removed_volume,
+            final_volume_mm3: sim.final_volume,
+            peak_area_mm2: peak(|s| s.area),
+            peak_axial_depth_mm: peak(|s| s.axial_depth),
+            peak_radial_engagement_mm: peak(|s| s.radial_engagement),
+            air_share: if total > 0.0 { air / total } else { 0.0 },
+            work: sim.work,
+            program_spindle_speeds: program.spindle_speeds,
+            findings,
+        }
+    }
+}
+
+impl std::fmt::Display for MaterialReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = &self.tool;
+        writeln!(
+            f,
+            "tool          {:?} end mill D {} mm, r {} mm, {} flutes, flute length {} mm",
+            self.tool_kind, t.diameter, t.corner_radius, t.flutes, t.flute_length
+        )?;
+        writeln!(
+            f,
+            "stock         {:.1} mm³ → removed {:.1} mm³ → {:.1} mm³ ({}×{} dexels of {:.3} mm, \
+             {} samples of {:.3} mm, {:.1} % in air)",
+            self.initial_volume_mm3,
+            self.removed_volume_mm3,
+            self.final_volume_mm3,
+            self.dexels[0],
+            self.dexels[1],
+            self.cell_mm[0],
+            self.samples,
+            self.sample_step_mm,
+            100.0 * self.air_share
+        )?;
+        writeln!(
+            f,
+            "engagement    peak A {:.3} mm², a_p {:.3} mm, a_e {:.3} mm",
+            self.peak_area_mm2, self.peak_axial_depth_mm, self.peak_radial_engagement_mm
+        )?;
+        if let Some(n) = self.process.spindle_speed {
+            writeln!(
+                f,
+                "spindle       {n} rpm{}",
+                if self.program_spindle_speeds > 1 {
+                    format!(
+                        " (the lowest of the program's {} speeds)",
+                        self.program_spindle_speeds
+                    )
+                } else {
+                    String::new()
+                }
+            )?;
+        }
+        Ok(())
     }
 }
