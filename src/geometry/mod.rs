@@ -96,8 +96,11 @@ pub struct Span {
 /// ([`crate::constraints::stations`]), so each interval between stations lies in one piece.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ProcessCaps {
+    /// Start of each piece in u (the first is 0).
     pub u: Vec<f64>,
+    /// Feed cap of each piece, mm/s.
     pub cap: Vec<f64>,
+    /// The process limit that sets each cap (`None`: programmed or maximum feed).
     pub by: Vec<Option<crate::material::ProcessLimit>>,
 }
 

@@ -75,10 +75,12 @@ impl Dexels {
         )
     }
 
-    /// Centre of column `i` (x) and row `j` (y), mm.
+    /// Centre of column `i` (x), mm.
     pub fn x(&self, i: usize) -> f64 {
         self.x0 + (i as f64 + 0.5) * self.hx
     }
+
+    /// Centre of row `j` (y), mm.
     pub fn y(&self, j: usize) -> f64 {
         self.y0 + (j as f64 + 0.5) * self.hy
     }
