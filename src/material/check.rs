@@ -4,7 +4,9 @@
 //! One finding per CL move and limit, with the move's worst sample: the programmed feed (times
 //! the feed override), the limit's allowed feed there, and by how much the first exceeds the
 //! second. A rapid (`G0` / `RAPID`) that removes material is an error-level finding whatever
-//! the limits. Excesses up to [`CHECK_TOLERANCE`] are not reported.
+//! the limits, once it removes more than one cell cube (h_x·h_y·min(h_x, h_y)): less is the
+//! grid grazing a wall the tool slides along (a retract along the tool axis), not a cut.
+//! Excesses up to [`CHECK_TOLERANCE`] are not reported.
 
 use super::cut::Sample;
 use super::{Material, ProcessLimit, Simulation};
@@ -73,11 +75,12 @@ impl std::fmt::Display for Finding {
 pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Finding> {
     let mut out: Vec<Finding> = Vec::new();
     let mut by_move: Vec<&Sample> = Vec::new();
+    let grazing = sim.cell.0 * sim.cell.1 * sim.cell.0.min(sim.cell.1);
     let flush = |group: &[&Sample], out: &mut Vec<Finding>| {
         let Some(first) = group.first() else { return };
         let removed: f64 = group.iter().map(|s| s.removed).sum();
         if first.rapid {
-            if removed > 0.0 {
+            if removed > grazing {
                 let area = group.iter().map(|s| s.area).fold(0.0, f64::max);
                 out.push(Finding {
                     severity: Severity::Error,
