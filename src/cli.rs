@@ -60,6 +60,67 @@ pub enum Command {
     Compare(CompareArgs),
     /// Constraint study: cycle time and its sensitivity against one axis limit.
     Sweep(SweepArgs),
+    /// Overload check (needs a stock): cut the stock along the program and list every move
+    /// whose programmed feed exceeds a process limit, and every rapid through material.
+    Check(CheckArgs),
+}
+
+/// The material model's options (`solve`, `gcode`, `interpolate`, `compare`, `sweep`,
+/// `check`): they apply when the machine file has a `stock` (see `feedopt::material`).
+#[derive(Debug, Clone, Default, Args)]
+pub struct MaterialArgs {
+    /// Dexel cell size of the material model, mm (default: tool diameter / 50).
+    #[arg(long, value_name = "MM")]
+    pub cell: Option<f64>,
+    /// Sample step of the engagement along the path, mm (default: the larger of 5 cells and
+    /// D/8).
+    #[arg(long, value_name = "MM")]
+    pub sample_step: Option<f64>,
+    /// Spindle speed, rpm (instead of the program's S / SPINDL/ or the machine file's
+    /// `process.spindle_speed`).
+    #[arg(long, value_name = "RPM")]
+    pub spindle_speed: Option<f64>,
+    /// Tool diameter, mm (instead of the program's CUTTER/ or the machine file's `tool`).
+    #[arg(long, value_name = "MM")]
+    pub tool_diameter: Option<f64>,
+    /// Tool corner radius, mm (0: flat, D/2: ball-nose).
+    #[arg(long, value_name = "MM")]
+    pub tool_corner_radius: Option<f64>,
+    /// Tool flute length, mm (default 2 D).
+    #[arg(long, value_name = "MM")]
+    pub tool_flute_length: Option<f64>,
+    /// Number of flutes (teeth).
+    #[arg(long, value_name = "N")]
+    pub tool_flutes: Option<u32>,
+    /// Ignore the machine file's stock, tool and process sections: axis limits and programmed
+    /// feeds only.
+    #[arg(long)]
+    pub no_material: bool,
+}
+
+#[derive(Debug, Args)]
+/// Arguments of `feedopt check`: the overload check of seed 003.
+pub struct CheckArgs {
+    /// Machine file with `stock`, `tool` and `process` sections.
+    #[arg(long, short)]
+    pub machine: PathBuf,
+    /// Toolpath file (APT CL or G-code).
+    pub toolpath: PathBuf,
+    /// Print one JSON object (the material report with its `findings`).
+    #[arg(long)]
+    pub json: bool,
+    /// Input format instead of the file's extension: apt or gcode.
+    #[arg(long, value_enum)]
+    pub format: Option<FormatChoice>,
+    /// G-code dialect (default: detected from the program).
+    #[arg(long)]
+    pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// Factor on every programmed feed, as the machine would run it (0.001 to 1000).
+    #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+    pub feed_override: f64,
+    #[command(flatten)]
+    /// Stock, tool and process limits beyond the machine file.
+    pub material: MaterialArgs,
 }
 
 #[derive(Debug, Args)]
@@ -172,6 +233,9 @@ pub struct SolveArgs {
     /// (seconds); 1 µs to 1 s.
     #[arg(long, default_value = "1ms", value_parser = parse_period)]
     pub period: f64,
+    #[command(flatten)]
+    /// Stock, tool and process limits beyond the machine file.
+    pub material: MaterialArgs,
 }
 
 /// A duration: a number of seconds, or with unit `s`, `ms` or `us`.
@@ -335,9 +399,16 @@ fn solve_with_progress(
 
 /// `feedopt solve`: returns what to print on stdout.
 pub fn solve(args: &SolveArgs) -> Result<String> {
-    let options = args.options()?;
+    let mut options = args.options()?;
     let machine = args.machine(&options)?;
     let (input, warnings) = read_input(args)?;
+    let material = apply_material(
+        &args.machine,
+        &args.toolpath,
+        &args.material,
+        &input,
+        &mut options,
+    )?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     let (detected, dwell) = reader_used(args, &input)?;
     if let Some(out) = &args.output {
@@ -356,37 +427,179 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     summary.warnings = warnings;
     summary.set_reader(&detected, dwell);
     Ok(if args.json {
-        let mut s = serde_json::to_string_pretty(&summary)
+        let mut value = serde_json::to_value(&summary)
+            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+        if let (Some(m), Some(obj)) = (&material, value.as_object_mut()) {
+            let m = serde_json::to_value(m)
+                .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+            obj.insert("material".into(), m);
+        }
+        let mut s = serde_json::to_string_pretty(&value)
             .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
         s.push('\n');
         s
     } else {
-        summary.to_string()
+        let mut s = summary.to_string();
+        if let Some(m) = &material {
+            s.push('\n');
+            s.push_str(&m.to_string());
+            for f in &m.findings {
+                s.push_str(&format!("check         line {}: {f}\n", f.line));
+            }
+        }
+        s
     })
+}
+
+/// Runs the material stage when the machine file has a stock (and `--no-material` is not
+/// given): cuts the stock along the toolpath, checks the programmed feeds against the process
+/// limits, and, where any process limit is given, puts its feed caps into `options`.
+fn apply_material(
+    machine_file: &std::path::Path,
+    toolpath_file: &std::path::Path,
+    args: &MaterialArgs,
+    input: &toolpath::Input,
+    options: &mut Options,
+) -> Result<Option<crate::material::MaterialReport>> {
+    use crate::material;
+    let given = args.cell.is_some()
+        || args.sample_step.is_some()
+        || args.spindle_speed.is_some()
+        || args.tool_diameter.is_some()
+        || args.tool_corner_radius.is_some()
+        || args.tool_flute_length.is_some()
+        || args.tool_flutes.is_some();
+    if args.no_material {
+        return Ok(None);
+    }
+    let spec = material::from_machine_file(machine_file)?;
+    let toolpath::Input::Cl(tp) = input else {
+        if spec.is_some_and(|s| s.stock.is_some()) || given {
+            return Err(Error::Usage(format!(
+                "{}: a joint-space path has no tool tip to cut a stock with: remove the \
+                 machine file's `stock` or give --no-material",
+                toolpath_file.display()
+            )));
+        }
+        return Ok(None);
+    };
+    let program = material::program::scan_file(toolpath_file)?;
+    let overrides = material::Overrides {
+        tool: material::ToolSpec {
+            diameter: args.tool_diameter,
+            corner_radius: args.tool_corner_radius,
+            flute_length: args.tool_flute_length,
+            flutes: args.tool_flutes,
+        },
+        spindle_speed: args.spindle_speed,
+        options: material::CutOptions {
+            cell: args.cell,
+            step: args.sample_step,
+        },
+    };
+    let Some(m) = material::Material::resolve(machine_file, spec, &program, &overrides)? else {
+        if given {
+            return Err(Error::Usage(format!(
+                "{}: the material options need a stock: add the machine file's `stock` section",
+                machine_file.display()
+            )));
+        }
+        return Ok(None);
+    };
+    let sim = material::simulate(tp, &m)?;
+    let findings = material::check::overloads(&sim, &m, options.geometry.feed_override);
+    if m.process.any() {
+        let limits = material::FeedLimits::new(&sim, &m, tp.points.len());
+        options.process = Some(std::sync::Arc::new(limits));
+    }
+    Ok(Some(material::MaterialReport::new(
+        &m, &sim, &program, findings,
+    )))
+}
+
+/// `feedopt check`: returns what to print on stdout.
+pub fn check(args: &CheckArgs) -> Result<String> {
+    let mut options = Options::default();
+    options.geometry.feed_override = args.feed_override;
+    options.geometry.validate()?;
+    let (input, _) = read_input_from(&args.machine, &args.toolpath, args.format, args.dialect)?;
+    let Some(report) = apply_material(
+        &args.machine,
+        &args.toolpath,
+        &args.material,
+        &input,
+        &mut options,
+    )?
+    else {
+        return Err(Error::Usage(format!(
+            "{}: the overload check needs a stock: add the machine file's `stock` section \
+             (and `tool`, `process`)",
+            args.machine.display()
+        )));
+    };
+    if args.json {
+        let mut s = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+        s.push('\n');
+        return Ok(s);
+    }
+    let mut s = format!("toolpath      {}\n", args.toolpath.display());
+    s.push_str(&report.to_string());
+    let errors = report
+        .findings
+        .iter()
+        .filter(|f| f.severity == crate::material::check::Severity::Error)
+        .count();
+    s.push_str(&format!(
+        "findings      {} ({errors} error{}, {} warning{})\n",
+        report.findings.len(),
+        if errors == 1 { "" } else { "s" },
+        report.findings.len() - errors,
+        if report.findings.len() - errors == 1 {
+            ""
+        } else {
+            "s"
+        }
+    ));
+    for f in &report.findings {
+        s.push_str(&format!("{}:{}: {f}\n", args.toolpath.display(), f.line));
+    }
+    Ok(s)
 }
 
 /// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned.
 fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
-    let format = args.format.map(|f| match f {
+    read_input_from(&args.machine, &args.toolpath, args.format, args.dialect)
+}
+
+/// Reads `toolpath_file` for the machine of `machine_file`; its reader's warnings are printed
+/// on stderr and returned.
+fn read_input_from(
+    machine_file: &std::path::Path,
+    toolpath_file: &std::path::Path,
+    format: Option<FormatChoice>,
+    dialect: Option<crate::toolpath::gcode::Dialect>,
+) -> Result<(toolpath::Input, Vec<String>)> {
+    let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
         FormatChoice::Csv => toolpath::Format::Csv,
     });
-    let (_, references) = Machine::references_from_file(&args.machine)?;
-    let machine = Machine::from_file(&args.machine)?;
+    let (_, references) = Machine::references_from_file(machine_file)?;
+    let machine = Machine::from_file(machine_file)?;
     let options = toolpath::ReadOptions {
         format,
-        dialect: args.dialect,
+        dialect,
         machine: Some(toolpath::MachineContext::new(&machine, &references)),
     };
-    let (input, _) = toolpath::read_with(&args.toolpath, &options)?;
+    let (input, _) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.
     let warnings: Vec<String> = match &input {
         toolpath::Input::Cl(t) => t
             .warnings
             .iter()
             .map(|w| {
-                let text = format!("{}:{}: {}", args.toolpath.display(), w.line, w.message);
+                let text = format!("{}:{}: {}", toolpath_file.display(), w.line, w.message);
                 crate::files::escape_control(&text)
             })
             .collect(),
@@ -426,13 +639,20 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
             "compare writes no schedule file (-o): use `feedopt solve -o` for feedopt's".into(),
         ));
     }
-    let options = crate::compare::CompareOptions {
+    let mut options = crate::compare::CompareOptions {
         solve: a.options()?,
         junction_deviation: args.junction_deviation,
     };
     options.validate()?;
     let machine = a.machine(&options.solve)?;
     let (input, _) = read_input(a)?;
+    apply_material(
+        &a.machine,
+        &a.toolpath,
+        &a.material,
+        &input,
+        &mut options.solve,
+    )?;
     let name = a.toolpath.display().to_string();
     let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
     #[cfg(feature = "plot")]
@@ -477,6 +697,13 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     o.validate()?;
     let machine = solve.machine(&o.solve)?;
     let (input, _) = read_input(solve)?;
+    apply_material(
+        &solve.machine,
+        &solve.toolpath,
+        &solve.material,
+        &input,
+        &mut o.solve,
+    )?;
     let result = crate::sweep::sweep(&machine, &input, &solve.toolpath.display().to_string(), &o)?;
     if let Some(out) = &solve.output {
         result.write(out)?;
@@ -501,6 +728,7 @@ pub fn run(cli: &Cli) -> Result<String> {
         Command::Interpolate(args) => interpolate(args),
         Command::Compare(args) => compare(args),
         Command::Sweep(args) => sweep(args),
+        Command::Check(args) => check(args),
     }
     .map_err(name_flag)
 }
@@ -550,6 +778,9 @@ pub struct PlanArgs {
     /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
     #[arg(long)]
     pub no_jerk: bool,
+    #[command(flatten)]
+    /// Stock, tool and process limits beyond the machine file.
+    pub material: MaterialArgs,
 }
 
 impl PlanArgs {
@@ -583,15 +814,23 @@ impl PlanArgs {
             plot: None,
             chord_tolerance: self.chord_tolerance,
             no_jerk: self.no_jerk,
+            material: self.material.clone(),
         }
     }
 }
 
 /// Reads, solves; reader warnings go to stderr.
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
-    let options = args.options()?;
+    let mut options = args.options()?;
     let machine = args.machine(&options)?;
     let (input, _) = read_input(args)?;
+    apply_material(
+        &args.machine,
+        &args.toolpath,
+        &args.material,
+        &input,
+        &mut options,
+    )?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
 }

@@ -33,6 +33,9 @@ pub enum Bound {
     Feed,
     /// The chord error of one interpolation period (seed 004).
     Chord,
+    /// A process limit of the material model ([`crate::material`]): chip load, material
+    /// removal rate, spindle power or the air-cut feed.
+    Process(crate::material::ProcessLimit),
     /// Nothing binds (no finite bound).
     #[default]
     None,
@@ -143,7 +146,7 @@ impl SpanProblem {
         machine: &Machine,
         chord: Option<&Chord>,
         u: f64,
-        cap: f64,
+        cap: (f64, Option<crate::material::ProcessLimit>),
     ) {
         let na = kin.n_axes();
         let w = span.eval(u);
@@ -152,7 +155,10 @@ impl SpanProblem {
             SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
             SpanKind::Reorientation | SpanKind::Joint => 0.0,
         };
-        let mut best = velocity_bound(machine, na, &jet, tip_speed, cap);
+        let mut best = velocity_bound(machine, na, &jet, tip_speed, cap.0);
+        if let (Bound::Feed, Some(limit)) = (best.1, cap.1) {
+            best.1 = Bound::Process(limit);
+        }
         let (rows, b_star, by) = essential_rows(&jet, &self.acceleration, best.0);
         // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
         if b_star < best.0 {
@@ -194,7 +200,7 @@ impl SpanProblem {
                 next.next();
                 let u = at(i);
                 debug_assert!(u > self.u[i] && u < self.u[i + 1]);
-                let cap = span.feed_caps[span.spline.segment(u)];
+                let cap = span.interval_cap(u);
                 p.push_station(span, kin, machine, chord, u, cap);
             }
         }
@@ -363,10 +369,22 @@ pub struct Grid {
     pub min_parts: usize,
 }
 
-/// Stations of a span: every knot, and each knot segment divided into equal parts, at least
-/// `grid.min_parts` and none longer than `grid.spacing`; at least two intervals in all.
+/// Stations of a span: every knot and every break of its process caps
+/// ([`crate::geometry::ProcessCaps`]), and each piece between them divided into equal parts, at
+/// least `grid.min_parts` per knot segment and none longer than `grid.spacing`; at least two
+/// intervals in all.
 pub fn stations(span: &Span, grid: Grid) -> Vec<f64> {
-    let knots = span.spline.knots();
+    let mut merged;
+    let knots = match &span.process {
+        Some(pc) if pc.u.len() > 1 => {
+            merged = span.spline.knots().to_vec();
+            merged.extend_from_slice(&pc.u[1..]);
+            merged.sort_by(f64::total_cmp);
+            merged.dedup();
+            &merged[..]
+        }
+        _ => span.spline.knots(),
+    };
     let min_parts = grid.min_parts.max(if knots.len() == 2 { 2 } else { 1 });
     let spacing = grid.spacing;
     let mut u = Vec::with_capacity(knots.len());
@@ -383,28 +401,22 @@ pub fn stations(span: &Span, grid: Grid) -> Vec<f64> {
     u
 }
 
-/// Feed cap at each station: the lower cap of the CL moves that contain its two neighbouring
-/// intervals. Every CL point is a station, so each interval lies within one move, and b linear
-/// between stations keeps that move's cap over the whole interval. (Taking every move that
-/// merely touches the neighbourhood would smear each cap one interval into the next move: an
-/// O(Δu) error at every CL point of a program whose feed changes block by block.)
-fn station_feed_caps(span: &Span, u: &[f64]) -> Vec<f64> {
+/// Feed cap at each station: the lower cap of the CL moves (or the process model's pieces,
+/// [`Span::interval_cap`]) that contain its two neighbouring intervals, with the process limit
+/// that sets it. Every CL point and every process break is a station, so each interval lies
+/// within one move and one piece, and b linear between stations keeps that cap over the whole
+/// interval. (Taking every move that merely touches the neighbourhood would smear each cap one
+/// interval into the next move: an O(Δu) error at every CL point of a program whose feed
+/// changes block by block.)
+fn station_feed_caps(span: &Span, u: &[f64]) -> Vec<(f64, Option<crate::material::ProcessLimit>)> {
     let n = u.len() - 1;
-    let caps = &span.feed_caps;
-    let interval_cap = |k: usize| caps[span.spline.segment(0.5 * (u[k] + u[k + 1]))];
+    let interval_cap = |k: usize| span.interval_cap(0.5 * (u[k] + u[k + 1]));
+    let none = (f64::INFINITY, None);
     (0..=n)
         .map(|i| {
-            let before = if i > 0 {
-                interval_cap(i - 1)
-            } else {
-                f64::INFINITY
-            };
-            let after = if i < n {
-                interval_cap(i)
-            } else {
-                f64::INFINITY
-            };
-            before.min(after)
+            let before = if i > 0 { interval_cap(i - 1) } else { none };
+            let after = if i < n { interval_cap(i) } else { none };
+            if before.0 <= after.0 { before } else { after }
         })
         .collect()
 }

@@ -45,7 +45,7 @@
 //!
 //! Each stage is a module with one job and plain data between stages:
 //! [`toolpath`] (readers) → [`geometry`] (spans, splines) → [`kinematics`] (q, t_q, K_q) →
-//! [`constraints`] (rows on b) → [`solver`] (Clarabel; the O(N) reachability pass; the
+//! [`material`] (optional: dexel stock, engagement, process feed caps) → [`constraints`] (rows on b) → [`solver`] (Clarabel; the O(N) reachability pass; the
 //! jerk-limited SCP) → [`schedule`] (time, eq. 43, through the [`motion`] laws between
 //! stations) → [`verify`] (re-simulation at the servo period) → [`report`] (summary) and
 //! [`writers`] (JSON, CSV, G-code, plots). [`optimize::optimize`] runs them all (and
@@ -98,6 +98,7 @@ pub mod geometry;
 pub mod interpolate;
 pub mod kinematics;
 pub mod machine;
+pub mod material;
 pub mod motion;
 #[allow(missing_docs)]
 pub mod optimize;

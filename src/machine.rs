@@ -12,7 +12,9 @@
 //! in mm/s and mm/s², rotary axes in °/s and °/s². An optional `"jerk"` (number or `[min, max]`,
 //! mm/s³ or °/s³) makes the schedule jerk-limited. An axis may also give its travel, `"min"` and
 //! `"max"` (mm or degrees, both or neither, `min < max`). `feed.max` (mm/s) caps the tool-tip
-//! feed V; the `feed` section is optional. Unknown fields, missing axes or limits,
+//! feed V; the `feed` section is optional. The optional `stock`, `tool` and `process` sections
+//! belong to the material model and are read by [`crate::material::from_machine_file`].
+//! Unknown fields, missing axes or limits,
 //! non-positive limits and keys given twice in one object are errors that name the field; so
 //! are implausible magnitudes: limits outside [`MIN_LIMIT`]…[`MAX_LIMIT`] of their unit (jerk
 //! up to [`MAX_JERK_LIMIT`]) and lengths beyond ±[`MAX_LENGTH`] mm.
@@ -544,7 +546,19 @@ impl Parser {
 
     fn machine(&self, root: &Value) -> Result<Machine> {
         let obj = self.object(root, "(top level)")?;
-        self.only_known(obj, "", &["name", "kinematics", "axes", "feed"])?;
+        self.only_known(
+            obj,
+            "",
+            &[
+                "name",
+                "kinematics",
+                "axes",
+                "feed",
+                "stock",
+                "tool",
+                "process",
+            ],
+        )?;
         let name = match obj.get("name") {
             None => String::new(),
             Some(Value::String(s)) => s.clone(),

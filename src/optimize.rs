@@ -66,6 +66,9 @@ pub struct Options {
     pub jerk_limited: bool,
     /// The sequential convex programme of a jerk-limited solve.
     pub jerk: JerkOptions,
+    /// Process feed caps from the material stage ([`crate::material::FeedLimits`], computed
+    /// on the same toolpath): attached to the spans before the constraints are built.
+    pub process: Option<std::sync::Arc<crate::material::FeedLimits>>,
 }
 
 impl Default for Options {
@@ -84,6 +87,7 @@ impl Default for Options {
             refine_until_verified: true,
             jerk_limited: true,
             jerk: JerkOptions::default(),
+            process: None,
         }
     }
 }
@@ -168,7 +172,7 @@ pub fn optimize_observed(
     }
     let kin = Kinematics::new(machine);
     let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
-    let path = Path::build(
+    let mut path = Path::build(
         toolpath,
         &angles,
         machine.feed_max,
@@ -182,6 +186,9 @@ pub fn optimize_observed(
             toolpath.points.first().map_or(1, |p| p.line),
             "no motion: every CL point is at the same position",
         ));
+    }
+    if let Some(limits) = &options.process {
+        limits.attach(&mut path, toolpath, machine.feed_max)?;
     }
     optimize_path(machine, path, options, progress)
 }
@@ -558,6 +565,7 @@ impl Plan<'_> {
                 Bound::AxisJerk(j) => format!("the {} jerk limit", self.axes[j]),
                 Bound::Feed => "the programmed feed".to_string(),
                 Bound::Chord => "the chord tolerance".to_string(),
+                Bound::Process(l) => format!("the {} limit", l.label()),
                 Bound::None => "the limits".to_string(),
             };
             Error::Infeasible(format!(
@@ -770,7 +778,6 @@ impl Plan<'_> {
         };
         Ok((lv, refinement, estimate))
     }
-
 
     /// Jerk-limited solves, refined adaptively as [`Plan::solve_adaptive`] refines the
     /// acceleration-limited ones, with the SCP itself as the solver.
@@ -1146,6 +1153,7 @@ impl Plan<'_> {
                 Bound::AxisJerk(j) => Some(format!("{} jerk", self.axes[j])),
                 Bound::Feed => Some("the feed cap".to_string()),
                 Bound::Chord => Some("the chord tolerance".to_string()),
+                Bound::Process(l) => Some(format!("the {} limit", l.label())),
                 Bound::None => None,
             })
             .collect();

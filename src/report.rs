@@ -119,6 +119,7 @@ pub fn binding_label(bound: Bound, axes: &[&str]) -> String {
         Bound::AxisJerk(j) => format!("{} jerk", axes[j]),
         Bound::Feed => "feed".to_string(),
         Bound::Chord => "chord error".to_string(),
+        Bound::Process(l) => l.label().to_string(),
         Bound::None => "none".to_string(),
     }
 }

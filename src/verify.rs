@@ -407,7 +407,7 @@ fn check_intervals(
             // On a knot q''' jumps: the interval starts with its own segment's.
             at_start = Point::new(span, kin, seg, ua, moving, jerk);
         }
-        let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+        let cap = span.feed_cap(seg, ua);
         acc.check(&at_start, &s0, cap, ua, ta, si, i);
         if jerk && iv.law == Law::Linear && (i > 0 || s0.b == 0.0) {
             // ü jumps at the station: a controller sampling at the period sees the step
@@ -431,7 +431,7 @@ fn check_intervals(
             while seg < last_seg && knots[seg + 1] < u {
                 seg += 1;
             }
-            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            let cap = span.feed_cap(seg, u);
             let pt = Point::new(span, kin, seg, u, moving, jerk);
             acc.check(&pt, &st, cap, u, t, si, i);
             samples += 1;
@@ -444,7 +444,7 @@ fn check_intervals(
         while seg < last_seg && knots[seg + 1] < ub {
             seg += 1;
         }
-        let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+        let cap = span.feed_cap(seg, ub);
         let at_end = Point::new(span, kin, seg, ub, moving, jerk);
         acc.check(&at_end, &s1, cap, ub, tb, si, i);
         station_checks += 1;
@@ -666,6 +666,8 @@ mod tests {
             spline: CubicSpline::new(&[0.0, len], &[[0.0; PATH_DIM], end]),
             feed_caps: vec![cap],
             lines: vec![1, 2],
+            points: vec![0, 1],
+            process: None,
         }
     }
 

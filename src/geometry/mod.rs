@@ -82,6 +82,45 @@ pub struct Span {
     pub feed_caps: Vec<f64>,
     /// Source line of the CL point at each knot.
     pub lines: Vec<usize>,
+    /// Index into [`Toolpath::points`] of the CL point at each knot (empty where the knots are
+    /// not CL points: a dresser profile refitted by biarcs, a joint-space path).
+    pub points: Vec<usize>,
+    /// Feed caps of a process model ([`crate::material`]), which replace `feed_caps` on this
+    /// span where present: a piecewise-constant cap in u whose breaks are stations.
+    pub process: Option<ProcessCaps>,
+}
+
+/// A piecewise-constant feed cap along a span's u, from the material stage
+/// ([`crate::material::FeedLimits::attach`]): piece k covers `[u[k], u[k+1])` (the last one up
+/// to the span's end) with cap `cap[k]` (mm/s, `f64::INFINITY`: none) set by `by[k]` (`None`:
+/// the programmed or the machine's maximum feed). Every break `u[k]`, k ≥ 1, is made a station
+/// ([`crate::constraints::stations`]), so each interval between stations lies in one piece.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ProcessCaps {
+    /// Start of each piece in u (the first is 0).
+    pub u: Vec<f64>,
+    /// Feed cap of each piece, mm/s.
+    pub cap: Vec<f64>,
+    /// The process limit that sets each cap (`None`: programmed or maximum feed).
+    pub by: Vec<Option<crate::material::ProcessLimit>>,
+}
+
+impl ProcessCaps {
+    /// The piece containing `u` (the later one on a break).
+    pub fn piece(&self, u: f64) -> usize {
+        self.u.partition_point(|&x| x <= u).saturating_sub(1)
+    }
+
+    /// The lowest cap at `u`: on a break, the lower of the two pieces that meet there.
+    pub fn at(&self, u: f64) -> (f64, Option<crate::material::ProcessLimit>) {
+        let k = self.piece(u);
+        let here = (self.cap[k], self.by[k]);
+        if k > 0 && self.u[k] == u && self.cap[k - 1] < here.0 {
+            (self.cap[k - 1], self.by[k - 1])
+        } else {
+            here
+        }
+    }
 }
 
 impl Span {
@@ -93,6 +132,28 @@ impl Span {
     /// Path coordinates and their u-derivatives at `u`.
     pub fn eval(&self, u: f64) -> PathJet {
         self.spline.eval(u)
+    }
+
+    /// The feed cap (mm/s) at `u` in spline segment `seg`: the process model's where the span
+    /// has one ([`ProcessCaps::at`]), else the CL move's.
+    pub fn feed_cap(&self, seg: usize, u: f64) -> f64 {
+        match &self.process {
+            Some(p) => p.at(u).0,
+            None => self.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY),
+        }
+    }
+
+    /// The feed cap on the interval of stations around `u` (strictly inside one piece, e.g. an
+    /// interval's midpoint), and the process limit that sets it (`None`: the programmed or
+    /// machine feed).
+    pub fn interval_cap(&self, u: f64) -> (f64, Option<crate::material::ProcessLimit>) {
+        match &self.process {
+            Some(p) => {
+                let k = p.piece(u);
+                (p.cap[k], p.by[k])
+            }
+            None => (self.feed_caps[self.spline.segment(u)], None),
+        }
     }
 
     /// Source line of the CL point nearest to `u`.
@@ -174,7 +235,8 @@ impl Path {
                 .collect();
             let mut feed_caps: Vec<f64> = idx.windows(2).map(|w| cap(w[0], w[1])).collect();
             let mut lines: Vec<usize> = idx.iter().map(|&i| pts[i].line).collect();
-            let deviation = if moving && profile_normal && options.tolerance_mm > 0.0 {
+            let refitted = moving && profile_normal && options.tolerance_mm > 0.0;
+            let deviation = if refitted {
                 let fitted = dresser_profile(&values, &feed_caps, &lines, options.tolerance_mm);
                 (values, feed_caps, lines) = (fitted.values, fitted.caps, fitted.lines);
                 fitted.deviation
@@ -206,6 +268,8 @@ impl Path {
                 spline: CubicSpline::new(&u, &values),
                 feed_caps,
                 lines,
+                points: if refitted { Vec::new() } else { idx.to_vec() },
+                process: None,
             });
         }
         Ok(Path { spans })
@@ -326,6 +390,8 @@ impl Path {
                 spline,
                 feed_caps: vec![f64::INFINITY; u.len() - 1],
                 lines: jp.lines.clone(),
+                points: Vec::new(),
+                process: None,
             }],
         })
     }

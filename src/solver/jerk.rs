@@ -249,7 +249,7 @@ impl JerkData {
             let seg = span.spline.segment(um);
             let w = span.spline.eval_in(seg, um);
             let jets = kin.axis_jets(&w);
-            let cap = span.feed_caps.get(seg).copied().unwrap_or(f64::INFINITY);
+            let cap = span.feed_cap(seg, um);
             let speed = if moving {
                 (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt()
             } else {

@@ -270,7 +270,7 @@ impl Rows {
 pub(crate) fn on_velocity_bound(p: &crate::constraints::SpanProblem, b: &[f64], i: usize) -> f64 {
     use crate::constraints::Bound;
     match p.b_max_by[i] {
-        Bound::AxisVelocity(_) | Bound::Feed | Bound::Chord
+        Bound::AxisVelocity(_) | Bound::Feed | Bound::Chord | Bound::Process(_)
             if p.b_max[i].is_finite() && p.b_max[i] > 0.0 =>
         {
             b[i] / p.b_max[i]

@@ -105,6 +105,12 @@ fn bound_colour(b: Bound) -> RGBColor {
             RGBColor(r / 2 + 127, g / 2 + 127, b / 2 + 127)
         }
         Bound::Chord => RGBColor(156, 39, 176),
+        Bound::Process(l) => match l {
+            crate::material::ProcessLimit::ChipLoad => RGBColor(121, 85, 72),
+            crate::material::ProcessLimit::Mrr => RGBColor(233, 30, 99),
+            crate::material::ProcessLimit::Power => RGBColor(255, 152, 0),
+            crate::material::ProcessLimit::Air => RGBColor(3, 169, 244),
+        },
         Bound::None => RGBColor(170, 170, 170),
     }
 }

@@ -1,0 +1,395 @@
+//! The cut: the tool's swept volume removes material from the dexels, sample by sample along
+//! the path, and each sample records what the tool engaged.
+//!
+//! **Samples.** Every CL move (from point k−1 to point k) is divided into
+//! ⌈(|ΔP| + L_f·Δθ)/step⌉ equal steps, where Δθ is the angle the tool axis turns and `step`
+//! the sample step (fixed by the grid, [`super::CutOptions`]): a sampling of the *path*, not of
+//! the solver's stations, so the result is a piecewise-constant function of the path that any
+//! station set can query.
+//!
+//! **Removal, vertical tool** (the axis is +Z at both ends of the move: exact). The tool moves
+//! straight from P₀ to P₁. A dexel at (x, y) meets it while the horizontal distance d(t) of
+//! the axis is at most R, which holds on one interval t ∈ [t_a, t_b] (d² is quadratic in t). At
+//! each t the tool covers `[z(t) + f(d(t)), z(t) + L_f]` of the line (f: [`Tool::bottom`]);
+//! these intervals move continuously with t, so their union is the single interval
+//! `[min g, max (z + L_f)]` with `g(t) = z(t) + f(d(t))`. z is linear and f(d(t)) convex (f
+//! is convex and non-decreasing, d(t) convex), so g is convex: its minimum lies at an end for
+//! a flat end mill or a plunge, at the closest approach for a level move, and is found by
+//! golden-section search (to 1e-9 mm) on a ramp. Each dexel is thus cut exactly.
+//!
+//! **Removal, tilted tool** (sound, conservative). The tool passes through poses at
+//! t = j/m (P linear, the axis interpolated and normalised) with m chosen so that no point of
+//! the cutting part moves more than half a cell between poses. Each pose's crossing with a
+//! dexel line is exact ([`Tool::line_hit`]); consecutive poses that both cross a dexel are
+//! joined into `[min lo, max hi]`. The union of the continuous family of crossings between two
+//! such poses is connected and contains both, so the joined interval lies inside the true swept
+//! volume: material is never removed that the tool does not reach. What may be left is the
+//! sliver the swept surface bulges past the chord between poses, a sagitta of the order of
+//! (half a cell)² / (8 r) for a surface of curvature radius r: it can only make the engagement
+//! look larger, hence the feed lower (safe).
+//!
+//! **Engagement of a sample** (the tool at the step's end pose P, axis O, feed direction f):
+//! - removed volume ΔV (mm³) and engaged cross-section `A = ΔV / Δs` (mm²) normal to the feed,
+//!   Δs the tip's travel in the step: the material removal rate is `A·V`;
+//! - axial depth a_p: the highest removed material above the tip along O;
+//! - radial engagement a_e = min(A / a_p, D): the width of a cut of uniform depth (exact for a
+//!   flat end mill in a slot, a side step or a pocket floor);
+//! - engagement angle φ of a side cut (the material reaching the tool's periphery on one side,
+//!   as in slots, side steps and pocket floors): `φ = acos(1 − 2 a_e/D)` (a slot 180°, a
+//!   half-width side step 90°);
+//! - a plunge (f along O, |O × f| < 1e-9 |f|): a_e is the diameter of the disc of area A,
+//!   φ = 360°.
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use super::dexel::{Dexels, remove};
+use super::tool::Tool;
+use crate::toolpath::{Feed, Toolpath};
+
+/// What the tool engaged over one sample step.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Sample {
+    /// The CL point the move ends at (index into [`Toolpath::points`]).
+    pub point: usize,
+    /// The step's fractions of that move, `[t0, t1]` ⊂ [0, 1].
+    pub t: [f64; 2],
+    /// Source line of the CL point the move ends at.
+    pub line: usize,
+    /// Δs: the tool tip's travel in the step, mm.
+    pub length: f64,
+    /// ΔV: material removed, mm³.
+    pub removed: f64,
+    /// A = ΔV/Δs, mm² (0 where the tip does not travel).
+    pub area: f64,
+    /// a_p, mm.
+    pub axial_depth: f64,
+    /// a_e, mm.
+    pub radial_engagement: f64,
+    /// φ, degrees.
+    pub engagement_angle: f64,
+    /// The move is a rapid (G0 / `RAPID`).
+    pub rapid: bool,
+    /// The move's programmed feed, mm/s (`None`: rapid, inverse-time or none).
+    pub programmed_feed: Option<f64>,
+}
+
+/// Per-step sums over the dexels a step cut.
+#[derive(Debug, Clone, Copy)]
+struct Acc {
+    length: f64,
+    axial_max: f64,
+}
+
+impl Acc {
+    const ZERO: Acc = Acc {
+        length: 0.0,
+        axial_max: f64::NEG_INFINITY,
+    };
+    fn join(self, o: Acc) -> Acc {
+        Acc {
+            length: self.length + o.length,
+            axial_max: self.axial_max.max(o.axial_max),
+        }
+    }
+}
+
+/// One step of a move: from tip `p0`, axis `o0` to `p1`, `o1`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Step {
+    pub p0: Vector3<f64>,
+    pub p1: Vector3<f64>,
+    pub o0: Vector3<f64>,
+    pub o1: Vector3<f64>,
+}
+
+impl Step {
+    /// The axis is vertical (+Z) at both ends: removal is exact.
+    fn vertical(&self) -> bool {
+        (self.o0 - Vector3::z()).norm() < 1e-12 && (self.o1 - Vector3::z()).norm() < 1e-12
+    }
+
+    /// How far any point of the cutting part moves: |ΔP| + L_f·Δθ (an upper bound), mm.
+    pub fn extent(&self, tool: &Tool) -> f64 {
+        (self.p1 - self.p0).norm() + tool.flute_length * angle(&self.o0, &self.o1)
+    }
+
+    /// Poses of a tilted step (at least 2), so that no point moves more than `delta` between.
+    pub fn poses(&self, tool: &Tool, delta: f64) -> usize {
+        if self.vertical() {
+            1
+        } else {
+            ((self.extent(tool) / delta).ceil() as usize).max(1) + 1
+        }
+    }
+
+    fn pose(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let o = (self.o0 * (1.0 - t) + self.o1 * t).normalize();
+        (self.p0 + (self.p1 - self.p0) * t, o)
+    }
+
+    /// The XY rectangle `[x0, y0, x1, y1]` the step's tool covers (with `poses` poses).
+    pub fn bounds(&self, tool: &Tool, poses: usize) -> [f64; 4] {
+        let r = tool.radius();
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut add = |p: Vector3<f64>| {
+            b[0] = b[0].min(p.x - r);
+            b[1] = b[1].min(p.y - r);
+            b[2] = b[2].max(p.x + r);
+            b[3] = b[3].max(p.y + r);
+        };
+        if poses <= 1 {
+            add(self.p0);
+            add(self.p1);
+        } else {
+            for j in 0..poses {
+                let (p, o) = self.pose(j as f64 / (poses - 1) as f64);
+                add(p);
+                add(p + o * tool.flute_length);
+            }
+        }
+        b
+    }
+}
+
+/// The angle between two unit vectors, radians.
+fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// The grid cells (i0..=i1, j0..=j1) that rectangle `b` covers, if any.
+pub(crate) fn cell_range(d: &Dexels, b: &[f64; 4]) -> Option<(usize, usize, usize, usize)> {
+    let i0 = ((b[0] - d.x0) / d.hx - 0.5).ceil().max(0.0);
+    let j0 = ((b[1] - d.y0) / d.hy - 0.5).ceil().max(0.0);
+    let i1 = ((b[2] - d.x0) / d.hx - 0.5).floor().min(d.nx as f64 - 1.0);
+    let j1 = ((b[3] - d.y0) / d.hy - 0.5).floor().min(d.ny as f64 - 1.0);
+    (i0 <= i1 && j0 <= j1).then_some((i0 as usize, i1 as usize, j0 as usize, j1 as usize))
+}
+
+/// The z interval a vertical tool sweeps on the dexel line through (x, y) moving straight
+/// from `p0` to `p1` (module doc), if it reaches the line.
+pub fn vertical_sweep(
+    tool: &Tool,
+    p0: &Vector3<f64>,
+    p1: &Vector3<f64>,
+    x: f64,
+    y: f64,
+) -> Option<[f64; 2]> {
+    let r = tool.radius();
+    let (ax, ay) = (p0.x - x, p0.y - y);
+    let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
+    let qa = dx * dx + dy * dy;
+    let qb = ax * dx + ay * dy; // half the linear coefficient
+    let qc = ax * ax + ay * ay;
+    let (ta, tb) = if qa <= 1e-24 {
+        if qc > r * r {
+            return None;
+        }
+        (0.0, 1.0)
+    } else {
+        let disc = qb * qb - qa * (qc - r * r);
+        if disc < 0.0 {
+            return None;
+        }
+        let sq = disc.sqrt();
+        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+        if ta > tb {
+            return None;
+        }
+        (ta, tb)
+    };
+    let dz = p1.z - p0.z;
+    let z = |t: f64| p0.z + dz * t;
+    let dist = |t: f64| (qa * t * t + 2.0 * qb * t + qc).max(0.0).sqrt().min(r);
+    let g = |t: f64| z(t) + tool.bottom(dist(t));
+    let lo = if tool.corner_radius == 0.0 || qa <= 1e-24 {
+        g(ta).min(g(tb))
+    } else if dz == 0.0 {
+        g((-qb / qa).clamp(ta, tb))
+    } else {
+        golden_min(g, ta, tb)
+    };
+    Some([lo, z(ta).max(z(tb)) + tool.flute_length])
+}
+
+/// The minimum of a convex function on [a, b] (golden-section search, to 1e-12 of the range,
+/// checked against both ends).
+fn golden_min(g: impl Fn(f64) -> f64, a0: f64, b0: f64) -> f64 {
+    const G: f64 = 0.618_033_988_749_894_8;
+    let (mut a, mut b) = (a0, b0);
+    let (mut x1, mut x2) = (b - G * (b - a), a + G * (b - a));
+    let (mut f1, mut f2) = (g(x1), g(x2));
+    for _ in 0..80 {
+        if b - a <= 1e-12 * (b0 - a0) {
+            break;
+        }
+        if f1 <= f2 {
+            b = x2;
+            (x2, f2) = (x1, f1);
+            x1 = b - G * (b - a);
+            f1 = g(x1);
+        } else {
+            a = x1;
+            (x1, f1) = (x2, f2);
+            x2 = a + G * (b - a);
+            f2 = g(x2);
+        }
+    }
+    f1.min(f2).min(g(a0)).min(g(b0))
+}
+
+/// Removes one step's swept volume from the dexels (rows in parallel) and returns the sample's
+/// engagement (its `point`, `t`, `line`, `rapid` and feed are the caller's to fill).
+pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64) -> Sample {
+    let poses = step.poses(tool, delta);
+    let bounds = step.bounds(tool, poses);
+    let (pe, oe) = (step.p1, step.o1.normalize());
+    let f = step.p1 - step.p0;
+    let plunge = oe.cross(&f).norm() <= 1e-9 * f.norm();
+    let acc = match cell_range(dexels, &bounds) {
+        None => Acc::ZERO,
+        Some((i0, i1, j0, j1)) => {
+            let nx = dexels.nx;
+            let (x0, y0, hx, hy) = (dexels.x0, dexels.y0, dexels.hx, dexels.hy);
+            let vertical = poses == 1;
+            dexels.cells[j0 * nx..(j1 + 1) * nx]
+                .par_chunks_mut(nx)
+                .enumerate()
+                .map(|(jj, row)| {
+                    let y = y0 + ((j0 + jj) as f64 + 0.5) * hy;
+                    let mut acc = Acc::ZERO;
+                    let mut note = |x: f64, c: super::dexel::Cut| {
+                        if c.length <= 0.0 {
+                            return;
+                        }
+                        let top = Vector3::new(x, y, c.z_hi) - pe;
+                        let bottom = Vector3::new(x, y, c.z_lo) - pe;
+                        acc.length += c.length;
+                        acc.axial_max = acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
+                    };
+                    for i in i0..=i1 {
+                        let x = x0 + (i as f64 + 0.5) * hx;
+                        let cell = &mut row[i];
+                        if cell.is_empty() {
+                            continue;
+                        }
+                        if vertical {
+                            if let Some([lo, hi]) = vertical_sweep(tool, &step.p0, &step.p1, x, y) {
+                                note(x, remove(cell, lo, hi));
+                            }
+                        } else {
+                            let mut run: Option<[f64; 2]> = None;
+                            for j in 0..poses {
+                                let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
+                                match (tool.line_hit(&p, &o, x, y), run) {
+                                    (Some(h), Some(r)) => {
+                                        run = Some([r[0].min(h[0]), r[1].max(h[1])]);
+                                    }
+                                    (Some(h), None) => run = Some(h),
+                                    (None, Some(r)) => {
+                                        note(x, remove(cell, r[0], r[1]));
+                                        run = None;
+                                    }
+                                    (None, None) => {}
+                                }
+                            }
+                            if let Some(r) = run {
+                                note(x, remove(cell, r[0], r[1]));
+                            }
+                        }
+                    }
+                    acc
+                })
+                .reduce(|| Acc::ZERO, Acc::join)
+        }
+    };
+    let cell_area = dexels.hx * dexels.hy;
+    let removed = acc.length * cell_area;
+    let length = f.norm();
+    let area = if length > 0.0 { removed / length } else { 0.0 };
+    let d = tool.diameter;
+    let axial_depth = if acc.length > 0.0 {
+        acc.axial_max.max(0.0)
+    } else {
+        0.0
+    };
+    let (radial_engagement, engagement_angle) = if area <= 0.0 {
+        (0.0, 0.0)
+    } else if plunge {
+        ((4.0 * area / std::f64::consts::PI).sqrt().min(d), 360.0)
+    } else {
+        let ae = if axial_depth > 0.0 {
+            (area / axial_depth).min(d)
+        } else {
+            d
+        };
+        (
+            ae,
+            (1.0 - 2.0 * ae / d).clamp(-1.0, 1.0).acos().to_degrees(),
+        )
+    };
+    Sample {
+        point: 0,
+        t: [0.0, 1.0],
+        line: 0,
+        length,
+        removed,
+        area,
+        axial_depth,
+        radial_engagement,
+        engagement_angle,
+        rapid: false,
+        programmed_feed: None,
+    }
+}
+
+/// The steps of CL move k (from point k−1 to k) at sample step `step`: their count (0 where
+/// the tool neither moves nor turns).
+pub(crate) fn steps_of_move(tp: &Toolpath, k: usize, tool: &Tool, step: f64) -> usize {
+    let (a, b) = (&tp.points[k - 1], &tp.points[k]);
+    let whole = Step {
+        p0: a.p,
+        p1: b.p,
+        o0: a.o,
+        o1: b.o,
+    };
+    let e = whole.extent(tool);
+    if e <= 1e-9 {
+        0
+    } else {
+        (e / step).ceil().max(1.0) as usize
+    }
+}
+
+/// Step `s` of `n` of CL move k.
+pub(crate) fn step_of_move(tp: &Toolpath, k: usize, s: usize, n: usize) -> Step {
+    let (a, b) = (&tp.points[k - 1], &tp.points[k]);
+    let (t0, t1) = (s as f64 / n as f64, (s + 1) as f64 / n as f64);
+    let at = |t: f64| {
+        (
+            a.p + (b.p - a.p) * t,
+            (a.o * (1.0 - t) + b.o * t).normalize(),
+        )
+    };
+    let ((p0, o0), (p1, o1)) = (at(t0), at(t1));
+    Step { p0, p1, o0, o1 }
+}
+
+/// The programmed feed of the move ending at CL point k, mm/s, and whether it is a rapid.
+pub(crate) fn move_feed(tp: &Toolpath, k: usize) -> (Option<f64>, bool) {
+    match tp.points[k].feed {
+        Feed::Programmed(v) => (Some(v), false),
+        Feed::Rapid => (None, true),
+        Feed::BlockTime(t) => (
+            Some((tp.points[k].p - tp.points[k - 1].p).norm() / t),
+            false,
+        ),
+        Feed::Unspecified => (None, false),
+    }
+}

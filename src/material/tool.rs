@@ -1,0 +1,298 @@
+//! The cutter: a flat, ball or bull-nose end mill as a solid of revolution about its axis.
+//!
+//! With the tool tip at **P** and the unit axis **O** pointing from the tip towards the spindle,
+//! a point **X** lies at height `h = (X − P)·O` along the axis and radius `ρ = |X − P − h O|`
+//! from it. The cutting part of the tool is the convex solid
+//!
+//! ```text
+//! 0 ≤ h ≤ L_f,   ρ ≤ r(h),   r(h) = R − r_c + √(r_c² − (r_c − h)²)  for h < r_c,   R above,
+//! ```
+//!
+//! with R = D/2 the tool radius, r_c the corner radius (0: flat end mill, R: ball-nose, in
+//! between: bull-nose) and L_f the flute length. Seen from below along a vertical axis the
+//! tool's lower surface is `z = P_z + f(d)` at horizontal distance d from the axis, with
+//! `f(d) = 0` for d ≤ R − r_c and `r_c − √(r_c² − (d − R + r_c)²)` up to R: convex and
+//! non-decreasing in d.
+
+use nalgebra::Vector3;
+
+/// The largest tool diameter (mm) feedopt accepts: 1 m.
+pub const MAX_TOOL_DIAMETER_MM: f64 = 1000.0;
+
+/// The shape of an end mill, for messages and reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ToolKind {
+    /// Corner radius 0.
+    Flat,
+    /// Corner radius D/2.
+    Ball,
+    /// Corner radius between 0 and D/2.
+    BullNose,
+}
+
+/// An end mill.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Tool {
+    /// D, mm.
+    pub diameter: f64,
+    /// r_c, mm (0 ≤ r_c ≤ D/2).
+    pub corner_radius: f64,
+    /// L_f, mm: the length of the cutting part above the tip (> r_c).
+    pub flute_length: f64,
+    /// z, the number of teeth (flutes).
+    pub flutes: u32,
+}
+
+impl Tool {
+    /// A tool, validated: a one-line reason naming the quantity when it is not a tool.
+    pub fn new(
+        diameter: f64,
+        corner_radius: f64,
+        flute_length: f64,
+        flutes: u32,
+    ) -> Result<Tool, String> {
+        if !(diameter.is_finite() && diameter > 0.0 && diameter <= MAX_TOOL_DIAMETER_MM) {
+            return Err(format!(
+                "tool diameter {diameter} mm must be positive and at most {MAX_TOOL_DIAMETER_MM} mm"
+            ));
+        }
+        let r = 0.5 * diameter;
+        if !(corner_radius.is_finite() && (0.0..=r * (1.0 + 1e-12)).contains(&corner_radius)) {
+            return Err(format!(
+                "corner radius {corner_radius} mm must lie between 0 and half the diameter ({r} mm)"
+            ));
+        }
+        if !(flute_length.is_finite()
+            && flute_length > corner_radius
+            && flute_length <= 100.0 * diameter.max(1.0))
+        {
+            return Err(format!(
+                "flute length {flute_length} mm must exceed the corner radius ({corner_radius} mm) \
+                 and be at most 100 diameters"
+            ));
+        }
+        if flutes == 0 || flutes > 64 {
+            return Err(format!("{flutes} flutes: a tool has 1 to 64"));
+        }
+        Ok(Tool {
+            diameter,
+            corner_radius: corner_radius.min(r),
+            flute_length,
+            flutes,
+        })
+    }
+
+    /// R = D/2, mm.
+    pub fn radius(&self) -> f64 {
+        0.5 * self.diameter
+    }
+
+    /// Flat, ball or bull-nose.
+    pub fn kind(&self) -> ToolKind {
+        if self.corner_radius == 0.0 {
+            ToolKind::Flat
+        } else if self.corner_radius >= self.radius() {
+            ToolKind::Ball
+        } else {
+            ToolKind::BullNose
+        }
+    }
+
+    /// f(d): height of the lower surface above the tip at horizontal distance `d` ≤ R from
+    /// the axis of a vertical tool (module doc).
+    pub fn bottom(&self, d: f64) -> f64 {
+        let rc = self.corner_radius;
+        let x = d - (self.radius() - rc);
+        if x <= 0.0 {
+            0.0
+        } else {
+            rc - (rc * rc - x * x).max(0.0).sqrt()
+        }
+    }
+
+    /// r(h): the tool's radius at height `h` (0 ≤ h) above the tip.
+    pub fn radius_at(&self, h: f64) -> f64 {
+        let (r, rc) = (self.radius(), self.corner_radius);
+        if h >= rc {
+            r
+        } else {
+            let y = rc - h;
+            r - rc + (rc * rc - y * y).max(0.0).sqrt()
+        }
+    }
+
+    /// The interval of z (mm) where the vertical line through (x, y) crosses the tool at tip
+    /// `p` and unit axis `o` (a static pose), if it does. Exact for flat and ball-nose tools
+    /// (quadratics); for a bull-nose tool the torus part is solved as a convex problem in z
+    /// (ρ(z) − r(h(z)) is convex: a norm of an affine function minus a concave one) to 1e-9 mm.
+    pub fn line_hit(&self, p: &Vector3<f64>, o: &Vector3<f64>, x: f64, y: f64) -> Option<[f64; 2]> {
+        let (dx, dy) = (x - p.x, y - p.y);
+        let (r, rc, lf) = (self.radius(), self.corner_radius, self.flute_length);
+        // With s = z − P_z: h(s) = c + s O_z, ρ²(s) = a s² − 2 c O_z s + (dx² + dy² − c²).
+        let c = dx * o.x + dy * o.y;
+        let a = 1.0 - o.z * o.z;
+        let q0 = dx * dx + dy * dy - c * c;
+        // The s where h(s) lies within [h0, h1].
+        let slab = |h0: f64, h1: f64| -> Option<(f64, f64)> {
+            if o.z.abs() < 1e-15 {
+                return (c >= h0 && c <= h1).then_some((f64::NEG_INFINITY, f64::INFINITY));
+            }
+            let (s0, s1) = ((h0 - c) / o.z, (h1 - c) / o.z);
+            Some((s0.min(s1), s0.max(s1)))
+        };
+        // The s where ρ²(s) ≤ rad².
+        let within = |rad: f64| -> Option<(f64, f64)> {
+            let cc = q0 - rad * rad;
+            if a < 1e-15 {
+                return (cc <= 0.0).then_some((f64::NEG_INFINITY, f64::INFINITY));
+            }
+            let bh = -c * o.z; // half of the linear coefficient
+            let disc = bh * bh - a * cc;
+            if disc < 0.0 {
+                return None;
+            }
+            let sq = disc.sqrt();
+            Some(((-bh - sq) / a, (-bh + sq) / a))
+        };
+        let meet = |x: Option<(f64, f64)>, y: Option<(f64, f64)>| -> Option<(f64, f64)> {
+            let (x, y) = (x?, y?);
+            let lo = x.0.max(y.0);
+            let hi = x.1.min(y.1);
+            (lo <= hi).then_some((lo, hi))
+        };
+        // The cylinder h ∈ [r_c, L_f], ρ ≤ R.
+        let mut hit = meet(slab(rc, lf), within(r));
+        // The end h ∈ [0, r_c].
+        let end = if rc == 0.0 {
+            None
+        } else if rc >= r {
+            // Ball: the sphere of radius R about P + R O (its part above h = R lies in the
+            // cylinder).
+            let (ex, ey, ez) = (dx - r * o.x, dy - r * o.y, -r * o.z);
+            // |(ex, ey, ez + s)|² ≤ R²
+            let disc = r * r - ex * ex - ey * ey;
+            (disc >= 0.0).then(|| {
+                let sq = disc.sqrt();
+                (-ez - sq, -ez + sq)
+            })
+        } else {
+            let (s0, s1) = slab(0.0, rc)?;
+            // No part of the torus section reaches the line: outside the cylinder of radius R.
+            meet(Some((s0, s1)), within(r)).and_then(|(s0, s1)| {
+                let f = |s: f64| {
+                    let rho2 = (a * s * s - 2.0 * c * o.z * s + q0).max(0.0);
+                    rho2.sqrt() - self.radius_at(c + s * o.z)
+                };
+                convex_sublevel(f, s0, s1, 1e-9)
+            })
+        };
+        hit = match (hit, end) {
+            (Some(x), Some(y)) => Some((x.0.min(y.0), x.1.max(y.1))),
+            (x, y) => x.or(y),
+        };
+        hit.filter(|h| h.0.is_finite() && h.1.is_finite())
+            .map(|(lo, hi)| [p.z + lo, p.z + hi])
+    }
+}
+
+/// The interval of [s0, s1] where the convex function f ≤ 0, to within `tol`: golden-section
+/// search for the minimum, then bisection for both ends.
+fn convex_sublevel(f: impl Fn(f64) -> f64, s0: f64, s1: f64, tol: f64) -> Option<(f64, f64)> {
+    const G: f64 = 0.618_033_988_749_894_8;
+    let (mut a, mut b) = (s0, s1);
+    let (mut x1, mut x2) = (b - G * (b - a), a + G * (b - a));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    let mut guard = 0;
+    while b - a > tol && guard < 200 {
+        if f1 <= f2 {
+            b = x2;
+            (x2, f2) = (x1, f1);
+            x1 = b - G * (b - a);
+            f1 = f(x1);
+        } else {
+            a = x1;
+            (x1, f1) = (x2, f2);
+            x2 = a + G * (b - a);
+            f2 = f(x2);
+        }
+        guard += 1;
+    }
+    let m = 0.5 * (a + b);
+    if f(m) > 0.0 {
+        return None;
+    }
+    let root = |mut inside: f64, mut outside: f64| {
+        if f(outside) <= 0.0 {
+            return outside;
+        }
+        let mut guard = 0;
+        while (outside - inside).abs() > tol && guard < 200 {
+            let mid = 0.5 * (inside + outside);
+            if f(mid) <= 0.0 {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+            guard += 1;
+        }
+        inside
+    };
+    Some((root(m, s0), root(m, s1)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn membership(t: &Tool, p: &Vector3<f64>, o: &Vector3<f64>, x: &Vector3<f64>) -> bool {
+        let d = x - p;
+        let h = d.dot(o);
+        let rho = (d - h * o).norm();
+        (0.0..=t.flute_length).contains(&h) && rho <= t.radius_at(h)
+    }
+
+    /// The line hit agrees with point membership for every shape and many tilted poses.
+    #[test]
+    fn line_hit_agrees_with_membership() {
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for tool in [
+            Tool::new(10.0, 0.0, 20.0, 3).unwrap(),
+            Tool::new(10.0, 5.0, 20.0, 2).unwrap(),
+            Tool::new(10.0, 2.0, 20.0, 4).unwrap(),
+        ] {
+            for _ in 0..300 {
+                let o = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 + rnd()).normalize();
+                let p = Vector3::new(rnd(), rnd(), rnd());
+                let (x, y) = (p.x + 16.0 * (rnd() - 0.5), p.y + 16.0 * (rnd() - 0.5));
+                let hit = tool.line_hit(&p, &o, x, y);
+                for k in 0..400 {
+                    let z = p.z - 5.0 + 30.0 * k as f64 / 400.0;
+                    let inside = membership(&tool, &p, &o, &Vector3::new(x, y, z));
+                    let by_hit = hit.is_some_and(|[lo, hi]| z >= lo - 1e-7 && z <= hi + 1e-7);
+                    let near =
+                        hit.is_some_and(|[lo, hi]| (z - lo).abs() < 1e-6 || (z - hi).abs() < 1e-6);
+                    assert!(inside == by_hit || near, "{tool:?} z {z} hit {hit:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn vertical_bottom_matches_the_profile() {
+        let t = Tool::new(10.0, 2.0, 20.0, 4).unwrap();
+        let o = Vector3::z();
+        let p = Vector3::zeros();
+        for k in 0..50 {
+            let d = 5.0 * k as f64 / 50.0;
+            let [lo, hi] = t.line_hit(&p, &o, d, 0.0).unwrap();
+            assert!((lo - t.bottom(d)).abs() < 1e-9 && (hi - 20.0).abs() < 1e-12);
+        }
+    }
+}
