@@ -678,7 +678,19 @@ fn solve_piece(
     let mut from_iterate = false;
     let mut subproblems = 0;
     for it in 0..options.max_iterations.max(1) {
-        let mut sol = program.solve(&bbar, abar.as_deref(), settings, &mut carried)?;
+        let mut sol = match program.solve(&bbar, abar.as_deref(), settings, &mut carried) {
+            Ok(sol) => sol,
+            // Every iterate is jerk-feasible: when a later subproblem fails (a time limit,
+            // a numerical stall), the best iterate so far is a valid answer, not yet
+            // converged; say so through the status (issue 14: solver failure is not the
+            // user's problem).
+            Err(e) if best.is_some() => {
+                tracing::debug!("SCP {it}: {e}; keeping the best iterate");
+                status = status.worst(Status::AlmostOptimal);
+                break;
+            }
+            Err(e) => return Err(e),
+        };
         subproblems += 1;
         status = status.worst(sol.status);
         iterations += sol.iterations;
