@@ -100,6 +100,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         axes: Some(axes.chars().collect()),
         reference,
         work_offset,
+        travel: Default::default(),
     }
 }
 

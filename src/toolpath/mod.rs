@@ -150,6 +150,9 @@ pub struct MachineContext {
     /// Machine coordinates minus program coordinates, X Y Z, mm (the trunnion kinematics'
     /// `work-offset`; zero for every other kinematics).
     pub work_offset: [f64; 3],
+    /// Travel `(min, max)` per axis X Y Z A B C, machine coordinates (mm, degrees), where the
+    /// machine file gives it (Heidenhain `M140 MB MAX` retracts Z to its max).
+    pub travel: [Option<(f64, f64)>; 6],
 }
 
 impl MachineContext {
@@ -175,11 +178,19 @@ impl MachineContext {
             KinematicsSpec::TableTable { params, .. } => params.work_offset,
             _ => [0.0; 3],
         };
+        let travel = std::array::from_fn(|i| {
+            machine
+                .axes
+                .iter()
+                .find(|a| a.name == NAMES[i])
+                .and_then(|a| a.travel)
+        });
         MachineContext {
             file: references.file.clone(),
             axes,
             reference,
             work_offset,
+            travel,
         }
     }
 
@@ -223,16 +234,16 @@ impl Format {
 /// Extensions read as APT CL.
 pub const APT_EXTENSIONS: &[&str] = &["cls", "clsf", "apt", "cl", "aptsource"];
 /// Extensions read as G-code (`.mpf`/`.spf`: Sinumerik main program / subprogram; `.ptp`: NX
-/// post output; `.txt`: by content).
+/// post output; `.h`: Heidenhain Klartext; `.txt`: by content).
 pub const GCODE_EXTENSIONS: &[&str] = &[
     "ngc", "nc", "gcode", "tap", "mpf", "spf", "ptp", "eia", "min", "iso", "h", "txt",
 ];
 
 /// Chooses the reader and dialect: the options first, then the file's content (a `GOTO/`
-/// record is APT; `TRAORI`, `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are
-/// Sinumerik; `G43.4`, `G43.5`, `G68.2`, `G05.1`, `M98` or an `O1234` program number are
-/// Fanuc; `M428`–`M430` or `O<…>` are LinuxCNC), then the extension (`.mpf`, `.spf`:
-/// Sinumerik), else LinuxCNC.
+/// record is APT; a first block `BEGIN PGM` is Heidenhain Klartext; `TRAORI`, `MCALL`,
+/// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are Sinumerik; `G43.4`, `G43.5`, `G68.2`,
+/// `G05.1`, `M98` or an `O1234` program number are Fanuc; `M428`–`M430` or `O<…>` are
+/// LinuxCNC), then the extension (`.mpf`, `.spf`: Sinumerik; `.h`: Heidenhain), else LinuxCNC.
 pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected> {
     let ext = path
         .extension()
@@ -255,10 +266,11 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         (Format::Apt, "extension")
     } else if GCODE_EXTENSIONS.contains(&ext.as_str()) {
         (Format::Gcode, "extension")
-    } else if upper.contains('G')
-        && upper
-            .lines()
-            .any(|l| l.trim_start().starts_with(['G', 'N', 'X', 'Y', 'Z']))
+    } else if gcode::is_klartext(&upper)
+        || (upper.contains('G')
+            && upper
+                .lines()
+                .any(|l| l.trim_start().starts_with(['G', 'N', 'X', 'Y', 'Z'])))
     {
         (Format::Gcode, "content")
     } else {
@@ -276,6 +288,8 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         (Some(d), "content")
     } else if matches!(ext.as_str(), "mpf" | "spf") {
         (Some(gcode::Dialect::Sinumerik), "extension")
+    } else if ext == "h" {
+        (Some(gcode::Dialect::Heidenhain), "extension")
     } else {
         (Some(gcode::Dialect::default()), "default")
     };

@@ -3,6 +3,9 @@
 use nalgebra::Vector3;
 use std::path::Path;
 
+mod heidenhain;
+pub(super) use heidenhain::KlartextWords;
+
 use super::cycles::{self, Step};
 use super::dialect::*;
 use super::expr::Variables;
@@ -26,6 +29,32 @@ struct Block {
     letters: [Option<Num>; 26],
     /// Codes and keywords in the order written, with their text and `( … )` arguments.
     actions: Vec<(String, Action, Option<String>)>,
+    /// Klartext: the axis word is incremental (`IX+5`, this word only).
+    incremental: [bool; 6],
+    /// Klartext `DR±`: +1 counter-clockwise, −1 clockwise.
+    direction: Option<f64>,
+    /// Klartext `PA`/`IPA` (degrees) and `PR`/`IPR` (mm), `true` when incremental.
+    polar_angle: Option<(f64, bool)>,
+    polar_radius: Option<(f64, bool)>,
+    /// Klartext `MB`: the retract distance, mm.
+    retract: Option<f64>,
+    /// Klartext `A+Q120`, `B+Q121`, `C+Q122`: the rotary axis goes to the active PLANE's
+    /// solution.
+    plane_rotary: [bool; 3],
+    /// Set by the interpreter for Klartext arcs: the arc's plane (else the modal plane), its
+    /// centre (else R or I J K) and its signed sweep, radians (else from the end point).
+    arc_plane: Option<Plane>,
+    arc_centre: Option<ArcCentre>,
+    arc_sweep: Option<f64>,
+}
+
+/// Where a Klartext arc's centre comes from.
+#[derive(Debug, Clone, Copy)]
+enum ArcCentre {
+    /// The pole `CC`: the arc plane's first and second coordinate, program coordinates, mm.
+    At([f64; 2]),
+    /// `CT`: tangent to this unit direction (in the arc plane) at the start.
+    Tangent([f64; 2]),
 }
 
 impl Block {
@@ -128,6 +157,13 @@ pub(super) struct Interpreter<'a> {
     pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
     dwells: Vec<Dwell>,
+    /// The tangent (plane, unit direction in its two axes) at the end of the last straight
+    /// line or arc, and the point count right after it (Klartext `CT` must follow directly).
+    tangent: Option<(Plane, [f64; 2], usize)>,
+    /// Klartext `M126`: rotary axes take the shorter way to an absolute position.
+    shortest_path: bool,
+    /// The Klartext state ([`heidenhain`]).
+    klartext: heidenhain::State,
 }
 
 impl<'a> Interpreter<'a> {
@@ -169,6 +205,9 @@ impl<'a> Interpreter<'a> {
             points: Vec::new(),
             warnings: Vec::new(),
             dwells: Vec::new(),
+            tangent: None,
+            shortest_path: false,
+            klartext: heidenhain::State::default(),
         }
     }
 
@@ -254,20 +293,35 @@ impl<'a> Interpreter<'a> {
             match address {
                 Address::Axis(i) => {
                     duplicate(block.axes[i].is_some())?;
-                    if let Some(m) = self.machine
-                        && !m.has_axis(AXIS_NAMES[i])
-                    {
-                        return Err(self.error(
-                            line,
-                            format!(
-                                "`{text}`: the machine ({}) has no {} axis; use a machine \
-                                 file with that axis or a program posted for this machine",
-                                m.file.display(),
-                                AXIS_NAMES[i]
-                            ),
-                        ));
-                    }
+                    self.check_axis(line, &text, i)?;
                     block.axes[i] = Some(num);
+                }
+                Address::IncrementalAxis(i) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.incremental[i] = true;
+                }
+                Address::PlaneRotary(i) => {
+                    duplicate(block.axes[3 + i].is_some() || block.plane_rotary[i])?;
+                    self.check_axis(line, &text, 3 + i)?;
+                    block.plane_rotary[i] = true;
+                }
+                Address::ArcDirection => {
+                    duplicate(block.direction.is_some())?;
+                    block.direction = Some(num.value);
+                }
+                Address::PolarAngle(incremental) => {
+                    duplicate(block.polar_angle.is_some())?;
+                    block.polar_angle = Some((num.value, incremental));
+                }
+                Address::PolarRadius(incremental) => {
+                    duplicate(block.polar_radius.is_some())?;
+                    block.polar_radius = Some((num.value, incremental));
+                }
+                Address::Retract => {
+                    duplicate(block.retract.is_some())?;
+                    block.retract = Some(num.value);
                 }
                 Address::ArcCentre(i) => {
                     duplicate(block.centre[i].is_some())?;
@@ -341,6 +395,24 @@ impl<'a> Interpreter<'a> {
             self.set_call(line, name, block.letter('P'))?;
         }
         Ok(block)
+    }
+
+    /// An axis word for an axis the machine lacks is an error naming it.
+    fn check_axis(&self, line: usize, text: &str, i: usize) -> Result<()> {
+        if let Some(m) = self.machine
+            && !m.has_axis(AXIS_NAMES[i])
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}`: the machine ({}) has no {} axis; use a machine file with that \
+                     axis or a program posted for this machine",
+                    m.file.display(),
+                    AXIS_NAMES[i]
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Records a call of subprogram `name` repeated `count` times (P).
@@ -456,6 +528,7 @@ impl<'a> Interpreter<'a> {
         let mut sinumerik_cycle: Option<(String, u32, String)> = None;
         let mut modal_call = false;
         let mut tilted_plane = false;
+        let mut klartext = KlartextWords::default();
         for (text, action, args) in &block.actions {
             match *action {
                 Action::FeedMode(mode) => {
@@ -555,6 +628,16 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::Return => end = true,
                 Action::Call => fanuc_call = true,
+                Action::Path(kind) => klartext.path = Some((text.clone(), kind)),
+                Action::Statement(st) => {
+                    klartext.statement = Some((text.clone(), st, args.clone().unwrap_or_default()));
+                }
+                Action::RapidBlock => klartext.rapid = true,
+                Action::ToolCallFeed => klartext.tool_feed = true,
+                Action::CycleCallAt(now) => klartext.cycle_call = Some(now),
+                Action::RotaryShortestPath(on) => self.shortest_path = on,
+                Action::RetractToolAxis => klartext.retract = true,
+                Action::RetractMax => klartext.retract_max = true,
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -586,6 +669,11 @@ impl<'a> Interpreter<'a> {
         }
         if let Some((_, m)) = motion_code {
             self.motion = Some(m);
+        }
+        if self.spec.spaces == Spaces::Klartext {
+            return self
+                .klartext_block(line, block, klartext, machine)
+                .map(|()| self.end_if(end));
         }
 
         if dwell {
@@ -1077,7 +1165,18 @@ impl<'a> Interpreter<'a> {
         };
         let is_arc = matches!(motion, Motion::ArcCw | Motion::ArcCcw);
         if machine && is_arc {
-            return Err(self.error(line, "G53/SUPA (machine coordinates) with an arc"));
+            return Err(self.error(line, "G53/SUPA/M91 (machine coordinates) with an arc"));
+        }
+        if block.plane_rotary.iter().any(|&q| q) {
+            if self.swivel.is_none() {
+                return Err(self.error(
+                    line,
+                    "Q120–Q122 hold the rotary positions the control computes for a PLANE, but \
+                     no PLANE is active: program PLANE SPATIAL (or the rotary positions) first",
+                ));
+            }
+            // The tilted plane's tool vector rules: the rotary axes go where it points.
+            self.saw_rotary = true;
         }
 
         let start = self.pos;
@@ -1106,8 +1205,16 @@ impl<'a> Interpreter<'a> {
                 self.known[i] = true;
                 continue;
             }
-            let incremental = self.distance == Distance::Incremental && !machine;
-            end[i] = if incremental { start[i] + value } else { value };
+            let incremental =
+                (self.distance == Distance::Incremental || block.incremental[i]) && !machine;
+            end[i] = if incremental {
+                start[i] + value
+            } else if i >= 3 && self.shortest_path {
+                // Klartext M126: the shorter way to the absolute position.
+                start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
+            } else {
+                value
+            };
             if i < 3 && !incremental {
                 self.known[i] = true;
             }
@@ -1120,7 +1227,7 @@ impl<'a> Interpreter<'a> {
             self.warn(
                 line,
                 format!(
-                    "G53/SUPA: machine-coordinate move, taken as program coordinates + the \
+                    "G53/SUPA/M91: machine-coordinate move, taken as program coordinates + the \
                      work offset ({}, {}, {}) mm",
                     offset[0], offset[1], offset[2]
                 ),
@@ -1128,24 +1235,7 @@ impl<'a> Interpreter<'a> {
             let p = self.machine_to_program(machine_xyz);
             end[..3].copy_from_slice(p.as_slice());
         }
-        let unknown: Vec<String> = (0..3)
-            .filter(|&i| !self.known[i] && !self.unknown_warned[i])
-            .map(|i| AXIS_NAMES[i].to_string())
-            .collect();
-        if !unknown.is_empty() {
-            for i in 0..3 {
-                if !self.known[i] {
-                    self.unknown_warned[i] = true;
-                }
-            }
-            self.warn(
-                line,
-                format!(
-                    "{} not programmed yet: taken as 0 (the start position is unknown)",
-                    unknown.join(", ")
-                ),
-            );
-        }
+        self.warn_unknown(line);
 
         // Tool vector: Sinumerik-style words, or I J K on G0/G1 under Fanuc G43.5.
         let vector_words: [Option<f64>; 3] = if self.tcp == Tcp::OnIjkVector && !is_arc {
@@ -1187,6 +1277,7 @@ impl<'a> Interpreter<'a> {
 
         if self.tcp == Tcp::Off
             && !self.non_tcp_warned
+            && !block.plane_rotary.iter().any(|&q| q)
             && (end[3..] != [0.0; 3]
                 || block.axes[3..].iter().any(Option::is_some)
                 || vector_words.iter().any(Option::is_some))
@@ -1199,18 +1290,61 @@ impl<'a> Interpreter<'a> {
             );
         }
 
+        if block.axes[3..].iter().any(Option::is_some) || block.plane_rotary.iter().any(|&q| q) {
+            // Klartext PLANE … STAY: the rotary axes are positioned now.
+            self.klartext.stay_orientation = None;
+        }
         if is_arc {
             self.arc(line, motion, block, start, end)?;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
             self.push(line, &end, feed);
+            let (a, b) = (end[0] - start[0], end[1] - start[1]);
+            let len = a.hypot(b);
+            self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
+                .then(|| (Plane::Xy, [a / len, b / len], self.points.len()));
         }
         self.pos = end;
         Ok(())
     }
 
+    /// Warns once per axis that X, Y or Z is used before the program set it.
+    fn warn_unknown(&mut self, line: usize) {
+        let unknown: Vec<String> = (0..3)
+            .filter(|&i| !self.known[i] && !self.unknown_warned[i])
+            .map(|i| AXIS_NAMES[i].to_string())
+            .collect();
+        if !unknown.is_empty() {
+            for i in 0..3 {
+                if !self.known[i] {
+                    self.unknown_warned[i] = true;
+                }
+            }
+            self.warn(
+                line,
+                format!(
+                    "{} not programmed yet: taken as 0 (the start position is unknown)",
+                    unknown.join(", ")
+                ),
+            );
+        }
+    }
+
     fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
         let frame = self.frame_now();
+        if let Some(o) = self.klartext.stay_orientation {
+            // Klartext PLANE … STAY: the rotary axes have not moved yet; the tool keeps the
+            // orientation it had (workpiece coordinates).
+            let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
+            self.points.push(ClPoint {
+                p,
+                o,
+                feed,
+                rotary: None,
+                line,
+            });
+            return;
+        }
         let (p, o, rotary) = if frame.is_identity() {
             (
                 Vector3::new(q[0], q[1], q[2]),
@@ -1290,8 +1424,9 @@ impl<'a> Interpreter<'a> {
         start: [f64; 6],
         end: [f64; 6],
     ) -> Result<()> {
-        let (a, b, n) = self.plane.axes();
-        let plane = self.plane.code();
+        let arc_plane = block.arc_plane.unwrap_or(self.plane);
+        let (a, b, n) = arc_plane.axes();
+        let plane = arc_plane.code();
         let centre_names = ['I', 'J', 'K'];
         if block.centre[n].is_some() {
             self.warn(
@@ -1302,13 +1437,31 @@ impl<'a> Interpreter<'a> {
                 ),
             );
         }
-        let ccw = motion == Motion::ArcCcw;
+        let mut ccw = motion == Motion::ArcCcw;
         let (s0, s1) = (start[a], start[b]);
         let (e0, e1) = (end[a], end[b]);
         let chord = (e0 - s0).hypot(e1 - s1);
         let in_plane = block.centre[a].is_some() || block.centre[b].is_some();
 
-        let (c0, c1) = if let Some(r) = block.radius {
+        let (c0, c1) = if let Some(ArcCentre::At(c)) = block.arc_centre {
+            (c[0], c[1])
+        } else if let Some(ArcCentre::Tangent(t)) = block.arc_centre {
+            // Klartext CT: the circle through start and end tangent to t at the start; its
+            // centre lies on the start's normal n at s = |d|² / (2 n·d), d = end − start.
+            let (d0, d1) = (e0 - s0, e1 - s1);
+            let (n0, n1) = (-t[1], t[0]);
+            let nd = n0 * d0 + n1 * d1;
+            if chord < FULL_CIRCLE_MM || nd.abs() <= 1e-9 * chord.max(1.0) {
+                return Err(self.error(
+                    line,
+                    "CT: the end point lies on the tangent of the contour before it, so the \
+                     tangential arc is a straight line: program L",
+                ));
+            }
+            let s = (d0 * d0 + d1 * d1) / (2.0 * nd);
+            ccw = s > 0.0;
+            (s0 + s * n0, s1 + s * n1)
+        } else if let Some(r) = block.radius {
             if in_plane {
                 return Err(self.error(line, "an arc with both R and I/J/K"));
             }
@@ -1378,7 +1531,10 @@ impl<'a> Interpreter<'a> {
         let theta_s = (s1 - c1).atan2(s0 - c0);
         let theta_e = (e1 - c1).atan2(e0 - c0);
         let tau = std::f64::consts::TAU;
-        let mut sweep = if chord < FULL_CIRCLE_MM {
+        let mut sweep = if let Some(sweep) = block.arc_sweep {
+            // Klartext CP: the signed sweep as programmed (turns included).
+            sweep.abs()
+        } else if chord < FULL_CIRCLE_MM {
             tau
         } else if ccw {
             (theta_e - theta_s).rem_euclid(tau)
@@ -1412,6 +1568,9 @@ impl<'a> Interpreter<'a> {
 
         let r_max = r_start.max(r_end);
         let chords = crate::toolpath::arc_chords(sweep, r_max).map_err(|e| self.error(line, e))?;
+        let phi_end = theta_s + sweep;
+        let turn = sweep.signum();
+        let tangent = [-phi_end.sin() * turn, phi_end.cos() * turn];
         let mut qs = Vec::with_capacity(chords);
         for k in 1..=chords {
             if k == chords {
@@ -1464,6 +1623,7 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
+        self.tangent = Some((arc_plane, tangent, self.points.len()));
         Ok(())
     }
 }

@@ -289,6 +289,7 @@ pub(super) fn lex(
 ) -> std::result::Result<Vec<Item>, String> {
     let mut items = Vec::new();
     match spec.spaces {
+        Spaces::Klartext => return super::klartext::lex(spec, block, vars),
         Spaces::Ignored => {
             let compact: String = block.chars().filter(|c| !c.is_whitespace()).collect();
             lex_letters(spec, &compact, vars, &mut items)?;

@@ -24,6 +24,13 @@
 //!   may be keywords (`TRAORI`, `MSG("…")`) or `NAME=value`; TCP on `TRAORI`, off `TRAFOOF`;
 //!   tool vector `A3= B3= C3=`; `CR=` radius, `TURN=` extra turns; `G70`/`G71` inch/mm for
 //!   geometry only, `G700`/`G710` for F too; the motion mode starts as G0.
+//! * [`HEIDENHAIN`]: TNC 640 Klartext, not G-code: a block number and a statement whose first
+//!   word says what it is (`L X+10 FMAX`, `CC`, `C … DR+`, `CYCL DEF 200`, `PLANE SPATIAL`).
+//!   Its own lexer ([`klartext`]) turns each block into the words this interpreter reads, and
+//!   the table holds the path functions, statements, named words and M functions; what they
+//!   do is described in [`klartext`] and the interpreter's Klartext part. Subprograms are
+//!   labels ([`Subprograms::Labels`]). TCP on `M128` / `FUNCTION TCPM`, off `M129` /
+//!   `FUNCTION RESET TCPM`; tool vector `TX TY TZ` on `LN` blocks.
 //!
 //! # What is read
 //!
@@ -126,6 +133,7 @@ mod dialect;
 pub mod expr;
 pub mod frames;
 mod interp;
+pub mod klartext;
 mod lexer;
 pub mod subprograms;
 
@@ -165,8 +173,8 @@ pub const R_ARC_TOLERANCE_MM: f64 = 0.00127;
 /// An I J K arc whose end is this close to its start (in the plane, mm) is a full circle.
 const FULL_CIRCLE_MM: f64 = 1e-9;
 
-/// File extensions read as G-code.
-pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap"];
+/// File extensions read as G-code (Heidenhain Klartext: `.h`).
+pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap", "h"];
 
 // ---------------------------------------------------------------------------------------------
 // Entry points
@@ -206,10 +214,14 @@ pub fn parse_for(
     interp.finish(program.last_line())
 }
 
-/// The dialect a program's text (upper-cased) shows, if any: Sinumerik (`TRAORI`, `TRAFOOF`,
-/// `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`,
-/// `G68.2`, `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
+/// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
+/// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
+/// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
+/// `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
+    if is_klartext(upper) {
+        return Some(Dialect::Heidenhain);
+    }
     let has = |w: &str| upper.contains(w);
     let sinumerik = [
         "TRAORI", "TRAFOOF", "MCALL", "CYCLE8", "DEF REAL", "SUPA ", "G710", "G700", "MSG(",
@@ -233,4 +245,19 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
         (false, false, true) => Some(Dialect::LinuxCnc),
         _ => None,
     }
+}
+
+/// Whether a program's text (upper-cased) is Heidenhain Klartext: its first block (after
+/// blank and comment lines) is `BEGIN PGM`, with or without a block number.
+pub fn is_klartext(upper: &str) -> bool {
+    upper
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with(';') && !l.starts_with('%'))
+        .is_some_and(|l| {
+            klartext::strip_block_number(l)
+                .split_whitespace()
+                .take(2)
+                .eq(["BEGIN", "PGM"])
+        })
 }
