@@ -116,9 +116,14 @@ pub struct SolveArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
-    /// G-code dialect: linuxcnc, fanuc or sinumerik (default: detected from the program).
+    /// G-code dialect: linuxcnc, fanuc, sinumerik or heidenhain (default: detected from the
+    /// program).
     #[arg(long)]
     pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
+    /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable; the target one of CYCLE81–CYCLE89).
+    #[arg(long = "cycle-alias", value_name = "FROM=TO")]
+    pub cycle_alias: Vec<String>,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -406,9 +411,12 @@ fn solve_with_progress(
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let options = args.options()?;
     let machine = args.machine()?;
-    let (input, warnings) = read_input(args)?;
+    let (input, warnings, detected) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
-    let (detected, dwell) = reader_used(args, &input)?;
+    let dwell = match &input {
+        toolpath::Input::Cl(t) => t.dwell_time(),
+        toolpath::Input::Joint(_) => 0.0,
+    };
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
@@ -433,8 +441,9 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     })
 }
 
-/// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned.
-fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
+/// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned, with
+/// what reader was used and what it assumed.
+fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
     let format = args.format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
@@ -442,12 +451,18 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
     });
     let (_, references) = Machine::references_from_file(&args.machine)?;
     let machine = Machine::from_file(&args.machine)?;
+    let cycle_aliases = args
+        .cycle_alias
+        .iter()
+        .map(|a| toolpath::gcode::parse_cycle_alias(a))
+        .collect::<Result<Vec<_>>>()?;
     let options = toolpath::ReadOptions {
         format,
         dialect: args.dialect,
         machine: Some(toolpath::MachineContext::new(&machine, &references)),
+        cycle_aliases,
     };
-    let (input, _) = toolpath::read_with(&args.toolpath, &options)?;
+    let (input, detected) = toolpath::read_with(&args.toolpath, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.
     let warnings: Vec<String> = match &input {
         toolpath::Input::Cl(t) => t
@@ -463,27 +478,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
     for w in &warnings {
         eprintln!("feedopt: warning: {w}");
     }
-    Ok((input, warnings))
-}
-
-/// What reader and dialect `read_input` used, and the toolpath's dwell time (s).
-fn reader_used(args: &SolveArgs, input: &toolpath::Input) -> Result<(toolpath::Detected, f64)> {
-    let bytes = std::fs::read(&args.toolpath).map_err(|e| Error::io(&args.toolpath, e))?;
-    let options = toolpath::ReadOptions {
-        format: args.format.map(|f| match f {
-            FormatChoice::Apt => toolpath::Format::Apt,
-            FormatChoice::Gcode => toolpath::Format::Gcode,
-            FormatChoice::Csv => toolpath::Format::Csv,
-        }),
-        dialect: args.dialect,
-        machine: None,
-    };
-    let detected = toolpath::detect(&args.toolpath, &String::from_utf8_lossy(&bytes), &options)?;
-    let dwell = match input {
-        toolpath::Input::Cl(t) => t.dwell_time(),
-        toolpath::Input::Joint(_) => 0.0,
-    };
-    Ok((detected, dwell))
+    Ok((input, warnings, detected))
 }
 
 /// `feedopt compare`: returns what to print on stdout.
@@ -505,7 +500,7 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
         )));
     }
     let machine = a.machine()?;
-    let (input, _) = read_input(a)?;
+    let (input, _, _) = read_input(a)?;
     let name = a.toolpath.display().to_string();
     let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
     if let Some(plot) = &a.plot {
@@ -542,7 +537,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     let options = solve.options()?;
     // `options()` has checked --plot (and -o) already.
     let machine = solve.machine()?;
-    let (input, _) = read_input(solve)?;
+    let (input, _, _) = read_input(solve)?;
     let mut o =
         crate::sweep::SweepOptions::new(&args.axis, args.limit, args.from, args.to, args.steps);
     o.fd_step = args.fd_step;
@@ -602,6 +597,10 @@ pub struct PlanArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
+    /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
+    /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable).
+    #[arg(long = "cycle-alias", value_name = "FROM=TO")]
+    pub cycle_alias: Vec<String>,
     /// Solver: `clarabel` or `reach`.
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
     pub solver: SolverChoice,
@@ -644,6 +643,7 @@ impl PlanArgs {
             ignore_programmed_feed: self.ignore_programmed_feed,
             format: self.format,
             dialect: Some(dialect),
+            cycle_alias: self.cycle_alias.clone(),
             solver: self.solver,
             start_feed: self.start_feed,
             end_feed: self.end_feed,
@@ -659,7 +659,7 @@ impl PlanArgs {
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
     let options = args.options()?;
     let machine = args.machine()?;
-    let (input, _) = read_input(args)?;
+    let (input, _, _) = read_input(args)?;
     let solution = solve_with_progress(&machine, &input, &options)?;
     Ok((machine, input, options, solution))
 }

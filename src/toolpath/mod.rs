@@ -206,6 +206,9 @@ pub struct ReadOptions {
     pub format: Option<Format>,
     pub dialect: Option<gcode::Dialect>,
     pub machine: Option<MachineContext>,
+    /// Cycles read under another name ([`gcode::parse_cycle_alias`]: `("CYCLE76",
+    /// "CYCLE86")` reads a machine builder's CYCLE76 as the standard CYCLE86).
+    pub cycle_aliases: Vec<(String, String)>,
 }
 
 /// What a reader was used, and why.
@@ -218,6 +221,40 @@ pub struct Detected {
     /// `"default"` (for the dialect when nothing in the file tells).
     pub format_by: &'static str,
     pub dialect_by: &'static str,
+    /// What the reader assumed where the machine file is silent ([`read_with`] fills it;
+    /// [`detect`] leaves it empty).
+    pub assumed: Assumed,
+}
+
+/// What a reader assumed where the program and the machine file leave something open.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Assumed {
+    /// Axes X Y Z A B C that a `G28`/`G30` sent to a reference point the machine file does
+    /// not give (`axes.Z.reference`): machine zero, machine coordinate 0, was used — the
+    /// controls' default.
+    pub reference_at_machine_zero: [bool; 6],
+}
+
+impl Assumed {
+    /// One line saying what was assumed, or `None` when nothing was.
+    pub fn reference_note(&self) -> Option<String> {
+        const NAMES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
+        let axes: Vec<&str> = NAMES
+            .iter()
+            .zip(self.reference_at_machine_zero)
+            .filter(|(_, d)| *d)
+            .map(|(n, _)| *n)
+            .collect();
+        (!axes.is_empty()).then(|| {
+            let fields: Vec<String> = axes.iter().map(|a| format!("axes.{a}.reference")).collect();
+            format!(
+                "G28/G30 reference of {}: machine zero, the controls' default; set {} in the \
+                 machine file",
+                axes.join(", "),
+                fields.join(", ")
+            )
+        })
+    }
 }
 
 impl Format {
@@ -298,6 +335,7 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         dialect,
         format_by,
         dialect_by,
+        assumed: Assumed::default(),
     })
 }
 
@@ -305,7 +343,7 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
 pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)> {
     let bytes = read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);
-    let detected = detect(path, &text, options)?;
+    let mut detected = detect(path, &text, options)?;
     let input = match detected.format {
         Format::Csv => Input::Joint(joint_csv::parse(
             path,
@@ -317,12 +355,17 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
             &text,
             options.machine.as_ref(),
         )?)?),
-        Format::Gcode => Input::Cl(plausible(gcode::parse_for(
-            path,
-            &text,
-            detected.dialect.unwrap_or_default().spec(),
-            options.machine.as_ref(),
-        )?)?),
+        Format::Gcode => {
+            let (toolpath, assumed) = gcode::parse_assumed(
+                path,
+                &text,
+                detected.dialect.unwrap_or_default().spec(),
+                options.machine.as_ref(),
+                &options.cycle_aliases,
+            )?;
+            detected.assumed = assumed;
+            Input::Cl(plausible(toolpath)?)
+        }
     };
     Ok((input, detected))
 }
@@ -425,7 +468,7 @@ pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> 
     let options = ReadOptions {
         format,
         dialect: Some(dialect),
-        machine: None,
+        ..Default::default()
     };
     read_with(path, &options).map(|(input, _)| input)
 }

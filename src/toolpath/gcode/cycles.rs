@@ -45,8 +45,11 @@
 //! programmed F). CYCLE86: feed, dwell, rapid out (the lift-off moves RPA/RPO/RPAP are not
 //! read). CYCLE87/CYCLE88: feed, (CYCLE88: dwell), the operator's stop (M0: not timed, a
 //! warning), rapid out. CYCLE89: feed, dwell, feed out. `CYCLE76`/`CYCLE77` are Sinumerik's
-//! spigot milling cycles, not drilling: an error. A cycle whose RTP lies below RFP + SDIS
-//! retracts into the part as written, with a warning.
+//! spigot milling cycles, not drilling: an error that says so, and whether the call lacks the
+//! spigot's dimensions (NX posts write CYCLE86's list under the name CYCLE76); a machine whose
+//! CYCLE76 is a builder's boring cycle is read with a cycle alias
+//! ([`super::parse_cycle_alias`]: `--cycle-alias CYCLE76=CYCLE86`), never by a guess. A cycle
+//! whose RTP lies below RFP + SDIS retracts into the part as written, with a warning.
 //!
 //! # Heidenhain (`CYCL DEF 200`, `203`, `207`)
 //!
@@ -485,9 +488,34 @@ pub fn sinumerik_steps(
         }
         89 => s.extend([Feed(dp, None), Dwell(dwell(5)), Feed(safe, None)]),
         76 | 77 => {
+            // On an 840D these mill a spigot: CYCLE76 (RTP, RFP, SDIS, DP, DPR, _LENG, _WID,
+            // …), CYCLE77 (…, DPR, _PRAD, …). A post that writes a boring cycle's list under
+            // this name (NX's "BORING_NO_DRAG" writes CYCLE86's: …, DPR, DTB, SDIR, RPA, RPO,
+            // RPAP) names a cycle of the machine builder or of the post.
+            let what = if number == 76 {
+                "rectangular spigot milling, whose 6th and 7th parameters are the spigot's \
+                 length _LENG and width _WID"
+            } else {
+                "circular spigot milling, whose 6th parameter is the spigot's diameter _PRAD"
+            };
+            let missing = if number == 76 {
+                get(5).is_none() || get(6).is_none()
+            } else {
+                get(5).is_none()
+            };
+            let shape = if missing {
+                " This call does not give them (its list has the shape of a drilling or boring \
+                 cycle's: RTP, RFP, SDIS, DP, DPR, then DTB …), so a standard 840D would stop \
+                 with an alarm."
+            } else {
+                ""
+            };
             return Err(format!(
-                "{name} is Sinumerik's spigot milling cycle, not a drilling cycle, and is not \
-                 supported: post the operation as G0/G1/G2/G3 (or as CYCLE81–CYCLE89)"
+                "{name} on a Sinumerik 840D is {what}, not a drilling cycle; feedopt does not \
+                 mill spigots.{shape} If this machine's {name} is a machine builder's or the \
+                 post's cycle that works like a standard one, map it: --cycle-alias \
+                 {name}=CYCLE86 (or the cycle it is; ReadOptions::cycle_aliases); else post the \
+                 operation as CYCLE81–CYCLE89 or as G0/G1/G2/G3"
             ));
         }
         _ => return Err(format!("{name} is not a drilling cycle feedopt knows")),

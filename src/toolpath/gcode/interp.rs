@@ -13,7 +13,9 @@ use super::frames::{self, Frame};
 use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning};
+use crate::toolpath::{
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning,
+};
 
 /// The words of one block, sorted by meaning.
 #[derive(Debug, Default)]
@@ -164,6 +166,11 @@ pub(super) struct Interpreter<'a> {
     shortest_path: bool,
     /// The Klartext state ([`heidenhain`]).
     klartext: heidenhain::State,
+    /// What the reader assumed where the machine file is silent.
+    pub(super) assumed: Assumed,
+    /// Cycle aliases (`CYCLE76` read as `CYCLE86`), and those a warning has named.
+    pub(super) cycle_aliases: Vec<(String, String)>,
+    aliases_used: Vec<String>,
 }
 
 impl<'a> Interpreter<'a> {
@@ -208,6 +215,9 @@ impl<'a> Interpreter<'a> {
             tangent: None,
             shortest_path: false,
             klartext: heidenhain::State::default(),
+            assumed: Assumed::default(),
+            cycle_aliases: Vec::new(),
+            aliases_used: Vec::new(),
         }
     }
 
@@ -395,6 +405,26 @@ impl<'a> Interpreter<'a> {
             self.set_call(line, name, block.letter('P'))?;
         }
         Ok(block)
+    }
+
+    /// A Sinumerik cycle as the read options alias it: the name to show and the number to
+    /// expand (a warning names each alias the first time it applies).
+    fn alias(&mut self, line: usize, text: &str, number: u32) -> (String, u32) {
+        let Some((_, to)) = self.cycle_aliases.iter().find(|(from, _)| from == text) else {
+            return (text.to_string(), number);
+        };
+        let to = to.clone();
+        let Some(n) = to.strip_prefix("CYCLE").and_then(|d| d.parse().ok()) else {
+            return (text.to_string(), number);
+        };
+        if !self.aliases_used.iter().any(|a| a == text) {
+            self.aliases_used.push(text.to_string());
+            self.warn(
+                line,
+                format!("{text} is read as {to}, as the cycle alias {text}={to} says"),
+            );
+        }
+        (format!("{text} (as {to})"), n)
     }
 
     /// An axis word for an axis the machine lacks is an error naming it.
@@ -616,7 +646,8 @@ impl<'a> Interpreter<'a> {
                 Action::TiltedPlaneCancel => self.swivel = None,
                 Action::ModalCall => modal_call = true,
                 Action::SinumerikCycle(n) => {
-                    sinumerik_cycle = Some((text.clone(), n, args.clone().unwrap_or_default()));
+                    let (text, n) = self.alias(line, text, n);
+                    sinumerik_cycle = Some((text, n, args.clone().unwrap_or_default()));
                 }
                 Action::NoMotion(message) => {
                     no_motion = Some(message);
@@ -694,6 +725,12 @@ impl<'a> Interpreter<'a> {
             let args = self.arguments(line, &args)?;
             let args = self.sinumerik_cycle_units(number, args);
             if modal_call {
+                if matches!(number, 76 | 77) {
+                    // Spigot milling: an error where the program calls it, not at the first
+                    // position after it.
+                    cycles::sinumerik_steps(number, &args)
+                        .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
+                }
                 self.mcall = Some(ModalCall { number, args });
             } else {
                 self.run_sinumerik_cycle(line, &text, number, &args)?;
@@ -844,7 +881,8 @@ impl<'a> Interpreter<'a> {
 
     /// `G28`/`G30` (k = 1, 2; `G30 P3`: 3): via the intermediate point the axis words give
     /// (program coordinates, absolute or incremental), to the reference point of the same
-    /// axes (machine coordinates from the machine file). Both moves are rapids.
+    /// axes (machine coordinates from the machine file; where it gives none, machine zero,
+    /// with a warning and [`Assumed::reference_at_machine_zero`]). Both moves are rapids.
     fn reference(&mut self, line: usize, k: u8, block: &Block) -> Result<()> {
         let k = match (k, block.letter('P')) {
             (2, Some(p)) if (2.0..=4.0).contains(&p.value) && p.value.fract() == 0.0 => {
@@ -883,33 +921,57 @@ impl<'a> Interpreter<'a> {
         }
         let mut target = via;
         let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
+        let mut defaulted = Vec::new();
         for &i in &named {
-            let Some(r) = self
+            // The machine file's reference, else machine zero: the controls' default (Fanuc
+            // parameters 1240–1243, LinuxCNC 5161–5169 / 5181–5189 are 0 in machine
+            // coordinates, and Fanuc's machine zero is the reference position).
+            let r = match self
                 .machine
                 .and_then(|m| m.reference[i].get(k - 1).copied())
-            else {
-                let file = self.machine.map_or("the machine file".to_string(), |m| {
-                    m.file.display().to_string()
-                });
-                let which = if k == 1 {
-                    "`\"reference\": <position>`".to_string()
-                } else {
-                    format!("a list `\"reference\": [<G28 position>, …]` with {k} entries")
-                };
-                return Err(self.error(
-                    line,
-                    format!(
-                        "{code} moves {} to its reference point, which {file} does not give: \
-                         add {which} to axes.{} (machine coordinates, mm or °)",
-                        AXIS_NAMES[i], AXIS_NAMES[i]
-                    ),
-                ));
+            {
+                Some(r) => r,
+                None => {
+                    if !self.assumed.reference_at_machine_zero[i] {
+                        self.assumed.reference_at_machine_zero[i] = true;
+                        defaulted.push(AXIS_NAMES[i]);
+                    }
+                    0.0
+                }
             };
             if i < 3 {
                 machine_xyz[i] = r;
             } else {
                 target[i] = r;
             }
+        }
+        if !defaulted.is_empty() {
+            let file = self.machine.map_or("the machine file".to_string(), |m| {
+                m.file.display().to_string()
+            });
+            let fields: Vec<String> = defaulted
+                .iter()
+                .map(|a| format!("axes.{a}.reference"))
+                .collect();
+            let which = if k == 1 {
+                String::new()
+            } else {
+                format!(" to a list [<G28 position>, <G30 position>, …] of {k} entries")
+            };
+            self.warn(
+                line,
+                format!(
+                    "{code}: {file} gives no reference point for {}: machine zero (machine \
+                     coordinate 0, the controls' default) is used; to use another, set {}{which} \
+                     (machine coordinates, mm or °)",
+                    defaulted
+                        .iter()
+                        .map(|a| a.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    fields.join(", ")
+                ),
+            );
         }
         let xyz = self.machine_to_program(machine_xyz);
         target[..3].copy_from_slice(xyz.as_slice());

@@ -82,7 +82,11 @@
 //!   ([`MachineContext::work_offset`]; zero without a machine), with a warning saying so.
 //! * **G28/G30** (`G91 G28 Z0`, `G28 X0 Y0 B0`, `G30 P3 …`): a rapid to the intermediate point
 //!   the words give, then a rapid of the named axes to their reference point, read from the
-//!   machine file's `reference` (an error naming `axes.Z.reference` when it is missing).
+//!   machine file's `reference`. Where the file gives none, machine zero (machine coordinate
+//!   0): the controls' default (Fanuc parameters 1240–1243 and LinuxCNC 5161–5169 /
+//!   5181–5189 are 0, and Fanuc's machine zero is set at the reference position), with a
+//!   warning naming `axes.Z.reference` and [`Assumed::reference_at_machine_zero`] (the
+//!   summary's `reference` line and `--json` field).
 //! * **Canned cycles and dwells**: see [`cycles`]; `G4` (P seconds on LinuxCNC, P ms or X
 //!   seconds on Fanuc, F seconds on Sinumerik) and every cycle dwell become
 //!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
@@ -141,9 +145,9 @@ use std::path::Path;
 
 use crate::error::Result;
 pub use crate::toolpath::Units;
+use crate::toolpath::{Assumed, MachineContext, Toolpath};
 #[allow(unused_imports)] // named by the module docs
 use crate::toolpath::{ClPoint, Feed, Warning};
-use crate::toolpath::{MachineContext, Toolpath};
 pub use dialect::*;
 use interp::Interpreter;
 pub use interp::{MAX_ARC_CHORDS, MAX_COORDINATE_MM};
@@ -206,12 +210,60 @@ pub fn parse_for(
     spec: &DialectSpec,
     machine: Option<&MachineContext>,
 ) -> Result<Toolpath> {
+    parse_assumed(source, text, spec, machine, &[]).map(|(toolpath, _)| toolpath)
+}
+
+/// A cycle alias `FROM=TO` (`CYCLE76=CYCLE86`): a Sinumerik cycle a machine builder or a post
+/// names `FROM`, read as the standard cycle `TO` (one feedopt expands: `CYCLE81`–`CYCLE89`).
+/// For machines whose own cycle works like a standard one; the reader warns where it applies
+/// one. Names are case-insensitive; an alias that is not two such names is an error saying
+/// what to write.
+pub fn parse_cycle_alias(text: &str) -> Result<(String, String)> {
+    let bad = |why: &str| {
+        crate::error::Error::Usage(format!(
+            "cycle alias `{text}`: {why}; write FROM=TO with Sinumerik cycle names, e.g. \
+             CYCLE76=CYCLE86"
+        ))
+    };
+    let (from, to) = text.split_once('=').ok_or_else(|| bad("no `=`"))?;
+    let name = |s: &str| -> Option<(String, u32)> {
+        let upper = s.trim().to_ascii_uppercase();
+        let n: u32 = upper.strip_prefix("CYCLE")?.parse().ok()?;
+        Some((upper, n))
+    };
+    let (from, _) = name(from).ok_or_else(|| bad("the name before `=` is not CYCLE<number>"))?;
+    let (to, n) = name(to).ok_or_else(|| bad("the name after `=` is not CYCLE<number>"))?;
+    if !(81..=89).contains(&n) {
+        return Err(bad(&format!(
+            "{to} is not a cycle feedopt expands (CYCLE81–CYCLE89)"
+        )));
+    }
+    if from == to {
+        return Err(bad("a cycle cannot be its own alias"));
+    }
+    Ok((from, to))
+}
+
+/// As [`parse_for`], with cycle aliases ([`parse_cycle_alias`]: a cycle called by the first
+/// name is read as the second), and what the reader assumed where the machine file is silent
+/// (each assumption is also a warning with its line).
+pub fn parse_assumed(
+    source: &Path,
+    text: &str,
+    spec: &DialectSpec,
+    machine: Option<&MachineContext>,
+    cycle_aliases: &[(String, String)],
+) -> Result<(Toolpath, Assumed)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let program = Program::scan(spec, source, text)?;
     let mut interp = Interpreter::new(spec, source, machine);
     interp.procs = program.proc_names();
+    interp.cycle_aliases = cycle_aliases.to_vec();
     program.run(spec, &mut interp, source)?;
-    interp.finish(program.last_line())
+    let assumed = interp.assumed;
+    interp
+        .finish(program.last_line())
+        .map(|toolpath| (toolpath, assumed))
 }
 
 /// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
