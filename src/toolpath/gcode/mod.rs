@@ -123,7 +123,7 @@
 //! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
 //!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
 //!   [`Warning`] naming the word and its line, never silently.
-//! * Errors ([`Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
+//! * Errors ([`crate::error::Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
 //!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,

@@ -1,57 +1,6 @@
 //! The Klartext part of the interpreter: what Heidenhain's path functions, statements, frames
-//! and cycles do, on the same modal state, motion, arc and cycle code as the G-code dialects
-//! (the words are read by [`crate::toolpath::gcode::klartext`]).
-//!
-//! * **Lines** `L`/`LN` go to the end point at F (modal, mm/min), or at rapid under `FMAX`
-//!   (this block only); `FAUTO` takes the `TOOL CALL`'s F. `LN … TX TY TZ` sets the tool
-//!   vector (normalised), read as the tool orientation under `M128`/`FUNCTION TCPM`.
-//! * **Arcs**: `CC` sets the circle centre (pole) and the arc plane from the two coordinates
-//!   it names (`CC X Y` XY, `CC Y Z` YZ, `CC X Z` ZX; `CC` alone: the current X Y; `IX`…
-//!   relative to the current position); `C` goes about it to the end point, `DR+`
-//!   counter-clockwise (positive rotation about the plane's normal, as G3 under G17/G18/G19),
-//!   `DR-` clockwise, an end point equal to the start a full circle; `CR X Y R± DR±` is the
-//!   R arc of G2/G3 in the XY plane (R+ at most 180°, R− more); `CT X Y` the arc through the
-//!   end point tangent to the line or arc just before it (in XY); `CP PA±a DR±` / `CP IPA±a`
-//!   goes about the pole at the current radius to polar angle a (measured from the plane's
-//!   first axis: +X in XY, +Y in YZ, +Z in ZX) or by a (turns included, a helix with `IZ`);
-//!   `LP PR PA` is a line to polar coordinates about the pole. The axis normal to the arc
-//!   plane moves linearly (a helix). Arcs are chords as in G-code ([`super::super`]).
-//! * **Machine coordinates** `M91`: as G53. **Rotary** `M126`: an absolute rotary word goes
-//!   the shorter way (`M127`: as written). **TCP** `M128`, `FUNCTION TCPM F TCP AXIS POS`:
-//!   on; `M129`, `FUNCTION RESET TCPM`: off (`AXIS SPAT` and `REFPNT CENTER-CENTER` are
-//!   errors; `F CONT` and `PATHCTRL VECTOR` are warnings: the tip feed and axis
-//!   interpolation are what the toolpath carries).
-//! * **Retract** `M140 MB d`: along the tool axis by d mm (at F if the block gives one, else
-//!   at rapid); `M140 MB MAX`: up to the machine's Z travel limit (`axes.Z.max` of the machine
-//!   file; an error when the machine or the field is missing, or the tool is tilted).
-//! * **Frames**: `CYCL DEF 7` datum shift (`7.1 X+…`, `7.2 Y…`, `7.3 Z…`; `IX` adds to the
-//!   shift; an omitted axis keeps its shift) and `PLANE` (the working plane: `SPATIAL SPA SPB
-//!   SPC`, R = Rz(SPC)·Ry(SPB)·Rx(SPA) about the fixed axes; `EULER EULPR EULNU EULROT`,
-//!   R = Rz(PR)·Rx(NU)·Rz(ROT); `VECTOR BX BY BZ NX NY NZ`; `RELATIV SPA/SPB/SPC` turns the
-//!   active plane further; `RESET`) compose as p_workpiece = shift + R·p, the frames of
-//!   [`super::super::frames`]: the plane turns about the shifted datum. A change of frame does
-//!   not move the tool: its position is re-expressed in the new coordinates. Under a plane
-//!   the tool points along the plane's Z. `TURN`/`MOVE` turn the tool there at once (a
-//!   reorientation point; `MB` retracts first); `STAY` leaves the rotary axes where they
-//!   are: the tool keeps its orientation until a block positions a rotary axis, e.g.
-//!   `L A+Q120 C+Q122 FMAX` (Q120–Q122: the control's solution for the plane). `PLANE RESET
-//!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
-//!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
-//!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
-//! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle (its Q parameters are
-//!   read when it is called); `CYCL CALL`, `M99` in a block (after its move) and `M89`
-//!   (after every block that positions X or Y, until `M99` or a new `CYCL DEF`) call it at
-//!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
-//!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at
-//!   rapid; `CYCL CALL POS X Y Z` at that point alike. The moves: [`cycles::heidenhain_steps`].
-//!   `CYCL DEF 9` is a dwell (`9.1 DWELL 1.5`: 1.5 s), `32` (tolerance) and `13` (spindle
-//!   orientation) move nothing, `247` (preset) is taken with a warning (the preset table is
-//!   the control's), and an error if a later one names another preset. Other cycles may be
-//!   defined (a warning); calling one is an error naming it.
-//! * `BEGIN PGM … MM` (`INCH` is an error), `TOOL CALL n Z S… F…` (S and F remembered; a
-//!   tool axis X or Y is an error), `BLK FORM`, `TOOL DEF`, `STOP` move nothing.
-//! * `RND` and `CHF` (rounding and chamfer between two contour elements) are errors naming
-//!   the line: post the contour with the arc or chamfer written out.
+//! and cycles do, on the same modal state, motion, arc and cycle code as the G-code dialects.
+//! The words and what they do are described in [`crate::toolpath::gcode::klartext`].
 
 use nalgebra::{Matrix3, Vector3};
 
