@@ -522,6 +522,9 @@ fn an_unknown_word_is_an_error_naming_line_and_word() {
     assert!(e.contains(":6:") && e.contains("APPR"), "{e}");
     let e = fails(&format!("{HEADER}4 L X+Q7 Y+0 Z+0 F100\n"));
     assert!(e.contains(":5:") && e.contains("Q7"), "{e}");
+    // Paraxial compensation lengthens the move by the tool radius: not the path as written.
+    let e = fails(&format!("{HEADER}4 L X+0 Y+0 Z+0 F100\n5 L X+10 R+ F100\n"));
+    assert!(e.contains(":6:") && e.contains("R+"), "{e}");
 }
 
 #[test]

@@ -1089,8 +1089,20 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
         ("R0", Action::Ignored),
         ("RL", Note(COMP)),
         ("RR", Note(COMP)),
-        ("R+", Note(COMP)),
-        ("R-", Note(COMP)),
+        (
+            "R+",
+            Unsup(
+                "paraxial radius compensation (R+/R-: the move lengthened or shortened by the \
+                 tool radius) is not supported: post the tool-centre path with R0",
+            ),
+        ),
+        (
+            "R-",
+            Unsup(
+                "paraxial radius compensation (R+/R-: the move lengthened or shortened by the \
+                 tool radius) is not supported: post the tool-centre path with R0",
+            ),
+        ),
         ("MB MAX", Action::RetractMax),
         ("RND", Action::Statement(Statement::Corner(false))),
         ("CHF", Action::Statement(Statement::Corner(true))),

@@ -110,8 +110,7 @@ impl Interpreter<'_> {
                     self.error(line, "M140 without MB: give MB <distance in mm> or MB MAX")
                 })?)
             };
-            let feed = block.feed.map(|_| ());
-            self.retract(line, "M140", mb, feed.is_some())?;
+            self.retract(line, "M140", mb, block.feed.is_some())?;
         }
         let arc = matches!(
             k.path,
