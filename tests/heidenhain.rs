@@ -106,7 +106,7 @@ fn lines_and_an_arc_about_cc_give_the_hand_computed_path_and_length() {
 fn fmax_is_this_block_only_and_f_stays_modal() {
     let tp = read(&format!(
         "{HEADER}4 L X+0 Y+0 Z+0 F500\n5 L X+10\n6 L X+20 FMAX\n7 L X+30\n8 L X+40 F MAX\n\
-         9 L X+50\n"
+         9 * - 1/2\" DRILL NEXT\n10 L X+50\n"
     ));
     let feeds: Vec<Feed> = tp.points.iter().map(|p| p.feed).collect();
     let f = Feed::Programmed(500.0 / 60.0);

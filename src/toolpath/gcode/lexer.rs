@@ -11,6 +11,14 @@ pub(super) fn split_blocks(
     spec: &DialectSpec,
     line: &str,
 ) -> std::result::Result<Vec<String>, String> {
+    // A Klartext structure comment (`12 * - 1/2" DRILL`) is all comment, quotes included.
+    if spec.spaces == Spaces::Klartext
+        && super::klartext::strip_block_number(line)
+            .trim_start()
+            .starts_with('*')
+    {
+        return Ok(vec![String::new()]);
+    }
     let mut blocks = Vec::new();
     let mut current = String::new();
     let mut chars = line.chars();
