@@ -209,9 +209,14 @@ pub struct SolveArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
-    /// G-code dialect: linuxcnc, fanuc or sinumerik (default: detected from the program).
+    /// G-code dialect: linuxcnc, fanuc, sinumerik or heidenhain (default: detected from the
+    /// program).
     #[arg(long)]
     pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
+    /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable; the target one of CYCLE81–CYCLE89).
+    #[arg(long = "cycle-alias", value_name = "FROM=TO")]
+    pub cycle_alias: Vec<String>,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -401,7 +406,7 @@ fn solve_with_progress(
 pub fn solve(args: &SolveArgs) -> Result<String> {
     let mut options = args.options()?;
     let machine = args.machine(&options)?;
-    let (input, warnings) = read_input(args)?;
+    let (input, warnings, detected) = read_input(args)?;
     let material = apply_material(
         &args.machine,
         &args.toolpath,
@@ -410,7 +415,10 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
         &mut options,
     )?;
     let solution = solve_with_progress(&machine, &input, &options)?;
-    let (detected, dwell) = reader_used(args, &input)?;
+    let dwell = match &input {
+        toolpath::Input::Cl(t) => t.dwell_time(),
+        toolpath::Input::Joint(_) => 0.0,
+    };
     if let Some(out) = &args.output {
         writers::write_schedule(out, &solution.schedule)?;
     }
@@ -522,7 +530,13 @@ pub fn check(args: &CheckArgs) -> Result<String> {
     let mut options = Options::default();
     options.geometry.feed_override = args.feed_override;
     options.geometry.validate()?;
-    let (input, _) = read_input_from(&args.machine, &args.toolpath, args.format, args.dialect)?;
+    let (input, _, _) = read_input_from(
+        &args.machine,
+        &args.toolpath,
+        args.format,
+        args.dialect,
+        &[],
+    )?;
     let Some(report) = apply_material(
         &args.machine,
         &args.toolpath,
@@ -568,8 +582,14 @@ pub fn check(args: &CheckArgs) -> Result<String> {
 }
 
 /// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned.
-fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>)> {
-    read_input_from(&args.machine, &args.toolpath, args.format, args.dialect)
+fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
+    read_input_from(
+        &args.machine,
+        &args.toolpath,
+        args.format,
+        args.dialect,
+        &args.cycle_alias,
+    )
 }
 
 /// Reads `toolpath_file` for the machine of `machine_file`; its reader's warnings are printed
@@ -579,7 +599,8 @@ fn read_input_from(
     toolpath_file: &std::path::Path,
     format: Option<FormatChoice>,
     dialect: Option<crate::toolpath::gcode::Dialect>,
-) -> Result<(toolpath::Input, Vec<String>)> {
+    cycle_alias: &[String],
+) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
@@ -587,12 +608,17 @@ fn read_input_from(
     });
     let (_, references) = Machine::references_from_file(machine_file)?;
     let machine = Machine::from_file(machine_file)?;
+    let cycle_aliases = cycle_alias
+        .iter()
+        .map(|a| toolpath::gcode::parse_cycle_alias(a))
+        .collect::<Result<Vec<_>>>()?;
     let options = toolpath::ReadOptions {
         format,
         dialect,
         machine: Some(toolpath::MachineContext::new(&machine, &references)),
+        cycle_aliases,
     };
-    let (input, _) = toolpath::read_with(toolpath_file, &options)?;
+    let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.
     let warnings: Vec<String> = match &input {
         toolpath::Input::Cl(t) => t
@@ -608,27 +634,7 @@ fn read_input_from(
     for w in &warnings {
         eprintln!("feedopt: warning: {w}");
     }
-    Ok((input, warnings))
-}
-
-/// What reader and dialect `read_input` used, and the toolpath's dwell time (s).
-fn reader_used(args: &SolveArgs, input: &toolpath::Input) -> Result<(toolpath::Detected, f64)> {
-    let bytes = std::fs::read(&args.toolpath).map_err(|e| Error::io(&args.toolpath, e))?;
-    let options = toolpath::ReadOptions {
-        format: args.format.map(|f| match f {
-            FormatChoice::Apt => toolpath::Format::Apt,
-            FormatChoice::Gcode => toolpath::Format::Gcode,
-            FormatChoice::Csv => toolpath::Format::Csv,
-        }),
-        dialect: args.dialect,
-        machine: None,
-    };
-    let detected = toolpath::detect(&args.toolpath, &String::from_utf8_lossy(&bytes), &options)?;
-    let dwell = match input {
-        toolpath::Input::Cl(t) => t.dwell_time(),
-        toolpath::Input::Joint(_) => 0.0,
-    };
-    Ok((detected, dwell))
+    Ok((input, warnings, detected))
 }
 
 /// `feedopt compare`: returns what to print on stdout.
@@ -645,7 +651,7 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
     };
     options.validate()?;
     let machine = a.machine(&options.solve)?;
-    let (input, _) = read_input(a)?;
+    let (input, _, _) = read_input(a)?;
     apply_material(
         &a.machine,
         &a.toolpath,
@@ -696,7 +702,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     o.progress = !solve.json && std::io::stderr().is_terminal();
     o.validate()?;
     let machine = solve.machine(&o.solve)?;
-    let (input, _) = read_input(solve)?;
+    let (input, _, _) = read_input(solve)?;
     apply_material(
         &solve.machine,
         &solve.toolpath,
@@ -762,6 +768,10 @@ pub struct PlanArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
+    /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
+    /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable).
+    #[arg(long = "cycle-alias", value_name = "FROM=TO")]
+    pub cycle_alias: Vec<String>,
     /// Solver: `clarabel` or `reach`.
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
     pub solver: SolverChoice,
@@ -807,6 +817,7 @@ impl PlanArgs {
             ignore_programmed_feed: self.ignore_programmed_feed,
             format: self.format,
             dialect: Some(dialect),
+            cycle_alias: self.cycle_alias.clone(),
             solver: self.solver,
             start_feed: self.start_feed,
             end_feed: self.end_feed,
@@ -823,7 +834,7 @@ impl PlanArgs {
 fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize::Solution)> {
     let mut options = args.options()?;
     let machine = args.machine(&options)?;
-    let (input, _) = read_input(args)?;
+    let (input, _, _) = read_input(args)?;
     apply_material(
         &args.machine,
         &args.toolpath,

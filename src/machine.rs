@@ -22,11 +22,15 @@
 //! An axis may give its **reference position**, `"reference": 0.0` (mm or degrees, machine
 //! coordinates), or several, `"reference": [0.0, -250.0]`: the first is the point `G28`
 //! (Fanuc, LinuxCNC) returns to, the second the one `G30` goes to (`G30 P3`: the third, …).
-//! Only the toolpath readers use it ([`References`], read by [`Machine::references_from_file`]);
-//! a program that needs a reference the file lacks is an error naming the field to add
-//! (`axes.Z.reference`). Machine coordinates (`G28`, `G53`, Sinumerik `SUPA`) are program
-//! coordinates plus the kinematics' `work-offset` (trunnion tables) or, for every other
-//! kinematics, the program coordinates themselves.
+//! Only the toolpath readers use it ([`References`], read by [`Machine::references_from_file`]).
+//! Where a program needs a reference the file lacks, the readers use machine zero (machine
+//! coordinate 0), the controls' default: Fanuc's reference positions (parameters 1240–1243)
+//! and LinuxCNC's G28/G30 positions (parameters 5161–5169, 5181–5189) are 0 in machine
+//! coordinates until set, and a Fanuc's machine zero is set at its reference position; they
+//! say so (a warning naming `axes.Z.reference`, the summary's `reference` line). Machine
+//! coordinates (`G28`, `G53`, Sinumerik `SUPA`, Heidenhain `M91`) are program coordinates plus
+//! the kinematics' `work-offset` (trunnion tables) or, for every other kinematics, the program
+//! coordinates themselves.
 //!
 //! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
 //!

@@ -790,7 +790,7 @@ impl Plan<'_> {
     /// each round cut the error by only 0.7, and Σ ε_k (9.8e-4) fell short of the true error
     /// (1.7e-3; test `adaptive_jerk_refinement_meets_its_estimate_on_the_closed_form`). So the
     /// estimate takes the order the rounds show: with ρ the ratio of the last two changes of
-    /// T (clamped to 0.5…0.9, 0.5 until there are two), F's error is at most
+    /// T (clamped to 0.5…0.9; the rounds go on until there are two, three rounds), F's error is at most
     /// Σ ε_k · ρ / (1 − ρ) (the geometric tail; ρ = 0.5 is Richardson's p = 1). Rounds stop
     /// when that is ≤ tol · T(F) (tol: the larger of the convergence and 10 × the SCP's own);
     /// F is the answer and that bound / T(F) the estimate. Otherwise every interval whose ε_k exceeds one path-wide
@@ -857,7 +857,9 @@ impl Plan<'_> {
                 cycle_time_s: time,
             });
             self.progress.round(stations, estimate / time, tol);
-            if estimate <= tol * time || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
+            // ρ is observed from the third round on; before, the estimate assumes p = 1.
+            let observed = refinement.len() >= 3;
+            if (observed && estimate <= tol * time) || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
                 break;
             }
             if 2 * stations > options.max_stations {

@@ -209,6 +209,9 @@ pub struct Summary {
     pub dialect_by: Option<String>,
     /// Dwells of the program (G4, cycle dwells), s: part of `cycle_time_s`.
     pub dwell_time_s: f64,
+    /// What the reader assumed for `G28`/`G30` where the machine file gives no reference
+    /// point (machine zero, the controls' default; the fields to set), else `null`.
+    pub reference: Option<String>,
 }
 
 /// Worst use of one axis's limits in the re-simulation.
@@ -336,6 +339,7 @@ impl Summary {
             dialect: None,
             dialect_by: None,
             dwell_time_s: 0.0,
+            reference: None,
         }
     }
 
@@ -347,6 +351,7 @@ impl Summary {
         self.dialect_by = detected.dialect.map(|_| detected.dialect_by.to_string());
         self.cycle_time_s += dwell_time_s - self.dwell_time_s;
         self.dwell_time_s = dwell_time_s;
+        self.reference = detected.assumed.reference_note();
     }
 }
 
@@ -376,6 +381,9 @@ impl fmt::Display for Summary {
                 )?,
                 None => writeln!(f, "read as       {} ({})", self.format, self.format_by)?,
             }
+        }
+        if let Some(reference) = &self.reference {
+            writeln!(f, "reference     {reference}")?;
         }
         if self.dwell_time_s > 0.0 {
             writeln!(

@@ -2,8 +2,8 @@
 //! and axes, each against hand-computed moves and times.
 
 use feedopt::error::Error;
-use feedopt::toolpath::gcode::{Dialect, parse, parse_for};
-use feedopt::toolpath::{Feed, MachineContext, Toolpath, apt};
+use feedopt::toolpath::gcode::{Dialect, parse, parse_assumed, parse_cycle_alias, parse_for};
+use feedopt::toolpath::{Feed, MachineContext, Toolpath, Warning, apt};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -100,6 +100,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         axes: Some(axes.chars().collect()),
         reference,
         work_offset,
+        travel: Default::default(),
     }
 }
 
@@ -129,20 +130,72 @@ fn g28_goes_via_the_intermediate_point() {
     assert_eq!(p[3], v(0.0, 10.0, 50.0));
     assert_eq!(p[4], v(-200.0, 0.0, 50.0));
     assert!(tp.points[1..].iter().all(|p| p.feed == Feed::Rapid));
-    // Without a reference in the machine file: an error naming the field to add.
-    let m = context("XYZBC", Default::default(), [0.0; 3]);
-    let e = parse_for(
+}
+
+#[test]
+fn g28_without_a_reference_goes_to_machine_zero_and_says_so() {
+    // No reference in the machine file: machine zero, the controls' default. Machine = program
+    // + work offset (−300, −200, −250), so machine zero is program (300, 200, 250).
+    let m = context("XYZBC", Default::default(), [-300.0, -200.0, -250.0]);
+    let text = "G90 G0 X10. Y20. Z5.\nG91 G28 Z0.\nG91 G28 Z10.\nG90 G28 X0. Y0.\n";
+    let (tp, assumed) = parse_assumed(
         Path::new("t.nc"),
-        "G0 X0. Y0. Z0.\nG91 G28 Z0.\n",
+        text,
         Dialect::Fanuc.spec(),
         Some(&m),
+        &[],
     )
-    .unwrap_err();
-    let text = message(e);
-    assert!(
-        text.contains(":2:") && text.contains("axes.Z") && text.contains("reference"),
-        "{text}"
+    .unwrap();
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(
+        p,
+        [
+            v(10.0, 20.0, 5.0),
+            // G91 G28 Z0: the intermediate point is where the tool is; then Z to machine 0.
+            v(10.0, 20.0, 250.0),
+            // G91 G28 Z10: via Z 260, back to 250.
+            v(10.0, 20.0, 260.0),
+            v(10.0, 20.0, 250.0),
+            // G90 G28 X0 Y0: via program (0, 0), then to machine zero (300, 200).
+            v(0.0, 0.0, 250.0),
+            v(300.0, 200.0, 250.0),
+        ]
     );
+    assert!(tp.points[1..].iter().all(|p| p.feed == Feed::Rapid));
+    assert_eq!(
+        assumed.reference_at_machine_zero,
+        [true, true, true, false, false, false]
+    );
+    let note = assumed.reference_note().unwrap();
+    assert!(
+        note.contains("axes.Z.reference") && note.contains("machine zero"),
+        "{note}"
+    );
+    // One warning per axis, at its first use, naming the field to set.
+    let w: Vec<&Warning> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("reference"))
+        .collect();
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].line == 2 && w[0].message.contains("axes.Z.reference"),
+        "{w:?}"
+    );
+    assert!(w[1].line == 4 && w[1].message.contains("axes.X.reference, axes.Y.reference"));
+    // Given references are used and assume nothing.
+    let refs = [vec![1.0], vec![2.0], vec![3.0], vec![], vec![], vec![]];
+    let m = context("XYZBC", refs, [0.0; 3]);
+    let (tp, assumed) = parse_assumed(
+        Path::new("t.nc"),
+        text,
+        Dialect::Fanuc.spec(),
+        Some(&m),
+        &[],
+    )
+    .unwrap();
+    assert_eq!(tp.points[1].p, v(10.0, 20.0, 3.0));
+    assert_eq!(assumed.reference_note(), None);
 }
 
 #[test]
@@ -291,4 +344,69 @@ fn arc_turns_and_chords_are_bounded() {
         Dialect::LinuxCnc,
     );
     assert!(e.contains("out of range") || e.contains("chords"), "{e}");
+}
+
+#[test]
+fn cycle76_with_a_boring_list_is_an_error_and_an_alias_reads_it_as_cycle86() {
+    // As NX posts "BORING_NO_DRAG" for an 840D: CYCLE86's list under the name CYCLE76.
+    let nx = "G71 G90 G0 X0 Y0 Z20\nF120\nMCALL CYCLE76(20,0,2,-10,,3,,,,)\nX10\nX20\nMCALL\n";
+    let e = parse(Path::new("t.mpf"), nx, Dialect::Sinumerik)
+        .unwrap_err()
+        .to_string();
+    for needle in [":3:", "spigot", "_WID", "--cycle-alias CYCLE76=CYCLE86"] {
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+    // A spigot call with its dimensions is still an error (feedopt mills no spigots), without
+    // the alarm note.
+    let e = parse(
+        Path::new("t.mpf"),
+        "G71 G0 X0 Y0 Z20\nCYCLE76(20,0,2,-10,,40,30,5)\n",
+        Dialect::Sinumerik,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains(":2:") && e.contains("spigot") && !e.contains("alarm"),
+        "{e}"
+    );
+    // With the alias: exactly CYCLE86's moves (per hole: rapid to RFP + SDIS = 2, feed to −10,
+    // dwell DTB = 3 s, rapid to RTP = 20), and a warning naming the alias where it applies.
+    let alias = parse_cycle_alias(" cycle76 = CYCLE86 ").unwrap();
+    assert_eq!(alias, ("CYCLE76".to_string(), "CYCLE86".to_string()));
+    let (aliased, _) = parse_assumed(
+        Path::new("t.mpf"),
+        nx,
+        Dialect::Sinumerik.spec(),
+        None,
+        &[alias],
+    )
+    .unwrap();
+    let plain = gcode(Dialect::Sinumerik, &nx.replace("CYCLE76", "CYCLE86"));
+    assert_eq!(aliased.points, plain.points);
+    assert_eq!(aliased.dwells, plain.dwells);
+    assert!((aliased.dwell_time() - 6.0).abs() < 1e-12);
+    let z: Vec<f64> = aliased.points[1..5].iter().map(|p| p.p.z).collect();
+    assert_eq!(z, [20.0, 2.0, -10.0, 20.0]);
+    assert!(
+        aliased
+            .warnings
+            .iter()
+            .any(|w| w.line == 3 && w.message.contains("CYCLE76 is read as CYCLE86")),
+        "{:?}",
+        aliased.warnings
+    );
+    // Aliases are two cycle names, the second one feedopt expands.
+    for bad in [
+        "CYCLE76",
+        "CYCLE76=CYCLE100",
+        "G76=G86",
+        "CYCLE86=CYCLE86",
+        "=CYCLE86",
+    ] {
+        let e = parse_cycle_alias(bad).unwrap_err().to_string();
+        assert!(
+            e.contains("cycle alias") && e.contains("CYCLE76=CYCLE86"),
+            "{bad}: {e}"
+        );
+    }
 }

@@ -1168,3 +1168,67 @@ fn implausible_toolpath_magnitudes_name_the_line() {
     ]);
     assert_success(&out);
 }
+
+#[test]
+fn g28_reference_default_and_cycle_alias_on_the_command_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    // The machine file gives no reference: G28 goes to machine zero, and the summary and
+    // --json say so, naming the field to set.
+    w.write(
+        "g28.nc",
+        "G21 G90 G0 X0 Y0 Z5\nG1 X50 F3000\nG91 G28 Z0\nM30\n",
+    );
+    let args = [
+        "solve",
+        "-m",
+        "machine.json",
+        "g28.nc",
+        "--stations",
+        STATIONS,
+    ];
+    let out = w.run(&args);
+    assert_success(&out);
+    assert!(
+        stdout(&out).contains("reference     G28/G30 reference of Z: machine zero"),
+        "{}",
+        stdout(&out)
+    );
+    let out = w.run(&[&args[..], &["--json"]].concat());
+    assert_success(&out);
+    let v = parse_json(&stdout(&out), "stdout");
+    let r = v["reference"].as_str().unwrap_or_default();
+    assert!(r.contains("axes.Z.reference"), "{v}");
+    // A program without G28: null.
+    w.write("line.cls", LINE);
+    let out = w.solve_line(&["--json"]);
+    assert!(parse_json(&stdout(&out), "stdout")["reference"].is_null());
+    // A post's CYCLE76 with CYCLE86's list: an error naming the option, and with it, read.
+    w.write(
+        "spigot.mpf",
+        "G71 G90 G0 X0 Y0 Z20\nF120\nMCALL CYCLE76(20,0,2,-10,,3,,,,)\nX10\nMCALL\nM30\n",
+    );
+    let args = [
+        "solve",
+        "-m",
+        "machine.json",
+        "spigot.mpf",
+        "--stations",
+        STATIONS,
+    ];
+    let out = w.run(&args);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("spigot.mpf:3:") && stderr(&out).contains("--cycle-alias"));
+    let out = w.run(&[&args[..], &["--cycle-alias", "CYCLE76=CYCLE86", "--json"]].concat());
+    assert_success(&out);
+    let v = parse_json(&stdout(&out), "stdout");
+    assert_eq!(v["dwell_time_s"], 3.0);
+    assert!(stderr(&out).contains("CYCLE76 is read as CYCLE86"));
+    let out = w.run(&[&args[..], &["--cycle-alias", "CYCLE76=CYCLE7"]].concat());
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("cycle alias `CYCLE76=CYCLE7`"),
+        "{}",
+        stderr(&out)
+    );
+}

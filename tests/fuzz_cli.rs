@@ -458,11 +458,12 @@ fn toolpath_case(dir: &Path, ext: &str, bytes: Vec<u8>) -> Result<bool, String> 
 }
 
 /// Fields of the summary that are `null` by design: no estimate on a fixed grid, no dialect
-/// for an APT or CSV input.
-const OPTIONAL: [&str; 3] = [
+/// for an APT or CSV input, no reference note when the reader assumed no G28/G30 reference.
+const OPTIONAL: [&str; 4] = [
     "summary.error_estimate",
     "summary.dialect",
     "summary.dialect_by",
+    "summary.reference",
 ];
 
 /// Checks a JSON summary for NaN (serde_json writes NaN and infinities as null).

@@ -85,8 +85,12 @@ fn dialect_from_str_and_default() {
     assert_eq!("linuxcnc".parse::<Dialect>().unwrap(), Dialect::LinuxCnc);
     assert_eq!("Fanuc".parse::<Dialect>().unwrap(), Dialect::Fanuc);
     assert_eq!("SINUMERIK".parse::<Dialect>().unwrap(), Dialect::Sinumerik);
-    let e = "heidenhain".parse::<Dialect>().unwrap_err().to_string();
-    assert!(e.contains("heidenhain") && e.contains("linuxcnc"), "{e}");
+    assert_eq!(
+        "Heidenhain".parse::<Dialect>().unwrap(),
+        Dialect::Heidenhain
+    );
+    let e = "mazak".parse::<Dialect>().unwrap_err().to_string();
+    assert!(e.contains("mazak") && e.contains("linuxcnc"), "{e}");
     for d in Dialect::ALL {
         assert_eq!(d.to_string().parse::<Dialect>().unwrap(), d);
     }

@@ -10,29 +10,17 @@ fn dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/cam")
 }
 
-/// The machine file, with `reference` positions added when `references` (the shared files
-/// give none, and the Mori program returns to them with G28/G30).
-fn context(machine: &str, references: bool) -> MachineContext {
+/// The machine file as the shared folder has it (it gives no `reference` positions).
+fn context(machine: &str) -> MachineContext {
     let path = dir().join("machines").join(machine);
-    let mut json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).expect("machine file")).unwrap();
-    if references {
-        for axis in json["axes"].as_object_mut().unwrap().values_mut() {
-            axis["reference"] = serde_json::json!([0.0, 0.0]);
-        }
-    }
-    let text = json.to_string();
+    let text = std::fs::read_to_string(&path).expect("machine file");
     let m = Machine::from_json(&path, &text).unwrap();
     MachineContext::new(&m, &references_from_json(&path, &text, &m).unwrap())
 }
 
-fn read(
-    file: &str,
-    machine: &str,
-    references: bool,
-) -> feedopt::error::Result<(Input, toolpath::Detected)> {
+fn read(file: &str, machine: &str) -> feedopt::error::Result<(Input, toolpath::Detected)> {
     let options = ReadOptions {
-        machine: Some(context(machine, references)),
+        machine: Some(context(machine)),
         ..Default::default()
     };
     toolpath::read_with(&dir().join(file), &options)
@@ -60,7 +48,7 @@ fn every_real_program_reads_with_defaults() {
         ("aamorim_basemach.apt", "xyz_mill.json", None),
     ];
     for (file, machine, dialect) in cases {
-        let (input, detected) = read(file, machine, true).unwrap_or_else(|e| panic!("{e}"));
+        let (input, detected) = read(file, machine).unwrap_or_else(|e| panic!("{e}"));
         let Input::Cl(tp) = input else {
             panic!("{file}: not a CL path")
         };
@@ -79,12 +67,35 @@ fn every_real_program_reads_with_defaults() {
             assert_eq!(detected.format, Format::Apt);
         }
     }
-    // The Mori program returns to the reference points: without them in the machine file,
-    // an error names the field to add.
-    let e = read("nx_mori_nmv5000_mm.nc", "trt_bc_mori_nmv5000.json", false).unwrap_err();
-    assert!(e.to_string().contains("axes.Z"), "{e}");
+    // The Mori program returns to the reference points: the shared machine file gives none,
+    // so machine zero (the controls' default) is used, and said.
+    let (_, detected) = read("nx_mori_nmv5000_mm.nc", "trt_bc_mori_nmv5000.json").unwrap();
+    let note = detected.assumed.reference_note().unwrap_or_default();
+    assert!(note.contains("axes.Z.reference"), "{note}");
     // The NX DMU 70 program calls CYCLE76, Sinumerik's rectangular spigot milling cycle, with a
-    // drilling cycle's arguments: an error naming it, not a guess.
-    let e = read("nx_dmu70evo_840d.mpf", "headtable_dmu70.json", false).unwrap_err();
-    assert!(e.to_string().contains("CYCLE76"), "{e}");
+    // boring cycle's arguments: an error naming it and the way out, not a guess …
+    let e = read("nx_dmu70evo_840d.mpf", "headtable_dmu70.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(":1011:")
+            && e.contains("CYCLE76")
+            && e.contains("--cycle-alias CYCLE76=CYCLE86"),
+        "{e}"
+    );
+    // … and with the alias the user gives, it reads.
+    let options = ReadOptions {
+        machine: Some(context("headtable_dmu70.json")),
+        cycle_aliases: vec![("CYCLE76".into(), "CYCLE86".into())],
+        ..Default::default()
+    };
+    let (input, _) = toolpath::read_with(&dir().join("nx_dmu70evo_840d.mpf"), &options).unwrap();
+    let Input::Cl(tp) = input else {
+        panic!("not a CL path")
+    };
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 1011 && w.message.contains("CYCLE86"))
+    );
 }

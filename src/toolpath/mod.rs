@@ -150,6 +150,9 @@ pub struct MachineContext {
     /// Machine coordinates minus program coordinates, X Y Z, mm (the trunnion kinematics'
     /// `work-offset`; zero for every other kinematics).
     pub work_offset: [f64; 3],
+    /// Travel `(min, max)` per axis X Y Z A B C, machine coordinates (mm, degrees), where the
+    /// machine file gives it (Heidenhain `M140 MB MAX` retracts Z to its max).
+    pub travel: [Option<(f64, f64)>; 6],
 }
 
 impl MachineContext {
@@ -175,11 +178,19 @@ impl MachineContext {
             KinematicsSpec::TableTable { params, .. } => params.work_offset,
             _ => [0.0; 3],
         };
+        let travel = std::array::from_fn(|i| {
+            machine
+                .axes
+                .iter()
+                .find(|a| a.name == NAMES[i])
+                .and_then(|a| a.travel)
+        });
         MachineContext {
             file: references.file.clone(),
             axes,
             reference,
             work_offset,
+            travel,
         }
     }
 
@@ -195,6 +206,9 @@ pub struct ReadOptions {
     pub format: Option<Format>,
     pub dialect: Option<gcode::Dialect>,
     pub machine: Option<MachineContext>,
+    /// Cycles read under another name ([`gcode::parse_cycle_alias`]: `("CYCLE76",
+    /// "CYCLE86")` reads a machine builder's CYCLE76 as the standard CYCLE86).
+    pub cycle_aliases: Vec<(String, String)>,
 }
 
 /// What a reader was used, and why.
@@ -207,6 +221,40 @@ pub struct Detected {
     /// `"default"` (for the dialect when nothing in the file tells).
     pub format_by: &'static str,
     pub dialect_by: &'static str,
+    /// What the reader assumed where the machine file is silent ([`read_with`] fills it;
+    /// [`detect`] leaves it empty).
+    pub assumed: Assumed,
+}
+
+/// What a reader assumed where the program and the machine file leave something open.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Assumed {
+    /// Axes X Y Z A B C that a `G28`/`G30` sent to a reference point the machine file does
+    /// not give (`axes.Z.reference`): machine zero, machine coordinate 0, was used — the
+    /// controls' default.
+    pub reference_at_machine_zero: [bool; 6],
+}
+
+impl Assumed {
+    /// One line saying what was assumed, or `None` when nothing was.
+    pub fn reference_note(&self) -> Option<String> {
+        const NAMES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
+        let axes: Vec<&str> = NAMES
+            .iter()
+            .zip(self.reference_at_machine_zero)
+            .filter(|(_, d)| *d)
+            .map(|(n, _)| *n)
+            .collect();
+        (!axes.is_empty()).then(|| {
+            let fields: Vec<String> = axes.iter().map(|a| format!("axes.{a}.reference")).collect();
+            format!(
+                "G28/G30 reference of {}: machine zero, the controls' default; set {} in the \
+                 machine file",
+                axes.join(", "),
+                fields.join(", ")
+            )
+        })
+    }
 }
 
 impl Format {
@@ -223,16 +271,16 @@ impl Format {
 /// Extensions read as APT CL.
 pub const APT_EXTENSIONS: &[&str] = &["cls", "clsf", "apt", "cl", "aptsource"];
 /// Extensions read as G-code (`.mpf`/`.spf`: Sinumerik main program / subprogram; `.ptp`: NX
-/// post output; `.txt`: by content).
+/// post output; `.h`: Heidenhain Klartext; `.txt`: by content).
 pub const GCODE_EXTENSIONS: &[&str] = &[
     "ngc", "nc", "gcode", "tap", "mpf", "spf", "ptp", "eia", "min", "iso", "h", "txt",
 ];
 
 /// Chooses the reader and dialect: the options first, then the file's content (a `GOTO/`
-/// record is APT; `TRAORI`, `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are
-/// Sinumerik; `G43.4`, `G43.5`, `G68.2`, `G05.1`, `M98` or an `O1234` program number are
-/// Fanuc; `M428`–`M430` or `O<…>` are LinuxCNC), then the extension (`.mpf`, `.spf`:
-/// Sinumerik), else LinuxCNC.
+/// record is APT; a first block `BEGIN PGM` is Heidenhain Klartext; `TRAORI`, `MCALL`,
+/// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are Sinumerik; `G43.4`, `G43.5`, `G68.2`,
+/// `G05.1`, `M98` or an `O1234` program number are Fanuc; `M428`–`M430` or `O<…>` are
+/// LinuxCNC), then the extension (`.mpf`, `.spf`: Sinumerik; `.h`: Heidenhain), else LinuxCNC.
 pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected> {
     let ext = path
         .extension()
@@ -255,10 +303,11 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         (Format::Apt, "extension")
     } else if GCODE_EXTENSIONS.contains(&ext.as_str()) {
         (Format::Gcode, "extension")
-    } else if upper.contains('G')
-        && upper
-            .lines()
-            .any(|l| l.trim_start().starts_with(['G', 'N', 'X', 'Y', 'Z']))
+    } else if gcode::is_klartext(&upper)
+        || (upper.contains('G')
+            && upper
+                .lines()
+                .any(|l| l.trim_start().starts_with(['G', 'N', 'X', 'Y', 'Z'])))
     {
         (Format::Gcode, "content")
     } else {
@@ -276,6 +325,8 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         (Some(d), "content")
     } else if matches!(ext.as_str(), "mpf" | "spf") {
         (Some(gcode::Dialect::Sinumerik), "extension")
+    } else if ext == "h" {
+        (Some(gcode::Dialect::Heidenhain), "extension")
     } else {
         (Some(gcode::Dialect::default()), "default")
     };
@@ -284,6 +335,7 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
         dialect,
         format_by,
         dialect_by,
+        assumed: Assumed::default(),
     })
 }
 
@@ -291,7 +343,7 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
 pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)> {
     let bytes = read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);
-    let detected = detect(path, &text, options)?;
+    let mut detected = detect(path, &text, options)?;
     let input = match detected.format {
         Format::Csv => Input::Joint(joint_csv::parse(
             path,
@@ -303,12 +355,17 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
             &text,
             options.machine.as_ref(),
         )?)?),
-        Format::Gcode => Input::Cl(plausible(gcode::parse_for(
-            path,
-            &text,
-            detected.dialect.unwrap_or_default().spec(),
-            options.machine.as_ref(),
-        )?)?),
+        Format::Gcode => {
+            let (toolpath, assumed) = gcode::parse_assumed(
+                path,
+                &text,
+                detected.dialect.unwrap_or_default().spec(),
+                options.machine.as_ref(),
+                &options.cycle_aliases,
+            )?;
+            detected.assumed = assumed;
+            Input::Cl(plausible(toolpath)?)
+        }
     };
     Ok((input, detected))
 }
@@ -411,7 +468,7 @@ pub fn read_as(path: &Path, format: Option<Format>, dialect: gcode::Dialect) -> 
     let options = ReadOptions {
         format,
         dialect: Some(dialect),
-        machine: None,
+        ..Default::default()
     };
     read_with(path, &options).map(|(input, _)| input)
 }

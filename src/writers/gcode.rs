@@ -141,8 +141,8 @@ struct Words {
     comment: fn(&str) -> String,
 }
 
-fn words(dialect: Dialect) -> Words {
-    match dialect {
+fn words(dialect: Dialect) -> Result<Words> {
+    Ok(match dialect {
         Dialect::LinuxCnc => Words {
             header: &["G21 G90 G17"],
             tcp_on: "M428",
@@ -164,7 +164,14 @@ fn words(dialect: Dialect) -> Words {
             footer: &["M30"],
             comment: |c| format!("; {c}"),
         },
-    }
+        Dialect::Heidenhain => {
+            return Err(Error::Usage(
+                "the writer writes G-code (linuxcnc, fanuc or sinumerik), not Heidenhain \
+                 Klartext: give --dialect linuxcnc, fanuc or sinumerik"
+                    .into(),
+            ));
+        }
+    })
 }
 
 /// A coordinate: 6 decimals, never `-0.000000`.
@@ -374,6 +381,7 @@ pub fn program(
     geometry: &GeometryOptions,
     options: &GcodeOptions,
 ) -> Result<Program> {
+    let w = words(options.dialect)?;
     let kin = &solution.kinematics;
     if matches!(kin, Kinematics::Joint { .. }) {
         return Err(Error::Usage(
@@ -443,7 +451,6 @@ pub fn program(
         }
     }
 
-    let w = words(options.dialect);
     let mut text = String::new();
     let comment = |s: &str| (w.comment)(s);
     let _ = writeln!(

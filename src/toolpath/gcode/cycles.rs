@@ -45,8 +45,29 @@
 //! programmed F). CYCLE86: feed, dwell, rapid out (the lift-off moves RPA/RPO/RPAP are not
 //! read). CYCLE87/CYCLE88: feed, (CYCLE88: dwell), the operator's stop (M0: not timed, a
 //! warning), rapid out. CYCLE89: feed, dwell, feed out. `CYCLE76`/`CYCLE77` are Sinumerik's
-//! spigot milling cycles, not drilling: an error. A cycle whose RTP lies below RFP + SDIS
-//! retracts into the part as written, with a warning.
+//! spigot milling cycles, not drilling: an error that says so, and whether the call lacks the
+//! spigot's dimensions (NX posts write CYCLE86's list under the name CYCLE76); a machine whose
+//! CYCLE76 is a builder's boring cycle is read with a cycle alias
+//! ([`super::parse_cycle_alias`]: `--cycle-alias CYCLE76=CYCLE86`), never by a guess. A cycle
+//! whose RTP lies below RFP + SDIS retracts into the part as written, with a warning.
+//!
+//! # Heidenhain (`CYCL DEF 200`, `203`, `207`)
+//!
+//! Q parameters (mm, mm/min, s): Q200 set-up clearance (above the surface), Q201 depth
+//! (negative, from the surface; 0: the cycle does nothing), Q203 surface coordinate, Q204 2nd
+//! set-up clearance (above the surface), Q206 plunging feed, Q202 plunging depth, Q210 dwell at
+//! the top, Q211 dwell at the depth. With S = Q203 + Q200 (the set-up height) and the depths
+//! Q203 − Q202, Q203 − 2·Q202, … down to Q203 + Q201 (the last one exact):
+//!
+//! | cycle | moves |
+//! |---|---|
+//! | 200 DRILLING | rapid to S; per infeed: feed Q206 to the depth, then (not after the last) rapid to S, dwell Q210, rapid to Q200 above the depth reached; at the depth dwell Q211, rapid to Q203 + max(Q200, Q204) |
+//! | 203 UNIVERSAL DRILLING | as 200, but each infeed Q212 shorter (never below Q205); after an infeed, Q213 times a chip break (rapid up Q256, feed on), then a full retract (feed Q208 to S, dwell Q210, rapid to Q200 above the depth); at the depth dwell Q211, feed Q208 to S, rapid to Q203 + Q204 if higher (Q208 = 0: Q206) |
+//! | 207 RIGID TAPPING | rapid to S, feed |Q239| × S (pitch × the `TOOL CALL`'s spindle speed) to the depth and back to S, rapid to Q203 + Q204 if higher |
+//!
+//! The chip break's retract speed is the machine's: taken as rapid. Q395 = 1 (depth to the
+//! full diameter, which needs the tool's point angle) is an error, as is a missing Q
+//! parameter the cycle needs.
 
 /// Clearance of a peck's rapid return above the last depth (and G73's retract), mm: LinuxCNC's
 /// 0.010 in; on Fanuc it is parameter 5114/5115.
@@ -202,6 +223,180 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
     Ok((s, note))
 }
 
+/// Heidenhain drilling cycle `number` (200, 203, 207) from its Q parameters (`q(200)` …),
+/// the spindle speed (rpm, for 207) and a raise of the surface Q203 by `offset` mm (a
+/// pattern point's Z). Starts from where the tool is (over the hole). The second value names
+/// assumptions, for warnings.
+pub fn heidenhain_steps(
+    number: u32,
+    q: &dyn Fn(u32) -> Option<f64>,
+    spindle_rpm: Option<f64>,
+    offset: f64,
+) -> Result<(Vec<Step>, Vec<&'static str>), String> {
+    use Step::*;
+    if !matches!(number, 200 | 203 | 207) {
+        return Err(format!(
+            "cycle {number} is not a cycle feedopt can expand (200, 203 and 207 are): post the \
+             operation as L moves"
+        ));
+    }
+    let need = |n: u32| {
+        q(n).ok_or_else(|| format!("cycle {number}: Q{n} is not defined (the CYCL DEF gives it)"))
+    };
+    let finite = |n: u32, v: f64| {
+        if v.is_finite() && v.abs() <= crate::toolpath::MAX_COORDINATE_MM {
+            Ok(v)
+        } else {
+            Err(format!("cycle {number}: Q{n} = {v} is out of range"))
+        }
+    };
+    let surface = finite(203, need(203)?)? + offset;
+    let clearance = finite(200, need(200)?)?.abs();
+    let depth = finite(201, need(201)?)?;
+    if depth > 0.0 {
+        return Err(format!(
+            "cycle {number}: depth Q201 = {depth} must be negative (below the surface Q203)"
+        ));
+    }
+    if depth == 0.0 {
+        return Ok((
+            Vec::new(),
+            vec!["depth Q201 = 0: the control does not run the cycle"],
+        ));
+    }
+    if q(395).is_some_and(|v| v != 0.0) {
+        return Err(format!(
+            "cycle {number}: Q395 = 1 (the depth to the full diameter) needs the tool's point \
+             angle: post with Q395 = 0"
+        ));
+    }
+    let second = finite(204, q(204).unwrap_or(0.0))?.max(0.0);
+    let safe = surface + clearance;
+    let bottom = surface + depth;
+    let dwell = |n: u32| -> Result<f64, String> {
+        let v = q(n).unwrap_or(0.0);
+        if (0.0..=1e6).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!(
+                "cycle {number}: dwell Q{n} = {v} s is out of range"
+            ))
+        }
+    };
+    let feed = |n: u32| -> Result<f64, String> {
+        let f = need(n)?;
+        if (1e-3..=1e9).contains(&f) {
+            Ok(f)
+        } else {
+            Err(format!(
+                "cycle {number}: feed Q{n} = {f} mm/min is out of range"
+            ))
+        }
+    };
+    let mut s = vec![Rapid(safe)];
+    let mut notes = Vec::new();
+    match number {
+        200 | 203 => {
+            let f = feed(206)?;
+            let plunge = finite(202, need(202)?)?.abs();
+            if plunge == 0.0 {
+                return Err(format!("cycle {number}: plunging depth Q202 is 0"));
+            }
+            let (top, bottom_dwell) = (dwell(210)?, dwell(211)?);
+            let (decrement, breaks, minimum, retract_feed, chip) = if number == 203 {
+                let f208 = finite(208, q(208).unwrap_or(0.0))?;
+                (
+                    finite(212, q(212).unwrap_or(0.0))?.abs(),
+                    finite(213, q(213).unwrap_or(0.0))?.max(0.0).round() as u64,
+                    finite(205, q(205).unwrap_or(0.0))?.abs(),
+                    if f208 > 0.0 { f208 } else { f },
+                    finite(256, q(256).unwrap_or(0.0))?.abs(),
+                )
+            } else {
+                (0.0, 0, 0.0, f, 0.0)
+            };
+            if breaks > 0 {
+                notes.push("the chip-breaking retract Q256 is taken at rapid traverse");
+            }
+            let mut depth_now = surface;
+            let mut step = plunge;
+            let mut broken = 0u64;
+            let mut n = 0usize;
+            loop {
+                let next = (depth_now - step).max(bottom);
+                s.push(Feed(next, Some(f)));
+                depth_now = next;
+                n += 1;
+                if depth_now <= bottom {
+                    break;
+                }
+                if n >= MAX_PECKS {
+                    return Err(format!(
+                        "cycle {number}: more than {MAX_PECKS} infeeds in one hole: check Q202"
+                    ));
+                }
+                if broken < breaks {
+                    broken += 1;
+                    s.push(Rapid((depth_now + chip).min(safe)));
+                } else {
+                    broken = 0;
+                    if number == 203 {
+                        s.push(Feed(safe, Some(retract_feed)));
+                    } else {
+                        s.push(Rapid(safe));
+                    }
+                    if top > 0.0 {
+                        s.push(Dwell(top));
+                    }
+                    s.push(Rapid((depth_now + clearance).min(safe)));
+                }
+                if decrement > 0.0 {
+                    step = (step - decrement).max(minimum);
+                    if step <= 1e-6 {
+                        return Err(format!(
+                            "cycle {number}: the decrement Q212 brings the plunging depth to 0; \
+                             give a minimum plunging depth Q205"
+                        ));
+                    }
+                }
+            }
+            if bottom_dwell > 0.0 {
+                s.push(Dwell(bottom_dwell));
+            }
+            if number == 203 {
+                s.push(Feed(safe, Some(retract_feed)));
+                if second > clearance {
+                    s.push(Rapid(surface + second));
+                }
+            } else {
+                s.push(Rapid(surface + clearance.max(second)));
+            }
+        }
+        _ => {
+            // 207
+            let pitch = finite(239, need(239)?)?.abs();
+            let Some(rpm) = spindle_rpm.filter(|r| r.is_finite() && *r > 0.0) else {
+                return Err(
+                    "cycle 207: rigid tapping feeds at pitch × spindle speed, and no TOOL CALL \
+                     gave S"
+                        .to_string(),
+                );
+            };
+            let f = pitch * rpm;
+            if !(1e-3..=1e9).contains(&f) {
+                return Err(format!(
+                    "cycle 207: the tapping feed Q239 × S = {f} mm/min is out of range"
+                ));
+            }
+            s.extend([Feed(bottom, Some(f)), Feed(safe, Some(f))]);
+            if second > clearance {
+                s.push(Rapid(surface + second));
+            }
+        }
+    }
+    Ok((s, notes))
+}
+
 /// Sinumerik `CYCLE8x(...)` parameters, lengths in mm (already scaled), positional.
 pub fn sinumerik_steps(
     number: u32,
@@ -293,9 +488,34 @@ pub fn sinumerik_steps(
         }
         89 => s.extend([Feed(dp, None), Dwell(dwell(5)), Feed(safe, None)]),
         76 | 77 => {
+            // On an 840D these mill a spigot: CYCLE76 (RTP, RFP, SDIS, DP, DPR, _LENG, _WID,
+            // …), CYCLE77 (…, DPR, _PRAD, …). A post that writes a boring cycle's list under
+            // this name (NX's "BORING_NO_DRAG" writes CYCLE86's: …, DPR, DTB, SDIR, RPA, RPO,
+            // RPAP) names a cycle of the machine builder or of the post.
+            let what = if number == 76 {
+                "rectangular spigot milling, whose 6th and 7th parameters are the spigot's \
+                 length _LENG and width _WID"
+            } else {
+                "circular spigot milling, whose 6th parameter is the spigot's diameter _PRAD"
+            };
+            let missing = if number == 76 {
+                get(5).is_none() || get(6).is_none()
+            } else {
+                get(5).is_none()
+            };
+            let shape = if missing {
+                " This call does not give them (its list has the shape of a drilling or boring \
+                 cycle's: RTP, RFP, SDIS, DP, DPR, then DTB …), so a standard 840D would stop \
+                 with an alarm."
+            } else {
+                ""
+            };
             return Err(format!(
-                "{name} is Sinumerik's spigot milling cycle, not a drilling cycle, and is not \
-                 supported: post the operation as G0/G1/G2/G3 (or as CYCLE81–CYCLE89)"
+                "{name} on a Sinumerik 840D is {what}, not a drilling cycle; feedopt does not \
+                 mill spigots.{shape} If this machine's {name} is a machine builder's or the \
+                 post's cycle that works like a standard one, map it: --cycle-alias \
+                 {name}=CYCLE86 (or the cycle it is; ReadOptions::cycle_aliases); else post the \
+                 operation as CYCLE81–CYCLE89 or as G0/G1/G2/G3"
             ));
         }
         _ => return Err(format!("{name} is not a drilling cycle feedopt knows")),

@@ -20,11 +20,22 @@ pub enum Dialect {
     Fanuc,
     /// Siemens Sinumerik 840D, 5-axis as far as `TRAORI` and tool vectors need.
     Sinumerik,
+    /// Heidenhain TNC 640 Klartext (conversational, `.h`): not G-code, but read by the same
+    /// interpreter through [`HEIDENHAIN`] and the Klartext lexer (see [`super::klartext`]).
+    Heidenhain,
 }
 
 impl Dialect {
     /// All built-in dialects.
-    pub const ALL: [Dialect; 3] = [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik];
+    pub const ALL: [Dialect; 4] = [
+        Dialect::LinuxCnc,
+        Dialect::Fanuc,
+        Dialect::Sinumerik,
+        Dialect::Heidenhain,
+    ];
+
+    /// The G-code dialects (those the G-code writer writes; Klartext is not G-code).
+    pub const GCODE: [Dialect; 3] = [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik];
 
     /// The dialect's table.
     pub fn spec(self) -> &'static DialectSpec {
@@ -32,15 +43,17 @@ impl Dialect {
             Dialect::LinuxCnc => &LINUXCNC,
             Dialect::Fanuc => &FANUC,
             Dialect::Sinumerik => &SINUMERIK,
+            Dialect::Heidenhain => &HEIDENHAIN,
         }
     }
 
-    /// The name used on the command line (`linuxcnc`, `fanuc`, `sinumerik`).
+    /// The name used on the command line (`linuxcnc`, `fanuc`, `sinumerik`, `heidenhain`).
     pub fn name(self) -> &'static str {
         match self {
             Dialect::LinuxCnc => "linuxcnc",
             Dialect::Fanuc => "fanuc",
             Dialect::Sinumerik => "sinumerik",
+            Dialect::Heidenhain => "heidenhain",
         }
     }
 }
@@ -54,7 +67,7 @@ impl fmt::Display for Dialect {
 impl FromStr for Dialect {
     type Err = Error;
 
-    /// `linuxcnc`, `fanuc` or `sinumerik` (case-insensitive).
+    /// `linuxcnc`, `fanuc`, `sinumerik` or `heidenhain` (case-insensitive).
     fn from_str(s: &str) -> Result<Self> {
         let wanted = s.trim().to_ascii_lowercase();
         Dialect::ALL
@@ -62,7 +75,8 @@ impl FromStr for Dialect {
             .find(|d| d.name() == wanted)
             .ok_or_else(|| {
                 Error::Usage(format!(
-                    "unknown G-code dialect `{s}` (expected linuxcnc, fanuc or sinumerik)"
+                    "unknown G-code dialect `{s}` (expected linuxcnc, fanuc, sinumerik or \
+                     heidenhain)"
                 ))
             })
     }
@@ -84,6 +98,10 @@ pub enum Spaces {
     Ignored,
     /// Separates words, which may then be keywords (`TRAORI`) or `NAME=value`.
     Separate,
+    /// Heidenhain Klartext: a block number, then a statement whose first word(s) say what it
+    /// is (`L`, `CC`, `CYCL DEF`, …); words `NAME±value` (`X+10`, `IX-5`, `DR+`) separated by
+    /// spaces (see [`super::klartext`]).
+    Klartext,
 }
 
 /// What a letter or named word addresses.
@@ -116,6 +134,21 @@ pub enum Address {
     /// A subprogram call by number, the word as written naming it (Sinumerik `L123`; `P`
     /// in the same block is the repeat count).
     Call,
+    /// Klartext: an incremental axis word 0–5 (`IX+5`: this word only, never modal).
+    IncrementalAxis(usize),
+    /// Klartext: the direction of a circular path, `DR+` (counter-clockwise, value +1) or
+    /// `DR-` (clockwise, −1).
+    ArcDirection,
+    /// Klartext: a polar angle about the pole `CC`, degrees; `true`: incremental (`IPA`).
+    PolarAngle(bool),
+    /// Klartext: a polar radius from the pole `CC`, mm; `true`: incremental (`IPR`).
+    PolarRadius(bool),
+    /// Klartext `M140 MB`: the retract distance along the tool axis, mm (`MB MAX` is the
+    /// keyword [`Action::RetractMax`]).
+    Retract,
+    /// Klartext `A+Q120`, `B+Q121`, `C+Q122` (0–2 = A B C): the rotary axis positioned to the
+    /// solution the control computes for the active `PLANE` (Q120–Q122 are its output).
+    PlaneRotary(usize),
 }
 
 /// Motion modes (modal group 1).
@@ -234,12 +267,73 @@ pub enum Action {
     ModalCall,
     /// Sinumerik `CYCLE81`–`CYCLE89` (and the spigot cycles 76/77, an error).
     SinumerikCycle(u32),
+    /// Klartext path functions other than the straight lines `L`/`LN`
+    /// ([`Motion::Linear`]).
+    Path(PathKind),
+    /// Klartext statements: the keyword (one or more words) takes the rest of the block as
+    /// its arguments.
+    Statement(Statement),
+    /// Klartext `FMAX`: this block is a rapid (F stays as programmed for the next block).
+    RapidBlock,
+    /// Klartext `FAUTO`: the feed the `TOOL CALL` gave.
+    ToolCallFeed,
+    /// Klartext `M99` (`true`: call the defined cycle at the end of this block) and `M89`
+    /// (`false`: after every positioning block until `M99` or `CYCL DEF`).
+    CycleCallAt(bool),
+    /// Klartext `M126` (true) / `M127` (false): rotary axes take the shorter way to an
+    /// absolute position.
+    RotaryShortestPath(bool),
+    /// Klartext `M140`: retract along the tool axis by the block's `MB` (see
+    /// [`Address::Retract`], [`Action::RetractMax`]).
+    RetractToolAxis,
+    /// Klartext `MB MAX`: retract to the travel limit.
+    RetractMax,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
     Note(&'static str),
     /// Rejected with this error.
     Unsupported(&'static str),
+}
+
+/// Klartext path functions (see [`super::klartext`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathKind {
+    /// `CC X Y`: the circle centre (and pole); no motion.
+    Centre,
+    /// `C X Y DR±`: an arc about `CC` to the end point.
+    PoleArc,
+    /// `CR X Y R± DR±`: an arc of radius R to the end point.
+    RadiusArc,
+    /// `CT X Y`: an arc tangent to the contour before it.
+    TangentArc,
+    /// `CP PA/IPA DR±`: an arc about `CC` to a polar angle.
+    PolarArc,
+    /// `LP PR PA`: a line to polar coordinates about `CC`.
+    PolarLine,
+}
+
+/// Klartext statements: their arguments are read by the interpreter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Statement {
+    /// `BEGIN PGM name MM`.
+    ProgramBegin,
+    /// `TOOL CALL n Z S… F…`.
+    ToolCall,
+    /// `CYCL DEF n …`.
+    CycleDef,
+    /// `CYCL CALL`, `CYCL CALL PAT`, `CYCL CALL POS X Y Z`.
+    CycleCall,
+    /// `PATTERN DEF POS1 (X Y Z) …`.
+    PatternDef,
+    /// `PLANE SPATIAL|EULER|VECTOR|RELATIV|RESET …`.
+    Plane,
+    /// `FUNCTION TCPM …`.
+    Tcpm,
+    /// `FN k: …` (Q-parameter arithmetic; `FN 9`–`FN 12` jumps are the runner's).
+    Fn,
+    /// `RND R…` / `CHF …` between two straight lines (`true`: chamfer).
+    Corner(bool),
 }
 
 /// Sinumerik programmable frame instructions.
@@ -261,6 +355,10 @@ pub enum Subprograms {
     /// Sinumerik: `PROC NAME` (or a `%_N_NAME_SPF` header) … `RET`/`M17` after the main
     /// program, called by name (`NAME`, `L123`).
     Procs,
+    /// Heidenhain: labels `LBL n` / `LBL "NAME"` in the one program; `CALL LBL n` runs from
+    /// the label to `LBL 0` and returns, `CALL LBL n REP m` repeats the section between the
+    /// label and the call m more times; `FN 9`–`FN 12` jump to a label.
+    Labels,
 }
 
 /// Numbers without a decimal point count least input increments (Fanuc's default).
@@ -847,6 +945,250 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     g94_clears_feed: false,
     integer_increments: None,
     subprograms: Subprograms::Procs,
+};
+
+/// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
+/// `LP` and the statements (`TOOL CALL`, `CYCL DEF`, `PLANE`, …) are keywords; the words
+/// after them are letters (`X+10`, `F500`, `M3`, `R+5`) and named words (`IX-5`, `DR+`,
+/// `TX+0.7`). There are no G codes. See [`super::klartext`] for what each does.
+pub static HEIDENHAIN: DialectSpec = DialectSpec {
+    name: "Heidenhain",
+    paren_comments: false,
+    semicolon: Semicolon::Comment,
+    spaces: Spaces::Klartext,
+    letters: &[
+        ('X', Axis(0)),
+        ('Y', Axis(1)),
+        ('Z', Axis(2)),
+        ('A', Axis(3)),
+        ('B', Axis(4)),
+        ('C', Axis(5)),
+        ('R', Address::Radius),
+        ('F', Address::Feed),
+        ('M', Address::M),
+        ('S', Address::Ignored),
+    ],
+    named: &[
+        ("IX", Address::IncrementalAxis(0)),
+        ("IY", Address::IncrementalAxis(1)),
+        ("IZ", Address::IncrementalAxis(2)),
+        ("IA", Address::IncrementalAxis(3)),
+        ("IB", Address::IncrementalAxis(4)),
+        ("IC", Address::IncrementalAxis(5)),
+        ("TX", Address::ToolVector(0)),
+        ("TY", Address::ToolVector(1)),
+        ("TZ", Address::ToolVector(2)),
+        // LN surface normals: only 3D radius compensation (a DR2 delta) reads them.
+        ("NX", Address::Ignored),
+        ("NY", Address::Ignored),
+        ("NZ", Address::Ignored),
+        ("DR", Address::ArcDirection),
+        ("PA", Address::PolarAngle(false)),
+        ("IPA", Address::PolarAngle(true)),
+        ("PR", Address::PolarRadius(false)),
+        ("IPR", Address::PolarRadius(true)),
+        ("MB", Address::Retract),
+        ("LA", Address::Ignored),
+        ("LR", Address::Ignored),
+        (
+            "FU",
+            Address::Unsupported("feed per revolution (FU) is not supported: program F in mm/min"),
+        ),
+        (
+            "FZ",
+            Address::Unsupported("feed per tooth (FZ) is not supported: program F in mm/min"),
+        ),
+    ],
+    g_codes: &[],
+    m_codes: &[
+        ("0", Action::Ignored),
+        ("1", Action::Ignored),
+        ("2", ProgramEnd),
+        ("3..9", Action::Ignored),
+        ("13", Action::Ignored),
+        ("14", Action::Ignored),
+        ("19", Action::Ignored),
+        ("30", ProgramEnd),
+        ("89", Action::CycleCallAt(false)),
+        ("91", MachineCoordinates),
+        (
+            "92",
+            Unsup(
+                "M92 (coordinates from the machine builder's second datum) is not supported: \
+                 that datum is machine data; post the move with M91 or in program coordinates",
+            ),
+        ),
+        (
+            "94",
+            Unsup(
+                "M94 (rotary display reduced below 360°) is not supported: post the program \
+                 without it",
+            ),
+        ),
+        ("99", Action::CycleCallAt(true)),
+        ("101", Action::Ignored),
+        ("102", Action::Ignored),
+        (
+            "103",
+            Note("M103 (reduced plunging feed) is not modelled: F is used as programmed"),
+        ),
+        ("104", Action::Ignored),
+        ("105..108", Action::Ignored),
+        (
+            "109..111",
+            Note(
+                "M109–M111 (feed at the cutting edge on arcs) are not modelled: F is used as programmed",
+            ),
+        ),
+        (
+            "114",
+            Unsup("M114 (the old tilted-axis compensation) is not supported: post with M128"),
+        ),
+        ("115", Action::Tcp(Tcp::Off)),
+        (
+            "116",
+            Note(
+                "M116 (rotary feed in mm/min) is not modelled: F on a rotary-only block is read as °/min",
+            ),
+        ),
+        ("117", Action::Ignored),
+        ("118", Action::Ignored),
+        ("120", Action::Ignored),
+        ("126", Action::RotaryShortestPath(true)),
+        ("127", Action::RotaryShortestPath(false)),
+        ("128", Action::Tcp(Tcp::On)),
+        ("129", Action::Tcp(Tcp::Off)),
+        (
+            "130",
+            Unsup(
+                "M130 (untilted coordinates in a tilted plane) is not supported: post the move \
+                 in the tilted plane's coordinates",
+            ),
+        ),
+        ("134", Action::Ignored),
+        ("135", Action::Ignored),
+        ("136", Unsup(PER_REV)),
+        ("137", Action::Ignored),
+        ("138", Action::Ignored),
+        ("140", Action::RetractToolAxis),
+        ("141..145", Action::Ignored),
+        ("148..150", Action::Ignored),
+        ("197", Action::Ignored),
+    ],
+    keywords: &[
+        ("L", Mo(Motion::Linear)),
+        ("LN", Mo(Motion::Linear)),
+        ("C", Action::Path(PathKind::PoleArc)),
+        ("CC", Action::Path(PathKind::Centre)),
+        ("CR", Action::Path(PathKind::RadiusArc)),
+        ("CT", Action::Path(PathKind::TangentArc)),
+        ("CP", Action::Path(PathKind::PolarArc)),
+        ("LP", Action::Path(PathKind::PolarLine)),
+        ("FMAX", Action::RapidBlock),
+        ("FAUTO", Action::ToolCallFeed),
+        ("R0", Action::Ignored),
+        ("RL", Note(COMP)),
+        ("RR", Note(COMP)),
+        (
+            "R+",
+            Unsup(
+                "paraxial radius compensation (R+/R-: the move lengthened or shortened by the \
+                 tool radius) is not supported: post the tool-centre path with R0",
+            ),
+        ),
+        (
+            "R-",
+            Unsup(
+                "paraxial radius compensation (R+/R-: the move lengthened or shortened by the \
+                 tool radius) is not supported: post the tool-centre path with R0",
+            ),
+        ),
+        ("MB MAX", Action::RetractMax),
+        ("RND", Action::Statement(Statement::Corner(false))),
+        ("CHF", Action::Statement(Statement::Corner(true))),
+        (
+            "APPR",
+            Unsup("approach functions (APPR) are not supported: post the approach as L/C blocks"),
+        ),
+        (
+            "DEP",
+            Unsup("departure functions (DEP) are not supported: post the departure as L/C blocks"),
+        ),
+        (
+            "FPOL",
+            Unsup("FK free contour programming is not supported: post the contour as L/C blocks"),
+        ),
+        (
+            "FL",
+            Unsup("FK free contour programming is not supported: post the contour as L/C blocks"),
+        ),
+        (
+            "FC",
+            Unsup("FK free contour programming is not supported: post the contour as L/C blocks"),
+        ),
+        (
+            "FLT",
+            Unsup("FK free contour programming is not supported: post the contour as L/C blocks"),
+        ),
+        (
+            "FCT",
+            Unsup("FK free contour programming is not supported: post the contour as L/C blocks"),
+        ),
+        ("SPL", Unsup(SPLINES)),
+        ("BEGIN PGM", Action::Statement(Statement::ProgramBegin)),
+        ("END PGM", ProgramEnd),
+        ("BLK FORM", Action::Ignored),
+        ("TOOL CALL", Action::Statement(Statement::ToolCall)),
+        ("TOOL DEF", Action::Ignored),
+        ("CYCL DEF", Action::Statement(Statement::CycleDef)),
+        ("CYCL CALL", Action::Statement(Statement::CycleCall)),
+        ("PATTERN DEF", Action::Statement(Statement::PatternDef)),
+        (
+            "SEL PATTERN",
+            Unsup(
+                "point tables (SEL PATTERN) are not supported: they are another file; post the \
+                 holes as positions or a PATTERN DEF",
+            ),
+        ),
+        ("PLANE", Action::Statement(Statement::Plane)),
+        ("FUNCTION TCPM", Action::Statement(Statement::Tcpm)),
+        ("FUNCTION RESET TCPM", Action::Tcp(Tcp::Off)),
+        (
+            "FUNCTION",
+            Unsup("this FUNCTION is not supported (FUNCTION TCPM and FUNCTION RESET TCPM are)"),
+        ),
+        ("FN", Action::Statement(Statement::Fn)),
+        ("STOP", Action::Ignored),
+        (
+            "TCH PROBE",
+            Unsup("probing cycles (TCH PROBE) are not supported: they move until a contact"),
+        ),
+        (
+            "CALL PGM",
+            Unsup(
+                "calls of other programs (CALL PGM) are not supported: feedopt reads one file; \
+                 post the program with its subprograms as LBL sections",
+            ),
+        ),
+        (
+            "SEL PGM",
+            Unsup("SEL PGM (another program file) is not supported: feedopt reads one file"),
+        ),
+        (
+            "SEL CYCLE",
+            Unsup("SEL CYCLE (a cycle in another file) is not supported: feedopt reads one file"),
+        ),
+        ("SEL TABLE", Action::Ignored),
+        ("SEL CORR-TABLE", Action::Ignored),
+        (
+            "DECLARE",
+            Unsup("string parameters (DECLARE STRING) are not supported"),
+        ),
+    ],
+    initial_motion: None,
+    g94_clears_feed: false,
+    integer_increments: None,
+    subprograms: Subprograms::Labels,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

@@ -5,6 +5,8 @@
 //!   `=` in any address: `Z=_Z_HOME`, `X=R1*2`, `X=(R1+1)/2`.
 //! * Fanuc and LinuxCNC: numbered parameters `#100` (`#[expr]`), LinuxCNC named parameters
 //!   `#<name>`, assignments `#100=5.`, values `X#100`, `X-#100`, `X[#1+2]`; brackets group.
+//! * Heidenhain: Q parameters `Q1`, `QL1`, `QR1` (`Q1 = Q2 + 5`, `X+Q1`; see
+//!   [`super::klartext`]), unset until assigned.
 //!
 //! Operators `+ - * /` with the usual precedence, unary minus, parentheses (Sinumerik) or
 //! brackets (Fanuc, LinuxCNC), and the functions `SIN COS TAN` (degrees), `SQRT ABS ATAN`
@@ -38,10 +40,23 @@ impl Variables {
     }
 
     /// Whether `name` is a variable an assignment may set: a declared name, an R parameter
-    /// (`R` and digits), a Fanuc `#n` or LinuxCNC `#<name>`.
+    /// (`R` and digits), a Fanuc `#n`, a LinuxCNC `#<name>` or a Heidenhain Q parameter.
     pub fn assignable(&self, name: &str) -> bool {
         let name = name.to_ascii_uppercase();
-        self.declared.contains_key(&name) || is_r_parameter(&name) || name.starts_with('#')
+        self.declared.contains_key(&name)
+            || is_r_parameter(&name)
+            || name.starts_with('#')
+            || is_q_parameter(&name)
+    }
+
+    /// The value of `name`, if it has one.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.values.get(&name.to_ascii_uppercase()).copied()
+    }
+
+    /// Whether `name` has a value (assigned, or declared).
+    pub fn is_set(&self, name: &str) -> bool {
+        self.values.contains_key(&name.to_ascii_uppercase())
     }
 
     pub fn set(&mut self, name: &str, value: f64) {
@@ -56,7 +71,7 @@ impl Variables {
         if is_r_parameter(&name) {
             return Ok(0.0); // Sinumerik R parameters start at 0
         }
-        Err(if name.starts_with('#') {
+        Err(if name.starts_with('#') || is_q_parameter(&name) {
             format!("parameter `{name}` is read before it is set")
         } else {
             format!("`{name}` is not a number nor a variable the program defines (DEF)")
@@ -71,6 +86,16 @@ pub fn is_r_parameter(name: &str) -> bool {
         && upper.len() <= 4
         && upper.starts_with('R')
         && upper[1..].chars().all(|c| c.is_ascii_digit())
+}
+
+/// `Q`, `QL` or `QR` followed by digits (Heidenhain Q parameters).
+pub fn is_q_parameter(name: &str) -> bool {
+    let u = name.to_ascii_uppercase();
+    let digits = u
+        .strip_prefix("QL")
+        .or_else(|| u.strip_prefix("QR"))
+        .or_else(|| u.strip_prefix('Q'));
+    digits.is_some_and(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()))
 }
 
 /// Evaluates `text` with `vars`.

@@ -3,6 +3,9 @@
 use nalgebra::Vector3;
 use std::path::Path;
 
+mod heidenhain;
+pub(super) use heidenhain::KlartextWords;
+
 use super::cycles::{self, Step};
 use super::dialect::*;
 use super::expr::Variables;
@@ -10,7 +13,9 @@ use super::frames::{self, Frame};
 use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
-use crate::toolpath::{ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning};
+use crate::toolpath::{
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning,
+};
 
 /// The words of one block, sorted by meaning.
 #[derive(Debug, Default)]
@@ -26,6 +31,32 @@ struct Block {
     letters: [Option<Num>; 26],
     /// Codes and keywords in the order written, with their text and `( … )` arguments.
     actions: Vec<(String, Action, Option<String>)>,
+    /// Klartext: the axis word is incremental (`IX+5`, this word only).
+    incremental: [bool; 6],
+    /// Klartext `DR±`: +1 counter-clockwise, −1 clockwise.
+    direction: Option<f64>,
+    /// Klartext `PA`/`IPA` (degrees) and `PR`/`IPR` (mm), `true` when incremental.
+    polar_angle: Option<(f64, bool)>,
+    polar_radius: Option<(f64, bool)>,
+    /// Klartext `MB`: the retract distance, mm.
+    retract: Option<f64>,
+    /// Klartext `A+Q120`, `B+Q121`, `C+Q122`: the rotary axis goes to the active PLANE's
+    /// solution.
+    plane_rotary: [bool; 3],
+    /// Set by the interpreter for Klartext arcs: the arc's plane (else the modal plane), its
+    /// centre (else R or I J K) and its signed sweep, radians (else from the end point).
+    arc_plane: Option<Plane>,
+    arc_centre: Option<ArcCentre>,
+    arc_sweep: Option<f64>,
+}
+
+/// Where a Klartext arc's centre comes from.
+#[derive(Debug, Clone, Copy)]
+enum ArcCentre {
+    /// The pole `CC`: the arc plane's first and second coordinate, program coordinates, mm.
+    At([f64; 2]),
+    /// `CT`: tangent to this unit direction (in the arc plane) at the start.
+    Tangent([f64; 2]),
 }
 
 impl Block {
@@ -128,6 +159,18 @@ pub(super) struct Interpreter<'a> {
     pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
     dwells: Vec<Dwell>,
+    /// The tangent (plane, unit direction in its two axes) at the end of the last straight
+    /// line or arc, and the point count right after it (Klartext `CT` must follow directly).
+    tangent: Option<(Plane, [f64; 2], usize)>,
+    /// Klartext `M126`: rotary axes take the shorter way to an absolute position.
+    shortest_path: bool,
+    /// The Klartext state ([`heidenhain`]).
+    klartext: heidenhain::State,
+    /// What the reader assumed where the machine file is silent.
+    pub(super) assumed: Assumed,
+    /// Cycle aliases (`CYCLE76` read as `CYCLE86`), and those a warning has named.
+    pub(super) cycle_aliases: Vec<(String, String)>,
+    aliases_used: Vec<String>,
 }
 
 impl<'a> Interpreter<'a> {
@@ -169,6 +212,12 @@ impl<'a> Interpreter<'a> {
             points: Vec::new(),
             warnings: Vec::new(),
             dwells: Vec::new(),
+            tangent: None,
+            shortest_path: false,
+            klartext: heidenhain::State::default(),
+            assumed: Assumed::default(),
+            cycle_aliases: Vec::new(),
+            aliases_used: Vec::new(),
         }
     }
 
@@ -254,20 +303,35 @@ impl<'a> Interpreter<'a> {
             match address {
                 Address::Axis(i) => {
                     duplicate(block.axes[i].is_some())?;
-                    if let Some(m) = self.machine
-                        && !m.has_axis(AXIS_NAMES[i])
-                    {
-                        return Err(self.error(
-                            line,
-                            format!(
-                                "`{text}`: the machine ({}) has no {} axis; use a machine \
-                                 file with that axis or a program posted for this machine",
-                                m.file.display(),
-                                AXIS_NAMES[i]
-                            ),
-                        ));
-                    }
+                    self.check_axis(line, &text, i)?;
                     block.axes[i] = Some(num);
+                }
+                Address::IncrementalAxis(i) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.incremental[i] = true;
+                }
+                Address::PlaneRotary(i) => {
+                    duplicate(block.axes[3 + i].is_some() || block.plane_rotary[i])?;
+                    self.check_axis(line, &text, 3 + i)?;
+                    block.plane_rotary[i] = true;
+                }
+                Address::ArcDirection => {
+                    duplicate(block.direction.is_some())?;
+                    block.direction = Some(num.value);
+                }
+                Address::PolarAngle(incremental) => {
+                    duplicate(block.polar_angle.is_some())?;
+                    block.polar_angle = Some((num.value, incremental));
+                }
+                Address::PolarRadius(incremental) => {
+                    duplicate(block.polar_radius.is_some())?;
+                    block.polar_radius = Some((num.value, incremental));
+                }
+                Address::Retract => {
+                    duplicate(block.retract.is_some())?;
+                    block.retract = Some(num.value);
                 }
                 Address::ArcCentre(i) => {
                     duplicate(block.centre[i].is_some())?;
@@ -341,6 +405,44 @@ impl<'a> Interpreter<'a> {
             self.set_call(line, name, block.letter('P'))?;
         }
         Ok(block)
+    }
+
+    /// A Sinumerik cycle as the read options alias it: the name to show and the number to
+    /// expand (a warning names each alias the first time it applies).
+    fn alias(&mut self, line: usize, text: &str, number: u32) -> (String, u32) {
+        let Some((_, to)) = self.cycle_aliases.iter().find(|(from, _)| from == text) else {
+            return (text.to_string(), number);
+        };
+        let to = to.clone();
+        let Some(n) = to.strip_prefix("CYCLE").and_then(|d| d.parse().ok()) else {
+            return (text.to_string(), number);
+        };
+        if !self.aliases_used.iter().any(|a| a == text) {
+            self.aliases_used.push(text.to_string());
+            self.warn(
+                line,
+                format!("{text} is read as {to}, as the cycle alias {text}={to} says"),
+            );
+        }
+        (format!("{text} (as {to})"), n)
+    }
+
+    /// An axis word for an axis the machine lacks is an error naming it.
+    fn check_axis(&self, line: usize, text: &str, i: usize) -> Result<()> {
+        if let Some(m) = self.machine
+            && !m.has_axis(AXIS_NAMES[i])
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}`: the machine ({}) has no {} axis; use a machine file with that \
+                     axis or a program posted for this machine",
+                    m.file.display(),
+                    AXIS_NAMES[i]
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Records a call of subprogram `name` repeated `count` times (P).
@@ -456,6 +558,7 @@ impl<'a> Interpreter<'a> {
         let mut sinumerik_cycle: Option<(String, u32, String)> = None;
         let mut modal_call = false;
         let mut tilted_plane = false;
+        let mut klartext = KlartextWords::default();
         for (text, action, args) in &block.actions {
             match *action {
                 Action::FeedMode(mode) => {
@@ -543,7 +646,8 @@ impl<'a> Interpreter<'a> {
                 Action::TiltedPlaneCancel => self.swivel = None,
                 Action::ModalCall => modal_call = true,
                 Action::SinumerikCycle(n) => {
-                    sinumerik_cycle = Some((text.clone(), n, args.clone().unwrap_or_default()));
+                    let (text, n) = self.alias(line, text, n);
+                    sinumerik_cycle = Some((text, n, args.clone().unwrap_or_default()));
                 }
                 Action::NoMotion(message) => {
                     no_motion = Some(message);
@@ -555,6 +659,16 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::Return => end = true,
                 Action::Call => fanuc_call = true,
+                Action::Path(kind) => klartext.path = Some((text.clone(), kind)),
+                Action::Statement(st) => {
+                    klartext.statement = Some((text.clone(), st, args.clone().unwrap_or_default()));
+                }
+                Action::RapidBlock => klartext.rapid = true,
+                Action::ToolCallFeed => klartext.tool_feed = true,
+                Action::CycleCallAt(now) => klartext.cycle_call = Some(now),
+                Action::RotaryShortestPath(on) => self.shortest_path = on,
+                Action::RetractToolAxis => klartext.retract = true,
+                Action::RetractMax => klartext.retract_max = true,
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -587,6 +701,11 @@ impl<'a> Interpreter<'a> {
         if let Some((_, m)) = motion_code {
             self.motion = Some(m);
         }
+        if self.spec.spaces == Spaces::Klartext {
+            return self
+                .klartext_block(line, block, klartext, machine)
+                .map(|()| self.end_if(end));
+        }
 
         if dwell {
             return self.dwell(line, &block).map(|()| self.end_if(end));
@@ -606,6 +725,12 @@ impl<'a> Interpreter<'a> {
             let args = self.arguments(line, &args)?;
             let args = self.sinumerik_cycle_units(number, args);
             if modal_call {
+                if matches!(number, 76 | 77) {
+                    // Spigot milling: an error where the program calls it, not at the first
+                    // position after it.
+                    cycles::sinumerik_steps(number, &args)
+                        .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
+                }
                 self.mcall = Some(ModalCall { number, args });
             } else {
                 self.run_sinumerik_cycle(line, &text, number, &args)?;
@@ -756,7 +881,8 @@ impl<'a> Interpreter<'a> {
 
     /// `G28`/`G30` (k = 1, 2; `G30 P3`: 3): via the intermediate point the axis words give
     /// (program coordinates, absolute or incremental), to the reference point of the same
-    /// axes (machine coordinates from the machine file). Both moves are rapids.
+    /// axes (machine coordinates from the machine file; where it gives none, machine zero,
+    /// with a warning and [`Assumed::reference_at_machine_zero`]). Both moves are rapids.
     fn reference(&mut self, line: usize, k: u8, block: &Block) -> Result<()> {
         let k = match (k, block.letter('P')) {
             (2, Some(p)) if (2.0..=4.0).contains(&p.value) && p.value.fract() == 0.0 => {
@@ -795,33 +921,57 @@ impl<'a> Interpreter<'a> {
         }
         let mut target = via;
         let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
+        let mut defaulted = Vec::new();
         for &i in &named {
-            let Some(r) = self
+            // The machine file's reference, else machine zero: the controls' default (Fanuc
+            // parameters 1240–1243, LinuxCNC 5161–5169 / 5181–5189 are 0 in machine
+            // coordinates, and Fanuc's machine zero is the reference position).
+            let r = match self
                 .machine
                 .and_then(|m| m.reference[i].get(k - 1).copied())
-            else {
-                let file = self.machine.map_or("the machine file".to_string(), |m| {
-                    m.file.display().to_string()
-                });
-                let which = if k == 1 {
-                    "`\"reference\": <position>`".to_string()
-                } else {
-                    format!("a list `\"reference\": [<G28 position>, …]` with {k} entries")
-                };
-                return Err(self.error(
-                    line,
-                    format!(
-                        "{code} moves {} to its reference point, which {file} does not give: \
-                         add {which} to axes.{} (machine coordinates, mm or °)",
-                        AXIS_NAMES[i], AXIS_NAMES[i]
-                    ),
-                ));
+            {
+                Some(r) => r,
+                None => {
+                    if !self.assumed.reference_at_machine_zero[i] {
+                        self.assumed.reference_at_machine_zero[i] = true;
+                        defaulted.push(AXIS_NAMES[i]);
+                    }
+                    0.0
+                }
             };
             if i < 3 {
                 machine_xyz[i] = r;
             } else {
                 target[i] = r;
             }
+        }
+        if !defaulted.is_empty() {
+            let file = self.machine.map_or("the machine file".to_string(), |m| {
+                m.file.display().to_string()
+            });
+            let fields: Vec<String> = defaulted
+                .iter()
+                .map(|a| format!("axes.{a}.reference"))
+                .collect();
+            let which = if k == 1 {
+                String::new()
+            } else {
+                format!(" to a list [<G28 position>, <G30 position>, …] of {k} entries")
+            };
+            self.warn(
+                line,
+                format!(
+                    "{code}: {file} gives no reference point for {}: machine zero (machine \
+                     coordinate 0, the controls' default) is used; to use another, set {}{which} \
+                     (machine coordinates, mm or °)",
+                    defaulted
+                        .iter()
+                        .map(|a| a.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    fields.join(", ")
+                ),
+            );
         }
         let xyz = self.machine_to_program(machine_xyz);
         target[..3].copy_from_slice(xyz.as_slice());
@@ -1077,7 +1227,18 @@ impl<'a> Interpreter<'a> {
         };
         let is_arc = matches!(motion, Motion::ArcCw | Motion::ArcCcw);
         if machine && is_arc {
-            return Err(self.error(line, "G53/SUPA (machine coordinates) with an arc"));
+            return Err(self.error(line, "G53/SUPA/M91 (machine coordinates) with an arc"));
+        }
+        if block.plane_rotary.iter().any(|&q| q) {
+            if self.swivel.is_none() {
+                return Err(self.error(
+                    line,
+                    "Q120–Q122 hold the rotary positions the control computes for a PLANE, but \
+                     no PLANE is active: program PLANE SPATIAL (or the rotary positions) first",
+                ));
+            }
+            // The tilted plane's tool vector rules: the rotary axes go where it points.
+            self.saw_rotary = true;
         }
 
         let start = self.pos;
@@ -1106,8 +1267,16 @@ impl<'a> Interpreter<'a> {
                 self.known[i] = true;
                 continue;
             }
-            let incremental = self.distance == Distance::Incremental && !machine;
-            end[i] = if incremental { start[i] + value } else { value };
+            let incremental =
+                (self.distance == Distance::Incremental || block.incremental[i]) && !machine;
+            end[i] = if incremental {
+                start[i] + value
+            } else if i >= 3 && self.shortest_path {
+                // Klartext M126: the shorter way to the absolute position.
+                start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
+            } else {
+                value
+            };
             if i < 3 && !incremental {
                 self.known[i] = true;
             }
@@ -1120,7 +1289,7 @@ impl<'a> Interpreter<'a> {
             self.warn(
                 line,
                 format!(
-                    "G53/SUPA: machine-coordinate move, taken as program coordinates + the \
+                    "G53/SUPA/M91: machine-coordinate move, taken as program coordinates + the \
                      work offset ({}, {}, {}) mm",
                     offset[0], offset[1], offset[2]
                 ),
@@ -1128,24 +1297,7 @@ impl<'a> Interpreter<'a> {
             let p = self.machine_to_program(machine_xyz);
             end[..3].copy_from_slice(p.as_slice());
         }
-        let unknown: Vec<String> = (0..3)
-            .filter(|&i| !self.known[i] && !self.unknown_warned[i])
-            .map(|i| AXIS_NAMES[i].to_string())
-            .collect();
-        if !unknown.is_empty() {
-            for i in 0..3 {
-                if !self.known[i] {
-                    self.unknown_warned[i] = true;
-                }
-            }
-            self.warn(
-                line,
-                format!(
-                    "{} not programmed yet: taken as 0 (the start position is unknown)",
-                    unknown.join(", ")
-                ),
-            );
-        }
+        self.warn_unknown(line);
 
         // Tool vector: Sinumerik-style words, or I J K on G0/G1 under Fanuc G43.5.
         let vector_words: [Option<f64>; 3] = if self.tcp == Tcp::OnIjkVector && !is_arc {
@@ -1187,6 +1339,7 @@ impl<'a> Interpreter<'a> {
 
         if self.tcp == Tcp::Off
             && !self.non_tcp_warned
+            && !block.plane_rotary.iter().any(|&q| q)
             && (end[3..] != [0.0; 3]
                 || block.axes[3..].iter().any(Option::is_some)
                 || vector_words.iter().any(Option::is_some))
@@ -1199,18 +1352,61 @@ impl<'a> Interpreter<'a> {
             );
         }
 
+        if block.axes[3..].iter().any(Option::is_some) || block.plane_rotary.iter().any(|&q| q) {
+            // Klartext PLANE … STAY: the rotary axes are positioned now.
+            self.klartext.stay_orientation = None;
+        }
         if is_arc {
             self.arc(line, motion, block, start, end)?;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
             self.push(line, &end, feed);
+            let (a, b) = (end[0] - start[0], end[1] - start[1]);
+            let len = a.hypot(b);
+            self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
+                .then(|| (Plane::Xy, [a / len, b / len], self.points.len()));
         }
         self.pos = end;
         Ok(())
     }
 
+    /// Warns once per axis that X, Y or Z is used before the program set it.
+    fn warn_unknown(&mut self, line: usize) {
+        let unknown: Vec<String> = (0..3)
+            .filter(|&i| !self.known[i] && !self.unknown_warned[i])
+            .map(|i| AXIS_NAMES[i].to_string())
+            .collect();
+        if !unknown.is_empty() {
+            for i in 0..3 {
+                if !self.known[i] {
+                    self.unknown_warned[i] = true;
+                }
+            }
+            self.warn(
+                line,
+                format!(
+                    "{} not programmed yet: taken as 0 (the start position is unknown)",
+                    unknown.join(", ")
+                ),
+            );
+        }
+    }
+
     fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
         let frame = self.frame_now();
+        if let Some(o) = self.klartext.stay_orientation {
+            // Klartext PLANE … STAY: the rotary axes have not moved yet; the tool keeps the
+            // orientation it had (workpiece coordinates).
+            let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
+            self.points.push(ClPoint {
+                p,
+                o,
+                feed,
+                rotary: None,
+                line,
+            });
+            return;
+        }
         let (p, o, rotary) = if frame.is_identity() {
             (
                 Vector3::new(q[0], q[1], q[2]),
@@ -1290,8 +1486,9 @@ impl<'a> Interpreter<'a> {
         start: [f64; 6],
         end: [f64; 6],
     ) -> Result<()> {
-        let (a, b, n) = self.plane.axes();
-        let plane = self.plane.code();
+        let arc_plane = block.arc_plane.unwrap_or(self.plane);
+        let (a, b, n) = arc_plane.axes();
+        let plane = arc_plane.code();
         let centre_names = ['I', 'J', 'K'];
         if block.centre[n].is_some() {
             self.warn(
@@ -1302,13 +1499,31 @@ impl<'a> Interpreter<'a> {
                 ),
             );
         }
-        let ccw = motion == Motion::ArcCcw;
+        let mut ccw = motion == Motion::ArcCcw;
         let (s0, s1) = (start[a], start[b]);
         let (e0, e1) = (end[a], end[b]);
         let chord = (e0 - s0).hypot(e1 - s1);
         let in_plane = block.centre[a].is_some() || block.centre[b].is_some();
 
-        let (c0, c1) = if let Some(r) = block.radius {
+        let (c0, c1) = if let Some(ArcCentre::At(c)) = block.arc_centre {
+            (c[0], c[1])
+        } else if let Some(ArcCentre::Tangent(t)) = block.arc_centre {
+            // Klartext CT: the circle through start and end tangent to t at the start; its
+            // centre lies on the start's normal n at s = |d|² / (2 n·d), d = end − start.
+            let (d0, d1) = (e0 - s0, e1 - s1);
+            let (n0, n1) = (-t[1], t[0]);
+            let nd = n0 * d0 + n1 * d1;
+            if chord < FULL_CIRCLE_MM || nd.abs() <= 1e-9 * chord.max(1.0) {
+                return Err(self.error(
+                    line,
+                    "CT: the end point lies on the tangent of the contour before it, so the \
+                     tangential arc is a straight line: program L",
+                ));
+            }
+            let s = (d0 * d0 + d1 * d1) / (2.0 * nd);
+            ccw = s > 0.0;
+            (s0 + s * n0, s1 + s * n1)
+        } else if let Some(r) = block.radius {
             if in_plane {
                 return Err(self.error(line, "an arc with both R and I/J/K"));
             }
@@ -1378,7 +1593,10 @@ impl<'a> Interpreter<'a> {
         let theta_s = (s1 - c1).atan2(s0 - c0);
         let theta_e = (e1 - c1).atan2(e0 - c0);
         let tau = std::f64::consts::TAU;
-        let mut sweep = if chord < FULL_CIRCLE_MM {
+        let mut sweep = if let Some(sweep) = block.arc_sweep {
+            // Klartext CP: the signed sweep as programmed (turns included).
+            sweep.abs()
+        } else if chord < FULL_CIRCLE_MM {
             tau
         } else if ccw {
             (theta_e - theta_s).rem_euclid(tau)
@@ -1412,6 +1630,9 @@ impl<'a> Interpreter<'a> {
 
         let r_max = r_start.max(r_end);
         let chords = crate::toolpath::arc_chords(sweep, r_max).map_err(|e| self.error(line, e))?;
+        let phi_end = theta_s + sweep;
+        let turn = sweep.signum();
+        let tangent = [-phi_end.sin() * turn, phi_end.cos() * turn];
         let mut qs = Vec::with_capacity(chords);
         for k in 1..=chords {
             if k == chords {
@@ -1464,6 +1685,7 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
+        self.tangent = Some((arc_plane, tangent, self.points.len()));
         Ok(())
     }
 }

@@ -11,6 +11,14 @@ pub(super) fn split_blocks(
     spec: &DialectSpec,
     line: &str,
 ) -> std::result::Result<Vec<String>, String> {
+    // A Klartext structure comment (`12 * - 1/2" DRILL`) is all comment, quotes included.
+    if spec.spaces == Spaces::Klartext
+        && super::klartext::strip_block_number(line)
+            .trim_start()
+            .starts_with('*')
+    {
+        return Ok(vec![String::new()]);
+    }
     let mut blocks = Vec::new();
     let mut current = String::new();
     let mut chars = line.chars();
@@ -289,6 +297,7 @@ pub(super) fn lex(
 ) -> std::result::Result<Vec<Item>, String> {
     let mut items = Vec::new();
     match spec.spaces {
+        Spaces::Klartext => return super::klartext::lex(spec, block, vars),
         Spaces::Ignored => {
             let compact: String = block.chars().filter(|c| !c.is_whitespace()).collect();
             lex_letters(spec, &compact, vars, &mut items)?;

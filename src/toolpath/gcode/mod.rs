@@ -24,6 +24,13 @@
 //!   may be keywords (`TRAORI`, `MSG("…")`) or `NAME=value`; TCP on `TRAORI`, off `TRAFOOF`;
 //!   tool vector `A3= B3= C3=`; `CR=` radius, `TURN=` extra turns; `G70`/`G71` inch/mm for
 //!   geometry only, `G700`/`G710` for F too; the motion mode starts as G0.
+//! * [`HEIDENHAIN`]: TNC 640 Klartext, not G-code: a block number and a statement whose first
+//!   word says what it is (`L X+10 FMAX`, `CC`, `C … DR+`, `CYCL DEF 200`, `PLANE SPATIAL`).
+//!   Its own lexer ([`klartext`]) turns each block into the words this interpreter reads, and
+//!   the table holds the path functions, statements, named words and M functions; what they
+//!   do is described in [`klartext`] and the interpreter's Klartext part. Subprograms are
+//!   labels ([`Subprograms::Labels`]). TCP on `M128` / `FUNCTION TCPM`, off `M129` /
+//!   `FUNCTION RESET TCPM`; tool vector `TX TY TZ` on `LN` blocks.
 //!
 //! # What is read
 //!
@@ -75,7 +82,11 @@
 //!   ([`MachineContext::work_offset`]; zero without a machine), with a warning saying so.
 //! * **G28/G30** (`G91 G28 Z0`, `G28 X0 Y0 B0`, `G30 P3 …`): a rapid to the intermediate point
 //!   the words give, then a rapid of the named axes to their reference point, read from the
-//!   machine file's `reference` (an error naming `axes.Z.reference` when it is missing).
+//!   machine file's `reference`. Where the file gives none, machine zero (machine coordinate
+//!   0): the controls' default (Fanuc parameters 1240–1243 and LinuxCNC 5161–5169 /
+//!   5181–5189 are 0, and Fanuc's machine zero is set at the reference position), with a
+//!   warning naming `axes.Z.reference` and [`Assumed::reference_at_machine_zero`] (the
+//!   summary's `reference` line and `--json` field).
 //! * **Canned cycles and dwells**: see [`cycles`]; `G4` (P seconds on LinuxCNC, P ms or X
 //!   seconds on Fanuc, F seconds on Sinumerik) and every cycle dwell become
 //!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
@@ -112,7 +123,7 @@
 //! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
 //!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
 //!   [`Warning`] naming the word and its line, never silently.
-//! * Errors ([`Error::Parse`](crate::error::Error::Parse) naming the file and line): a malformed number (`X1.2.3`, `Y-`,
+//! * Errors ([`crate::error::Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
 //!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
@@ -126,6 +137,7 @@ mod dialect;
 pub mod expr;
 pub mod frames;
 mod interp;
+pub mod klartext;
 mod lexer;
 pub mod subprograms;
 
@@ -133,9 +145,9 @@ use std::path::Path;
 
 use crate::error::Result;
 pub use crate::toolpath::Units;
+use crate::toolpath::{Assumed, MachineContext, Toolpath};
 #[allow(unused_imports)] // named by the module docs
 use crate::toolpath::{ClPoint, Feed, Warning};
-use crate::toolpath::{MachineContext, Toolpath};
 pub use dialect::*;
 use interp::Interpreter;
 pub use interp::{MAX_ARC_CHORDS, MAX_COORDINATE_MM};
@@ -165,8 +177,8 @@ pub const R_ARC_TOLERANCE_MM: f64 = 0.00127;
 /// An I J K arc whose end is this close to its start (in the plane, mm) is a full circle.
 const FULL_CIRCLE_MM: f64 = 1e-9;
 
-/// File extensions read as G-code.
-pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap"];
+/// File extensions read as G-code (Heidenhain Klartext: `.h`).
+pub const EXTENSIONS: &[&str] = &["ngc", "nc", "gcode", "tap", "h"];
 
 // ---------------------------------------------------------------------------------------------
 // Entry points
@@ -198,18 +210,70 @@ pub fn parse_for(
     spec: &DialectSpec,
     machine: Option<&MachineContext>,
 ) -> Result<Toolpath> {
+    parse_assumed(source, text, spec, machine, &[]).map(|(toolpath, _)| toolpath)
+}
+
+/// A cycle alias `FROM=TO` (`CYCLE76=CYCLE86`): a Sinumerik cycle a machine builder or a post
+/// names `FROM`, read as the standard cycle `TO` (one feedopt expands: `CYCLE81`–`CYCLE89`).
+/// For machines whose own cycle works like a standard one; the reader warns where it applies
+/// one. Names are case-insensitive; an alias that is not two such names is an error saying
+/// what to write.
+pub fn parse_cycle_alias(text: &str) -> Result<(String, String)> {
+    let bad = |why: &str| {
+        crate::error::Error::Usage(format!(
+            "cycle alias `{text}`: {why}; write FROM=TO with Sinumerik cycle names, e.g. \
+             CYCLE76=CYCLE86"
+        ))
+    };
+    let (from, to) = text.split_once('=').ok_or_else(|| bad("no `=`"))?;
+    let name = |s: &str| -> Option<(String, u32)> {
+        let upper = s.trim().to_ascii_uppercase();
+        let n: u32 = upper.strip_prefix("CYCLE")?.parse().ok()?;
+        Some((upper, n))
+    };
+    let (from, _) = name(from).ok_or_else(|| bad("the name before `=` is not CYCLE<number>"))?;
+    let (to, n) = name(to).ok_or_else(|| bad("the name after `=` is not CYCLE<number>"))?;
+    if !(81..=89).contains(&n) {
+        return Err(bad(&format!(
+            "{to} is not a cycle feedopt expands (CYCLE81–CYCLE89)"
+        )));
+    }
+    if from == to {
+        return Err(bad("a cycle cannot be its own alias"));
+    }
+    Ok((from, to))
+}
+
+/// As [`parse_for`], with cycle aliases ([`parse_cycle_alias`]: a cycle called by the first
+/// name is read as the second), and what the reader assumed where the machine file is silent
+/// (each assumption is also a warning with its line).
+pub fn parse_assumed(
+    source: &Path,
+    text: &str,
+    spec: &DialectSpec,
+    machine: Option<&MachineContext>,
+    cycle_aliases: &[(String, String)],
+) -> Result<(Toolpath, Assumed)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let program = Program::scan(spec, source, text)?;
     let mut interp = Interpreter::new(spec, source, machine);
     interp.procs = program.proc_names();
+    interp.cycle_aliases = cycle_aliases.to_vec();
     program.run(spec, &mut interp, source)?;
-    interp.finish(program.last_line())
+    let assumed = interp.assumed;
+    interp
+        .finish(program.last_line())
+        .map(|toolpath| (toolpath, assumed))
 }
 
-/// The dialect a program's text (upper-cased) shows, if any: Sinumerik (`TRAORI`, `TRAFOOF`,
-/// `MCALL`, `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`,
-/// `G68.2`, `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
+/// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
+/// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
+/// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
+/// `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
+    if is_klartext(upper) {
+        return Some(Dialect::Heidenhain);
+    }
     let has = |w: &str| upper.contains(w);
     let sinumerik = [
         "TRAORI", "TRAFOOF", "MCALL", "CYCLE8", "DEF REAL", "SUPA ", "G710", "G700", "MSG(",
@@ -233,4 +297,19 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
         (false, false, true) => Some(Dialect::LinuxCnc),
         _ => None,
     }
+}
+
+/// Whether a program's text (upper-cased) is Heidenhain Klartext: its first block (after
+/// blank and comment lines) is `BEGIN PGM`, with or without a block number.
+pub fn is_klartext(upper: &str) -> bool {
+    upper
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with(';') && !l.starts_with('%'))
+        .is_some_and(|l| {
+            klartext::strip_block_number(l)
+                .split_whitespace()
+                .take(2)
+                .eq(["BEGIN", "PGM"])
+        })
 }

@@ -20,6 +20,17 @@
 //!   anywhere in the file; those lines are not part of the main program. `o100 call` runs the
 //!   body once, `o100 return` returns early. Call arguments are not passed (a body that reads
 //!   `#1` is an error naming it); other O-words (`if`, `while`, …) are errors.
+//! * **Heidenhain** ([`Subprograms::Labels`]): one program with labels `LBL 5` / `LBL "NAME"`
+//!   (each defined once). `CALL LBL 5` runs from the label to `LBL 0` (or the end of the
+//!   program) and returns to the block after the call. `CALL LBL 5 REP m` with the label
+//!   before the call is a program-section repeat: the section from the label to the call,
+//!   which has run once already, runs m more times, then the program goes on after the call
+//!   (REP on a call of a label after it is an error: a repeat count belongs to a section
+//!   repeat). A main program that runs into a label or `LBL 0` goes on (the control does the
+//!   same: a subprogram before `M30` runs once). `FN 9: IF a EQU b GOTO LBL n` (`FN 10` `NE`,
+//!   `FN 11` `GT`, `FN 12` `LT`) jumps to the label when the condition holds. Every block run
+//!   counts towards [`MAX_EXPANDED_BLOCKS`] (past the file's own lines), so a jump loop is an
+//!   error, not a hang. A `~` at the end of a line continues the block on the next line.
 //!
 //! # How a call runs
 //!
@@ -37,6 +48,7 @@ use std::path::Path;
 
 use super::dialect::{DialectSpec, Subprograms};
 use super::interp::{Call, Interpreter};
+use super::klartext::{self, LabelOp};
 use super::lexer::{lex, split_blocks};
 use crate::error::{Error, Result};
 
@@ -66,10 +78,15 @@ struct Frame {
     /// Next line (index into the section's lines) and block within it.
     pos: usize,
     block: usize,
+    /// Where a run starts (0; for a Heidenhain label, the line after it).
+    start: usize,
     /// Runs still to make, this one included.
     runs: u64,
     /// The call as written and its line (none for the main program).
     call: Option<(String, usize)>,
+    /// A Heidenhain label call: the index of the calling line (a section repeat's pass ends
+    /// there) and the label's name.
+    label: Option<(usize, String)>,
 }
 
 /// A LinuxCNC O-word subroutine line: `o100 sub`, `o<name> call [..]`, …
@@ -184,6 +201,8 @@ pub(super) struct Program {
     lines: Vec<Line>,
     sections: Vec<Section>,
     by_name: HashMap<String, usize>,
+    /// Heidenhain labels: name → index of the label's line.
+    labels: HashMap<String, usize>,
     style: Subprograms,
 }
 
@@ -206,13 +225,76 @@ impl Program {
                 lines: Vec::new(),
             }],
             by_name: HashMap::new(),
+            labels: HashMap::new(),
             style: spec.subprograms,
         };
         match spec.subprograms {
             Subprograms::OWordSub => program.scan_owords(source)?,
             Subprograms::OPrograms | Subprograms::Procs => program.scan_headers(source)?,
+            Subprograms::Labels => {
+                program.join_continuations(text);
+                program.scan_labels(source)?;
+            }
         }
         Ok(program)
+    }
+
+    /// Klartext: a line ending in `~` continues on the next line (its block is joined to this
+    /// line's; the next line is left empty).
+    fn join_continuations(&mut self, text: &str) {
+        let raw: Vec<&str> = text.lines().collect();
+        let mut i = 0;
+        while i < self.lines.len() {
+            let mut j = i;
+            while j + 1 < self.lines.len()
+                && raw.get(j).is_some_and(|r| r.trim_end().ends_with('~'))
+            {
+                j += 1;
+                let next = std::mem::replace(&mut self.lines[j].blocks, Ok(Vec::new()));
+                let add = match next {
+                    Ok(b) => b.join(" "),
+                    Err(m) => {
+                        self.lines[i].blocks = Err(m);
+                        continue;
+                    }
+                };
+                if let Ok(blocks) = &mut self.lines[i].blocks {
+                    match blocks.last_mut() {
+                        Some(last) => {
+                            let trimmed = last.trim_end();
+                            let trimmed = trimmed.strip_suffix('~').unwrap_or(trimmed);
+                            *last = format!("{trimmed} {}", add.trim());
+                        }
+                        None => blocks.push(add),
+                    }
+                }
+            }
+            i = j + 1;
+        }
+    }
+
+    /// Heidenhain: one section with every line; labels are positions in it.
+    fn scan_labels(&mut self, source: &Path) -> Result<()> {
+        for i in 0..self.lines.len() {
+            self.sections[0].lines.push(i);
+            let number = self.lines[i].number;
+            let block = klartext::strip_block_number(self.first_block(i));
+            // Other label blocks, and malformed ones, are read when they run.
+            if let Ok(Some(LabelOp::Label(name))) = klartext::label_op(block) {
+                if let Some(&k) = self.labels.get(&name) {
+                    return Err(Error::parse(
+                        source,
+                        number,
+                        format!(
+                            "LBL {name} is defined twice (lines {} and {number}): rename one",
+                            self.lines[k].number
+                        ),
+                    ));
+                }
+                self.labels.insert(name, i);
+            }
+        }
+        Ok(())
     }
 
     /// The first block of line `i`, trimmed (empty when it has none or an unclosed comment).
@@ -362,10 +444,14 @@ impl Program {
             section: 0,
             pos: 0,
             block: 0,
+            start: 0,
             runs: 1,
             call: None,
+            label: None,
         }];
         let mut expanded = 0usize;
+        // Every block run: past the file's lines plus the expansion bound, a jump loops.
+        let mut run_blocks = 0usize;
         while let Some(&Frame {
             section,
             pos,
@@ -409,9 +495,82 @@ impl Program {
                     return Err(self.too_many(source, number, &stack));
                 }
             }
-            if text.starts_with('/') {
+            run_blocks += 1;
+            if run_blocks > MAX_EXPANDED_BLOCKS + self.lines.len() {
+                return Err(self.located(
+                    Error::parse(
+                        source,
+                        number,
+                        format!(
+                            "the program runs more than {} blocks: a jump (FN 9–12) that loops \
+                             for ever, or repeats too large to expand",
+                            MAX_EXPANDED_BLOCKS + self.lines.len()
+                        ),
+                    ),
+                    &stack,
+                ));
+            }
+            if text.starts_with('/')
+                || (self.style == Subprograms::Labels
+                    && klartext::strip_block_number(text).starts_with('/'))
+            {
                 interp.warn(number, "block delete `/`: block skipped");
                 continue;
+            }
+            if self.style == Subprograms::Labels {
+                let body = klartext::strip_block_number(text);
+                let op = klartext::label_op(body)
+                    .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+                match op {
+                    None => {}
+                    Some(LabelOp::Label(_)) => continue,
+                    Some(LabelOp::End) => {
+                        // In the main program, a subprogram's end is run through.
+                        if stack.len() > 1 && !self.ret(&mut stack) {
+                            return Ok(());
+                        }
+                        continue;
+                    }
+                    Some(LabelOp::Call { name, repeats }) => {
+                        let own = stack
+                            .last()
+                            .and_then(|f| f.label.as_ref())
+                            .is_some_and(|(at, _)| *at == pos);
+                        if own {
+                            // A section repeat's pass is over.
+                            if !self.ret(&mut stack) {
+                                return Ok(());
+                            }
+                        } else {
+                            self.enter_label(&mut stack, &name, repeats, pos, number, source)?;
+                        }
+                        continue;
+                    }
+                    Some(LabelOp::Jump {
+                        name,
+                        a,
+                        compare,
+                        b,
+                    }) => {
+                        let value = |e: &str| {
+                            klartext::value(e, &interp.vars).map_err(|m| {
+                                self.located(
+                                    Error::parse(source, number, format!("`{e}`: {m}")),
+                                    &stack,
+                                )
+                            })
+                        };
+                        let (a, b) = (value(&a)?, value(&b)?);
+                        if klartext::holds(compare, a, b) {
+                            let target = self.label(&name, number, source, &stack)?;
+                            if let Some(top) = stack.last_mut() {
+                                top.pos = target + 1;
+                                top.block = 0;
+                            }
+                        }
+                        continue;
+                    }
+                }
             }
             if self.style == Subprograms::OWordSub
                 && let Some((name, kind)) = oword(text)
@@ -468,7 +627,7 @@ impl Program {
         };
         if top.runs > 1 {
             top.runs -= 1;
-            top.pos = 0;
+            top.pos = top.start;
             top.block = 0;
         } else {
             stack.pop();
@@ -494,6 +653,7 @@ impl Program {
                 Subprograms::OPrograms => format!("{name} … M99"),
                 Subprograms::Procs => format!("PROC {name} … RET"),
                 Subprograms::OWordSub => format!("{name} sub … {name} endsub"),
+                Subprograms::Labels => format!("LBL {name} … LBL 0"),
             };
             return Err(self.located(
                 Error::parse(
@@ -534,8 +694,92 @@ impl Program {
             section,
             pos: 0,
             block: 0,
+            start: 0,
             runs,
             call: Some((call.text, number)),
+            label: None,
+        });
+        Ok(())
+    }
+
+    /// The line index of label `name` (an error naming it when the file lacks it).
+    fn label(&self, name: &str, number: usize, source: &Path, stack: &[Frame]) -> Result<usize> {
+        self.labels.get(name).copied().ok_or_else(|| {
+            self.located(
+                Error::parse(
+                    source,
+                    number,
+                    format!(
+                        "LBL {name} is not in this file: add `LBL {name}` … `LBL 0`, or post the \
+                         program without the call"
+                    ),
+                ),
+                stack,
+            )
+        })
+    }
+
+    /// `CALL LBL name [REP repeats]` at line index `at` (line `number`).
+    fn enter_label(
+        &self,
+        stack: &mut Vec<Frame>,
+        name: &str,
+        repeats: Option<u64>,
+        at: usize,
+        number: usize,
+        source: &Path,
+    ) -> Result<()> {
+        let target = self.label(name, number, source, stack)?;
+        let text = match repeats {
+            Some(r) => format!("CALL LBL {name} REP {r}"),
+            None => format!("CALL LBL {name}"),
+        };
+        let runs = match repeats {
+            None => 1,
+            Some(_) if target > at => {
+                return Err(self.located(
+                    Error::parse(
+                        source,
+                        number,
+                        format!(
+                            "`{text}`: LBL {name} comes after the call (a subprogram); a repeat \
+                             count belongs to a program-section repeat, whose label comes \
+                             before the call: call the subprogram without REP, from a repeated \
+                             section"
+                        ),
+                    ),
+                    stack,
+                ));
+            }
+            Some(r) => r,
+        };
+        if runs == 0 {
+            return Ok(());
+        }
+        if stack.len() > MAX_CALL_DEPTH {
+            return Err(self.located(
+                Error::parse(
+                    source,
+                    number,
+                    format!(
+                        "`{text}`: label calls nested more than {MAX_CALL_DEPTH} deep (does a \
+                         subprogram call itself?)"
+                    ),
+                ),
+                stack,
+            ));
+        }
+        if runs > MAX_EXPANDED_BLOCKS as u64 {
+            return Err(self.too_many(source, number, stack));
+        }
+        stack.push(Frame {
+            section: 0,
+            pos: target + 1,
+            block: 0,
+            start: target + 1,
+            runs,
+            call: Some((text, number)),
+            label: Some((at, name.to_string())),
         });
         Ok(())
     }
@@ -559,10 +803,15 @@ impl Program {
         let Some(Frame {
             section,
             call: Some((text, line)),
+            label,
             ..
         }) = stack.last()
         else {
             return e;
+        };
+        let name = match label {
+            Some((_, name)) => format!("LBL {name}"),
+            None => format!("subprogram {}", self.sections[*section].name),
         };
         match e {
             Error::Parse {
@@ -572,10 +821,7 @@ impl Program {
             } => Error::Parse {
                 file,
                 line: at,
-                message: format!(
-                    "{message} (in subprogram {}, called by `{text}` at line {line})",
-                    self.sections[*section].name
-                ),
+                message: format!("{message} (in {name}, called by `{text}` at line {line})"),
             },
             other => other,
         }

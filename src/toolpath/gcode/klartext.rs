@@ -1,0 +1,649 @@
+//! Heidenhain TNC 640 Klartext (conversational, `.h`): a lexer that turns each block into the
+//! common interpreter's input (words resolved through [`super::HEIDENHAIN`]), and the
+//! label, jump and `FN` statements the program runner and the lexer handle themselves.
+//!
+//! # Blocks
+//!
+//! A line is a block: an optional block number (`12 L X+10 FMAX`), then the statement. `;`
+//! starts a comment, a block starting with `*` is a structure comment (`* - ROUGHING`), a
+//! line ending in `~` continues on the next line (cycle definitions as the TNC 640 writes
+//! them), `/` before the block skips it (block delete, as in the G-code dialects: skipped with
+//! a warning). Numbers carry their sign (`X+10`, `X-5`; `X10` is read too) and may use a comma
+//! as the decimal separator (`X-6,964`). A value may be a Q parameter (`X+Q1`, `FQ53`).
+//!
+//! The first word (or words) say what the block is; the table's keywords are matched longest
+//! first (`FUNCTION RESET TCPM` before `FUNCTION`):
+//!
+//! * **Path functions**, followed by words: `L` / `LN` (straight line; `LN` with the tool
+//!   vector `TX TY TZ`, the surface normal `NX NY NZ` is only read by 3D radius compensation
+//!   and is ignored), `CC` (circle centre and pole), `C` (arc about `CC`), `CR` (arc by
+//!   radius), `CT` (tangential arc), `CP` (arc about `CC` by polar angle), `LP` (line to polar
+//!   coordinates).
+//! * **Statements**, whose words belong to them: `BEGIN PGM`, `END PGM`, `BLK FORM`,
+//!   `TOOL CALL`, `TOOL DEF`, `CYCL DEF`, `CYCL CALL`, `PATTERN DEF`, `PLANE`,
+//!   `FUNCTION TCPM`, `FUNCTION RESET TCPM`, `RND`, `CHF`, `STOP`.
+//! * **Other blocks**: `M` functions alone (`M3`, `M140 MB MAX`), Q-parameter assignments
+//!   (`Q1 = 5`, `Q200=+2`, `FN 0: Q1 = +5`, `FN 1`–`FN 5`), labels and jumps (`LBL 1`,
+//!   `LBL 0`, `CALL LBL 1 REP 2`, `FN 9: IF +Q1 EQU +1 GOTO LBL 5`; see
+//!   [`super::subprograms`]).
+//!
+//! Within a block, words are `NAME±value`: the letters `X Y Z A B C R F M S`, the named words
+//! `IX IY IZ IA IB IC` (incremental, this word only), `DR+`/`DR-`, `PA IPA PR IPR`,
+//! `TX TY TZ`, `NX NY NZ`, `MB`; and the keywords `FMAX`/`F MAX` (this block is a rapid; F
+//! stays), `FAUTO`/`F AUTO` (the `TOOL CALL` feed), `R0`/`RL`/`RR`, `MB MAX`. A word the
+//! table does not know is an **error** naming it (a Klartext word may move the tool), except
+//! an `M` function, which the interpreter warns about as in every dialect. Axis words outside
+//! a path function are an error.
+//!
+//! # Q parameters
+//!
+//! `Q`, `QL`, `QR` parameters are read before they are set only by mistake: that is an error
+//! naming the parameter, except `Q120`–`Q122` in a rotary word (`L A+Q120 C+Q122 FMAX`): they
+//! hold the rotary positions the control computes for the active `PLANE`, which the reader
+//! does not need (the tool vector of the tilted plane rules there). Assignments: `Q1 = expr`
+//! (`+ - * /`, parentheses and the functions of [`super::expr`]), `FN 0: Q1 = +5` (assign),
+//! `FN 1` (+), `FN 2` (−), `FN 3` (×), `FN 4` (`DIV`), `FN 5: Q1 = SQRT +Q2`. `FN 16`
+//! (`F-PRINT`) prints and is skipped; every other `FN` is an error naming it.
+//!
+//! # What the blocks do
+//!
+//! * **Lines** `L`/`LN` go to the end point at F (modal, mm/min), or at rapid under `FMAX`
+//!   (this block only); `FAUTO` takes the `TOOL CALL`'s F. `LN … TX TY TZ` sets the tool
+//!   vector (normalised), read as the tool orientation under `M128`/`FUNCTION TCPM`.
+//! * **Arcs**: `CC` sets the circle centre (pole) and the arc plane from the two coordinates
+//!   it names (`CC X Y` XY, `CC Y Z` YZ, `CC X Z` ZX; `CC` alone: the current X Y; `IX`…
+//!   relative to the current position); `C` goes about it to the end point, `DR+`
+//!   counter-clockwise (positive rotation about the plane's normal, as G3 under G17/G18/G19),
+//!   `DR-` clockwise, an end point equal to the start a full circle; `CR X Y R± DR±` is the
+//!   R arc of G2/G3 in the XY plane (R+ at most 180°, R− more); `CT X Y` the arc through the
+//!   end point tangent to the line or arc just before it (in XY); `CP PA±a DR±` / `CP IPA±a`
+//!   goes about the pole at the current radius to polar angle a (measured from the plane's
+//!   first axis: +X in XY, +Y in YZ, +Z in ZX) or by a (turns included, a helix with `IZ`);
+//!   `LP PR PA` is a line to polar coordinates about the pole. The axis normal to the arc
+//!   plane moves linearly (a helix). Arcs are chords as in G-code ([`super`]).
+//! * **Machine coordinates** `M91`: as G53. **Rotary** `M126`: an absolute rotary word goes
+//!   the shorter way (`M127`: as written). **TCP** `M128`, `FUNCTION TCPM F TCP AXIS POS`:
+//!   on; `M129`, `FUNCTION RESET TCPM`: off (`AXIS SPAT` and `REFPNT CENTER-CENTER` are
+//!   errors; `F CONT` and `PATHCTRL VECTOR` are warnings: the tip feed and axis
+//!   interpolation are what the toolpath carries).
+//! * **Retract** `M140 MB d`: along the tool axis by d mm (at F if the block gives one, else
+//!   at rapid); `M140 MB MAX`: up to the machine's Z travel limit (`axes.Z.max` of the machine
+//!   file; an error when the machine or the field is missing, or the tool is tilted).
+//! * **Frames**: `CYCL DEF 7` datum shift (`7.1 X+…`, `7.2 Y…`, `7.3 Z…`; `IX` adds to the
+//!   shift; an omitted axis keeps its shift) and `PLANE` (the working plane: `SPATIAL SPA SPB
+//!   SPC`, R = Rz(SPC)·Ry(SPB)·Rx(SPA) about the fixed axes; `EULER EULPR EULNU EULROT`,
+//!   R = Rz(PR)·Rx(NU)·Rz(ROT); `VECTOR BX BY BZ NX NY NZ`; `RELATIV SPA/SPB/SPC` turns the
+//!   active plane further; `RESET`) compose as p_workpiece = shift + R·p, the frames of
+//!   [`super::frames`]: the plane turns about the shifted datum. A change of frame does
+//!   not move the tool: its position is re-expressed in the new coordinates. Under a plane
+//!   the tool points along the plane's Z. `TURN`/`MOVE` turn the tool there at once (a
+//!   reorientation point; `MB` retracts first); `STAY` leaves the rotary axes where they
+//!   are: the tool keeps its orientation until a block positions a rotary axis, e.g.
+//!   `L A+Q120 C+Q122 FMAX` (Q120–Q122: the control's solution for the plane). `PLANE RESET
+//!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
+//!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
+//!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
+//! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle (its Q parameters are
+//!   read when it is called); `CYCL CALL`, `M99` in a block (after its move) and `M89`
+//!   (after every block that positions X or Y, until `M99` or a new `CYCL DEF`) call it at
+//!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
+//!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at
+//!   rapid; `CYCL CALL POS X Y Z` at that point alike. The moves: [`super::cycles::heidenhain_steps`].
+//!   `CYCL DEF 9` is a dwell (`9.1 DWELL 1.5`: 1.5 s), `32` (tolerance) and `13` (spindle
+//!   orientation) move nothing, `247` (preset) is taken with a warning (the preset table is
+//!   the control's), and an error if a later one names another preset. Other cycles may be
+//!   defined (a warning); calling one is an error naming it.
+//! * `BEGIN PGM … MM` (`INCH` is an error), `TOOL CALL n Z S… F…` (S and F remembered; a
+//!   tool axis X or Y is an error), `BLK FORM`, `TOOL DEF`, `STOP` move nothing.
+//! * `RND` and `CHF` (rounding and chamfer between two contour elements) are errors naming
+//!   the line: post the contour with the arc or chamfer written out.
+
+use super::dialect::{Action, Address, DialectSpec, Statement};
+use super::expr::{self, Variables};
+use super::lexer::{Item, Num};
+
+/// Longest keyword, words (`FUNCTION RESET TCPM`).
+const MAX_KEYWORD_WORDS: usize = 3;
+
+/// `12 L X+0` → `L X+0`; `/12 L` → `/12 L` (the runner skips block-delete blocks first).
+pub(super) fn strip_block_number(text: &str) -> &str {
+    let t = text.trim_start();
+    let digits = t.len() - t.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+    if digits == 0 {
+        return t;
+    }
+    let rest = &t[digits..];
+    if rest.is_empty() || rest.starts_with(char::is_whitespace) {
+        rest.trim_start()
+    } else {
+        t
+    }
+}
+
+/// Splits a block at spaces outside `( )` and quotes.
+fn tokens(text: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    let mut current = String::new();
+    let mut depth = 0usize;
+    let mut quoted = false;
+    for c in text.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            '(' if !quoted => depth += 1,
+            ')' if !quoted => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        if c.is_whitespace() && depth == 0 && !quoted {
+            if !current.is_empty() {
+                words.push(std::mem::take(&mut current));
+            }
+        } else {
+            current.push(c);
+        }
+    }
+    if !current.is_empty() {
+        words.push(current);
+    }
+    words
+}
+
+/// A number as Klartext writes it: optional sign, digits with at most one decimal point or
+/// comma.
+fn number(text: &str) -> Option<f64> {
+    let body = text.strip_prefix(['+', '-']).unwrap_or(text);
+    let digits = body.chars().filter(char::is_ascii_digit).count();
+    let points = body.chars().filter(|&c| c == '.' || c == ',').count();
+    if digits == 0 || points > 1 || digits + points != body.len() {
+        return None;
+    }
+    text.replace(',', ".")
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
+}
+
+/// A value: a number, or an expression over Q parameters (`+Q1`, `-Q5*2`).
+pub(super) fn value(text: &str, vars: &Variables) -> Result<f64, String> {
+    if let Some(v) = number(text) {
+        return Ok(v);
+    }
+    if text.contains(',') && text.chars().any(|c| c.is_ascii_digit()) {
+        return expr::eval(&comma_decimals(text), vars);
+    }
+    expr::eval(text, vars)
+}
+
+/// `1,5` → `1.5` where a comma stands between digits.
+fn comma_decimals(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    chars
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let digit = |k: Option<&char>| k.is_some_and(char::is_ascii_digit);
+            if c == ','
+                && digit(i.checked_sub(1).and_then(|k| chars.get(k)))
+                && digit(chars.get(i + 1))
+            {
+                '.'
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// `Q5 = expr` (spaces anywhere): the parameter and the expression, or `None`.
+fn assignment(text: &str) -> Option<(String, &str)> {
+    let (name, rest) = text.split_once('=')?;
+    let name = name.trim();
+    expr::is_q_parameter(name).then(|| (name.to_ascii_uppercase(), rest.trim()))
+}
+
+/// A keyword of the table that starts `words` (longest first): its length in words, text and
+/// action.
+fn keyword_at(spec: &DialectSpec, words: &[String]) -> Option<(usize, String, Action)> {
+    for n in (1..=MAX_KEYWORD_WORDS.min(words.len())).rev() {
+        let text = words[..n].join(" ").to_ascii_uppercase();
+        if let Some(&(_, action)) = spec.keywords.iter().find(|(k, _)| *k == text) {
+            return Some((n, text, action));
+        }
+    }
+    None
+}
+
+/// Whether a keyword's action starts a block (a path function or statement) rather than
+/// being a word inside one.
+fn starts_block(action: Action) -> bool {
+    matches!(
+        action,
+        Action::Motion(_) | Action::Path(_) | Action::Statement(_)
+    )
+}
+
+/// A named word or letter of the table.
+fn address(spec: &DialectSpec, name: &str) -> Option<Address> {
+    let mut chars = name.chars();
+    match (chars.next(), chars.next()) {
+        (Some(c), None) => spec.letters.iter().find(|(l, _)| *l == c).map(|&(_, a)| a),
+        _ => spec.named.iter().find(|(n, _)| *n == name).map(|&(_, a)| a),
+    }
+}
+
+/// Reads one Klartext block (block number already removed or not) into items.
+pub(super) fn lex(
+    spec: &DialectSpec,
+    block: &str,
+    vars: &mut Variables,
+) -> Result<Vec<Item>, String> {
+    let text = strip_block_number(block).trim();
+    let text = text.strip_suffix('~').unwrap_or(text).trim_end();
+    if text.is_empty() || text.starts_with('*') {
+        return Ok(Vec::new());
+    }
+    if let Some((name, expression)) = assignment(text) {
+        let v = value(expression, vars).map_err(|e| format!("`{name} =`: {e}"))?;
+        vars.set(&name, v);
+        return Ok(vec![Item::Skipped]);
+    }
+    let words = tokens(text);
+    let mut items = Vec::new();
+    let mut i = 0;
+    if let Some((n, key, action)) = keyword_at(spec, &words) {
+        if let Action::Unsupported(message) = action {
+            return Err(format!("{key}: {message}"));
+        }
+        if action == Action::Statement(Statement::Fn) {
+            return fn_statement(&words[n..].join(" "), vars).map(|()| vec![Item::Skipped]);
+        }
+        let takes_rest = matches!(action, Action::Statement(_)) || key.contains(' ');
+        if takes_rest {
+            items.push(Item::Keyword {
+                text: key,
+                action,
+                args: Some(words[n..].join(" ")),
+            });
+            return Ok(items);
+        }
+        items.push(Item::Keyword {
+            text: key,
+            action,
+            args: None,
+        });
+        i = n;
+    }
+    let path = matches!(
+        items.first(),
+        Some(Item::Keyword { action, .. }) if starts_block(*action)
+    );
+    while i < words.len() {
+        let word = words[i].to_ascii_uppercase();
+        let next = words.get(i + 1).map(|w| w.to_ascii_uppercase());
+        // Two-word keywords inside a block: `F MAX`, `F AUTO`, `MB MAX`.
+        let pair = next.as_ref().map(|n| format!("{word} {n}"));
+        let pair_key = match pair.as_deref() {
+            Some("F MAX") => Some(("FMAX".to_string(), 2)),
+            Some("F AUTO") => Some(("FAUTO".to_string(), 2)),
+            Some("MB MAX") => Some(("MB MAX".to_string(), 2)),
+            _ if word == "MBMAX" => Some(("MB MAX".to_string(), 1)),
+            _ => None,
+        };
+        // `MB 50`: the retract distance as its own word.
+        if word == "MB"
+            && let Some(n) = next.as_deref()
+            && n.starts_with(|c: char| c.is_ascii_digit() || matches!(c, '+' | '-' | '.' | 'Q'))
+        {
+            items.push(lex_word(
+                spec,
+                &format!("MB{}", words[i + 1]),
+                &format!("MB{n}"),
+                vars,
+            )?);
+            i += 2;
+            continue;
+        }
+        let (key, used) = pair_key.unwrap_or((word.clone(), 1));
+        if let Some(&(_, action)) = spec.keywords.iter().find(|(k, _)| *k == key) {
+            if starts_block(action) {
+                return Err(format!(
+                    "`{}`: a path function or statement must start the block",
+                    words[i]
+                ));
+            }
+            if let Action::Unsupported(message) = action {
+                return Err(format!("{key}: {message}"));
+            }
+            items.push(Item::Keyword {
+                text: key,
+                action,
+                args: None,
+            });
+            i += used;
+            continue;
+        }
+        items.push(lex_word(spec, &words[i], &word, vars)?);
+        i += 1;
+    }
+    let moves = items.iter().any(|item| {
+        matches!(
+            item,
+            Item::Word {
+                address: Address::Axis(_)
+                    | Address::IncrementalAxis(_)
+                    | Address::PolarAngle(_)
+                    | Address::PolarRadius(_)
+                    | Address::ToolVector(_)
+                    | Address::PlaneRotary(_),
+                ..
+            }
+        )
+    });
+    if moves && !path {
+        return Err(
+            "axis words without a path function: start the block with L, LN, C, CR, CT, CP or \
+             LP"
+            .into(),
+        );
+    }
+    Ok(items)
+}
+
+/// One word `NAME±value` (upper-cased in `upper`).
+fn lex_word(
+    spec: &DialectSpec,
+    written: &str,
+    upper: &str,
+    vars: &mut Variables,
+) -> Result<Item, String> {
+    let alpha_len = upper.len()
+        - upper
+            .trim_start_matches(|c: char| c.is_ascii_alphabetic())
+            .len();
+    if alpha_len == 0 {
+        return Err(format!("unexpected word `{written}`"));
+    }
+    // The longest known name, where a longer run of letters is a name and a Q parameter
+    // (`FQ53`: F and Q53).
+    let mut found = None;
+    for k in (1..=alpha_len).rev() {
+        let name = &upper[..k];
+        if let Some(a) = address(spec, name)
+            && (k == alpha_len || upper[k..].starts_with('Q'))
+        {
+            found = Some((name, a));
+            break;
+        }
+    }
+    let Some((name, address)) = found else {
+        return Err(format!(
+            "unknown word `{written}`: not a Klartext word feedopt knows (a word may move the \
+             tool, so it is not skipped)"
+        ));
+    };
+    let text = &upper[name.len()..];
+    if let Address::Unsupported(message) = address {
+        return Err(format!("`{written}`: {message}"));
+    }
+    if address == Address::ArcDirection {
+        let v = match text {
+            "+" => 1.0,
+            "-" => -1.0,
+            _ => return Err(format!("`{written}`: the direction is DR+ or DR-")),
+        };
+        return Ok(Item::Word {
+            text: written.to_string(),
+            address,
+            num: Num {
+                value: v,
+                point: true,
+            },
+        });
+    }
+    if let Address::Axis(i @ 3..=5) = address {
+        let q = ["Q120", "Q121", "Q122"][i - 3];
+        let t = text.strip_prefix('+').unwrap_or(text);
+        if t == q && !vars.is_set(q) {
+            return Ok(Item::Word {
+                text: written.to_string(),
+                address: Address::PlaneRotary(i - 3),
+                num: Num {
+                    value: 0.0,
+                    point: true,
+                },
+            });
+        }
+    }
+    if text.is_empty() {
+        return Err(format!("`{written}` has no value"));
+    }
+    let body = text.trim_start_matches(['+', '-']);
+    if body.starts_with(|c: char| c.is_ascii_digit() || c == '.') && body.contains(['E', 'e']) {
+        return Err(format!(
+            "`{written}`: exponent notation is not part of Klartext; write the number in full"
+        ));
+    }
+    let v = value(text, vars).map_err(|e| format!("`{written}`: {e}"))?;
+    Ok(Item::Word {
+        text: written.to_string(),
+        address,
+        num: Num {
+            value: v,
+            point: true,
+        },
+    })
+}
+
+/// `FN k: …` (the text after `FN`): assignments and arithmetic; `FN 9`–`FN 12` jumps never
+/// reach here (the runner takes them).
+fn fn_statement(text: &str, vars: &mut Variables) -> Result<(), String> {
+    let (number, rest) = text
+        .split_once(':')
+        .ok_or_else(|| format!("`FN {text}`: expected `FN <number>: …`"))?;
+    let number = number.trim();
+    let k: u32 = number
+        .parse()
+        .map_err(|_| format!("`FN {number}`: not an FN function number"))?;
+    let rest = rest.trim();
+    match k {
+        0..=5 => {}
+        16 => return Ok(()), // F-PRINT: writes a file, moves nothing
+        9..=12 => return Err(format!("FN {k}: a jump outside a program feedopt runs")),
+        14 => {
+            return Err(format!(
+                "FN 14: the program raises an error here ({rest}); the control would stop"
+            ));
+        }
+        18 => {
+            return Err(
+                "FN 18 (SYSREAD) reads the control's system data, which feedopt does not have"
+                    .into(),
+            );
+        }
+        _ => return Err(format!("FN {k} is not supported (FN 0–5, 9–12 and 16 are)")),
+    }
+    let Some((name, expression)) = assignment(rest) else {
+        return Err(format!("`FN {k}: {rest}`: expected `Q<n> = …`"));
+    };
+    let upper = expression.to_ascii_uppercase();
+    let v = match k {
+        4 => {
+            let (a, b) = upper
+                .split_once("DIV")
+                .ok_or_else(|| format!("`FN 4: {rest}`: expected `a DIV b`"))?;
+            let (a, b) = (value(a.trim(), vars)?, value(b.trim(), vars)?);
+            if b == 0.0 {
+                return Err(format!("`FN 4: {rest}`: division by zero"));
+            }
+            a / b
+        }
+        5 => {
+            let a = upper
+                .trim()
+                .strip_prefix("SQRT")
+                .ok_or_else(|| format!("`FN 5: {rest}`: expected `SQRT a`"))?;
+            let a = value(a.trim(), vars)?;
+            if a < 0.0 {
+                return Err(format!("`FN 5: {rest}`: the square root of {a}"));
+            }
+            a.sqrt()
+        }
+        // FN 0 assigns, FN 1–3 add, subtract, multiply: `+Q2 + +5` reads as an expression.
+        _ => value(expression, vars).map_err(|e| format!("`FN {k}: {rest}`: {e}"))?,
+    };
+    if !v.is_finite() {
+        return Err(format!("`FN {k}: {rest}` is not a finite number"));
+    }
+    vars.set(&name, v);
+    Ok(())
+}
+
+/// A comparison of `FN 9`–`FN 12`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Compare {
+    Equal,
+    NotEqual,
+    Greater,
+    Less,
+}
+
+/// What a label block does; the runner ([`super::subprograms`]) carries it out.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum LabelOp {
+    /// `LBL 1`, `LBL "NAME"`: a label (no effect when run through).
+    Label(String),
+    /// `LBL 0`: the end of a subprogram.
+    End,
+    /// `CALL LBL n [REP m]`.
+    Call { name: String, repeats: Option<u64> },
+    /// `FN 9: IF a EQU b GOTO LBL n` (and `FN 10`–`12`): jump when `a` compares to `b`.
+    Jump {
+        name: String,
+        a: String,
+        compare: Compare,
+        b: String,
+    },
+}
+
+/// A label name as written after `LBL`: a number (`5`, leading zeros dropped) or a quoted
+/// name.
+fn label_name(text: &str) -> Result<String, String> {
+    let t = text.trim();
+    if let Some(q) = t.strip_prefix('"') {
+        let name = q
+            .strip_suffix('"')
+            .ok_or_else(|| format!("`LBL {t}`: unclosed `\"`"))?;
+        if name.is_empty() {
+            return Err("`LBL \"\"`: an empty label name".into());
+        }
+        return Ok(format!("\"{name}\""));
+    }
+    let n: u64 = t
+        .parse()
+        .map_err(|_| format!("`LBL {t}`: a label is a number or a quoted name"))?;
+    Ok(n.to_string())
+}
+
+/// The label operation of a block (block number removed), if it is one.
+pub(super) fn label_op(text: &str) -> Result<Option<LabelOp>, String> {
+    let t = text.trim();
+    let t = t.strip_suffix('~').unwrap_or(t).trim();
+    let upper = t.to_ascii_uppercase();
+    if let Some(rest) = upper.strip_prefix("LBL")
+        && (rest.starts_with([' ', '"']) || rest.is_empty())
+    {
+        let name = label_name(&t[3..])?;
+        return Ok(Some(if name == "0" {
+            LabelOp::End
+        } else {
+            LabelOp::Label(name)
+        }));
+    }
+    if let Some(rest) = upper.strip_prefix("CALL LBL") {
+        let rest_written = &t[t.len() - rest.len()..];
+        let (name_part, reps) = match rest.find(" REP") {
+            Some(k) => (&rest_written[..k], Some(rest[k + 4..].trim())),
+            None => (rest_written, None),
+        };
+        let name = label_name(name_part)?;
+        if name == "0" {
+            return Err(
+                "CALL LBL 0: label 0 marks the end of a subprogram and cannot be called".into(),
+            );
+        }
+        let repeats = match reps {
+            None => None,
+            Some(r) => {
+                let count = r.split('/').next().unwrap_or("").trim();
+                let n: u64 = count.parse().map_err(|_| {
+                    format!("`CALL LBL {name} REP {r}`: the repeat count is a whole number")
+                })?;
+                Some(n)
+            }
+        };
+        return Ok(Some(LabelOp::Call { name, repeats }));
+    }
+    let compact: String = upper.split_whitespace().collect::<Vec<_>>().join(" ");
+    for (k, compare) in [
+        ("9", Compare::Equal),
+        ("10", Compare::NotEqual),
+        ("11", Compare::Greater),
+        ("12", Compare::Less),
+    ] {
+        let Some(rest) = compact
+            .strip_prefix(&format!("FN {k}:"))
+            .or_else(|| compact.strip_prefix(&format!("FN{k}:")))
+        else {
+            continue;
+        };
+        let op = match compare {
+            Compare::Equal => " EQU ",
+            Compare::NotEqual => " NE ",
+            Compare::Greater => " GT ",
+            Compare::Less => " LT ",
+        };
+        let bad = || format!("`FN {k}:{rest}`: expected `IF a{op}b GOTO LBL n`");
+        let body = rest.trim().strip_prefix("IF ").ok_or_else(bad)?;
+        let (cond, _) = body.split_once(" GOTO LBL ").ok_or_else(bad)?;
+        let (a, b) = cond.split_once(op).ok_or_else(bad)?;
+        // The label as written (a quoted name keeps its case).
+        let at = upper.rfind("LBL").ok_or_else(bad)?;
+        return Ok(Some(LabelOp::Jump {
+            name: label_name(&t[at + 3..])?,
+            a: a.trim().to_string(),
+            compare,
+            b: b.trim().to_string(),
+        }));
+    }
+    Ok(None)
+}
+
+/// Whether `a` compares to `b` (values of an `FN 9`–`FN 12` condition).
+pub(super) fn holds(compare: Compare, a: f64, b: f64) -> bool {
+    match compare {
+        Compare::Equal => a == b,
+        Compare::NotEqual => a != b,
+        Compare::Greater => a > b,
+        Compare::Less => a < b,
+    }
+}
+
+/// The words `NAME±value` of a statement's arguments, upper-cased, with the values as
+/// written (`SPA+45` → `("SPA", "+45")`); words without a value (`TURN`) have `""`.
+pub(super) fn named_words(args: &str) -> Vec<(String, String)> {
+    tokens(args)
+        .into_iter()
+        .map(|w| {
+            let upper = w.to_ascii_uppercase();
+            let k = upper.len()
+                - upper
+                    .trim_start_matches(|c: char| c.is_ascii_alphabetic())
+                    .len();
+            (upper[..k].to_string(), upper[k..].to_string())
+        })
+        .collect()
+}
+
+/// The statement's arguments split into words (outside parentheses and quotes).
+pub(super) fn words(args: &str) -> Vec<String> {
+    tokens(args)
+}

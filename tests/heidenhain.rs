@@ -1,0 +1,588 @@
+//! Heidenhain TNC 640 Klartext, the fourth dialect (issue 12 item 7): each construct against
+//! hand-computed paths, lengths, orientations and times.
+
+mod common;
+
+use feedopt::optimize::{Options, optimize};
+use feedopt::toolpath::gcode::{Dialect, parse, parse_for};
+use feedopt::toolpath::{self, ClPoint, Feed, Format, MachineContext, ReadOptions, Toolpath};
+use nalgebra::Vector3;
+use std::f64::consts::PI;
+use std::path::Path;
+
+fn read(text: &str) -> Toolpath {
+    parse(Path::new("t.h"), text, Dialect::Heidenhain).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+fn fails(text: &str) -> String {
+    match parse(Path::new("t.h"), text, Dialect::Heidenhain) {
+        Ok(tp) => panic!("expected an error, read {} points\n{text}", tp.points.len()),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
+    Vector3::new(x, y, z)
+}
+
+fn close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) -> bool {
+    (a - b).norm() <= tol
+}
+
+/// Length of the moves between the points.
+fn length(points: &[ClPoint]) -> f64 {
+    points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum()
+}
+
+/// Chords within e = 1 µm of an arc are shorter than it by α²/6 = e/(3r) relative (α their
+/// half angle, 1 − cos α = e/r): at most 3.4e-5 for r ≥ 10 mm.
+fn arc_close(got: f64, want: f64) -> bool {
+    got <= want + 1e-9 && want - got <= 3.4e-5 * want
+}
+
+/// Time of the feed moves at their programmed feeds, s.
+fn feed_time(tp: &Toolpath) -> f64 {
+    tp.points
+        .windows(2)
+        .map(|w| match w[1].feed {
+            Feed::Programmed(f) => (w[1].p - w[0].p).norm() / f,
+            _ => 0.0,
+        })
+        .sum()
+}
+
+const HEADER: &str = "0 BEGIN PGM T MM\n1 BLK FORM 0.1 Z X+0 Y+0 Z-20\n\
+                      2 BLK FORM 0.2 X+100 Y+100 Z+0\n3 TOOL CALL 1 Z S5000\n";
+
+#[test]
+fn lines_and_an_arc_about_cc_give_the_hand_computed_path_and_length() {
+    let text = format!(
+        "{HEADER}4 L X+0 Y+0 Z+5 R0 FMAX M3\n5 L Z-2 F300\n6 L X+50 F600\n7 CC X+50 Y+20\n\
+         8 C X+70 Y+20 DR+\n9 L IY+30 ; incremental, this word only\n10 L X+0\n\
+         11 END PGM T MM\n"
+    );
+    let tp = read(&text);
+    assert_eq!(tp.points[0].p, v(0.0, 0.0, 5.0));
+    assert_eq!(tp.points[0].feed, Feed::Rapid);
+    assert_eq!(tp.points[1].p, v(0.0, 0.0, -2.0));
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    assert_eq!(tp.points[2].p, v(50.0, 0.0, -2.0));
+    assert_eq!(tp.points[2].feed, Feed::Programmed(10.0));
+    // The quarter circle about (50, 20), radius 20, counter-clockwise from −90° to 0°.
+    let arc: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 9).collect();
+    assert!(arc.len() > 50, "chords within 1 µm: {}", arc.len());
+    let mut last_angle = -PI / 2.0;
+    for p in &arc {
+        let r = (p.p - v(50.0, 20.0, -2.0)).norm();
+        assert!((r - 20.0).abs() < 1e-9, "{r}");
+        let angle = (p.p.y - 20.0).atan2(p.p.x - 50.0);
+        assert!(angle > last_angle, "counter-clockwise");
+        last_angle = angle;
+        assert_eq!(p.feed, Feed::Programmed(10.0));
+    }
+    assert_eq!(arc.last().map(|p| p.p), Some(v(70.0, 20.0, -2.0)));
+    let n = tp.points.len();
+    assert_eq!(tp.points[n - 2].p, v(70.0, 50.0, -2.0));
+    assert_eq!(tp.points[n - 1].p, v(0.0, 50.0, -2.0));
+    // 7 + 50 + 10π (the chords a little shorter, see `arc_close`) + 30 + 70 mm.
+    let want = 7.0 + 50.0 + 10.0 * PI + 30.0 + 70.0;
+    let got = length(&tp.points);
+    assert!(
+        got <= want && want - got < 3.4e-5 * 10.0 * PI,
+        "{got} vs {want}"
+    );
+    // DR− goes the other way round: 270° clockwise, 30π mm.
+    let cw = read(&text.replace("DR+", "DR-"));
+    let arc: Vec<&ClPoint> = cw.points.iter().filter(|p| p.line == 9).collect();
+    let mut pts = vec![cw.points[2].clone()];
+    pts.extend(arc.iter().map(|p| (*p).clone()));
+    assert!(arc_close(length(&pts), 30.0 * PI), "{}", length(&pts));
+    // …passing left of the centre, through x = 30 within the 1 µm sagitta.
+    let left = arc.iter().map(|p| p.p.x).fold(f64::INFINITY, f64::min);
+    assert!((30.0..30.001).contains(&left), "{left}");
+}
+
+#[test]
+fn fmax_is_this_block_only_and_f_stays_modal() {
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+0 F500\n5 L X+10\n6 L X+20 FMAX\n7 L X+30\n8 L X+40 F MAX\n\
+         9 * - 1/2\" DRILL NEXT\n10 L X+50\n"
+    ));
+    let feeds: Vec<Feed> = tp.points.iter().map(|p| p.feed).collect();
+    let f = Feed::Programmed(500.0 / 60.0);
+    assert_eq!(feeds[1..], [f, Feed::Rapid, f, Feed::Rapid, f]);
+}
+
+#[test]
+fn cr_arc_by_radius_short_and_long() {
+    // From (50, 0) to (70, 20) with radius 20: R+ DR+ is the quarter circle about (50, 20);
+    // R− DR+ the three-quarter circle about (70, 0).
+    for (r, centre, sweep) in [
+        ("+20", v(50.0, 20.0, 0.0), 0.5 * PI),
+        ("-20", v(70.0, 0.0, 0.0), 1.5 * PI),
+    ] {
+        let tp = read(&format!(
+            "{HEADER}4 L X+50 Y+0 Z+0 F600\n5 CR X+70 Y+20 R{r} DR+\n"
+        ));
+        for p in &tp.points[1..] {
+            assert!(
+                ((p.p - centre).norm() - 20.0).abs() < 1e-9,
+                "R{r}: {:?}",
+                p.p
+            );
+        }
+        assert_eq!(tp.points.last().map(|p| p.p), Some(v(70.0, 20.0, 0.0)));
+        assert!(
+            arc_close(length(&tp.points), 20.0 * sweep),
+            "R{r}: {}",
+            length(&tp.points)
+        );
+    }
+    let e = fails(&format!(
+        "{HEADER}4 L X+50 Y+0 Z+0 F600\n5 CR X+70 Y+20 DR+\n"
+    ));
+    assert!(e.contains(":6:") && e.contains("without R"), "{e}");
+}
+
+#[test]
+fn ct_continues_the_line_tangentially() {
+    // Along +X to (10, 0), then CT to (20, 10): the circle tangent to +X at (10, 0) through
+    // (20, 10) has its centre at (10, 10) (s = |d|²/(2 n·d) = 200/20), radius 10, 90° ccw.
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+0 F600\n5 L X+10\n6 CT X+20 Y+10\n"
+    ));
+    let arc: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 7).collect();
+    for p in &arc {
+        assert!(((p.p - v(10.0, 10.0, 0.0)).norm() - 10.0).abs() < 1e-9);
+    }
+    // The first chord leaves along +X (tangent continuity), up to the chord's half angle.
+    let d = (arc[0].p - v(10.0, 0.0, 0.0)).normalize();
+    assert!(d.x > 0.999 && d.y > 0.0, "{d:?}");
+    assert!(arc_close(length(&tp.points[1..]), 5.0 * PI));
+    // Without a contour element just before it: an error naming the line.
+    let e = fails(&format!("{HEADER}4 CT X+20 Y+10\n"));
+    assert!(e.contains(":5:") && e.contains("CT"), "{e}");
+}
+
+#[test]
+fn cp_by_incremental_angle_is_a_helix_and_cc_y_z_is_the_yz_plane() {
+    // Two turns of radius 10 about the origin, 4 mm down: length √((40π)² + 4²).
+    let tp = read(&format!(
+        "{HEADER}4 L X+10 Y+0 Z+0 F600\n5 CC X+0 Y+0\n6 CP IPA+720 IZ-4 DR+\n"
+    ));
+    assert!(close(
+        tp.points.last().unwrap().p,
+        v(10.0, 0.0, -4.0),
+        1e-12
+    ));
+    let want = ((40.0 * PI).powi(2) + 16.0).sqrt();
+    assert!(
+        (length(&tp.points) - want).abs() < 1e-2,
+        "{}",
+        length(&tp.points)
+    );
+    // A lead-in arc as a CAM post writes it (`CC Y Z`, `CP IPA+90 DR+`): from (Y, Z) =
+    // (−58.6, −0.3) about (−57.4, −0.3), +90° about +X ends at (−57.4, −1.5), tangent to the
+    // line that follows along +Y.
+    let tp = read(&format!(
+        "{HEADER}4 L X+1.2 Y-58.6 Z-0.3 F600\n5 CC Y-57.4 Z-0.3\n6 CP IPA+90 DR+\n\
+         7 L Y-56.2 Z-1.5\n"
+    ));
+    let end = tp.points.iter().rfind(|p| p.line == 7).unwrap().p;
+    assert!(close(end, v(1.2, -57.4, -1.5), 1e-9), "{end:?}");
+    // …and `CC X Z` with DR+ turns from Z to X (positive about +Y).
+    let tp = read(&format!(
+        "{HEADER}4 L X+93.175 Y-14 Z+3.1 F600\n5 CC X+92.575 Z+3.1\n6 CP IPA+90 DR+\n"
+    ));
+    assert!(close(
+        tp.points.last().unwrap().p,
+        v(92.575, -14.0, 2.5),
+        1e-9
+    ));
+    // Against its DR: an error.
+    let e = fails(&format!(
+        "{HEADER}4 L X+10 Y+0 Z+0 F600\n5 CC X+0 Y+0\n6 CP IPA+90 DR-\n"
+    ));
+    assert!(e.contains(":7:"), "{e}");
+}
+
+#[test]
+fn ln_tool_vectors_under_m128_on_a_five_axis_machine() {
+    let m = common::machine(
+        r#"{"name": "hh", "kinematics": {"type": "head_head", "tool_length": 200},
+            "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                     "Y": {"velocity": 400, "acceleration": 2000},
+                     "Z": {"velocity": 400, "acceleration": 2000},
+                     "C": {"velocity": 120, "acceleration": 600},
+                     "A": {"velocity": 60, "acceleration": 400}},
+            "feed": {"max": 150}}"#,
+    );
+    let refs = feedopt::machine::References::default();
+    let ctx = MachineContext::new(&m, &refs);
+    let text = format!(
+        "{HEADER}4 M128\n5 LN X+0 Y+0 Z+10 NX+0 NY+0 NZ+1 TX+0 TY+0 TZ+1 FMAX\n\
+         6 LN X+10 Y+0 Z+10 NX+0 NY+0 NZ+1 TX+0 TY-0.5 TZ+0.8660254 F1200\n\
+         7 LN X+20 Y+0 Z+10 TX+0 TY-1 TZ+1\n8 M129\n9 END PGM T MM\n"
+    );
+    let tp = parse_for(
+        Path::new("t.h"),
+        &text,
+        Dialect::Heidenhain.spec(),
+        Some(&ctx),
+    )
+    .unwrap();
+    assert_eq!(tp.points.len(), 3);
+    assert!(close(tp.points[1].o, v(0.0, -0.5, 0.866_025_4), 1e-7));
+    // Normalised: (0, −1, 1)/√2.
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert!(close(tp.points[2].o, v(0.0, -h, h), 1e-12));
+    assert!(tp.points.iter().all(|p| p.rotary.is_none()));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    let sol = optimize(&m, &tp, &Options::default()).unwrap();
+    assert!(sol.verification.verified);
+    // An A/B word for an axis the machine lacks is an error naming it.
+    let e = parse_for(
+        Path::new("t.h"),
+        &format!("{HEADER}4 M128\n5 L X+0 B+10 FMAX\n"),
+        Dialect::Heidenhain.spec(),
+        Some(&ctx),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains(":6:") && e.contains("no B axis"), "{e}");
+}
+
+#[test]
+fn plane_spatial_turns_about_the_shifted_datum() {
+    // Datum shift X+10, then SPB+90: p = (10, 0, 0) + Ry(90°)·p'; the tool along Ry(90°)·Z =
+    // +X.
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 FMAX\n5 CYCL DEF 7.0 DATUM SHIFT\n6 CYCL DEF 7.1 X+10\n\
+         7 CYCL DEF 7.2 Y+0\n8 PLANE SPATIAL SPA+0 SPB+90 SPC+0 TURN FMAX\n\
+         9 L X+0 Y+0 Z+5 FMAX\n10 L X+2 Y+3 Z+5 F600\n11 PLANE RESET TURN FMAX\n\
+         12 L X+0 Y+0 Z+50 FMAX\n"
+    ));
+    // Point 1: the tool turned where it stood (a reorientation), then the moves.
+    assert_eq!(tp.points[1].p, v(0.0, 0.0, 50.0));
+    assert!(close(tp.points[1].o, v(1.0, 0.0, 0.0), 1e-12));
+    assert!(
+        close(tp.points[2].p, v(15.0, 0.0, 0.0), 1e-12),
+        "{:?}",
+        tp.points[2].p
+    );
+    // (2, 3, 5) tilted: Ry(90°)·(2, 3, 5) = (5, 3, −2), plus the shift.
+    assert!(
+        close(tp.points[3].p, v(15.0, 3.0, -2.0), 1e-12),
+        "{:?}",
+        tp.points[3].p
+    );
+    // PLANE RESET TURN: the tool back to +Z, in place; the shift stays.
+    assert!(close(tp.points[4].p, v(15.0, 3.0, -2.0), 1e-12));
+    assert!(close(tp.points[4].o, v(0.0, 0.0, 1.0), 1e-12));
+    assert!(close(tp.points[5].p, v(10.0, 0.0, 50.0), 1e-12));
+    // SPA+90 SPC+180 (as hyperMILL writes for "A-90 C0"): the tool along
+    // Rz(180°)·Rx(90°)·Z = +Y; STAY keeps the tool upright until the rotary axes move.
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 A+0 C+0 FMAX\n5 PLANE SPATIAL SPA90 SPB0 SPC180 STAY SEQ- TABLE ROT\n\
+         6 L X+1 Y+0 Z+50 FMAX\n7 L A+Q120 C+Q122 R0 FMAX M126\n8 L X+1 Y+0 Z+10 FMAX\n"
+    ));
+    assert!(
+        close(tp.points[1].o, v(0.0, 0.0, 1.0), 1e-12),
+        "STAY: not turned yet"
+    );
+    assert!(close(tp.points[2].o, v(0.0, 1.0, 0.0), 1e-12));
+    assert_eq!(
+        tp.points[1].p, tp.points[2].p,
+        "positioning the rotary axes moves no tip"
+    );
+    // (1, 0, 10) in the tilted plane: Rz(180°)·Rx(90°)·(1, 0, 10) = (−1, 10, 0).
+    assert!(
+        close(tp.points[3].p, v(-1.0, 10.0, 0.0), 1e-12),
+        "{:?}",
+        tp.points[3].p
+    );
+    // A shift while the plane is tilted, and PLANE AXIAL: errors naming the line.
+    let e = fails(&format!(
+        "{HEADER}4 PLANE SPATIAL SPA+0 SPB+30 SPC+0 STAY\n5 CYCL DEF 7.0 DATUM SHIFT\n\
+         6 CYCL DEF 7.1 X+5\n7 L X+0 Y+0 Z+0 FMAX\n"
+    ));
+    assert!(
+        e.contains(":8:") && e.contains("line 7") && e.contains("before PLANE"),
+        "{e}"
+    );
+    // A shift reset to 0 axis by axis under the plane, as posts write it, is fine.
+    read(&format!(
+        "{HEADER}4 CYCL DEF 7.0 DATUM SHIFT\n5 CYCL DEF 7.1 X+5\n6 CYCL DEF 7.2 Y+5\n\
+         7 PLANE SPATIAL SPA+0 SPB+30 SPC+0 TURN\n8 L X+0 Y+0 Z+0 FMAX\n\
+         9 CYCL DEF 7.0 DATUM SHIFT\n10 CYCL DEF 7.1 X+0\n11 CYCL DEF 7.2 Y+0\n\
+         12 PLANE RESET TURN\n13 L X+0 Y+0 Z+10 FMAX\n"
+    ));
+    let e = fails(&format!("{HEADER}4 PLANE AXIAL B+30 TURN FMAX\n"));
+    assert!(e.contains(":5:") && e.contains("PLANE AXIAL"), "{e}");
+}
+
+/// A cycle 200 of hand-computed moves: surface 0, clearance 2, depth −10 in infeeds of 4,
+/// feed 120 mm/min, dwell 0.5 s at the top and 1.5 s at the depth, 2nd clearance 20.
+const DRILL_NEW: &str = "5 CYCL DEF 200 DRILLING ~\n  Q200=+2 ;SET-UP CLEARANCE ~\n\
+                         Q201=-10 ;DEPTH ~\n  Q206=+120 ;FEED RATE FOR PLNGNG ~\n\
+                         Q202=+4 ;PLUNGING DEPTH ~\n  Q210=+0.5 ;DWELL TIME AT TOP ~\n\
+                         Q203=+0 ;SURFACE COORDINATE ~\n  Q204=+20 ;2ND SET-UP CLEARANCE ~\n\
+                         Q211=+1.5 ;DWELL TIME AT DEPTH\n";
+const DRILL_OLD: &str = "5 CYCL DEF 200 DRILLING\n  Q200=2 ;SET-UP CLEARANCE\n\
+                         Q201=-10 ;DEPTH\n  Q206=120 ;FEED RATE FOR PLUNGING\n\
+                         Q202=4 ;PLUNGING DEPTH\n  Q210=0.5 ;DWELL TIME AT TOP\n\
+                         Q203=0 ;SURFACE COORDINATE\n  Q204=20 ;2ND SET-UP CLEARANCE\n\
+                         Q211=1.5 ;DWELL TIME AT DEPTH\n";
+
+#[test]
+fn cycle_200_expands_into_its_moves_and_dwells() {
+    for def in [DRILL_NEW, DRILL_OLD] {
+        let tp = read(&format!(
+            "{HEADER}4 L X+10 Y+10 Z+50 R0 FMAX\n{def}20 CYCL CALL\n21 L X+30 Y+10 FMAX M99\n"
+        ));
+        // Z: rapid to 2; feed to −4; rapid to 2, dwell; rapid to −2; feed to −8; rapid to 2,
+        // dwell; rapid to −6; feed to −10; dwell 1.5; rapid to 0 + max(2, 20).
+        let hole = [2.0, -4.0, 2.0, -2.0, -8.0, 2.0, -6.0, -10.0, 20.0];
+        let z: Vec<f64> = tp.points[1..10].iter().map(|p| p.p.z).collect();
+        assert_eq!(z, hole, "{def}");
+        let feeds: Vec<bool> = tp.points[1..10]
+            .iter()
+            .map(|p| p.feed == Feed::Programmed(2.0))
+            .collect();
+        assert_eq!(
+            feeds,
+            [false, true, false, false, true, false, false, true, false]
+        );
+        // M99 after the move: the same hole at X 30.
+        assert_eq!(tp.points[10].p, v(30.0, 10.0, 20.0));
+        let z2: Vec<f64> = tp.points[11..].iter().map(|p| p.p.z).collect();
+        assert_eq!(z2, hole);
+        // Per hole: 6 + 6 + 4 mm at 2 mm/s and 0.5 + 0.5 + 1.5 s of dwell.
+        assert!(
+            (feed_time(&tp) - 2.0 * 8.0).abs() < 1e-9,
+            "{}",
+            feed_time(&tp)
+        );
+        assert!(
+            (tp.dwell_time() - 2.0 * 2.5).abs() < 1e-12,
+            "{:?}",
+            tp.dwells
+        );
+    }
+}
+
+#[test]
+fn cycle_call_pat_drills_every_pattern_point() {
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 R0 FMAX\n{DRILL_NEW}20 PATTERN DEF ~\n  POS1 (X+10 Y+10 Z+0) ~\n\
+         POS2 (X+20 IY+5 Z-1)\n21 CYCL CALL PAT FMAX M13\n"
+    ));
+    let bottoms: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.feed == Feed::Programmed(2.0) && (p.p.z == -10.0 || p.p.z == -11.0))
+        .map(|p| p.p)
+        .collect();
+    assert_eq!(bottoms, [v(10.0, 10.0, -10.0), v(20.0, 15.0, -11.0)]);
+    // Between the points, at the 2nd set-up clearance of the first (0 + 20).
+    assert!(tp.points.iter().any(|p| p.p == v(20.0, 15.0, 20.0)));
+}
+
+#[test]
+fn cycle_203_with_chip_breaking_and_207_tapping() {
+    // 203: infeeds 4, 3, 3 (decrement 1, minimum 3) to −10; one chip break (retract 0.5 at
+    // rapid) before every full retract (at Q208 = 600 mm/min).
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+10 R0 FMAX\n5 CYCL DEF 203 UNIVERSAL DRILLING ~\n Q200=+2 ~\n\
+         Q201=-10 ~\n Q206=+120 ~\n Q202=+4 ~\n Q210=+0 ~\n Q203=+0 ~\n Q204=+5 ~\n Q212=+1 ~\n\
+         Q213=+1 ~\n Q205=+3 ~\n Q211=+0 ~\n Q208=+600 ~\n Q256=+0.5\n6 CYCL CALL\n"
+    ));
+    let z: Vec<f64> = tp.points[1..].iter().map(|p| p.p.z).collect();
+    assert_eq!(z, [2.0, -4.0, -3.5, -7.0, 2.0, -5.0, -10.0, 2.0, 5.0]);
+    assert_eq!(
+        tp.points[5].feed,
+        Feed::Programmed(10.0),
+        "full retract at Q208"
+    );
+    // 207: feed = pitch 1.5 × S 1000 = 1500 mm/min in and out.
+    let tp = read(
+        "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
+         3 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3 ;SET-UP CLEARANCE~\n Q201=-12 ;DEPTH~\n\
+         Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n Q204=5 ;2ND SET-UP CLEARANCE\n\
+         4 L X+0 Y+0 R0 F MAX M99\n",
+    );
+    // (The positioning block moves nothing: the tool is there already.)
+    let z: Vec<(f64, Feed)> = tp.points[2..].iter().map(|p| (p.p.z, p.feed)).collect();
+    assert_eq!(
+        z,
+        [
+            (3.0, Feed::Rapid),
+            (-12.0, Feed::Programmed(25.0)),
+            (3.0, Feed::Programmed(25.0)),
+            (5.0, Feed::Rapid)
+        ]
+    );
+    // A cycle feedopt cannot expand: defined with a warning, called with an error.
+    let e = fails(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n Q200=3~\n\
+         Q201=-85\n6 L X+0 Y+0 FMAX M99\n"
+    ));
+    assert!(e.contains(":9:") && e.contains("cycle 241"), "{e}");
+}
+
+#[test]
+fn labels_repeat_sections_and_call_subprograms() {
+    let tp = read(
+        "0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 LBL 1\n3 L IX+10\n4 CALL LBL 1 REP 2/2\n\
+         5 L Y+5\n6 CALL LBL \"Down\"\n7 L X+0\n8 M30\n9 LBL \"Down\"\n10 L IZ-1\n11 LBL 0\n\
+         12 END PGM R MM\n",
+    );
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    // The section runs once, then twice more (REP 2); the subprogram once, then back.
+    assert_eq!(
+        p,
+        [
+            v(0.0, 0.0, 0.0),
+            v(10.0, 0.0, 0.0),
+            v(20.0, 0.0, 0.0),
+            v(30.0, 0.0, 0.0),
+            v(30.0, 5.0, 0.0),
+            v(30.0, 5.0, -1.0),
+            v(0.0, 5.0, -1.0),
+        ]
+    );
+    assert_eq!(tp.points[5].line, 11, "the subprogram's own line");
+    // FN 9–12 jumps with Q parameters: a counted loop of three.
+    let tp = read(
+        "0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 FN 0: Q1 = +0\n3 LBL 2\n4 L IX+1\n\
+         5 FN 1: Q1 = +Q1 + +1\n6 FN 12: IF +Q1 LT +3 GOTO LBL 2\n7 END PGM R MM\n",
+    );
+    assert_eq!(tp.points.last().map(|p| p.p), Some(v(3.0, 0.0, 0.0)));
+    assert_eq!(tp.points.len(), 4);
+    // A loop that never ends is an error, not a hang; so is a call of a missing label.
+    let e =
+        fails("0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 LBL 3\n3 FN 9: IF +0 EQU +0 GOTO LBL 3\n");
+    assert!(e.contains("more than"), "{e}");
+    let e = fails("0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 CALL LBL 9\n");
+    assert!(e.contains(":3:") && e.contains("LBL 9"), "{e}");
+}
+
+#[test]
+fn detected_by_extension_h_and_by_content() {
+    let opts = ReadOptions::default();
+    let body = "L X+0 Y+0 Z+0 FMAX\nL X+10 F100\n";
+    let d = toolpath::detect(Path::new("part.H"), body, &opts).unwrap();
+    assert_eq!(
+        (d.format, d.dialect, d.dialect_by),
+        (Format::Gcode, Some(Dialect::Heidenhain), "extension")
+    );
+    let text = format!("; a comment first\n0  BEGIN PGM part MM\n1 {body}");
+    for name in ["part.nc", "part.txt", "part.prg"] {
+        let d = toolpath::detect(Path::new(name), &text, &opts).unwrap();
+        assert_eq!(d.format, Format::Gcode, "{name}");
+        assert_eq!(
+            (d.dialect, d.dialect_by),
+            (Some(Dialect::Heidenhain), "content"),
+            "{name}"
+        );
+    }
+    // Read from a file with the defaults.
+    let dir = std::env::temp_dir().join(format!("feedopt-heidenhain-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("part.h");
+    std::fs::write(
+        &file,
+        format!("{HEADER}4 L X+0 Y+0 Z+0 FMAX\n5 L X+10 F100\n6 END PGM T MM\n"),
+    )
+    .unwrap();
+    let tp = toolpath::read(&file).unwrap();
+    assert_eq!(tp.points.len(), 2);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(
+        "heidenhain".parse::<Dialect>().unwrap(),
+        Dialect::Heidenhain
+    );
+}
+
+#[test]
+fn an_unknown_word_is_an_error_naming_line_and_word() {
+    let e = fails(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+0 FMAX\n5 L X+10 FOO+3 F100\n"
+    ));
+    assert!(e.contains(":6:") && e.contains("FOO+3"), "{e}");
+    let e = fails(&format!("{HEADER}4 X+10\n"));
+    assert!(e.contains(":5:") && e.contains("path function"), "{e}");
+    let e = fails(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+0 F100\n5 L X+10\n6 RND R2\n7 L Y+10\n"
+    ));
+    assert!(e.contains(":7:") && e.contains("RND"), "{e}");
+    let e = fails(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+0 F100\n5 APPR LT X+10 Y+0 LEN5 RL\n"
+    ));
+    assert!(e.contains(":6:") && e.contains("APPR"), "{e}");
+    let e = fails(&format!("{HEADER}4 L X+Q7 Y+0 Z+0 F100\n"));
+    assert!(e.contains(":5:") && e.contains("Q7"), "{e}");
+    // Paraxial compensation lengthens the move by the tool radius: not the path as written.
+    let e = fails(&format!("{HEADER}4 L X+0 Y+0 Z+0 F100\n5 L X+10 R+ F100\n"));
+    assert!(e.contains(":6:") && e.contains("R+"), "{e}");
+}
+
+#[test]
+fn m140_mb_max_retracts_to_the_z_travel_limit() {
+    let m = common::machine(
+        r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                     "Y": {"velocity": 400, "acceleration": 2000},
+                     "Z": {"velocity": 400, "acceleration": 2000, "min": -400, "max": 120}}}"#,
+    );
+    let ctx = MachineContext::new(&m, &feedopt::machine::References::default());
+    let text =
+        format!("{HEADER}4 L X+5 Y+5 Z+2 FMAX\n5 L M140 MB MAX\n6 L X+10 Y+0 FMAX\n7 M140 MB 20\n");
+    let tp = parse_for(
+        Path::new("t.h"),
+        &text,
+        Dialect::Heidenhain.spec(),
+        Some(&ctx),
+    )
+    .unwrap();
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(
+        p,
+        [
+            v(5.0, 5.0, 2.0),
+            v(5.0, 5.0, 120.0),
+            v(10.0, 0.0, 120.0),
+            v(10.0, 0.0, 140.0)
+        ]
+    );
+    // Without the travel: an error naming the field to add.
+    let e = parse(Path::new("t.h"), &text, Dialect::Heidenhain)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(":6:") && e.contains("axes.Z"), "{e}");
+}
+
+/// The Klartext seed of `reader_fuzz.rs`: every construct in one program.
+const EVERYTHING: &str = "0 BEGIN PGM F MM\n1 BLK FORM 0.1 Z X+0 Y+0 Z-20\n2 TOOL CALL 1 Z S5000 F800\n\
+     3 L X+0 Y+0 Z+5 R0 FMAX M3\n4 CC X+10 Y+0\n5 C X+20 Y+0 DR+ F600\n6 CR X+30 Y+10 R+10 DR-\n\
+     7 CT X+40 Y+0\n8 CC Y+0 Z+0\n9 CP IPA+720 IX-2 DR+\n10 LP PR+5 PA+30\n11 L IX+5 F MAX\n\
+     12 FN 0: Q1 = +3\n13 Q2 = Q1 * 2\n14 L X+Q2 FAUTO\n15 M128\n\
+     16 LN X+1 Y+2 Z+3 NX+0 NY+0 NZ+1 TX+0 TY-0.5 TZ+0.866 F500\n17 M129\n\
+     18 CYCL DEF 7.0 DATUM SHIFT\n19 CYCL DEF 7.1 X+10\n\
+     20 PLANE SPATIAL SPA+0 SPB+45 SPC+0 TURN MB 50 FMAX\n21 L A+Q120 C+Q122 FMAX\n\
+     22 CYCL DEF 200 DRILLING ~\n  Q200=+2 ;A ~\n  Q201=-10 ;B ~\n  Q206=+100 ~\n  Q202=+3 ~\n\
+     Q203=+0 ~\n  Q204=+20\n23 L X+0 Y+0 FMAX M99\n24 PATTERN DEF ~\n  POS1 (X+1 Y+1 Z+0)\n\
+     25 CYCL CALL PAT\n26 PLANE RESET STAY\n27 LBL 1\n28 L IX+1\n29 CALL LBL 1 REP 3/3\n\
+     30 FN 9: IF +Q1 EQU +3 GOTO LBL 2\n31 LBL 2\n32 CALL LBL 5\n33 M140 MB 10\n34 M30\n\
+     35 LBL 5\n36 CYCL DEF 9.0 DWELL TIME\n37 CYCL DEF 9.1 DWELL 1.5\n38 LBL 0\n39 END PGM F MM\n";
+
+#[test]
+fn a_program_with_every_construct_reads() {
+    let tp = read(EVERYTHING);
+    // Cycle 9's 1.5 s in the subprogram; cycle 200 has no dwells.
+    assert!((tp.dwell_time() - 1.5).abs() < 1e-12, "{:?}", tp.dwells);
+    // The section repeat: LBL 1 … CALL LBL 1 REP 3 moves +1 in X four times.
+    let repeat: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 36).collect();
+    assert_eq!(repeat.len(), 4);
+    assert!(tp.points.len() > 100);
+}
