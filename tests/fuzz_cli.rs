@@ -207,6 +207,16 @@ fn fuzz_long() {
     c.assert_clean(&out);
 }
 
+/// Prints the targets' names, one per line (`fuzz-target <name>`), for
+/// `benches/fuzz_long.sh`.
+#[test]
+#[ignore = "lists the fuzz targets for benches/fuzz_long.sh"]
+fn fuzz_list_targets() {
+    for t in fuzz::targets() {
+        println!("fuzz-target {}", t.name);
+    }
+}
+
 /// The target list: every dialect has its target, names select, unknown names are refused
 /// with the list of names.
 #[test]

@@ -30,91 +30,43 @@ pub struct Seed {
     pub dialect: Option<Dialect>,
 }
 
-/// A G-code dialect's row: the dialect, hand-made programs, the machine file they run on,
-/// and words and lines of the dialect beyond its table (constructs with arguments).
+/// A G-code dialect's row: the dialect, the extension of its programs, hand-made programs,
+/// the machine file they run on, and words and lines of the dialect beyond its table
+/// (constructs with arguments).
 pub type DialectRow = (
     Dialect,
+    &'static str,
     &'static [&'static str],
     &'static str,
     &'static [&'static str],
 );
 
 /// Every dialect fuzzed, one row each. Adding a dialect to [`Dialect::ALL`] adds its target
-/// `gcode-<name>`; the row gives it seeds (without one the short run fails and says so).
+/// `gcode-<name>`; its row here gives it seeds (without one the short run fails and says so),
+/// and its real programs are rows of [`SHARED`].
+#[rustfmt::skip]
 pub const DIALECTS: &[DialectRow] = &[
-    (
-        Dialect::LinuxCnc,
-        LINUXCNC_PROGRAMS,
-        TRUNNION_AC,
-        LINUXCNC_WORDS,
-    ),
-    (Dialect::Fanuc, FANUC_PROGRAMS, TRUNNION_BC, FANUC_WORDS),
-    (
-        Dialect::Sinumerik,
-        SINUMERIK_PROGRAMS,
-        TRUNNION_BC,
-        SINUMERIK_WORDS,
-    ),
+    (Dialect::LinuxCnc, "ngc", LINUXCNC_PROGRAMS, TRUNNION_AC, LINUXCNC_WORDS),
+    (Dialect::Fanuc, "nc", FANUC_PROGRAMS, TRUNNION_BC, FANUC_WORDS),
+    (Dialect::Sinumerik, "mpf", SINUMERIK_PROGRAMS, TRUNNION_BC, SINUMERIK_WORDS),
 ];
 
-/// Real programs under `../shared`: (program, machine file, reader: a dialect name or `apt`).
-/// Machine files without `reference` positions get `[0, 0]` on every axis (G28/G30 need them).
+/// Real programs under `../shared`: (program, machine file, reader: a dialect name or `apt`),
+/// the machine files `realworld/cam/README.md` names. Machine files without `reference`
+/// positions get `[0, 0]` on every axis (G28/G30 need them).
+#[rustfmt::skip]
 pub const SHARED: &[(&str, &str, &str)] = &[
-    (
-        "realworld/cam/elmoe_keychain.mpf",
-        "realworld/cam/machines/trt_bc_spinner_u5.json",
-        "sinumerik",
-    ),
-    (
-        "realworld/cam/nx_dmu70evo_840d.mpf",
-        "realworld/cam/machines/headtable_dmu70.json",
-        "sinumerik",
-    ),
-    (
-        "realworld/cam/nx_mori_nmv5000_mm.nc",
-        "realworld/cam/machines/trt_bc_mori_nmv5000.json",
-        "fanuc",
-    ),
-    (
-        "realworld/cam/nx_roeders_rfm600_finish.nc",
-        "realworld/cam/machines/xyz_mill.json",
-        "fanuc",
-    ),
-    (
-        "realworld/linuxcnc/boat-xyzac.ngc",
-        "realworld/linuxcnc/boat-xyzac.machine.json",
-        "linuxcnc",
-    ),
-    (
-        "realworld/linuxcnc/boat-xyzbc.ngc",
-        "realworld/linuxcnc/boat-xyzbc.machine.json",
-        "linuxcnc",
-    ),
-    (
-        "realworld/linuxcnc/impeller-7bl-xyzac.ngc",
-        "realworld/linuxcnc/impeller-7bl-xyzac.machine.json",
-        "linuxcnc",
-    ),
-    (
-        "realworld/cam/camotics_bear.nc",
-        "realworld/cam/machines/xyz_mill.json",
-        "linuxcnc",
-    ),
-    (
-        "realworld/cam/camotics_flower_mold.nc",
-        "realworld/cam/machines/xyz_mill.json",
-        "linuxcnc",
-    ),
-    (
-        "realworld/cam/aamorim_boss.apt",
-        "realworld/cam/machines/xyz_mill.json",
-        "apt",
-    ),
-    (
-        "realworld/cam/aamorim_basemach.apt",
-        "realworld/cam/machines/xyz_mill.json",
-        "apt",
-    ),
+    ("realworld/cam/elmoe_keychain.mpf", "realworld/cam/machines/trt_bc_spinner_u5.json", "sinumerik"),
+    ("realworld/cam/nx_dmu70evo_840d.mpf", "realworld/cam/machines/headtable_dmu70.json", "sinumerik"),
+    ("realworld/cam/nx_mori_nmv5000_mm.nc", "realworld/cam/machines/trt_bc_mori_nmv5000.json", "fanuc"),
+    ("realworld/cam/nx_roeders_rfm600_finish.nc", "realworld/cam/machines/xyz_mill.json", "fanuc"),
+    ("realworld/linuxcnc/boat-xyzac.ngc", "realworld/linuxcnc/boat-xyzac.machine.json", "linuxcnc"),
+    ("realworld/linuxcnc/boat-xyzbc.ngc", "realworld/linuxcnc/boat-xyzbc.machine.json", "linuxcnc"),
+    ("realworld/linuxcnc/impeller-7bl-xyzac.ngc", "realworld/linuxcnc/impeller-7bl-xyzac.machine.json", "linuxcnc"),
+    ("realworld/cam/camotics_bear.nc", "realworld/cam/machines/xyz_mill.json", "linuxcnc"),
+    ("realworld/cam/camotics_flower_mold.nc", "realworld/cam/machines/xyz_mill.json", "linuxcnc"),
+    ("realworld/cam/aamorim_boss.apt", "realworld/cam/machines/xyz_mill.json", "apt"),
+    ("realworld/cam/aamorim_basemach.apt", "realworld/cam/machines/xyz_mill.json", "apt"),
 ];
 
 // ---------------------------------------------------------------------------------------------
@@ -811,12 +763,8 @@ pub fn dialect_row(dialect: Dialect) -> Option<&'static DialectRow> {
 
 /// The seeds of the G-code target of `dialect` (empty when it has no row).
 pub fn gcode(dialect: Dialect, shared: bool) -> Vec<Seed> {
-    let Some(&(_, programs, machine, _)) = dialect_row(dialect) else {
+    let Some(&(_, ext, programs, machine, _)) = dialect_row(dialect) else {
         return Vec::new();
-    };
-    let ext = match dialect {
-        Dialect::Sinumerik => "mpf",
-        _ => "nc",
     };
     let mut out: Vec<Seed> = programs
         .iter()
@@ -943,7 +891,7 @@ pub fn gcode_vocabulary(dialect: Dialect) -> Vocabulary {
             words.push(letter.to_string());
         }
     }
-    let extra = dialect_row(dialect).map_or(&[][..], |r| r.3);
+    let extra = dialect_row(dialect).map_or(&[][..], |r| r.4);
     words.extend(extra.iter().map(|w| w.to_string()));
     Vocabulary {
         lines: extra.iter().map(|w| w.to_string()).collect(),

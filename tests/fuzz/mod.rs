@@ -884,7 +884,7 @@ impl Campaign {
             }
         );
         out.push_str(&format!(
-            "  {:<16} {:>9} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>9} {:>8}\n",
+            "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8} {:>11} {:>10} {:>8} {:>8}\n",
             "target",
             "cases",
             "errors",
@@ -892,13 +892,14 @@ impl Campaign {
             "kinds",
             "seeds",
             "mean ms",
+            "mean CPU ms",
             "slowest ms",
             "CPU s",
             "wall s"
         ));
         for (t, f) in figures {
             out.push_str(&format!(
-                "  {:<16} {:>9} {:>9} {:>8} {:>7} {:>9} {:>9.3} {:>10.1} {:>9.1} {:>8.1}\n",
+                "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8.3} {:>11.3} {:>10.1} {:>8.1} {:>8.1}\n",
                 t,
                 f.cases,
                 f.errors,
@@ -906,6 +907,7 @@ impl Campaign {
                 f.kinds.len(),
                 format!("{}/{}", f.seeds - f.seed_errors, f.seeds),
                 f.total.as_secs_f64() * 1e3 / f.cases.max(1) as f64,
+                f.cpu_s * 1e3 / f.cases.max(1) as f64,
                 f.slowest.as_secs_f64() * 1e3,
                 f.cpu_s,
                 f.wall_s
@@ -916,8 +918,9 @@ impl Campaign {
         }
         out.push_str(
             "  (errors: cases that ended in one clean error line; kinds: distinct error \
-             messages without numbers and quoted text; seeds: read cleanly / all; CPU s: this \
-             process, and for solve its feedopt children too)\n",
+             messages without numbers and quoted text; seeds: read cleanly / run; mean and \
+             slowest ms: wall time of a case; CPU: this process, and for solve its feedopt \
+             children too)\n",
         );
         out
     }
