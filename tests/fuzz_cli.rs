@@ -85,6 +85,7 @@ fn short(seed: u64, shared: bool, cases: u64, solves: u64) -> Campaign {
     let mut c = Campaign::new(Settings {
         seed,
         shared,
+        structure_aware: true,
         parse_bound: PARSE_BOUND,
         solve_bound: SHORT_SOLVE_BOUND,
         work: dir.path().to_path_buf(),
@@ -194,6 +195,7 @@ fn fuzz_long() {
     let mut c = Campaign::new(Settings {
         seed: env_f64("FEEDOPT_FUZZ_SEED").map_or(2, |s| s as u64),
         shared: cfg!(shared_data),
+        structure_aware: true,
         parse_bound: PARSE_BOUND,
         solve_bound: env_f64("FEEDOPT_FUZZ_BOUND_S").map_or(SOLVE_BOUND, Duration::from_secs_f64),
         work: out.clone(),
@@ -205,6 +207,57 @@ fn fuzz_long() {
     }
     eprint!("{}", c.table("long"));
     c.assert_clean(&out);
+}
+
+/// Structure-aware mutations reach more of the G-code reader than blind ones: from the same
+/// hand-made seeds, over the same number of cases, they meet more kinds of error (each kind a
+/// different check of the reader), and at least as many of their programs are read to the end
+/// (seed 5, 400 cases: 45 against 37 kinds on LinuxCNC, 47/31 Fanuc, 53/43 Sinumerik; 102/95,
+/// 122/100 and 148/126 read).
+#[test]
+fn structure_aware_mutations_reach_deeper_than_blind_ones() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |target: &fuzz::Target, structure_aware: bool| {
+        let mut c = Campaign::new(Settings {
+            seed: 5,
+            shared: false,
+            structure_aware,
+            parse_bound: PARSE_BOUND,
+            solve_bound: SHORT_SOLVE_BOUND,
+            work: dir.path().to_path_buf(),
+            out: None,
+        });
+        let budget = Budget {
+            cases: Some(400),
+            ..Budget::default()
+        };
+        c.run(target, &budget);
+        c.assert_clean(&repo("target/fuzz-failures"));
+        c.figures.pop().expect("ran").1
+    };
+    for t in fuzz::targets() {
+        let Kind::Gcode(_) = t.kind else { continue };
+        let (aware, blind) = (run(&t, true), run(&t, false));
+        let read = |f: &fuzz::Figures| f.cases - f.errors;
+        eprintln!(
+            "{}: structure-aware {} kinds of error, {} of {} read; blind {} kinds, {} read",
+            t.name,
+            aware.kinds.len(),
+            read(&aware),
+            aware.cases,
+            blind.kinds.len(),
+            read(&blind)
+        );
+        assert!(
+            aware.kinds.len() > blind.kinds.len() && read(&aware) >= read(&blind),
+            "{}: structure-aware {} kinds of error and {} programs read, blind {} and {}",
+            t.name,
+            aware.kinds.len(),
+            read(&aware),
+            blind.kinds.len(),
+            read(&blind)
+        );
+    }
 }
 
 /// Prints the targets' names, one per line (`fuzz-target <name>`), for

@@ -178,10 +178,11 @@ fn bounded<T: Send + 'static>(
     }
 }
 
-/// The kind of an error message: without the file, numbers and quoted text, so that the
-/// number of kinds seen says how many different checks the mutations reached.
+/// The kind of an error message: what follows the file's name, without numbers and quoted
+/// text, so that the number of kinds seen says how many different checks the mutations
+/// reached.
 fn kind_of(msg: &str, file: &str) -> String {
-    let msg = msg.replace(file, "");
+    let msg = msg.rfind(file).map_or(msg, |i| &msg[i + file.len()..]);
     let mut out = String::new();
     let mut quoted = false;
     let mut last_digit = false;
@@ -543,6 +544,9 @@ pub struct Settings {
     pub seed: u64,
     /// Add the excerpts of `../shared` to the corpora.
     pub shared: bool,
+    /// Use the structure-aware mutations (words, constructs, records, keys, columns); without,
+    /// only the blind ones (bytes, lines, numbers, splices).
+    pub structure_aware: bool,
     /// Time bound of one in-process read.
     pub parse_bound: Duration,
     /// Time bound of one `feedopt solve`.
@@ -623,12 +627,17 @@ impl Campaign {
     /// The seeds and mutation vocabulary of a target.
     fn corpus(&self, kind: Kind) -> (Vec<Seed>, Vocabulary) {
         let shared = self.settings.shared;
-        match kind {
+        let (seeds, vocabulary) = match kind {
             Kind::Apt => (corpus::apt(shared), corpus::apt_vocabulary()),
             Kind::Gcode(d) => (corpus::gcode(d, shared), corpus::gcode_vocabulary(d)),
             Kind::Machine => (corpus::machines(shared), corpus::machine_vocabulary()),
             Kind::JointCsv => (corpus::joint_csv_seeds(), corpus::csv_vocabulary()),
             Kind::Solve => (corpus::solves(shared, 120), Vocabulary::default()),
+        };
+        if self.settings.structure_aware {
+            (seeds, vocabulary)
+        } else {
+            (seeds, Vocabulary::default())
         }
     }
 
@@ -687,11 +696,23 @@ impl Campaign {
             };
             let seed = &seeds[k];
             if self.settings.out.is_some() {
+                let input = match target.kind {
+                    Kind::Machine => "machine.json".to_string(),
+                    Kind::Solve => format!(
+                        "path.{} and machine.json, with the arguments `feedopt solve --stations \
+                         50 --json -m machine.json path.{} -o out.csv` and --solver, --dialect \
+                         or --no-jerk (either file may be mutated)",
+                        seed.ext, seed.ext
+                    ),
+                    _ => format!(
+                        "path.{} (read with the context of the seed's machine file, or none)",
+                        seed.ext
+                    ),
+                };
                 let _ = std::fs::write(
                     work.join("CASE.txt"),
                     format!(
-                        "target {}, case {case}, seed {:?}, mutation: {how}\n(the input is the \
-                         other file of this folder)\n",
+                        "target {}, case {case}, seed {:?}, mutation: {how}\ninput: {input}\n",
                         target.name, seed.name
                     ),
                 );
@@ -804,11 +825,13 @@ impl Campaign {
                 (machine_case(work.join("machine.json"), text, bound), files)
             }
             Kind::Solve => {
-                // Mutate the toolpath, the machine, or both (`text` is the mutated toolpath).
-                let (machine, toolpath, how) = match rng.below(3) {
+                // Mutate the toolpath (three times in five), the machine, or both (`text` is
+                // the mutated toolpath). Most mutated machine files are not JSON any more and
+                // end the solve at once, so the toolpath gets most of the cases.
+                let (machine, toolpath, how) = match rng.below(5) {
                     _ if pristine => (seed.machine.clone(), text, "nothing"),
-                    0 => (seed.machine.clone(), text, "toolpath"),
-                    1 => {
+                    0..=2 => (seed.machine.clone(), text, "toolpath"),
+                    3 => {
                         let (m, _) = mutate(rng, &seed.machine, &corpus::machine_vocabulary(), &[]);
                         (m, seed.text.clone(), "machine")
                     }
