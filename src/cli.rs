@@ -481,6 +481,11 @@ fn apply_material(
         return Ok(None);
     }
     let spec = material::from_machine_file(machine_file)?;
+    if !given && spec.is_none_or(|s| s.stock.is_none()) {
+        // No stock, no material stage: the program is not scanned for tools (a program with
+        // several cutters solves as before).
+        return Ok(None);
+    }
     let toolpath::Input::Cl(tp) = input else {
         if spec.is_some_and(|s| s.stock.is_some()) || given {
             return Err(Error::Usage(format!(
