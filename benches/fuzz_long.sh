@@ -17,9 +17,10 @@
 #
 # Writes target/fuzz-long/<target>/: figures.txt (cases, clean errors, failures, kinds of
 # error, seeds read cleanly, mean and slowest ms, CPU and wall seconds), log.txt,
-# failures/case-<n>/ (each failing input with WHAT.txt) and work/ (the last case; after an
-# abort, CASE.txt names the case that caused it). Prints every target's figures at the end,
-# also to target/fuzz-long/summary.txt. Exit status 1 when any target failed or died.
+# failures/case-<n>/ (each failing input with WHAT.txt) and work/ (the last case, copied from
+# the scratch folder on /dev/shm where the cases are written; after an abort, CASE.txt names
+# the case that caused it). Prints every target's figures at the end, also to
+# target/fuzz-long/summary.txt. Exit status 1 when any target failed or died.
 #
 # FUZZ_SEED (default 2) chooses the cases; FUZZ_BOUND_S (default 10) bounds one solve. With
 # ../shared beside the crate (when built), the corpora include excerpts of its real programs.
@@ -44,6 +45,10 @@ fi
 [ ${#targets[@]} -gt 0 ] || { echo "fuzz_long.sh: no targets" >&2; exit 2; }
 
 mkdir -p "$out"
+shm=/dev/shm
+[ -d "$shm" ] && [ -w "$shm" ] || shm=${TMPDIR:-/tmp}
+work=$(mktemp -d -p "$shm" feedopt-fuzz.XXXXXX)
+trap 'rm -rf "$work"' EXIT
 status=0
 summary=()
 for t in "${targets[@]}"; do
@@ -55,11 +60,14 @@ for t in "${targets[@]}"; do
   (
     ulimit -v $((mem_gb * 1024 * 1024))
     FEEDOPT_FUZZ_TARGET=$t FEEDOPT_FUZZ_CPU_MINUTES=$minutes FEEDOPT_FUZZ_OUT=$out \
+      FEEDOPT_FUZZ_WORK=$work \
       FEEDOPT_FUZZ_SEED=${FUZZ_SEED:-2} FEEDOPT_FUZZ_BOUND_S=${FUZZ_BOUND_S:-10} \
       nice -n 19 "$bin" --ignored --exact fuzz_long --nocapture --test-threads 1
   ) > "$dir/log.txt" 2>&1
   rc=$?
   set -e
+  cp -r "$work/$t/work" "$dir/" 2> /dev/null || true
+  rm -rf "${work:?}/$t"
   if [ $rc -eq 0 ]; then
     verdict="clean"
   elif [ -d "$dir/failures" ]; then

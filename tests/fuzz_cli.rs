@@ -50,9 +50,10 @@
 //!   of one solve (default 10 s, the acceptance); a read is bounded by 5 s.
 //! - `FEEDOPT_FUZZ_OUT` (default `target/fuzz-long`): per target, `figures.txt` (cases, clean
 //!   errors, failures, kinds of error, seeds read cleanly, mean and slowest ms, CPU and wall
-//!   seconds), `failures/case-<n>/` (the inputs and `WHAT.txt`, saved as they are found) and
-//!   `work/` (the case running now, described in `CASE.txt`: after an abort, the input that
-//!   caused it).
+//!   seconds) and `failures/case-<n>/` (the inputs and `WHAT.txt`, saved as they are found).
+//! - `FEEDOPT_FUZZ_WORK` (default: a new folder in `/dev/shm`, printed at the start): where
+//!   the cases' files are written; `<work>/<target>/work/` holds the case running now,
+//!   described in `CASE.txt` (after an abort, the input that caused it).
 //!
 //! A case that hangs in-process stops its target (its thread cannot be stopped and would
 //! skew the rest). The short runs save failing inputs under `target/fuzz-failures/`.
@@ -81,7 +82,7 @@ fn repo(p: &str) -> PathBuf {
 
 /// A short campaign over every target: `cases` cases per reader target, `solves` solves.
 fn short(seed: u64, shared: bool, cases: u64, solves: u64) -> Campaign {
-    let dir = tempfile::tempdir().expect("temp dir");
+    let dir = fuzz::scratch_dir();
     let mut c = Campaign::new(Settings {
         seed,
         shared,
@@ -196,13 +197,19 @@ fn fuzz_long() {
     let out = std::env::var_os("FEEDOPT_FUZZ_OUT")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo("target/fuzz-long"));
+    // The scratch folder is kept (an abort leaves its last case there), unless it is ours and
+    // the run ends.
+    let scratch = fuzz::scratch_dir();
+    let work =
+        std::env::var_os("FEEDOPT_FUZZ_WORK").map_or_else(|| scratch.path().into(), PathBuf::from);
+    eprintln!("fuzz: the cases are written to {}", work.display());
     let mut c = Campaign::new(Settings {
         seed: env_f64("FEEDOPT_FUZZ_SEED").map_or(2, |s| s as u64),
         shared: cfg!(shared_data),
         structure_aware: true,
         parse_bound: PARSE_BOUND,
         solve_bound: env_f64("FEEDOPT_FUZZ_BOUND_S").map_or(SOLVE_BOUND, Duration::from_secs_f64),
-        work: out.clone(),
+        work,
         out: Some(out.clone()),
     });
     for t in &targets {
@@ -221,7 +228,7 @@ fn fuzz_long() {
 /// are fixed-form, so most inserted words end a program in an error (71 against 53 kinds).
 #[test]
 fn structure_aware_mutations_reach_deeper_than_blind_ones() {
-    let dir = tempfile::tempdir().expect("temp dir");
+    let dir = fuzz::scratch_dir();
     let run = |target: &fuzz::Target, structure_aware: bool| {
         let mut c = Campaign::new(Settings {
             seed: 5,

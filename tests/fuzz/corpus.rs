@@ -120,7 +120,7 @@ pub const JOINT_MACHINE_3: &str = r#"{"name": "three joints", "kinematics": {"ty
           "j3": {"velocity": [-1, 3], "acceleration": [-4, 6], "jerk": [-40, 60]}}}
 "#;
 
-/// A head/table machine (the APT hand-made seed's), with a dresser-free pivot.
+/// A B head on a C table (the machine of the hand-made APT seed).
 pub const HEAD_TABLE: &str = r#"{
   "name": "B head + C table",
   "kinematics": {"type": "head_table", "pivot_length": 150},

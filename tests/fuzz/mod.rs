@@ -93,6 +93,19 @@ pub fn select(list: &str) -> Result<Vec<Target>, String> {
         .collect()
 }
 
+/// A scratch folder for the cases' files: on tmpfs (`/dev/shm`) where there is one. Every case
+/// writes its input over the last one's, and on ext4 that replacement (a truncation: a
+/// write-back and a discard of the old blocks on close) took about 40 % of a small case's CPU
+/// time.
+pub fn scratch_dir() -> tempfile::TempDir {
+    let shm = Path::new("/dev/shm");
+    let b = tempfile::Builder::new()
+        .prefix("feedopt-fuzz-")
+        .tempdir_in(shm);
+    b.or_else(|_| tempfile::tempdir())
+        .expect("a scratch folder")
+}
+
 // ---------------------------------------------------------------------------------------------
 // CPU time
 // ---------------------------------------------------------------------------------------------
@@ -151,29 +164,54 @@ pub enum Outcome {
     Hung(String),
 }
 
-/// Runs `f` on its own thread under `bound`: `Err(Outcome)` on a panic or a hang (the hung
-/// thread is left behind: the caller stops the target).
-fn bounded<T: Send + 'static>(
-    bound: Duration,
-    f: impl FnOnce() -> T + Send + 'static,
-) -> Result<T, Outcome> {
-    let (tx, rx) = mpsc::channel();
-    let handle = std::thread::spawn(move || {
-        let r = f();
-        let _ = tx.send(());
-        r
-    });
-    match rx.recv_timeout(bound) {
-        Ok(()) | Err(mpsc::RecvTimeoutError::Disconnected) => handle.join().map_err(|p| {
-            let msg = p
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_default();
-            Outcome::Failed(format!("panic: {msg}"))
-        }),
-        Err(mpsc::RecvTimeoutError::Timeout) => {
-            Err(Outcome::Hung(format!("still running after {bound:?}")))
+/// A job for the [`Worker`]: one case, read and judged.
+type Job = Box<dyn FnOnce() -> Outcome + Send>;
+
+/// One thread that runs the in-process cases of a target one after another, each under a
+/// time bound. (A thread per case would cost a thread's creation and teardown each time:
+/// about as much system time as a small case.)
+struct Worker {
+    jobs: mpsc::Sender<Job>,
+    done: mpsc::Receiver<std::thread::Result<Outcome>>,
+}
+
+impl Worker {
+    fn new() -> Worker {
+        let (jobs, inbox) = mpsc::channel::<Job>();
+        let (outbox, done) = mpsc::channel();
+        std::thread::spawn(move || {
+            for job in inbox {
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+                if outbox.send(r).is_err() {
+                    break;
+                }
+            }
+        });
+        Worker { jobs, done }
+    }
+
+    /// Runs `job` under `bound`: its outcome, `Failed` on a panic, `Hung` past the bound (the
+    /// worker is then busy for good: the caller stops the target).
+    fn run(&self, bound: Duration, job: Job) -> Outcome {
+        if self.jobs.send(job).is_err() {
+            return Outcome::Failed("the worker thread is gone".into());
+        }
+        match self.done.recv_timeout(bound) {
+            Ok(Ok(outcome)) => outcome,
+            Ok(Err(p)) => {
+                let msg = p
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
+                Outcome::Failed(format!("panic: {msg}"))
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                Outcome::Hung(format!("still running after {bound:?}"))
+            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                Outcome::Failed("the worker thread is gone".into())
+            }
         }
     }
 }
@@ -325,7 +363,6 @@ fn toolpath_case(
     format: Format,
     dialect: Option<Dialect>,
     machine: Option<MachineContext>,
-    bound: Duration,
 ) -> Outcome {
     if let Err(e) = std::fs::write(&path, &bytes) {
         return Outcome::Failed(format!("writing {}: {e}", path.display()));
@@ -341,11 +378,9 @@ fn toolpath_case(
         machine,
         cycle_aliases: Vec::new(),
     };
-    let read = bounded(bound, move || toolpath::read_with(&path, &options));
-    match read {
-        Err(outcome) => outcome,
-        Ok(Err(e)) => judge_error(&e, &name, lines),
-        Ok(Ok((input, _))) => {
+    match toolpath::read_with(&path, &options) {
+        Err(e) => judge_error(&e, &name, lines),
+        Ok((input, _)) => {
             let r = match &input {
                 Input::Cl(t) => judge_toolpath(t, lines),
                 Input::Joint(j) => judge_joint(j),
@@ -357,16 +392,14 @@ fn toolpath_case(
 
 /// Reads a mutated machine file in-process, as the CLI does (with its reference positions),
 /// and judges it.
-fn machine_case(path: PathBuf, bytes: Vec<u8>, bound: Duration) -> Outcome {
+fn machine_case(path: PathBuf, bytes: Vec<u8>) -> Outcome {
     if let Err(e) = std::fs::write(&path, &bytes) {
         return Outcome::Failed(format!("writing {}: {e}", path.display()));
     }
     let lines = line_count(&bytes);
-    let read = bounded(bound, move || Machine::references_from_file(&path));
-    match read {
-        Err(outcome) => outcome,
-        Ok(Err(e)) => judge_error(&e, "machine.json", lines),
-        Ok(Ok((m, references))) => {
+    match Machine::references_from_file(&path) {
+        Err(e) => judge_error(&e, "machine.json", lines),
+        Ok((m, references)) => {
             for a in &m.axes {
                 let limits = [Some(a.velocity), Some(a.acceleration), a.jerk];
                 for l in limits.into_iter().flatten() {
@@ -553,12 +586,13 @@ pub struct Settings {
     pub parse_bound: Duration,
     /// Time bound of one `feedopt solve`.
     pub solve_bound: Duration,
-    /// Where each case's input is written, under `<work>/<target>/work/`.
+    /// Where each case's input is written, under `<work>/<target>/work/` (best on tmpfs:
+    /// [`scratch_dir`]).
     pub work: PathBuf,
-    /// The long run's output folder: each case is described in `<out>/<target>/work/CASE.txt`
-    /// before it runs (after an abort, the last case is there), each failure is saved under
-    /// `<out>/<target>/failures/` as it is found and each target's figures go to
-    /// `<out>/<target>/figures.txt`.
+    /// The long run's output folder: each failure is saved under `<out>/<target>/failures/`
+    /// as it is found and each target's figures go to `<out>/<target>/figures.txt`; with it,
+    /// each case is described in `<work>/<target>/work/CASE.txt` before it runs (after an
+    /// abort, the last case is there).
     pub out: Option<PathBuf>,
 }
 
@@ -665,6 +699,7 @@ impl Campaign {
         let children = target.kind == Kind::Solve;
         let (t0, cpu0) = (Instant::now(), cpu_seconds(children).unwrap_or(0.0));
         let mut fig = Figures::default();
+        let worker = Worker::new();
         let stream = self.settings.seed.wrapping_mul(1_000_003) ^ hash(&target.name);
         let mut case: u64 = 0;
         loop {
@@ -730,6 +765,7 @@ impl Campaign {
                 &contexts,
                 k,
                 &mut rng,
+                &worker,
             );
             let elapsed = started.elapsed();
             fig.cases += 1;
@@ -768,8 +804,7 @@ impl Campaign {
                     self.failures.push(f);
                 }
                 if hung && target.kind != Kind::Solve {
-                    // The hung thread keeps a core busy: the rest of the target would
-                    // measure it, not the reader.
+                    // The hung worker keeps a core busy and takes no more cases.
                     fig.stopped = Some(format!("case {case} hung: {what}"));
                     break;
                 }
@@ -800,6 +835,7 @@ impl Campaign {
         contexts: &[MachineContext],
         k: usize,
         rng: &mut Rng,
+        worker: &Worker,
     ) -> (Outcome, Vec<(String, Vec<u8>)>) {
         let bound = self.settings.parse_bound;
         match kind {
@@ -819,12 +855,15 @@ impl Campaign {
                     (name.clone(), text.clone()),
                     ("machine.json".to_string(), seed.machine.clone()),
                 ];
-                let o = toolpath_case(work.join(&name), text, format, dialect, machine, bound);
-                (o, files)
+                let path = work.join(&name);
+                let job = move || toolpath_case(path, text, format, dialect, machine);
+                (worker.run(bound, Box::new(job)), files)
             }
             Kind::Machine => {
                 let files = vec![("machine.json".to_string(), text.clone())];
-                (machine_case(work.join("machine.json"), text, bound), files)
+                let path = work.join("machine.json");
+                let job = move || machine_case(path, text);
+                (worker.run(bound, Box::new(job)), files)
             }
             Kind::Solve => {
                 // Mutate the toolpath (three times in five), the machine, or both (`text` is
