@@ -258,7 +258,7 @@ fn optimize_path(
     };
     let (mut lv, mut refinement, error_estimate) = match options.stations {
         Some(total) => {
-            let lv = plan.solve_at(total, 0, options, None)?;
+            let lv = plan.solve_at(total, options)?;
             let r = Refinement {
                 stations: lv.schedule.stations.len(),
                 cycle_time_s: lv.schedule.cycle_time,
@@ -584,23 +584,15 @@ impl Plan<'_> {
         solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))
     }
 
-    /// Span `si` on the uniform grid of refinement `level` (level 0: every CL knot, each
-    /// segment divided so the spans share about `total` stations; level ℓ halves every interval
-    /// of level 0 ℓ times), with its end speeds: the start of the adaptive refinement (level 0)
-    /// and the levels of the jerk-limited one.
-    fn uniform_problem(
-        &self,
-        si: usize,
-        total: usize,
-        level: u32,
-        options: &Options,
-    ) -> Result<SpanProblem> {
+    /// Span `si` on a uniform grid (every CL knot, each segment divided so the spans share
+    /// about `total` stations), with its end speeds: the start of the adaptive refinements and
+    /// the fixed grid of `--stations`.
+    fn uniform_problem(&self, si: usize, total: usize, options: &Options) -> Result<SpanProblem> {
         let spans = &self.path.spans;
         let span = &spans[si];
-        let parts = 1usize << level;
         let grid = Grid {
-            spacing: span.length() / (total as f64 * self.weights[si]).max(8.0) / parts as f64,
-            min_parts: parts,
+            spacing: span.length() / (total as f64 * self.weights[si]).max(8.0),
+            min_parts: 1,
         };
         let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
         if let Some(c) = &options.verify.chord {
@@ -704,7 +696,7 @@ impl Plan<'_> {
                 self.bisect(
                     si,
                     options,
-                    self.uniform_problem(si, options.initial_stations, 0, options)?,
+                    self.uniform_problem(si, options.initial_stations, options)?,
                 )
             })
             .collect::<Vec<Result<_>>>()
@@ -819,7 +811,7 @@ impl Plan<'_> {
             .map(|si| {
                 let p = self.final_grid(
                     si,
-                    self.uniform_problem(si, options.initial_stations, 0, options)?,
+                    self.uniform_problem(si, options.initial_stations, options)?,
                     options,
                 );
                 let s = self.solve_span(si, &p, options, None, None)?;
@@ -1173,25 +1165,13 @@ impl Plan<'_> {
         ))
     }
 
-    /// Solves every span with about `total` stations at refinement `level`.
-    /// `previous`: the level before, whose profiles start the jerk-limited solves.
-    fn solve_at(
-        &self,
-        total: usize,
-        level: u32,
-        options: &Options,
-        previous: Option<&Level>,
-    ) -> Result<Level> {
+    /// Solves every span on a fixed grid of about `total` stations (`--stations`).
+    fn solve_at(&self, total: usize, options: &Options) -> Result<Level> {
         let mut problems = Vec::with_capacity(self.path.spans.len());
         let mut solutions = Vec::with_capacity(self.path.spans.len());
         for si in 0..self.path.spans.len() {
-            let p = self.final_grid(
-                si,
-                self.uniform_problem(si, total, level, options)?,
-                options,
-            );
-            let warm = previous.map(|lv| (&lv.problems[si], &lv.solutions[si]));
-            solutions.push(self.solve_span(si, &p, options, warm, None)?);
+            let p = self.final_grid(si, self.uniform_problem(si, total, options)?, options);
+            solutions.push(self.solve_span(si, &p, options, None, None)?);
             problems.push(p);
         }
         self.level(problems, solutions)

@@ -562,19 +562,8 @@ fn m140_mb_max_retracts_to_the_z_travel_limit() {
     assert!(e.contains(":6:") && e.contains("axes.Z"), "{e}");
 }
 
-/// The Klartext seed of `reader_fuzz.rs`: every construct in one program.
-const EVERYTHING: &str = "0 BEGIN PGM F MM\n1 BLK FORM 0.1 Z X+0 Y+0 Z-20\n2 TOOL CALL 1 Z S5000 F800\n\
-     3 L X+0 Y+0 Z+5 R0 FMAX M3\n4 CC X+10 Y+0\n5 C X+20 Y+0 DR+ F600\n6 CR X+30 Y+10 R+10 DR-\n\
-     7 CT X+40 Y+0\n8 CC Y+0 Z+0\n9 CP IPA+720 IX-2 DR+\n10 LP PR+5 PA+30\n11 L IX+5 F MAX\n\
-     12 FN 0: Q1 = +3\n13 Q2 = Q1 * 2\n14 L X+Q2 FAUTO\n15 M128\n\
-     16 LN X+1 Y+2 Z+3 NX+0 NY+0 NZ+1 TX+0 TY-0.5 TZ+0.866 F500\n17 M129\n\
-     18 CYCL DEF 7.0 DATUM SHIFT\n19 CYCL DEF 7.1 X+10\n\
-     20 PLANE SPATIAL SPA+0 SPB+45 SPC+0 TURN MB 50 FMAX\n21 L A+Q120 C+Q122 FMAX\n\
-     22 CYCL DEF 200 DRILLING ~\n  Q200=+2 ;A ~\n  Q201=-10 ;B ~\n  Q206=+100 ~\n  Q202=+3 ~\n\
-     Q203=+0 ~\n  Q204=+20\n23 L X+0 Y+0 FMAX M99\n24 PATTERN DEF ~\n  POS1 (X+1 Y+1 Z+0)\n\
-     25 CYCL CALL PAT\n26 PLANE RESET STAY\n27 LBL 1\n28 L IX+1\n29 CALL LBL 1 REP 3/3\n\
-     30 FN 9: IF +Q1 EQU +3 GOTO LBL 2\n31 LBL 2\n32 CALL LBL 5\n33 M140 MB 10\n34 M30\n\
-     35 LBL 5\n36 CYCL DEF 9.0 DWELL TIME\n37 CYCL DEF 9.1 DWELL 1.5\n38 LBL 0\n39 END PGM F MM\n";
+/// Every Klartext construct the reader knows, in one program (also a seed of the fuzzers).
+const EVERYTHING: &str = include_str!("common/everything.h");
 
 #[test]
 fn a_program_with_every_construct_reads() {

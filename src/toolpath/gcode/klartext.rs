@@ -100,7 +100,7 @@
 
 use super::dialect::{Action, Address, DialectSpec, Statement};
 use super::expr::{self, Variables};
-use super::lexer::{Item, Num};
+use super::lexer::{Item, Num, split_words};
 
 /// Longest keyword, words (`FUNCTION RESET TCPM`).
 const MAX_KEYWORD_WORDS: usize = 3;
@@ -118,33 +118,6 @@ pub(super) fn strip_block_number(text: &str) -> &str {
     } else {
         t
     }
-}
-
-/// Splits a block at spaces outside `( )` and quotes.
-fn tokens(text: &str) -> Vec<String> {
-    let mut words = Vec::new();
-    let mut current = String::new();
-    let mut depth = 0usize;
-    let mut quoted = false;
-    for c in text.chars() {
-        match c {
-            '"' => quoted = !quoted,
-            '(' if !quoted => depth += 1,
-            ')' if !quoted => depth = depth.saturating_sub(1),
-            _ => {}
-        }
-        if c.is_whitespace() && depth == 0 && !quoted {
-            if !current.is_empty() {
-                words.push(std::mem::take(&mut current));
-            }
-        } else {
-            current.push(c);
-        }
-    }
-    if !current.is_empty() {
-        words.push(current);
-    }
-    words
 }
 
 /// A number as Klartext writes it: optional sign, digits with at most one decimal point or
@@ -246,7 +219,7 @@ pub(super) fn lex(
         vars.set(&name, v);
         return Ok(vec![Item::Skipped]);
     }
-    let words = tokens(text);
+    let words = split_words(text);
     let mut items = Vec::new();
     let mut i = 0;
     if let Some((n, key, action)) = keyword_at(spec, &words) {
@@ -630,7 +603,7 @@ pub(super) fn holds(compare: Compare, a: f64, b: f64) -> bool {
 /// The words `NAME±value` of a statement's arguments, upper-cased, with the values as
 /// written (`SPA+45` → `("SPA", "+45")`); words without a value (`TURN`) have `""`.
 pub(super) fn named_words(args: &str) -> Vec<(String, String)> {
-    tokens(args)
+    split_words(args)
         .into_iter()
         .map(|w| {
             let upper = w.to_ascii_uppercase();
@@ -645,5 +618,5 @@ pub(super) fn named_words(args: &str) -> Vec<(String, String)> {
 
 /// The statement's arguments split into words (outside parentheses and quotes).
 pub(super) fn words(args: &str) -> Vec<String> {
-    tokens(args)
+    split_words(args)
 }

@@ -254,8 +254,8 @@ fn scan_name(chars: &[char], mut i: usize) -> usize {
     i
 }
 
-/// Splits a Sinumerik-style block at spaces outside `( )` and quotes.
-fn split_words(text: &str) -> Vec<String> {
+/// Splits a Sinumerik-style (or Klartext) block at spaces outside `( )` and quotes.
+pub(super) fn split_words(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut current = String::new();
     let mut depth = 0usize;
