@@ -347,17 +347,24 @@ fn arc_turns_and_chords_are_bounded() {
 }
 
 #[test]
-fn cycle76_with_a_boring_list_is_an_error_and_an_alias_reads_it_as_cycle86() {
-    // As NX posts "BORING_NO_DRAG" for an 840D: CYCLE86's list under the name CYCLE76.
+fn cycle76_with_a_boring_list_reads_as_cycle86_and_a_spigot_call_is_an_error() {
+    // As NX posts "BORING_NO_DRAG" for an 840D: CYCLE86's list under the name CYCLE76. A
+    // standard 840D refuses it as a spigot (no _LENG/_WID), so it is read as CYCLE86, said at
+    // its line, with the way to choose another boring cycle.
     let nx = "G71 G90 G0 X0 Y0 Z20\nF120\nMCALL CYCLE76(20,0,2,-10,,3,,,,)\nX10\nX20\nMCALL\n";
-    let e = parse(Path::new("t.mpf"), nx, Dialect::Sinumerik)
-        .unwrap_err()
-        .to_string();
-    for needle in [":3:", "spigot", "_WID", "--cycle-alias CYCLE76=CYCLE86"] {
-        assert!(e.contains(needle), "{needle}: {e}");
+    let read = gcode(Dialect::Sinumerik, nx);
+    let as86 = gcode(Dialect::Sinumerik, &nx.replace("CYCLE76", "CYCLE86"));
+    assert_eq!(read.points, as86.points);
+    assert_eq!(read.dwells, as86.dwells);
+    let note = read
+        .warnings
+        .iter()
+        .find(|w| w.message.contains("read as CYCLE86"))
+        .unwrap_or_else(|| panic!("{:?}", read.warnings));
+    for needle in ["_LENG", "_WID", "--cycle-alias CYCLE76=CYCLE85"] {
+        assert!(note.message.contains(needle), "{needle}: {}", note.message);
     }
-    // A spigot call with its dimensions is still an error (feedopt mills no spigots), without
-    // the alarm note.
+    // A spigot call with its dimensions is an error (feedopt mills no spigots).
     let e = parse(
         Path::new("t.mpf"),
         "G71 G0 X0 Y0 Z20\nCYCLE76(20,0,2,-10,,40,30,5)\n",
@@ -366,9 +373,31 @@ fn cycle76_with_a_boring_list_is_an_error_and_an_alias_reads_it_as_cycle86() {
     .unwrap_err()
     .to_string();
     assert!(
-        e.contains(":2:") && e.contains("spigot") && !e.contains("alarm"),
+        e.contains(":2:") && e.contains("spigot") && e.contains("--cycle-alias"),
         "{e}"
     );
+    let e = parse(
+        Path::new("t.mpf"),
+        "G71 G0 X0 Y0 Z20\nCYCLE77(20,0,2,-10,,40)\n",
+        Dialect::Sinumerik,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains(":2:") && e.contains("_PRAD"), "{e}");
+    // An alias chooses another boring cycle: CYCLE85 feeds out instead of the rapid.
+    let (as85, _) = parse_assumed(
+        Path::new("t.mpf"),
+        nx,
+        Dialect::Sinumerik.spec(),
+        None,
+        &[parse_cycle_alias("CYCLE76=CYCLE85").unwrap()],
+    )
+    .unwrap();
+    assert_eq!(
+        as85.points,
+        gcode(Dialect::Sinumerik, &nx.replace("CYCLE76", "CYCLE85")).points
+    );
+    assert_ne!(as85.points, as86.points);
     // With the alias: exactly CYCLE86's moves (per hole: rapid to RFP + SDIS = 2, feed to −10,
     // dwell DTB = 3 s, rapid to RTP = 20), and a warning naming the alias where it applies.
     let alias = parse_cycle_alias(" cycle76 = CYCLE86 ").unwrap();

@@ -46,6 +46,11 @@ fn every_real_program_reads_with_defaults() {
         ("nx_roeders_rfm600_finish.nc", "xyz_mill.json", None),
         ("aamorim_boss.apt", "xyz_mill.json", None),
         ("aamorim_basemach.apt", "xyz_mill.json", None),
+        (
+            "nx_dmu70evo_840d.mpf",
+            "headtable_dmu70.json",
+            Some("sinumerik"),
+        ),
     ];
     for (file, machine, dialect) in cases {
         let (input, detected) = read(file, machine).unwrap_or_else(|e| panic!("{e}"));
@@ -72,24 +77,9 @@ fn every_real_program_reads_with_defaults() {
     let (_, detected) = read("nx_mori_nmv5000_mm.nc", "trt_bc_mori_nmv5000.json").unwrap();
     let note = detected.assumed.reference_note().unwrap_or_default();
     assert!(note.contains("axes.Z.reference"), "{note}");
-    // The NX DMU 70 program calls CYCLE76, Sinumerik's rectangular spigot milling cycle, with a
-    // boring cycle's arguments: an error naming it and the way out, not a guess …
-    let e = read("nx_dmu70evo_840d.mpf", "headtable_dmu70.json")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains(":1011:")
-            && e.contains("CYCLE76")
-            && e.contains("--cycle-alias CYCLE76=CYCLE86"),
-        "{e}"
-    );
-    // … and with the alias the user gives, it reads.
-    let options = ReadOptions {
-        machine: Some(context("headtable_dmu70.json")),
-        cycle_aliases: vec![("CYCLE76".into(), "CYCLE86".into())],
-        ..Default::default()
-    };
-    let (input, _) = toolpath::read_with(&dir().join("nx_dmu70evo_840d.mpf"), &options).unwrap();
+    // The NX DMU 70 program calls CYCLE76 (Sinumerik's rectangular spigot milling) with
+    // CYCLE86's list and no spigot dimensions: read by default as CYCLE86, said at line 1011.
+    let (input, _) = read("nx_dmu70evo_840d.mpf", "headtable_dmu70.json").unwrap();
     let Input::Cl(tp) = input else {
         panic!("not a CL path")
     };

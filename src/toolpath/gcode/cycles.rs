@@ -45,10 +45,13 @@
 //! programmed F). CYCLE86: feed, dwell, rapid out (the lift-off moves RPA/RPO/RPAP are not
 //! read). CYCLE87/CYCLE88: feed, (CYCLE88: dwell), the operator's stop (M0: not timed, a
 //! warning), rapid out. CYCLE89: feed, dwell, feed out. `CYCLE76`/`CYCLE77` are Sinumerik's
-//! spigot milling cycles, not drilling: an error that says so, and whether the call lacks the
-//! spigot's dimensions (NX posts write CYCLE86's list under the name CYCLE76); a machine whose
-//! CYCLE76 is a builder's boring cycle is read with a cycle alias
-//! ([`super::parse_cycle_alias`]: `--cycle-alias CYCLE76=CYCLE86`), never by a guess. A cycle
+//! spigot milling cycles, not drilling. A call that gives the spigot's dimensions (`_LENG`,
+//! `_WID`; `_PRAD`) is an error: feedopt mills no spigots. A call without them cannot be a
+//! spigot (a standard 840D refuses it); its list is then CYCLE86's (RTP, RFP, SDIS, DP, DPR,
+//! DTB, …), as NX posts its "boring, no drag" operation, and it is read as CYCLE86 with a
+//! warning at its line. The boring cycles 85–89 all move down to DP and back to RTP; they
+//! differ in the retract's feed and dwell, and a cycle alias ([`super::parse_cycle_alias`]:
+//! `--cycle-alias CYCLE76=CYCLE85`) says which one a machine's CYCLE76 is. A cycle
 //! whose RTP lies below RFP + SDIS retracts into the part as written, with a warning.
 //!
 //! # Heidenhain (`CYCL DEF 200`, `203`, `207`)
@@ -503,19 +506,33 @@ pub fn sinumerik_steps(
             } else {
                 get(5).is_none()
             };
-            let shape = if missing {
-                " This call does not give them (its list has the shape of a drilling or boring \
-                 cycle's: RTP, RFP, SDIS, DP, DPR, then DTB …), so a standard 840D would stop \
-                 with an alarm."
-            } else {
-                ""
-            };
+            if missing {
+                // The spigot reading is impossible (a standard 840D stops with an alarm), and
+                // the list is CYCLE86's (RTP, RFP, SDIS, DP, DPR, DTB, …), as NX posts its
+                // "boring, no drag" operation: read it so, and say so where it applies. Every
+                // boring variant CYCLE85–89 moves along the same line (down to DP, back to RTP);
+                // they differ in the retract's feed and the dwell, which an alias chooses.
+                let (steps, mut notes) = sinumerik_steps(86, p)?;
+                notes.push(if number == 76 {
+                    "CYCLE76 without the spigot's length and width (_LENG, _WID), which a \
+                     standard 840D would refuse, has CYCLE86's list (RTP, RFP, SDIS, DP, DPR, \
+                     DTB …), as NX posts a boring cycle: read as CYCLE86 (feed to DP, dwell DTB, \
+                     rapid out); if this machine's CYCLE76 is another cycle, say which: \
+                     --cycle-alias CYCLE76=CYCLE85 (or 81–89)"
+                } else {
+                    "CYCLE77 without the spigot's diameter _PRAD, which a standard 840D would \
+                     refuse, has CYCLE86's list (RTP, RFP, SDIS, DP, DPR, DTB …): read as \
+                     CYCLE86 (feed to DP, dwell DTB, rapid out); if this machine's CYCLE77 is \
+                     another cycle, say which: --cycle-alias CYCLE77=CYCLE85 (or 81–89)"
+                });
+                return Ok((steps, notes));
+            }
             return Err(format!(
                 "{name} on a Sinumerik 840D is {what}, not a drilling cycle; feedopt does not \
-                 mill spigots.{shape} If this machine's {name} is a machine builder's or the \
-                 post's cycle that works like a standard one, map it: --cycle-alias \
-                 {name}=CYCLE86 (or the cycle it is; ReadOptions::cycle_aliases); else post the \
-                 operation as CYCLE81–CYCLE89 or as G0/G1/G2/G3"
+                 mill spigots. If this machine's {name} is a machine builder's or the post's \
+                 cycle that works like a standard one, map it: --cycle-alias {name}=CYCLE86 (or \
+                 the cycle it is; ReadOptions::cycle_aliases); else post the operation as \
+                 CYCLE81–CYCLE89 or as G0/G1/G2/G3"
             ));
         }
         _ => return Err(format!("{name} is not a drilling cycle feedopt knows")),

@@ -725,15 +725,16 @@ impl<'a> Interpreter<'a> {
             let args = self.arguments(line, &args)?;
             let args = self.sinumerik_cycle_units(number, args);
             if modal_call {
-                if matches!(number, 76 | 77) {
-                    // Spigot milling: an error where the program calls it, not at the first
-                    // position after it.
-                    cycles::sinumerik_steps(number, &args)
-                        .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
+                // The call's errors and notes depend on its arguments only: said once, where
+                // the program calls it, not at every position after it.
+                let (_, notes) = cycles::sinumerik_steps(number, &args)
+                    .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
+                for n in notes {
+                    self.warn(line, format!("MCALL {text}: {n}"));
                 }
                 self.mcall = Some(ModalCall { number, args });
             } else {
-                self.run_sinumerik_cycle(line, &text, number, &args)?;
+                self.run_sinumerik_cycle(line, &text, number, &args, true)?;
             }
         } else if modal_call {
             self.mcall = None;
@@ -766,6 +767,7 @@ impl<'a> Interpreter<'a> {
                     &format!("MCALL CYCLE{}", call.number),
                     call.number,
                     &call.args,
+                    false,
                 )?;
             }
         } else if no_motion.is_none() && (has_centre || block.radius.is_some()) {
@@ -1202,6 +1204,7 @@ impl<'a> Interpreter<'a> {
         text: &str,
         number: u32,
         args: &[Option<f64>],
+        warn: bool,
     ) -> Result<()> {
         if self.plane != Plane::Xy {
             return Err(self.error(
@@ -1211,8 +1214,10 @@ impl<'a> Interpreter<'a> {
         }
         let (steps, notes) = cycles::sinumerik_steps(number, args)
             .map_err(|e| self.error(line, format!("{text}: {e}")))?;
-        for n in notes {
-            self.warn(line, format!("{text}: {n}"));
+        if warn {
+            for n in notes {
+                self.warn(line, format!("{text}: {n}"));
+            }
         }
         self.run_steps(line, &steps)
     }
