@@ -330,6 +330,10 @@ fn optimize_path(
     })
 }
 
+/// How close to the jerk bound of its inner station a rest end's constant-jerk interval must
+/// run to be kept whole ([`Plan::rest_split`]).
+const REST_HOLDS: f64 = 0.9;
+
 /// Geometric grading of the stations into a rest end of a jerk-limited span (levels).
 const GRADING: usize = 4;
 
@@ -777,14 +781,20 @@ impl Plan<'_> {
     /// Every span has a grid G and a refinement F of it, each interval k of G divided into s_k
     /// equal parts (s_k a power of two, 2 to [`MAX_SPLIT`]); e_k is the change of interval k's
     /// time between G and F. Under an error ∝ h^p with p ≥ 1, F's error on interval k is at
-    /// most ε_k = e_k / (s_k − 1) (Richardson with p = 1). But the jerk-limited profile
-    /// converges more slowly than that near rest ends (b ∝ u^(4/3)): on a rest-to-rest line
-    /// each round cut the error by only 0.7, and Σ ε_k (9.8e-4) fell short of the true error
-    /// (1.7e-3; test `adaptive_jerk_refinement_meets_its_estimate_on_the_closed_form`). So the
-    /// estimate takes the order the rounds show: with ρ the ratio of the last two changes of
-    /// T (clamped to 0.5…0.9; the rounds go on until there are two, three rounds), F's error is at most
-    /// Σ ε_k · ρ / (1 − ρ) (the geometric tail; ρ = 0.5 is Richardson's p = 1). Rounds stop
-    /// when that is ≤ tol · T(F) (tol: the larger of the convergence and 10 × the SCP's own);
+    /// most ε_k = e_k / (s_k − 1) (Richardson with p = 1). Near a rest end the profile grows as
+    /// b ∝ u^(4/3), which quadratic pieces fit with the same relative misfit at every scale (an
+    /// error of order h^(1/3), which halving hardly shows: on a rest-to-rest line the estimate
+    /// was 6.3e-4 for a true 1.6e-3). So the first (last) interval of a span from (to) rest
+    /// ends where the full-jerk phase does ([`solver::jerk::rest_phase_length`], in
+    /// [`Self::final_grid`]), where its constant-jerk law is the profile's own, and it stays
+    /// whole while its jerk bound holds ([`Self::rest_split`]); its time still moves with its
+    /// neighbours' refinement, and that change is counted in ε. The estimate takes the order the
+    /// rounds show: with ρ the ratio of the last two changes of T (clamped to 0.5…0.9), F's
+    /// error is at most Σ ε_k · ρ / (1 − ρ) (the geometric tail; ρ = 0.5 is Richardson's
+    /// p = 1). ρ is observed from the third round on; a round that is within tolerance before
+    /// then halves every interval of F (a uniform halving, whose changes show the order).
+    /// Rounds stop when the bound is ≤ tol · T(F) (tol: the larger of the convergence and 10 ×
+    /// the SCP's own);
     /// F is the answer and that bound / T(F) the estimate. Otherwise every interval whose ε_k exceeds one path-wide
     /// threshold (the smallest ε_k summing to half the allowance stay) is replaced by its s_k
     /// parts in the next G, each part divided in the next F by as many as its share of ε_k
@@ -816,7 +826,7 @@ impl Plan<'_> {
                 );
                 let s = self.solve_span(si, &p, options, None, None)?;
                 let coarse = self.times(si, &p, &s)?;
-                let split = vec![2; p.intervals()];
+                let split = self.rest_split(si, &p, &s);
                 self.refine_jerk(si, options, &p, split, coarse, (&p, &s))
             })
             .collect::<Vec<Result<_>>>()
@@ -864,10 +874,17 @@ impl Plan<'_> {
                     options.max_stations
                 )));
             }
-            let threshold = threshold(
-                rounds.iter().flat_map(|r| r.eps.iter().copied()),
-                tol * time,
-            );
+            // Within tol before ρ is observed: halve every interval of F (keeping F's
+            // stations), so that the next changes of T are those of uniform halvings and show
+            // the order the estimate assumes (p = 1, ρ = 0.5) or a slower one.
+            let threshold = if estimate <= tol * time {
+                0.0
+            } else {
+                threshold(
+                    rounds.iter().flat_map(|r| r.eps.iter().copied()),
+                    tol * time,
+                )
+            };
             let next: Vec<Option<JerkRound>> = rounds
                 .par_iter()
                 .enumerate()
@@ -882,7 +899,11 @@ impl Plan<'_> {
                     for (k, &eps) in r.eps.iter().enumerate() {
                         let s = r.split[k];
                         keep[at] = true;
-                        if eps > threshold {
+                        if s == 1 {
+                            // A rest end's interval kept whole: its time is F's.
+                            coarse.push(r.fine_times[at]);
+                            split.push(1);
+                        } else if eps > threshold {
                             let part = eps / s as f64;
                             let more = (part / threshold).ceil().max(2.0).min(MAX_SPLIT as f64);
                             for j in 0..s {
@@ -921,6 +942,33 @@ impl Plan<'_> {
             0.0
         };
         Ok((lv, refinement, estimate))
+    }
+
+    /// Round 0's division of every interval of a jerk-limited span's grid `p` (solved: `s`):
+    /// halves, but a constant-jerk interval from or to rest whose jerk bound holds its inner
+    /// station ([`solver::jerk::rest_bounds`]) stays whole in every round. Its law is then the
+    /// profile's own (the full-jerk phase has not ended inside it), and halving it would only
+    /// put a quadratic piece where b ∝ u^(4/3) — the same relative misfit at every scale, an
+    /// error that halving hardly reduces and the estimate cannot see. Where the bound does not
+    /// hold (the interval runs past the phase's end), it is refined like any other.
+    fn rest_split(&self, si: usize, p: &SpanProblem, s: &SpanSolution) -> Vec<usize> {
+        let n = p.intervals();
+        let mut split = vec![2; n];
+        if n < 3 {
+            return split;
+        }
+        let bounds = solver::jerk::rest_bounds(&self.path.spans[si], &self.kin, self.machine, p);
+        // Within REST_HOLDS of the bound: the interval runs near full jerk to its end (the next
+        // intervals' own first-order misfit keeps b₁ a little below it: 0.6 % on the closed-form
+        // line), where one that runs past the phase's end stays well below it.
+        let holds = |b: f64, bound: f64| bound.is_finite() && b >= bound * REST_HOLDS;
+        if p.b_start == 0.0 && holds(s.b[1], bounds.0) {
+            split[0] = 1;
+        }
+        if p.b_end == 0.0 && holds(s.b[n - 1], bounds.1) {
+            split[n - 1] = 1;
+        }
+        split
     }
 
     /// F: every interval k of a span's grid `g` (whose intervals' times are `coarse`) divided
@@ -969,7 +1017,11 @@ impl Plan<'_> {
             .map(|(&s, &c)| {
                 let fine: f64 = tf[at..at + s].iter().sum();
                 at += s;
-                (c - fine).abs() / (s - 1) as f64
+                // An interval kept whole (a rest end's, [`Self::rest_split`]) has no
+                // discretisation error of its own, but its time moves with b at its inner
+                // station as its neighbours are refined: that change is theirs, counted here
+                // as one halving's (p = 1).
+                (c - fine).abs() / (s.max(2) - 1) as f64
             })
             .collect();
         Ok(JerkRound {
@@ -1019,16 +1071,34 @@ impl Plan<'_> {
             return p;
         }
         let n = p.intervals();
+        let (u0, un) = (p.u[0], p.u[n]);
         let mut u = p.u.clone();
+        // The end of the full-jerk phase from rest, where one can be estimated: the first
+        // (last) interval ends there, so its constant-jerk law is the profile's own
+        // ([`solver::jerk::rest_phase_length`]); the geometric grading continues beyond it.
+        let phase = |end: bool| {
+            (if end { p.b_end } else { p.b_start } == 0.0)
+                .then(|| solver::jerk::rest_phase_length(&p, self.machine, end))
+                .flatten()
+        };
+        let (first, last) = (phase(false), phase(true));
         if p.b_start == 0.0 {
-            let l = p.u[3] - p.u[0];
-            u.extend((1..=GRADING).map(|k| p.u[0] + l / f64::powi(2.0, k as i32)));
+            let l = p.u[3] - u0;
+            u.extend((1..=GRADING).map(|k| u0 + l / f64::powi(2.0, k as i32)));
         }
         if p.b_end == 0.0 {
-            let l = p.u[n] - p.u[n - 3];
-            u.extend((1..=GRADING).map(|k| p.u[n] - l / f64::powi(2.0, k as i32)));
+            let l = un - p.u[n - 3];
+            u.extend((1..=GRADING).map(|k| un - l / f64::powi(2.0, k as i32)));
         }
-        if u.len() == p.u.len() {
+        if let Some(d) = first {
+            u.retain(|&x| x == u0 || x > u0 + d * (1.0 + 1e-9));
+            u.push(u0 + d);
+        }
+        if let Some(d) = last {
+            u.retain(|&x| x == un || x < un - d * (1.0 + 1e-9));
+            u.push(un - d);
+        }
+        if u.len() == p.u.len() && first.is_none() && last.is_none() {
             return p;
         }
         u.sort_by(f64::total_cmp);

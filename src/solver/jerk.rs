@@ -329,6 +329,71 @@ impl JerkData {
     }
 }
 
+/// The bounds on b at station 1 and N−1 that the constant-jerk end intervals of `p` put there
+/// ([`JerkData::rest_bound`], without the rest of the jerk data): infinite at an end not at rest.
+pub fn rest_bounds(
+    span: &Span,
+    kin: &Kinematics,
+    machine: &Machine,
+    p: &SpanProblem,
+) -> (f64, f64) {
+    let limits: Vec<Option<Limit>> = machine
+        .axes
+        .iter()
+        .take(p.n_axes())
+        .map(|a| a.jerk)
+        .collect();
+    let n = p.intervals();
+    let mut rest = (f64::INFINITY, f64::INFINITY);
+    if n >= 2 {
+        if p.b_start == 0.0 {
+            rest.0 = rest_bound(span, kin, &limits, p.u[0], p.u[1], false);
+        }
+        if p.b_end == 0.0 {
+            rest.1 = rest_bound(span, kin, &limits, p.u[n], p.u[n - 1], true);
+        }
+    }
+    rest
+}
+
+/// Where the jerk-limited profile from rest at station `i` (0, or N when `end`) should stop
+/// growing at full jerk, u measured from that end, estimated from the limits there.
+///
+/// From rest, every axis moves as `q⃛ = q' u⃛` at first, so the path jerk is at most
+/// `J = min_j j_j/|q'_j|` and the path acceleration at most `A` (the acceleration limits at
+/// b = 0). At full jerk `u = J t³/6`; the phase lasts until ü reaches A (`t = A/J`), or until
+/// the speed V the profile may rise to is half reached (`t = √(V/J)`: +J then −J), or until
+/// half the span is used (`J t³ ≤ L/2`). V is taken as the lowest velocity bound on the near
+/// half of the span, so the estimate errs short: a constant-jerk interval that ends before
+/// the switch is exact, one that ends after it is not.
+pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Option<f64> {
+    let n = p.intervals();
+    let i = if end { n } else { 0 };
+    let jet = &p.jets[i];
+    let mut jerk = f64::INFINITY;
+    for (j, axis) in machine.axes.iter().take(p.n_axes()).enumerate() {
+        let (Some(lim), d) = (axis.jerk, jet.dq[j].abs()) else {
+            continue;
+        };
+        if d > 0.0 {
+            jerk = jerk.min(lim.max.min(-lim.min) / d);
+        }
+    }
+    let (lo, hi) = p.udd_range(i, 0.0);
+    let acc = if end { -lo } else { hi };
+    let half = if end { n / 2..n + 1 } else { 0..n / 2 + 1 };
+    let b_max = p.b_max[half].iter().copied().fold(f64::INFINITY, f64::min);
+    let len = p.u[n] - p.u[0];
+    if !(jerk.is_finite() && jerk > 0.0 && acc > 0.0 && len > 0.0) {
+        return None;
+    }
+    let t = (acc / jerk)
+        .min((b_max.sqrt() / jerk).sqrt())
+        .min((len / (2.0 * jerk)).cbrt());
+    let at = jerk * t * t * t / 6.0;
+    (at.is_finite() && at > 0.0 && at < 0.5 * len).then_some(at)
+}
+
 /// The largest b at the inner station of a constant-jerk interval from rest at `u_rest` to
 /// `u_in` (mirrored when `end`): with s = t/τ ∈ [0, 1], `u − u_rest = ±Δu s³`, `u̇ = 3Δu s²/τ`,
 /// `ü = ±6Δu s/τ²` (− into the end), `u⃛ = 6Δu/τ³`, τ = 3Δu/√b, so each axis's jerk is
