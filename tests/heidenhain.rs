@@ -467,6 +467,24 @@ fn labels_repeat_sections_and_call_subprograms() {
     assert!(e.contains(":3:") && e.contains("LBL 9"), "{e}");
 }
 
+/// A loop that does end, but after more passes than a toolpath holds: a counter to 100,000
+/// around a helix of 720° (445 chords), 45 million CL points. The arc that would pass
+/// `toolpath::MAX_POINTS` is refused before its chords are made, with its line.
+#[test]
+fn a_counted_loop_past_the_point_limit_is_an_error_before_the_points() {
+    let e = fails(
+        "0 BEGIN PGM F MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 FN 0: Q1 = +0\n3 CC X+10 Y+0\n\
+         4 LBL 2\n5 CP IPA+720 IZ-0.1 DR+ F500\n6 FN 1: Q1 = +Q1 + +1\n\
+         7 FN 12: IF +Q1 LT +100000 GOTO LBL 2\n8 END PGM F MM\n",
+    );
+    assert!(
+        e.contains("t.h:6:")
+            && e.contains(&format!("more than the {}", toolpath::MAX_POINTS))
+            && e.contains("check the jumps and repeat counts"),
+        "{e}"
+    );
+}
+
 #[test]
 fn detected_by_extension_h_and_by_content() {
     let opts = ReadOptions::default();
