@@ -48,6 +48,10 @@ cargo test --release --test fuzz_cli --no-run 2> "$out/build.log" || { cat "$out
 bin=$(grep -o 'target/release/deps/fuzz_cli-[0-9a-f]*' "$out/build.log" | tail -1)
 rm -f "$out/build.log"
 [ -x "$bin" ] || { echo "fuzz_long.sh: cannot find the test binary" >&2; exit 2; }
+# A copy of its own: a build in this tree during the campaign (hours) does not change the
+# binary that later targets run. (`solve` still runs target/release/feedopt.)
+cp "$bin" "$out/fuzz_cli"
+bin=$out/fuzz_cli
 
 if [ $# -gt 0 ]; then
   targets=("$@")
