@@ -69,6 +69,27 @@ fn g83_peck_cycle_moves_and_time() {
     assert_eq!(tp.points.last().map(|p| p.p), Some(v(6.0, 0.0, 2.0)));
 }
 
+/// A peck cycle repeated 1000 times (`L1000`), 5000 pecks a hole: 15 million moves from one
+/// block, more than a toolpath may hold (`toolpath::MAX_POINTS`). Refused before a move is
+/// made, naming the block and the repeat count.
+#[test]
+fn a_cycle_repeated_past_the_point_limit_is_refused_before_its_moves() {
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21 G90 G0 X0 Y0 Z10\nG91 G83 X1 Y0 Z-1000 R0 Q0.2 L1000 F60\n",
+        Dialect::LinuxCnc,
+    )
+    .map(|tp| tp.points.len())
+    .expect_err("15 million moves");
+    let e = message(e);
+    assert!(
+        e.contains("t.ngc:2:")
+            && e.contains("G83 with 1000 repeats")
+            && e.contains(&format!("more than the {}", feedopt::toolpath::MAX_POINTS)),
+        "{e}"
+    );
+}
+
 #[test]
 fn mcall_cycle83_at_three_positions() {
     // RTP 20, RFP 0, SDIS 2, DP −10, FDEP −4 (first depth 4), VARI 1 (swarf removal):

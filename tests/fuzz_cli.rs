@@ -47,13 +47,21 @@
 //!   `FEEDOPT_FUZZ_CASES`: cases per target. The first limit reached ends the target; without
 //!   any, each target gets 1 CPU minute.
 //! - `FEEDOPT_FUZZ_SEED` (default 2) chooses the cases; `FEEDOPT_FUZZ_BOUND_S` the time bound
-//!   of one solve (default 10 s, the acceptance); a read is bounded by 5 s.
+//!   of one solve (default 10 s, the acceptance); a read is bounded by 5 s. Both are
+//!   CPU time of the case (the worker thread's, or the `feedopt` child's on one thread), with
+//!   a wall-clock backstop of `fuzz::WALL_BACKSTOP` (60) times the bound: the campaign runs
+//!   under `nice 19` on a shared machine, where wall time would make "timeouts" of waiting.
 //! - `FEEDOPT_FUZZ_OUT` (default `target/fuzz-long`): per target, `figures.txt` (cases, clean
 //!   errors, failures, kinds of error, seeds read cleanly, mean and slowest ms, CPU and wall
 //!   seconds) and `failures/case-<n>/` (the inputs and `WHAT.txt`, saved as they are found).
-//! - `FEEDOPT_FUZZ_WORK` (default: a new folder in `/dev/shm`, printed at the start): where
-//!   the cases' files are written; `<work>/<target>/work/` holds the case running now,
-//!   described in `CASE.txt` (after an abort, the input that caused it).
+//! - `FEEDOPT_FUZZ_WORK` (default: a new folder in `/dev/shm`, printed at the start and
+//!   removed at the end; none is made when this is given): where the cases' files are
+//!   written; `<work>/<target>/work/` holds the case running now, described in `CASE.txt`
+//!   (after an abort, the input that caused it).
+//!
+//! A file the harness cannot write (a case's input, `CASE.txt`, a failing input, the figures)
+//! is a harness error: it stops the target, is printed as `HARNESS ERROR`, and is never
+//! counted as the target's failure.
 //!
 //! A case that hangs in-process stops its target (its thread cannot be stopped and would
 //! skew the rest). The short runs save failing inputs under `target/fuzz-failures/`.
@@ -197,11 +205,11 @@ fn fuzz_long() {
     let out = std::env::var_os("FEEDOPT_FUZZ_OUT")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo("target/fuzz-long"));
-    // The scratch folder is kept (an abort leaves its last case there), unless it is ours and
-    // the run ends.
-    let scratch = fuzz::scratch_dir();
-    let work =
-        std::env::var_os("FEEDOPT_FUZZ_WORK").map_or_else(|| scratch.path().into(), PathBuf::from);
+    // A folder given is used as it is (and kept: after an abort its last case is there); else
+    // a scratch folder of our own, removed when the run ends.
+    let given = std::env::var_os("FEEDOPT_FUZZ_WORK").map(PathBuf::from);
+    let scratch = given.is_none().then(fuzz::scratch_dir);
+    let work = given.unwrap_or_else(|| scratch.as_ref().expect("scratch").path().into());
     eprintln!("fuzz: the cases are written to {}", work.display());
     let mut c = Campaign::new(Settings {
         seed: env_f64("FEEDOPT_FUZZ_SEED").map_or(2, |s| s as u64),
@@ -336,6 +344,38 @@ fn cpu_time_counts_the_process_and_its_children() {
     assert!(
         (all1 - all0) - (own2 - own1) > 0.0,
         "the child's CPU time is not counted: {all0} → {all1}, own {own1} → {own2}"
+    );
+}
+
+/// The time bound of a case is the CPU time of the thread that runs it: a case that waits
+/// (here, sleeps) past the bound is not a hang, as a case waiting for a core on a busy machine
+/// is not; one that computes past it is.
+#[test]
+fn the_case_bound_is_cpu_time_not_wall_time() {
+    let worker = fuzz::Worker::new();
+    let bound = Duration::from_millis(50);
+    let sleeper = || {
+        std::thread::sleep(Duration::from_millis(200));
+        fuzz::Outcome::Accepted
+    };
+    let (outcome, cpu) = worker.run(bound, Box::new(sleeper));
+    assert!(
+        matches!(outcome, fuzz::Outcome::Accepted) && cpu < bound,
+        "{outcome:?} after {cpu:?} of CPU time"
+    );
+    // Busy until its own thread has used 200 ms of CPU time, however long that takes.
+    let spinner = || {
+        let t0 = fuzz::thread_cpu();
+        let mut x = 0u64;
+        while fuzz::thread_cpu() - t0 < Duration::from_millis(200) {
+            x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+        }
+        fuzz::Outcome::Accepted
+    };
+    let (outcome, cpu) = worker.run(bound, Box::new(spinner));
+    assert!(
+        matches!(&outcome, fuzz::Outcome::Hung(what) if what.contains("CPU time")) && cpu > bound,
+        "{outcome:?} after {cpu:?} of CPU time"
     );
 }
 

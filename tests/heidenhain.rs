@@ -459,12 +459,52 @@ fn labels_repeat_sections_and_call_subprograms() {
     );
     assert_eq!(tp.points.last().map(|p| p.p), Some(v(3.0, 0.0, 0.0)));
     assert_eq!(tp.points.len(), 4);
-    // A loop that never ends is an error, not a hang; so is a call of a missing label.
+    // A loop that never ends is an error, not a hang (at its second pass: nothing changed);
+    // so is a call of a missing label.
     let e =
         fails("0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 LBL 3\n3 FN 9: IF +0 EQU +0 GOTO LBL 3\n");
-    assert!(e.contains("more than"), "{e}");
+    assert!(e.contains("t.h:4:") && e.contains("for ever"), "{e}");
     let e = fails("0 BEGIN PGM R MM\n1 L X+0 Y+0 Z+0 F100\n2 CALL LBL 9\n");
     assert!(e.contains(":3:") && e.contains("LBL 9"), "{e}");
+}
+
+/// Fuzz case 6471 of gcode-heidenhain (seed 2), cut down: `LBL 2` moved before an `FN 9 …
+/// GOTO LBL 2` whose condition stays true, with a 720° helix in every pass. Bounded only by
+/// the 1,000,000 blocks a program may run, it made about 19 million CL points (2 GB) before
+/// its error, past the fuzz time bound of 5 s. Now the second pass, in the same state as the
+/// first, is the error: the jump's line, its label and what to do.
+#[test]
+fn a_jump_loop_through_a_helix_ends_in_an_error_naming_the_jump() {
+    let e = fails(
+        "0 BEGIN PGM F MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 LBL 2\n3 CC X+10 Y+0\n\
+         4 CP IPA+720 IZ-2 DR+ F600\n5 FN 0: Q1 = +3\n6 FN 9: IF +Q1 EQU +3 GOTO LBL 2\n\
+         7 END PGM F MM\n",
+    );
+    assert!(
+        e.contains("t.h:7:")
+            && e.contains("`FN 9: IF +Q1 EQU +3 GOTO LBL 2`")
+            && e.contains("LBL 2 (line 3) for ever")
+            && e.contains("a counter"),
+        "{e}"
+    );
+}
+
+/// A loop that does end, but after more passes than a toolpath holds: a counter to 100,000
+/// around a helix of 720° (445 chords), 45 million CL points. The arc that would pass
+/// `toolpath::MAX_POINTS` is refused before its chords are made, with its line.
+#[test]
+fn a_counted_loop_past_the_point_limit_is_an_error_before_the_points() {
+    let e = fails(
+        "0 BEGIN PGM F MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 FN 0: Q1 = +0\n3 CC X+10 Y+0\n\
+         4 LBL 2\n5 CP IPA+720 IZ-0.1 DR+ F500\n6 FN 1: Q1 = +Q1 + +1\n\
+         7 FN 12: IF +Q1 LT +100000 GOTO LBL 2\n8 END PGM F MM\n",
+    );
+    assert!(
+        e.contains("t.h:6:")
+            && e.contains(&format!("more than the {}", toolpath::MAX_POINTS))
+            && e.contains("check the jumps and repeat counts"),
+        "{e}"
+    );
 }
 
 #[test]

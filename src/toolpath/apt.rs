@@ -65,7 +65,8 @@
 //!   is evaluated (de Boor) and sampled adaptively until every sample interval's chord lies
 //!   within [`super::gcode::MAX_CHORD_ERROR_MM`] of the curve at its midpoint and quarter points
 //!   (at most [`NURBS_MAX_POINTS`] points per curve); each sample is a CL point. The tool
-//!   vector stays the last one.
+//!   vector stays the last one. A toolpath has at most [`super::MAX_POINTS`] CL points: an
+//!   arc or curve that would make more is an error before its points are made.
 //! * `MSYS/x0,y0,z0,xi,xj,xk,yi,yj,yk` (NX): the frame the following records are written in:
 //!   origin and the directions of its X and Y axes in world coordinates (Z = X × Y). Every
 //!   later point becomes origin + R·p and every tool vector R·v; `MSYS/` without numbers (or
@@ -205,11 +206,13 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         }
         if !continues && let Some((start, record)) = pending.take() {
             reader.record(start, &record)?;
+            reader.check_room(start, "this record", 0)?;
         }
     }
     // A `$` on the last line: take the record as it is.
     if let Some((start, record)) = pending.take() {
         reader.record(start, &record)?;
+        reader.check_room(start, "this record", 0)?;
     }
     reader.flush_nurbs()?;
     if let Some((line, _)) = reader.arc {
@@ -448,6 +451,12 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// Checks, before `what` makes `more` CL points (0: the points made so far), that the
+    /// toolpath stays within [`super::MAX_POINTS`].
+    fn check_room(&self, line: usize, what: &str, more: usize) -> Result<()> {
+        super::check_room(self.source, line, what, self.points.len(), more)
+    }
+
     fn emit(&mut self, p: Vector3<f64>, feed: Feed, line: usize) {
         self.points.push(ClPoint {
             p,
@@ -606,6 +615,7 @@ impl<'a> Reader<'a> {
         let along1 = n.dot(&(end - arc.centre));
         let chords = super::arc_chords(sweep, r0.max(r1))
             .map_err(|e| self.error(arc_line, format!("CIRCLE: {e}")))?;
+        self.check_room(line, "the arc", chords)?;
         for k in 1..=chords {
             let t = k as f64 / chords as f64;
             let p = if k == chords {
@@ -667,6 +677,7 @@ impl<'a> Reader<'a> {
         let samples = curve
             .sample(MAX_CHORD_ERROR_MM, NURBS_MAX_POINTS)
             .map_err(|e| self.error(line, format!("NURBS: {e}")))?;
+        self.check_room(line, "the NURBS curve", samples.len())?;
         let feed = if self.rapid_next {
             self.rapid_next = false;
             Feed::Rapid

@@ -33,6 +33,45 @@ pub fn arc_chords(sweep: f64, radius: f64) -> std::result::Result<usize, String>
     Ok((n as usize).max(1))
 }
 
+/// Most CL points a reader makes from one program: 4 million, the default station limit
+/// ([`crate::optimize::Options::max_stations`]; a station sits on every CL point, so a longer
+/// path could not be solved at the default anyway). It bounds the work that grows with what a
+/// program asks for rather than with its length: arcs with many turns, cycles, repeats,
+/// subprogram calls and jumps, which a few lines can multiply into any number of points.
+/// Every reader checks it *before* it makes a run of points ([`check_room`]), so the error
+/// comes before the work and the memory, never after.
+pub const MAX_POINTS: usize = 4_000_000;
+
+/// Checks that `more` CL points made at `line` of `source` by `what` (an arc's chords, a
+/// cycle's moves, a curve's samples), after the `have` made so far, stay within
+/// [`MAX_POINTS`]; `more = 0` checks what was made (a block's single points). The error names
+/// the file and line, the counts, and what to do.
+pub(crate) fn check_room(
+    source: &Path,
+    line: usize,
+    what: &str,
+    have: usize,
+    more: usize,
+) -> Result<()> {
+    if have.saturating_add(more) <= MAX_POINTS {
+        return Ok(());
+    }
+    let made = if more == 0 {
+        format!("the program has made {have} CL points by {what}")
+    } else {
+        format!("{what} makes {more} CL points after {have}")
+    };
+    Err(Error::parse(
+        source,
+        line,
+        format!(
+            "{made}: more than the {MAX_POINTS} a toolpath may have (a loop, repeat counts or \
+             arc turns that multiply the moves, or a program too long to solve at once): check \
+             the jumps and repeat counts, or split the program"
+        ),
+    ))
+}
+
 /// Millimetres per inch.
 pub const MM_PER_INCH: f64 = 25.4;
 

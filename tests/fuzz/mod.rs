@@ -1,5 +1,17 @@
 //! The fuzzing harness behind `tests/fuzz_cli.rs`: targets, running and judging one case,
 //! budgets (cases, CPU time, wall time) and the figures of a campaign.
+//!
+//! **The time bound of a case is CPU time**, never wall time: campaigns run under `nice 19`
+//! on a shared machine, where a case may wait for a core far longer than it runs (a read that
+//! takes 2 ms of CPU can take seconds of wall time), so a wall-clock bound would report
+//! "timeouts" that are the machine's, not the reader's. An in-process case runs on the
+//! [`Worker`] thread, whose CPU clock (`pthread_getcpuclockid`, `clock_gettime`) the harness
+//! reads while it waits; a `solve` case runs as a child, whose CPU time (all its threads,
+//! `utime + stime` of `/proc/<pid>/stat`) is read the same way, and after it ends its exact
+//! total (`getrusage(RUSAGE_CHILDREN)`). Past the bound the case is a hang. A wall-clock
+//! backstop of [`WALL_BACKSTOP`] × the bound catches a case that waits without using CPU
+//! (a deadlock, a sleep); under `nice 19` beside busy processes a CPU-bound case gets as
+//! little as a few percent of a core, hence the generous factor.
 
 pub mod corpus;
 pub mod mutate;
@@ -150,6 +162,56 @@ pub fn cpu_seconds(children: bool) -> Option<f64> {
 // Running one case
 // ---------------------------------------------------------------------------------------------
 
+/// The wall-clock backstop of a case, as a multiple of its CPU-time bound (see the module
+/// documentation): 5 s of CPU for a read, 5 minutes of wall time.
+pub const WALL_BACKSTOP: u32 = 60;
+
+/// Marks an error of the harness itself (writing a case's file, starting a child): not the
+/// target's failure. The campaign stops and reports it apart.
+const HARNESS: &str = "harness error";
+
+/// The calling thread's CPU time so far.
+pub fn thread_cpu() -> Duration {
+    clock_time(libc::CLOCK_THREAD_CPUTIME_ID).unwrap_or_default()
+}
+
+/// CPU time of the clock `clock` (a thread's: `pthread_getcpuclockid`).
+fn clock_time(clock: libc::clockid_t) -> Option<Duration> {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec to write into; a bad clock id only returns an error.
+    let rc = unsafe { libc::clock_gettime(clock, &mut t) };
+    (rc == 0).then(|| Duration::new(t.tv_sec as u64, t.tv_nsec as u32))
+}
+
+/// CPU time of this process's waited-for children (`getrusage(RUSAGE_CHILDREN)`).
+fn children_cpu() -> Duration {
+    // SAFETY: an all-zero rusage is a valid value for getrusage to overwrite.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `u` is a valid rusage to write into.
+    if unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut u) } != 0 {
+        return Duration::ZERO;
+    }
+    let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, t.tv_usec as u32 * 1000);
+    tv(u.ru_utime) + tv(u.ru_stime)
+}
+
+/// CPU time of process `pid` so far (all its threads: `utime + stime` of `/proc/<pid>/stat`;
+/// clock ticks, 10 ms), or `None` when it has ended.
+fn process_cpu(pid: u32) -> Option<Duration> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .map(|x| x.parse().unwrap_or(0.0))
+        .collect();
+    (f.len() == 2).then(|| Duration::from_secs_f64((f[0] + f[1]) / clock_ticks()))
+}
+
 /// How a case ended.
 #[derive(Debug)]
 pub enum Outcome {
@@ -162,24 +224,35 @@ pub enum Outcome {
     Failed(String),
     /// Still running past the time bound.
     Hung(String),
+    /// The harness itself failed (a case's file could not be written, a child not started):
+    /// the campaign stops; the target is not blamed.
+    Harness(String),
 }
 
 /// A job for the [`Worker`]: one case, read and judged.
-type Job = Box<dyn FnOnce() -> Outcome + Send>;
+pub type Job = Box<dyn FnOnce() -> Outcome + Send>;
 
 /// One thread that runs the in-process cases of a target one after another, each under a
-/// time bound. (A thread per case would cost a thread's creation and teardown each time:
-/// about as much system time as a small case.)
-struct Worker {
+/// bound on the thread's CPU time. (A thread per case would cost a thread's creation and
+/// teardown each time: about as much system time as a small case.)
+pub struct Worker {
     jobs: mpsc::Sender<Job>,
     done: mpsc::Receiver<std::thread::Result<Outcome>>,
+    /// The worker thread's CPU clock.
+    clock: libc::clockid_t,
+    /// Keeps the thread's id valid for its clock.
+    _thread: std::thread::JoinHandle<()>,
 }
 
+/// How often the harness looks at a running case's clocks.
+const POLL: Duration = Duration::from_millis(20);
+
 impl Worker {
-    fn new() -> Worker {
+    pub fn new() -> Worker {
+        use std::os::unix::thread::JoinHandleExt;
         let (jobs, inbox) = mpsc::channel::<Job>();
         let (outbox, done) = mpsc::channel();
-        std::thread::spawn(move || {
+        let thread = std::thread::spawn(move || {
             for job in inbox {
                 let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
                 if outbox.send(r).is_err() {
@@ -187,32 +260,73 @@ impl Worker {
                 }
             }
         });
-        Worker { jobs, done }
+        let mut clock: libc::clockid_t = 0;
+        // SAFETY: the thread is alive (it waits on `inbox`, which we hold) and `clock` is a
+        // valid place to write its clock id.
+        let rc = unsafe { libc::pthread_getcpuclockid(thread.as_pthread_t(), &mut clock) };
+        assert_eq!(rc, 0, "pthread_getcpuclockid: error {rc}");
+        Worker {
+            jobs,
+            done,
+            clock,
+            _thread: thread,
+        }
     }
 
-    /// Runs `job` under `bound`: its outcome, `Failed` on a panic, `Hung` past the bound (the
-    /// worker is then busy for good: the caller stops the target).
-    fn run(&self, bound: Duration, job: Job) -> Outcome {
+    /// The worker thread's CPU time so far.
+    fn cpu(&self) -> Duration {
+        clock_time(self.clock).unwrap_or_default()
+    }
+
+    /// Runs `job` under `bound` of the worker thread's CPU time (and a wall-clock backstop of
+    /// [`WALL_BACKSTOP`] × `bound`): its outcome and the CPU time it took; `Failed` on a
+    /// panic, `Hung` past the bound (the worker is then busy for good: the caller stops the
+    /// target).
+    pub fn run(&self, bound: Duration, job: Job) -> (Outcome, Duration) {
+        let (t0, cpu0) = (Instant::now(), self.cpu());
         if self.jobs.send(job).is_err() {
-            return Outcome::Failed("the worker thread is gone".into());
+            return (
+                Outcome::Failed("the worker thread is gone".into()),
+                Duration::ZERO,
+            );
         }
-        match self.done.recv_timeout(bound) {
-            Ok(Ok(outcome)) => outcome,
-            Ok(Err(p)) => {
-                let msg = p
-                    .downcast_ref::<String>()
-                    .cloned()
-                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                    .unwrap_or_default();
-                Outcome::Failed(format!("panic: {msg}"))
+        let backstop = bound * WALL_BACKSTOP;
+        let outcome = loop {
+            match self.done.recv_timeout(POLL) {
+                Ok(Ok(outcome)) => break outcome,
+                Ok(Err(p)) => {
+                    let msg = p
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_default();
+                    break Outcome::Failed(format!("panic: {msg}"));
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    let (cpu, wall) = (self.cpu() - cpu0, t0.elapsed());
+                    if cpu > bound {
+                        break Outcome::Hung(format!(
+                            "still running after {:.2} s of CPU time (bound {bound:?}; {:.1} s \
+                             wall)",
+                            cpu.as_secs_f64(),
+                            wall.as_secs_f64()
+                        ));
+                    }
+                    if wall > backstop {
+                        break Outcome::Hung(format!(
+                            "still running after {:.0} s of wall time (the backstop; {:.2} s of \
+                             CPU time)",
+                            wall.as_secs_f64(),
+                            cpu.as_secs_f64()
+                        ));
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    break Outcome::Failed("the worker thread is gone".into());
+                }
             }
-            Err(mpsc::RecvTimeoutError::Timeout) => {
-                Outcome::Hung(format!("still running after {bound:?}"))
-            }
-            Err(mpsc::RecvTimeoutError::Disconnected) => {
-                Outcome::Failed("the worker thread is gone".into())
-            }
-        }
+        };
+        (outcome, self.cpu() - cpu0)
     }
 }
 
@@ -365,7 +479,7 @@ fn toolpath_case(
     machine: Option<MachineContext>,
 ) -> Outcome {
     if let Err(e) = std::fs::write(&path, &bytes) {
-        return Outcome::Failed(format!("writing {}: {e}", path.display()));
+        return Outcome::Harness(format!("{HARNESS}: writing {}: {e}", path.display()));
     }
     let lines = line_count(&bytes);
     let name = path
@@ -394,7 +508,7 @@ fn toolpath_case(
 /// and judges it.
 fn machine_case(path: PathBuf, bytes: Vec<u8>) -> Outcome {
     if let Err(e) = std::fs::write(&path, &bytes) {
-        return Outcome::Failed(format!("writing {}: {e}", path.display()));
+        return Outcome::Harness(format!("{HARNESS}: writing {}: {e}", path.display()));
     }
     let lines = line_count(&bytes);
     match Machine::references_from_file(&path) {
@@ -451,8 +565,11 @@ fn nulls(v: &serde_json::Value, at: &str, out: &mut Vec<String>) {
 }
 
 /// Runs `feedopt solve --stations 50 --json -o out.csv` with the `extra` arguments (`--solver
-/// reach`, `--dialect fanuc`) on a mutated problem as a child process, killed after `bound`;
-/// `Ok(Some(line))`: it ended in one clean error line.
+/// reach`, `--dialect fanuc`) on a mutated problem as a child process, killed past `bound` of
+/// its CPU time (on one thread: `RAYON_NUM_THREADS=1`, so its CPU time is the time it would
+/// take on a free core) or [`WALL_BACKSTOP`] × `bound` of wall time; `Ok(Some(line))`: it
+/// ended in one clean error line. An error of the harness itself (writing the files, starting
+/// the child) starts with `harness error`.
 pub fn solve_case(
     dir: &Path,
     ext: &str,
@@ -461,9 +578,13 @@ pub fn solve_case(
     extra: &[&str],
     bound: Duration,
 ) -> Result<Option<String>, String> {
-    std::fs::write(dir.join("machine.json"), machine).map_err(|e| e.to_string())?;
+    let write = |name: &str, bytes: &[u8]| {
+        std::fs::write(dir.join(name), bytes)
+            .map_err(|e| format!("{HARNESS}: writing {}: {e}", dir.join(name).display()))
+    };
+    write("machine.json", machine)?;
     let tp = format!("path.{ext}");
-    std::fs::write(dir.join(&tp), toolpath).map_err(|e| e.to_string())?;
+    write(&tp, toolpath)?;
     let out_csv = dir.join("out.csv");
     let _ = std::fs::remove_file(&out_csv);
     let mut child = Command::new(env!("CARGO_BIN_EXE_feedopt"))
@@ -471,11 +592,12 @@ pub fn solve_case(
         .args(extra)
         .args(["-m", "machine.json", &tp, "-o", "out.csv"])
         .current_dir(dir)
+        .env("RAYON_NUM_THREADS", "1")
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .map_err(|e| format!("spawn: {e}"))?;
+        .map_err(|e| format!("{HARNESS}: starting feedopt: {e}"))?;
     // Drain the pipes while waiting, so that a chatty child cannot block on a full pipe.
     let (mut out, mut err) = (child.stdout.take(), child.stderr.take());
     let reader = std::thread::spawn(move || {
@@ -490,14 +612,25 @@ pub fn solve_case(
         (o, e)
     });
     let t0 = Instant::now();
+    let backstop = bound * WALL_BACKSTOP;
     let status = loop {
-        if let Some(s) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(s) = child
+            .try_wait()
+            .map_err(|e| format!("{HARNESS}: waiting for feedopt: {e}"))?
+        {
             break s;
         }
-        if t0.elapsed() > bound {
+        let cpu = process_cpu(child.id()).unwrap_or_default();
+        let wall = t0.elapsed();
+        if cpu > bound || wall > backstop {
             let _ = child.kill();
             let _ = child.wait();
-            return Err(format!("still running after {bound:?} (killed)"));
+            return Err(format!(
+                "still running after {:.2} s of CPU time and {:.1} s of wall time (bound \
+                 {bound:?} of CPU, backstop {backstop:?} of wall; killed)",
+                cpu.as_secs_f64(),
+                wall.as_secs_f64()
+            ));
         }
         std::thread::sleep(Duration::from_millis(2));
     };
@@ -610,12 +743,16 @@ pub struct Figures {
     pub seed_messages: Vec<String>,
     /// Distinct kinds of error message (without numbers and quoted text).
     pub kinds: HashSet<String>,
+    /// Wall time of the cases, and the longest case's CPU time (what the bound bounds: the
+    /// worker thread's, or for `solve` the child's).
     pub total: Duration,
     pub slowest: Duration,
     pub cpu_s: f64,
     pub wall_s: f64,
-    /// Why the target stopped before its budget (a hung case).
+    /// Why the target stopped before its budget (a hung case, a harness error).
     pub stopped: Option<String>,
+    /// An error of the harness itself that stopped the target (not a failure of the target).
+    pub harness: Option<String>,
 }
 
 /// A case that failed, with its input.
@@ -633,6 +770,8 @@ pub struct Failure {
 pub struct Campaign {
     pub settings: Settings,
     pub failures: Vec<Failure>,
+    /// Errors of the harness itself (writing files): reported apart from the failures.
+    pub harness: Vec<String>,
     pub figures: Vec<(String, Figures)>,
 }
 
@@ -656,6 +795,7 @@ impl Campaign {
         Campaign {
             settings,
             failures: Vec::new(),
+            harness: Vec::new(),
             figures: Vec::new(),
         }
     }
@@ -695,7 +835,8 @@ impl Campaign {
         };
         let others: Vec<&[u8]> = seeds.iter().map(|s| s.text.as_slice()).collect();
         let work = self.settings.work.join(&target.name).join("work");
-        std::fs::create_dir_all(&work).expect("work directory");
+        std::fs::create_dir_all(&work)
+            .unwrap_or_else(|e| panic!("HARNESS ERROR: {}: {e}", work.display()));
         let children = target.kind == Kind::Solve;
         let (t0, cpu0) = (Instant::now(), cpu_seconds(children).unwrap_or(0.0));
         let mut fig = Figures::default();
@@ -746,17 +887,27 @@ impl Campaign {
                         seed.ext
                     ),
                 };
-                let _ = std::fs::write(
+                let described = std::fs::write(
                     work.join("CASE.txt"),
                     format!(
                         "target {}, case {case}, seed {:?}, mutation: {how}\ninput: {input}\n",
                         target.name, seed.name
                     ),
                 );
+                if let Err(e) = described {
+                    let what = format!(
+                        "{HARNESS}: writing {}: {e}",
+                        work.join("CASE.txt").display()
+                    );
+                    eprintln!("HARNESS ERROR {}: {what}", target.name);
+                    fig.stopped = Some(what.clone());
+                    fig.harness = Some(what);
+                    break;
+                }
             }
             let started = Instant::now();
             let is_seed = (case as usize) < seeds.len();
-            let (outcome, files) = self.case(
+            let (outcome, cpu, files) = self.case(
                 target.kind,
                 &work,
                 seed,
@@ -768,10 +919,17 @@ impl Campaign {
                 &worker,
             );
             let elapsed = started.elapsed();
+            if let Outcome::Harness(what) = outcome {
+                // Not the target's failure: no failing input; the campaign reports it apart.
+                eprintln!("HARNESS ERROR {} case {case}: {what}", target.name);
+                fig.stopped = Some(format!("case {case}: {what}"));
+                fig.harness = Some(what);
+                break;
+            }
             fig.cases += 1;
             fig.seeds += is_seed as usize;
             fig.total += elapsed;
-            fig.slowest = fig.slowest.max(elapsed);
+            fig.slowest = fig.slowest.max(cpu);
             let mut failed = None;
             match outcome {
                 Outcome::Accepted => {}
@@ -785,6 +943,7 @@ impl Campaign {
                 }
                 Outcome::Failed(what) => failed = Some((what, false)),
                 Outcome::Hung(what) => failed = Some((what, true)),
+                Outcome::Harness(_) => unreachable!("handled above"),
             }
             if let Some((what, hung)) = failed {
                 fig.failures += 1;
@@ -798,8 +957,14 @@ impl Campaign {
                         seed: seed.name.clone(),
                         files,
                     };
-                    if let Some(out) = &self.settings.out {
-                        self.save_failure(&f, out);
+                    if let Some(out) = &self.settings.out
+                        && let Err(e) = self.save_failure(&f, out)
+                    {
+                        eprintln!("HARNESS ERROR {}: {e}", target.name);
+                        fig.stopped = Some(e.clone());
+                        fig.harness = Some(e);
+                        self.failures.push(f);
+                        break;
                     }
                     self.failures.push(f);
                 }
@@ -813,17 +978,24 @@ impl Campaign {
         }
         fig.wall_s = t0.elapsed().as_secs_f64();
         fig.cpu_s = cpu_seconds(children).unwrap_or(0.0) - cpu0;
+        if let Some(e) = &fig.harness {
+            self.harness.push(format!("{}: {e}", target.name));
+        }
         self.figures.push((target.name.clone(), fig));
         if let Some(out) = &self.settings.out {
-            let _ = std::fs::write(
-                out.join(&target.name).join("figures.txt"),
-                self.table_of(&self.figures[self.figures.len() - 1..], "long"),
-            );
+            let path = out.join(&target.name).join("figures.txt");
+            let table = self.table_of(&self.figures[self.figures.len() - 1..], "long");
+            if let Err(e) = std::fs::write(&path, table) {
+                let e = format!("{HARNESS}: writing {}: {e}", path.display());
+                eprintln!("HARNESS ERROR {}: {e}", target.name);
+                self.harness.push(e);
+            }
         }
     }
 
     /// Runs one case of `kind` on `text` (a mutation of `seed`, or the seed itself when
-    /// `pristine`): the outcome and the files to keep when it fails.
+    /// `pristine`): the outcome, the CPU time it took (the worker thread's, or the `solve`
+    /// child's) and the files to keep when it fails.
     #[allow(clippy::too_many_arguments)]
     fn case(
         &self,
@@ -836,7 +1008,7 @@ impl Campaign {
         k: usize,
         rng: &mut Rng,
         worker: &Worker,
-    ) -> (Outcome, Vec<(String, Vec<u8>)>) {
+    ) -> (Outcome, Duration, Vec<(String, Vec<u8>)>) {
         let bound = self.settings.parse_bound;
         match kind {
             Kind::Apt | Kind::Gcode(_) | Kind::JointCsv => {
@@ -857,13 +1029,15 @@ impl Campaign {
                 ];
                 let path = work.join(&name);
                 let job = move || toolpath_case(path, text, format, dialect, machine);
-                (worker.run(bound, Box::new(job)), files)
+                let (outcome, cpu) = worker.run(bound, Box::new(job));
+                (outcome, cpu, files)
             }
             Kind::Machine => {
                 let files = vec![("machine.json".to_string(), text.clone())];
                 let path = work.join("machine.json");
                 let job = move || machine_case(path, text);
-                (worker.run(bound, Box::new(job)), files)
+                let (outcome, cpu) = worker.run(bound, Box::new(job));
+                (outcome, cpu, files)
             }
             Kind::Solve => {
                 // Mutate the toolpath (three times in five), the machine, or both (`text` is
@@ -909,6 +1083,7 @@ impl Campaign {
                         format!("mutated: {how}; extra arguments: {extra:?}\n").into_bytes(),
                     ),
                 ];
+                let cpu0 = children_cpu();
                 let r = solve_case(
                     work,
                     seed.ext,
@@ -924,9 +1099,10 @@ impl Campaign {
                         message: line,
                     },
                     Err(what) if what.starts_with("still running") => Outcome::Hung(what),
+                    Err(what) if what.starts_with(HARNESS) => Outcome::Harness(what),
                     Err(what) => Outcome::Failed(what),
                 };
-                (o, files)
+                (o, children_cpu().saturating_sub(cpu0), files)
             }
         }
     }
@@ -948,7 +1124,7 @@ impl Campaign {
             }
         );
         out.push_str(&format!(
-            "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8} {:>11} {:>10} {:>8} {:>8}\n",
+            "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8} {:>11} {:>14} {:>8} {:>8}\n",
             "target",
             "cases",
             "errors",
@@ -957,13 +1133,13 @@ impl Campaign {
             "seeds",
             "mean ms",
             "mean CPU ms",
-            "slowest ms",
+            "slowest CPU ms",
             "CPU s",
             "wall s"
         ));
         for (t, f) in figures {
             out.push_str(&format!(
-                "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8.3} {:>11.3} {:>10.1} {:>8.1} {:>8.1}\n",
+                "  {:<16} {:>9} {:>9} {:>8} {:>6} {:>7} {:>8.3} {:>11.3} {:>14.1} {:>8.1} {:>8.1}\n",
                 t,
                 f.cases,
                 f.errors,
@@ -982,39 +1158,56 @@ impl Campaign {
         }
         out.push_str(
             "  (errors: cases that ended in one clean error line; kinds: distinct error \
-             messages without numbers and quoted text; seeds: read cleanly / run; mean and \
-             slowest ms: wall time of a case; CPU: this process, and for solve its feedopt \
-             children too)\n",
+             messages without numbers and quoted text; seeds: read cleanly / run; mean ms: \
+             wall time of a case; slowest CPU ms: the CPU time of the longest case, what the \
+             time bound bounds (the worker thread's, for solve the feedopt child's); mean CPU \
+             ms, CPU s: this process, and for solve its feedopt children too)\n",
         );
         out
     }
 
-    /// Writes a failing case's input under `dir/<target>/failures/case-<n>/`, with `WHAT.txt`.
-    fn save_failure(&self, f: &Failure, dir: &Path) {
+    /// Writes a failing case's input under `dir/<target>/failures/case-<n>/`, with `WHAT.txt`;
+    /// a harness error when it cannot.
+    fn save_failure(&self, f: &Failure, dir: &Path) -> Result<(), String> {
         let d = dir
             .join(&f.target)
             .join("failures")
             .join(format!("case-{}", f.case));
-        let _ = std::fs::create_dir_all(&d);
-        for (name, bytes) in &f.files {
-            let _ = std::fs::write(d.join(name), bytes);
-        }
-        let _ = std::fs::write(
-            d.join("WHAT.txt"),
-            format!(
-                "{}\nseed: {}\nmutation: {}\ncampaign seed {}\n",
-                f.what, f.seed, f.mutation, self.settings.seed
-            ),
-        );
+        let saved = std::fs::create_dir_all(&d)
+            .and_then(|()| {
+                f.files
+                    .iter()
+                    .try_for_each(|(name, bytes)| std::fs::write(d.join(name), bytes))
+            })
+            .and_then(|()| {
+                std::fs::write(
+                    d.join("WHAT.txt"),
+                    format!(
+                        "{}\nseed: {}\nmutation: {}\ncampaign seed {}\n",
+                        f.what, f.seed, f.mutation, self.settings.seed
+                    ),
+                )
+            });
+        saved.map_err(|e| format!("{HARNESS}: saving a failing input in {}: {e}", d.display()))
     }
 
-    /// Panics with the list of failures (after saving them under `dir`), if there are any.
+    /// Panics with the list of failures (after saving them under `dir`), if there are any,
+    /// and with the harness's own errors, apart (`HARNESS ERROR`: not the targets' failures).
     pub fn assert_clean(&self, dir: &Path) {
+        let mut harness = self.harness.clone();
+        for f in &self.failures {
+            if let Err(e) = self.save_failure(f, dir) {
+                harness.push(e);
+            }
+        }
+        assert!(
+            harness.is_empty(),
+            "HARNESS ERROR (the harness failed, not the targets; {} failing cases): {}",
+            self.failures.len(),
+            harness.join("; ")
+        );
         if self.failures.is_empty() {
             return;
-        }
-        for f in &self.failures {
-            self.save_failure(f, dir);
         }
         let list: Vec<String> = self
             .failures

@@ -29,14 +29,27 @@ pub struct Variables {
     values: HashMap<String, f64>,
     /// Declared with `DEF` (value 0 until assigned).
     declared: HashMap<String, ()>,
+    /// Changes so far ([`Variables::changes`]).
+    changes: u64,
 }
 
 impl Variables {
     /// Declares a Sinumerik user variable (value 0).
     pub fn declare(&mut self, name: &str) {
         let name = name.to_ascii_uppercase();
-        self.values.entry(name.clone()).or_insert(0.0);
+        if !self.values.contains_key(&name) {
+            self.changes += 1;
+            self.values.insert(name.clone(), 0.0);
+        }
         self.declared.insert(name, ());
+    }
+
+    /// How many times a value has changed so far (a new variable, or a different value
+    /// assigned; assigning the value a variable has is no change). The same count at two
+    /// moments of a run means the same values: the subprogram runner uses it to tell a jump
+    /// that loops for ever.
+    pub fn changes(&self) -> u64 {
+        self.changes
     }
 
     /// Whether `name` is a variable an assignment may set: a declared name, an R parameter
@@ -60,7 +73,11 @@ impl Variables {
     }
 
     pub fn set(&mut self, name: &str, value: f64) {
-        self.values.insert(name.to_ascii_uppercase(), value);
+        // Bit for bit: -0 after 0 is a change (1/-0 is not 1/0).
+        let old = self.values.insert(name.to_ascii_uppercase(), value);
+        if old.map(f64::to_bits) != Some(value.to_bits()) {
+            self.changes += 1;
+        }
     }
 
     fn get(&self, name: &str) -> Result<f64, String> {

@@ -1101,6 +1101,12 @@ impl<'a> Interpreter<'a> {
         if let Some(note) = note {
             self.warn(line, format!("G{}: {note}", c.code));
         }
+        // Each repeat: up to R, over the hole, and the cycle's moves.
+        self.check_room(
+            line,
+            &format!("G{} with {repeats} repeats", c.code),
+            repeats.saturating_mul(steps.len() + 2),
+        )?;
         for k in 0..repeats {
             let mut xy = [self.pos[0], self.pos[1]];
             for i in 0..2 {
@@ -1145,6 +1151,7 @@ impl<'a> Interpreter<'a> {
 
     /// Executes cycle steps from the current position.
     fn run_steps(&mut self, line: usize, steps: &[Step]) -> Result<()> {
+        self.check_room(line, "the cycle", steps.len())?;
         for step in steps {
             let mut q = self.pos;
             let feed = match *step {
@@ -1397,6 +1404,13 @@ impl<'a> Interpreter<'a> {
         }
     }
 
+    /// Checks, before this block makes `more` CL points (an arc's chords, a cycle's moves;
+    /// 0: the points made so far), that the program stays within
+    /// [`crate::toolpath::MAX_POINTS`].
+    pub(super) fn check_room(&self, line: usize, what: &str, more: usize) -> Result<()> {
+        crate::toolpath::check_room(self.source, line, what, self.points.len(), more)
+    }
+
     fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
         let frame = self.frame_now();
         if let Some(o) = self.klartext.stay_orientation {
@@ -1635,6 +1649,7 @@ impl<'a> Interpreter<'a> {
 
         let r_max = r_start.max(r_end);
         let chords = crate::toolpath::arc_chords(sweep, r_max).map_err(|e| self.error(line, e))?;
+        self.check_room(line, "the arc", chords)?;
         let phi_end = theta_s + sweep;
         let turn = sweep.signum();
         let tangent = [-phi_end.sin() * turn, phi_end.cos() * turn];

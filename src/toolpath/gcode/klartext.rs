@@ -520,6 +520,15 @@ fn label_name(text: &str) -> Result<String, String> {
 pub(super) fn label_op(text: &str) -> Result<Option<LabelOp>, String> {
     let t = text.trim();
     let t = t.strip_suffix('~').unwrap_or(t).trim();
+    // Most blocks are not label blocks: out before the copies and formats below (this runs
+    // for every block, every pass of a loop).
+    let head = t.as_bytes().get(..3).unwrap_or_default();
+    if !(head.eq_ignore_ascii_case(b"LBL")
+        || head.eq_ignore_ascii_case(b"CAL")
+        || head.get(..2).is_some_and(|h| h.eq_ignore_ascii_case(b"FN")))
+    {
+        return Ok(None);
+    }
     let upper = t.to_ascii_uppercase();
     if let Some(rest) = upper.strip_prefix("LBL")
         && (rest.starts_with([' ', '"']) || rest.is_empty())

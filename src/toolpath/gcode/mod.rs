@@ -97,7 +97,10 @@
 //!   `G700`/`G710` change F too.
 //! * **Bounds**: an axis word beyond ±[`MAX_COORDINATE_MM`] is an error naming it; an arc needs
 //!   at most [`MAX_ARC_CHORDS`] chords (so `P1000000000` turns or `TURN=100000000` are errors
-//!   before any work); exponent notation (`X1e309`) is an error naming the word.
+//!   before any work); exponent notation (`X1e309`) is an error naming the word. The whole
+//!   program makes at most [`crate::toolpath::MAX_POINTS`] CL points: an arc, a cycle (with
+//!   its repeats) or a block that would take it past that is an error naming its line, before
+//!   its points are made, however the program got there (repeats, calls, jumps).
 //! * **Subprograms in the file**: see [`subprograms`] (Fanuc/Haas `M98 P L` with `O<n> … M99`,
 //!   Sinumerik `PROC NAME … RET` and `L123`, LinuxCNC `o100 sub` / `o100 call`): expanded
 //!   where called, nesting and expansion bounded; a call of one not in the file is an error.

@@ -28,9 +28,10 @@
 //!   (REP on a call of a label after it is an error: a repeat count belongs to a section
 //!   repeat). A main program that runs into a label or `LBL 0` goes on (the control does the
 //!   same: a subprogram before `M30` runs once). `FN 9: IF a EQU b GOTO LBL n` (`FN 10` `NE`,
-//!   `FN 11` `GT`, `FN 12` `LT`) jumps to the label when the condition holds. Every block run
-//!   counts towards [`MAX_EXPANDED_BLOCKS`] (past the file's own lines), so a jump loop is an
-//!   error, not a hang. A `~` at the end of a line continues the block on the next line.
+//!   `FN 11` `GT`, `FN 12` `LT`) jumps to the label when the condition holds. A jump taken a
+//!   second time with no Q parameter changed since the first (and the same calls running)
+//!   would run the same pass for ever: an error naming the jump and its label, at once. A
+//!   `~` at the end of a line continues the block on the next line.
 //!
 //! # How a call runs
 //!
@@ -38,8 +39,14 @@
 //! with the caller's modal state, which they may change as on the control (units, feed, G90/91,
 //! motion mode, TCP); every point keeps the line of the block in the body that made it. A call
 //! of a subprogram that is not in the file is an error naming the line, the call and what to
-//! do; so are calls nested more than [`MAX_CALL_DEPTH`] deep and calls that expand to more than
-//! [`MAX_EXPANDED_BLOCKS`] blocks, before the work is done. A program end (`M2`, `M30`) in a
+//! do; so are calls nested more than [`MAX_CALL_DEPTH`] deep, a repeat count above
+//! [`MAX_EXPANDED_BLOCKS`] (before the work is done), and a program that runs more than
+//! [`MAX_EXPANDED_BLOCKS`] blocks or [`MAX_EXPANDED_BYTES`] of block text past its own
+//! (every block run counts, with its length: repeats, calls and jumps alike, so any loop
+//! ends). What the blocks make is bounded too: at most
+//! [`crate::toolpath::MAX_POINTS`] CL points, checked before an arc's chords or a cycle's
+//! moves are made, so a loop whose passes hold a helix or a cycle ends in an error, not in
+//! minutes of work and gigabytes of points. A program end (`M2`, `M30`) in a
 //! subprogram ends the whole program; a return (`M99`, `M17`, `RET`, `endsub`) in the main
 //! program ends it.
 
@@ -55,8 +62,16 @@ use crate::error::{Error, Result};
 /// Deepest nesting of subprogram calls (the main program is depth 0).
 pub const MAX_CALL_DEPTH: usize = 8;
 
-/// Most blocks that subprogram calls may run in all (repeats and nesting multiplied out).
+/// Most blocks a program may run past its own lines: what subprogram calls, repeats (nesting
+/// multiplied out) and jumps add. A block costs about 2 µs to read, so this bounds the blocks'
+/// own work to seconds; what they make is bounded by [`crate::toolpath::MAX_POINTS`].
 pub const MAX_EXPANDED_BLOCKS: usize = 1_000_000;
+
+/// Most characters of blocks a program may run past its own text (32 MiB): a block's work
+/// grows with its length (an expression of up to [`super::expr::MAX_EXPRESSION_LEN`]
+/// characters is evaluated at every pass), so a loop of long blocks is bounded by what it
+/// reads, not only by how many blocks (about 60 ns a character: a second or two).
+pub const MAX_EXPANDED_BYTES: usize = 32 << 20;
 
 /// One line of the file: its 1-based number and its blocks with comments removed (or the
 /// message of an unclosed comment, reported if the line is ever run).
@@ -87,6 +102,29 @@ struct Frame {
     /// A Heidenhain label call: the index of the calling line (a section repeat's pass ends
     /// there) and the label's name.
     label: Option<(usize, String)>,
+}
+
+/// The state when a Klartext jump (`FN 9`–`12`) is taken: the count of variable changes
+/// ([`super::expr::Variables::changes`]) and where every running (sub)program stands. A
+/// program's course depends on nothing else (the conditions, repeats and calls read only Q
+/// parameters and constants), so a jump taken again in the same state runs the same pass
+/// again, for ever.
+#[derive(Debug, PartialEq)]
+struct Loop {
+    changes: u64,
+    frames: Vec<(usize, usize, usize, usize, u64)>,
+}
+
+impl Loop {
+    fn now(stack: &[Frame], changes: u64) -> Loop {
+        Loop {
+            changes,
+            frames: stack
+                .iter()
+                .map(|f| (f.section, f.pos, f.block, f.start, f.runs))
+                .collect(),
+        }
+    }
 }
 
 /// A LinuxCNC O-word subroutine line: `o100 sub`, `o<name> call [..]`, …
@@ -199,6 +237,8 @@ fn sinumerik_header(block: &str) -> Option<(String, bool)> {
 /// The file split into its main program and subprograms.
 pub(super) struct Program {
     lines: Vec<Line>,
+    /// The file's length in bytes.
+    bytes: usize,
     sections: Vec<Section>,
     by_name: HashMap<String, usize>,
     /// Heidenhain labels: name → index of the label's line.
@@ -219,6 +259,7 @@ impl Program {
             .collect();
         let mut program = Program {
             lines,
+            bytes: text.len(),
             sections: vec![Section {
                 name: "the main program".into(),
                 header: 0,
@@ -449,9 +490,13 @@ impl Program {
             call: None,
             label: None,
         }];
-        let mut expanded = 0usize;
-        // Every block run: past the file's lines plus the expansion bound, a jump loops.
-        let mut run_blocks = 0usize;
+        // Every block run counts, and its length: past the file's own lines plus
+        // MAX_EXPANDED_BLOCKS, or its own text plus MAX_EXPANDED_BYTES, repeats, calls or jumps
+        // have run the program too long.
+        let (mut run_blocks, mut run_bytes) = (0usize, 0usize);
+        let mut jumps = 0usize;
+        // Klartext jumps taken: the line's index → the state then (see `Loop`).
+        let mut taken: HashMap<usize, Loop> = HashMap::new();
         while let Some(&Frame {
             section,
             pos,
@@ -489,26 +534,12 @@ impl Program {
             if text.is_empty() || text.starts_with('%') {
                 continue;
             }
-            if stack.len() > 1 {
-                expanded += 1;
-                if expanded > MAX_EXPANDED_BLOCKS {
-                    return Err(self.too_many(source, number, &stack));
-                }
-            }
             run_blocks += 1;
-            if run_blocks > MAX_EXPANDED_BLOCKS + self.lines.len() {
-                return Err(self.located(
-                    Error::parse(
-                        source,
-                        number,
-                        format!(
-                            "the program runs more than {} blocks: a jump (FN 9–12) that loops \
-                             for ever, or repeats too large to expand",
-                            MAX_EXPANDED_BLOCKS + self.lines.len()
-                        ),
-                    ),
-                    &stack,
-                ));
+            run_bytes += text.len();
+            if run_blocks > MAX_EXPANDED_BLOCKS + self.lines.len()
+                || run_bytes > MAX_EXPANDED_BYTES + self.bytes
+            {
+                return Err(self.too_many(source, number, &stack, jumps));
             }
             if text.starts_with('/')
                 || (self.style == Subprograms::Labels
@@ -563,6 +594,12 @@ impl Program {
                         let (a, b) = (value(&a)?, value(&b)?);
                         if klartext::holds(compare, a, b) {
                             let target = self.label(&name, number, source, &stack)?;
+                            let now = Loop::now(&stack, interp.vars.changes());
+                            if taken.get(&index) == Some(&now) {
+                                return Err(self.endless(source, number, body, &name, target));
+                            }
+                            taken.insert(index, now);
+                            jumps += 1;
                             if let Some(top) = stack.last_mut() {
                                 top.pos = target + 1;
                                 top.block = 0;
@@ -603,6 +640,7 @@ impl Program {
                 .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
             interp
                 .block(number, items)
+                .and_then(|()| interp.check_room(number, "this block", 0))
                 .map_err(|e| self.located(e, &stack))?;
             if let Some(call) = interp.call.take() {
                 self.enter(&mut stack, call, number, source)?;
@@ -669,28 +707,7 @@ impl Program {
                 stack,
             ));
         };
-        if runs == 0 {
-            return Ok(());
-        }
-        if stack.len() > MAX_CALL_DEPTH {
-            return Err(self.located(
-                Error::parse(
-                    source,
-                    number,
-                    format!(
-                        "`{}`: subprogram calls nested more than {MAX_CALL_DEPTH} deep (does a \
-                         subprogram call itself?)",
-                        call.text
-                    ),
-                ),
-                stack,
-            ));
-        }
-        // Every run costs at least one block: a huge repeat count of an empty body is bounded.
-        if runs > MAX_EXPANDED_BLOCKS as u64 {
-            return Err(self.too_many(source, number, stack));
-        }
-        stack.push(Frame {
+        let frame = Frame {
             section,
             pos: 0,
             block: 0,
@@ -698,7 +715,47 @@ impl Program {
             runs,
             call: Some((call.text, number)),
             label: None,
-        });
+        };
+        self.call(stack, frame, number, source)
+    }
+
+    /// Starts the call `frame` made at line `number` (every style's calls, and Klartext label
+    /// calls and section repeats): nothing for zero runs; an error past [`MAX_CALL_DEPTH`], or
+    /// for more runs than [`MAX_EXPANDED_BLOCKS`] (each run costs at least one block: a huge
+    /// repeat count of an empty body is refused before it starts).
+    fn call(
+        &self,
+        stack: &mut Vec<Frame>,
+        frame: Frame,
+        number: usize,
+        source: &Path,
+    ) -> Result<()> {
+        if frame.runs == 0 {
+            return Ok(());
+        }
+        let text = frame.call.as_ref().map_or("", |(t, _)| t.as_str());
+        if stack.len() > MAX_CALL_DEPTH {
+            let what = if frame.label.is_some() {
+                "label calls"
+            } else {
+                "subprogram calls"
+            };
+            return Err(self.located(
+                Error::parse(
+                    source,
+                    number,
+                    format!(
+                        "`{text}`: {what} nested more than {MAX_CALL_DEPTH} deep (does a \
+                         subprogram call itself?)"
+                    ),
+                ),
+                stack,
+            ));
+        }
+        if frame.runs > MAX_EXPANDED_BLOCKS as u64 {
+            return Err(self.too_many(source, number, stack, 0));
+        }
+        stack.push(frame);
         Ok(())
     }
 
@@ -753,26 +810,7 @@ impl Program {
             }
             Some(r) => r,
         };
-        if runs == 0 {
-            return Ok(());
-        }
-        if stack.len() > MAX_CALL_DEPTH {
-            return Err(self.located(
-                Error::parse(
-                    source,
-                    number,
-                    format!(
-                        "`{text}`: label calls nested more than {MAX_CALL_DEPTH} deep (does a \
-                         subprogram call itself?)"
-                    ),
-                ),
-                stack,
-            ));
-        }
-        if runs > MAX_EXPANDED_BLOCKS as u64 {
-            return Err(self.too_many(source, number, stack));
-        }
-        stack.push(Frame {
+        let frame = Frame {
             section: 0,
             pos: target + 1,
             block: 0,
@@ -780,21 +818,52 @@ impl Program {
             runs,
             call: Some((text, number)),
             label: Some((at, name.to_string())),
-        });
-        Ok(())
+        };
+        self.call(stack, frame, number, source)
     }
 
-    fn too_many(&self, source: &Path, number: usize, stack: &[Frame]) -> Error {
+    /// The error of a program that runs more than [`MAX_EXPANDED_BLOCKS`] blocks past its own
+    /// lines (or a call that would), after `jumps` Klartext jumps.
+    fn too_many(&self, source: &Path, number: usize, stack: &[Frame], jumps: usize) -> Error {
+        let jumped = if jumps > 0 {
+            format!(" ({jumps} jumps FN 9–12 taken: does a jump loop?)")
+        } else {
+            String::new()
+        };
         self.located(
             Error::parse(
                 source,
                 number,
                 format!(
-                    "subprogram calls expand to more than {MAX_EXPANDED_BLOCKS} blocks: lower \
-                     the repeat counts or post the program without subprogram calls"
+                    "subprogram calls, repeats and jumps run more than {MAX_EXPANDED_BLOCKS} \
+                     blocks or {} MiB of blocks past the program's own{jumped}: lower the \
+                     repeat counts, or post the program without subprogram calls",
+                    MAX_EXPANDED_BYTES >> 20
                 ),
             ),
             stack,
+        )
+    }
+
+    /// The error of a Klartext jump `block` at line `number` to label `name` (at line index
+    /// `target`) taken a second time with the same state: it loops for ever.
+    fn endless(
+        &self,
+        source: &Path,
+        number: usize,
+        block: &str,
+        name: &str,
+        target: usize,
+    ) -> Error {
+        Error::parse(
+            source,
+            number,
+            format!(
+                "`{block}` jumps back to LBL {name} (line {}) for ever: no Q parameter has \
+                 changed since it last jumped, so every pass runs the same way; make the loop \
+                 change what the condition reads (a counter), or remove the jump",
+                self.lines[target].number
+            ),
         )
     }
 
