@@ -43,95 +43,9 @@ use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{Kinematics, MAX_AXES};
 use crate::machine::{AxisKind, Machine};
-use crate::motion::{Interval, State};
+use crate::motion::State;
 use crate::optimize::Solution;
-use crate::schedule::interval_times;
-
-/// The schedule's motion as intervals, span by span, with each interval's start time and the
-/// station's arc length there: what the sampler and the G-code writer walk along.
-#[derive(Debug, Clone)]
-pub struct Timeline {
-    /// Per span: its stations' u, start times t (s) and arc lengths s, and b.
-    pub spans: Vec<SpanTimeline>,
-    /// The schedule's cycle time, s.
-    pub cycle_time: f64,
-}
-
-/// One span's stations on the global clock.
-#[derive(Debug, Clone)]
-pub struct SpanTimeline {
-    /// The stations' u.
-    pub u: Vec<f64>,
-    /// b = u̇² at the stations.
-    pub b: Vec<f64>,
-    /// ü at the stations of a jerk-limited profile.
-    pub a: Option<Vec<f64>>,
-    /// Time at each station, s (the schedule's).
-    pub t: Vec<f64>,
-    /// Arc length at each station, mm (the schedule's).
-    pub s: Vec<f64>,
-}
-
-impl SpanTimeline {
-    /// Interval `i` (stations i, i + 1).
-    pub fn interval(&self, i: usize) -> Interval {
-        Interval::of(&self.u, &self.b, self.a.as_deref(), i)
-    }
-
-    /// The interval containing `u` (the last one at the span's end).
-    pub fn interval_of(&self, u: f64) -> usize {
-        let n = self.u.len() - 1;
-        self.u
-            .partition_point(|&x| x <= u)
-            .saturating_sub(1)
-            .min(n - 1)
-    }
-
-    /// The time (s, global clock) at which the motion passes `u` on this span.
-    pub fn time_at(&self, u: f64) -> f64 {
-        let i = self.interval_of(u);
-        let dt = self.t[i + 1] - self.t[i];
-        self.t[i]
-            + self
-                .interval(i)
-                .time_to_x(u - self.u[i])
-                .unwrap_or(dt)
-                .min(dt)
-    }
-}
-
-impl Timeline {
-    /// The timeline of a solution's schedule. Station times are the schedule's own.
-    pub fn new(solution: &Solution) -> Result<Timeline> {
-        let stations = &solution.schedule.stations;
-        let mut spans = Vec::with_capacity(solution.problems.len());
-        let mut offset = 0;
-        for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
-            let n = p.u.len();
-            if sol.b.len() != n || offset + n > stations.len() || n < 2 {
-                return Err(Error::Solver(format!(
-                    "the schedule does not match its span problems ({} stations, span of {n})",
-                    stations.len()
-                )));
-            }
-            // Checks that the schedule's intervals are traversable (never zero speed).
-            interval_times(p, sol)?;
-            let st = &stations[offset..offset + n];
-            spans.push(SpanTimeline {
-                u: p.u.clone(),
-                b: sol.b.clone(),
-                a: sol.a.clone(),
-                t: st.iter().map(|s| s.t).collect(),
-                s: st.iter().map(|s| s.s).collect(),
-            });
-            offset += n;
-        }
-        Ok(Timeline {
-            spans,
-            cycle_time: solution.schedule.cycle_time,
-        })
-    }
-}
+use crate::schedule::{SpanTimeline, Timeline};
 
 /// One setpoint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -172,7 +86,7 @@ pub const MAX_SAMPLES: usize = 4_000_000;
 /// Samples the solution's motion at period `period` (s): see the module doc.
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
     crate::validate::period("period", period)?;
-    let timeline = Timeline::new(solution)?;
+    let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
     let cycle = timeline.cycle_time;
     let count = (cycle / period).ceil();
     if !(count.is_finite() && count < MAX_SAMPLES as f64) {
@@ -454,28 +368,4 @@ pub fn write_setpoints(path: &Path, sp: &Setpoints) -> Result<()> {
         SetpointFormat::Bin => setpoints_bin(sp)?,
     };
     crate::writers::write_atomically(path, &bytes)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_law_and_its_inverse_agree() {
-        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, 0);
-        // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
-        let dur = iv.duration().unwrap();
-        assert!((dur - 0.8).abs() < 1e-15);
-        for k in 0..=8 {
-            let tau = 0.1 * k as f64;
-            let st = iv.at(tau, dur);
-            assert!((st.ud - (2.0 + 1.25 * tau).min(3.0)).abs() < 1e-12);
-            assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
-        }
-        // From rest: u = ½ ü τ².
-        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, 0);
-        let st = rest.at(0.5, rest.duration().unwrap());
-        assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
-        assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);
-    }
 }

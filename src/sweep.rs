@@ -76,6 +76,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::constraints::{Bound, SpanProblem, essential_rows};
+use crate::error::number;
 use crate::error::{Error, Result};
 use crate::machine::{AxisKind, KinematicsSpec, Limit, Machine};
 use crate::optimize::{Options, Solution, optimize_input};
@@ -893,6 +894,53 @@ impl fmt::Display for Sweep {
 
 fn truncate(s: &str, n: usize) -> String {
     s.chars().take(n).collect()
+}
+
+impl SweepOptions {
+    /// Checks the range and steps of the study and its solve options (fields under `solve.`;
+    /// [`crate::validate`]). [`sweep`](crate::sweep::sweep) calls it, and checks the axis and the range
+    /// against the machine, before any work.
+    pub fn validate(&self) -> Result<()> {
+        for (field, v) in [("from", self.from), ("to", self.to)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::option(
+                    field,
+                    format!("must be a positive limit, got {}", number(v)),
+                ));
+            }
+        }
+        if self.steps == 0 {
+            return Err(Error::option("steps", "must be at least 1"));
+        }
+        if self.steps > MAX_STEPS {
+            return Err(Error::option(
+                "steps",
+                format!(
+                    "{} is more than {MAX_STEPS} (each step is three solves): give at most \
+                     {MAX_STEPS}",
+                    self.steps
+                ),
+            ));
+        }
+        if self.steps > 1 && self.to <= self.from {
+            return Err(Error::option(
+                "to",
+                format!(
+                    "({}) must be greater than from ({}) for more than one step",
+                    number(self.to),
+                    number(self.from)
+                ),
+            ));
+        }
+        let h = self.fd_step;
+        if !(h > 0.0 && h < 0.5) {
+            return Err(Error::option(
+                "fd_step",
+                format!("must be a relative step in (0, 0.5), got {}", number(h)),
+            ));
+        }
+        self.solve.validate().map_err(|e| e.within("solve"))
+    }
 }
 
 #[cfg(test)]

@@ -23,13 +23,15 @@
 //! the check is at least as strict as the solver's own rows.
 
 use crate::constraints::{Chord, SpanProblem};
+use crate::error::number;
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
 use crate::motion::{Interval, Law, State};
-use crate::schedule::interval_times;
 use crate::solver::SpanSolution;
+use crate::solver::interval_times;
+use crate::validate::{MIN_CHORD_TOLERANCE_MM, non_negative, period};
 
 /// Most servo instants a re-simulation checks (2e9: about 23 days of motion at 1 ms; on two
 /// cores about 10 min). A schedule that would need more is refused before the check starts.
@@ -278,8 +280,8 @@ pub fn verify(
                 .map(|i0| (si, i0, (i0 + CHUNK).min(n))),
         );
     }
-    let threads = crate::solver::resolve_threads(options.threads);
-    let parts = crate::solver::par_map(&chunks, threads, |&(si, i0, i1)| {
+    let threads = crate::parallel::resolve_threads(options.threads);
+    let parts = crate::parallel::par_map(&chunks, threads, |&(si, i0, i1)| {
         let mut acc = Accumulator {
             limits: limits.clone(),
             threshold: 1.0 + options.tolerance,
@@ -627,6 +629,29 @@ impl Accumulator {
         if let Some(v) = self.current.take() {
             self.violations.push(v);
         }
+    }
+}
+
+impl VerifyOptions {
+    /// Checks every field's range ([`crate::validate`]); the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        period("period", self.period)?;
+        non_negative("tolerance", self.tolerance, "(relative)")?;
+        if let Some(chord) = &self.chord {
+            let d = chord.tolerance;
+            if !(d.is_finite() && d >= MIN_CHORD_TOLERANCE_MM) {
+                return Err(Error::option(
+                    "chord.tolerance",
+                    format!(
+                        "{} mm: give a chord tolerance of at least {MIN_CHORD_TOLERANCE_MM:e} mm \
+                         (1 nm; smaller ones only slow the feed to a crawl)",
+                        number(d)
+                    ),
+                ));
+            }
+            period("chord.period", chord.period)?;
+        }
+        Ok(())
     }
 }
 
