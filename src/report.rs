@@ -136,8 +136,13 @@ pub struct AxisPeaks {
 /// Share of the path over which one limit holds the feed down.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct BindingShare {
-    /// e.g. `"feed"`, `"C velocity"`, `"A acceleration"`, `"none"`.
-    pub limit: String,
+    /// The limit ([`Bound::None`]: nothing binds). Not in the JSON, which names it (`name`).
+    #[serde(skip)]
+    pub limit: Bound,
+    /// Its name in reports ([`binding_label`]), e.g. `"feed"`, `"C velocity"`,
+    /// `"A acceleration"`, `"none"`: the JSON's `limit`.
+    #[serde(rename = "limit")]
+    pub name: String,
     /// Share of the tool-tip path length (0–1).
     pub share_of_path: f64,
     /// Share of the cycle time (0–1).
@@ -268,7 +273,8 @@ impl Summary {
         let mut binding: Vec<BindingShare> = by_bound
             .into_iter()
             .map(|(b, (ds, dt))| BindingShare {
-                limit: label(b),
+                limit: b,
+                name: label(b),
                 share_of_path: if length > 0.0 { ds / length } else { 0.0 },
                 share_of_time: if time > 0.0 { dt / time } else { 0.0 },
             })
@@ -485,7 +491,7 @@ impl fmt::Display for Summary {
             writeln!(
                 f,
                 "{:<29} {:>12.1} %  {:>12.1} %",
-                b.limit,
+                b.name,
                 100.0 * b.share_of_path,
                 100.0 * b.share_of_time
             )?;

@@ -504,21 +504,24 @@ pub fn sweep(
             _ => return Err(Error::Solver("a sweep step was lost".into())),
         };
         let fd = (plus.cycle_time - minus.cycle_time) / (2.0 * h * v);
-        let label = format!("{} {}", machine.axes[axis].name, which);
-        let binding_set = |e: &Eval| -> Vec<String> {
-            let mut l: Vec<String> = e
+        let swept = match which {
+            SweptLimit::Velocity => Bound::AxisVelocity(axis),
+            SweptLimit::Acceleration => Bound::AxisAcceleration(axis),
+        };
+        let binding_set = |e: &Eval| -> Vec<Bound> {
+            let mut l: Vec<Bound> = e
                 .summary
                 .binding
                 .iter()
-                .filter(|b| b.share_of_path > 0.0 && b.limit != "none")
-                .map(|b| b.limit.clone())
+                .filter(|b| b.share_of_path > 0.0 && b.limit != Bound::None)
+                .map(|b| b.limit)
                 .collect();
             l.sort();
             l
         };
         let same_set =
             binding_set(&minus) == binding_set(&mid) && binding_set(&plus) == binding_set(&mid);
-        let binds = binding_set(&mid).contains(&label);
+        let binds = binding_set(&mid).contains(&swept);
         let is_smooth = same_set
             && match (minus.sensitivity, mid.sensitivity, plus.sensitivity) {
                 (Some(a), Some(b), Some(c)) => smooth(a, b, c),
@@ -586,7 +589,7 @@ impl Sweep {
         let mut most: BTreeMap<&str, f64> = BTreeMap::new();
         for p in &self.points {
             for b in &p.binding {
-                let e = most.entry(b.limit.as_str()).or_insert(0.0);
+                let e = most.entry(b.name.as_str()).or_insert(0.0);
                 *e = e.max(b.share_of_time);
             }
         }
@@ -668,7 +671,7 @@ impl fmt::Display for Sweep {
                 let share = p
                     .binding
                     .iter()
-                    .find(|b| &b.limit == l)
+                    .find(|b| &b.name == l)
                     .map_or(0.0, |b| b.share_of_time);
                 write!(f, " {:>15.1}", 100.0 * share)?;
             }

@@ -54,7 +54,7 @@ impl Sweep {
                 p.worst_ratio
             );
             for l in &labels {
-                let b = p.binding.iter().find(|b| &b.limit == l);
+                let b = p.binding.iter().find(|b| &b.name == l);
                 let (sp, st) = b.map_or((0.0, 0.0), |b| (b.share_of_path, b.share_of_time));
                 let _ = write!(out, ",{sp},{st}");
             }
