@@ -68,6 +68,15 @@ pub struct State {
     pub uddd: f64,
 }
 
+impl State {
+    /// An axis's jerk at this instant from its u-derivatives q' (`dq`), q'' (`ddq`) and q'''
+    /// (`dddq`): `q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛` (u̇³ as u̇·b). The one jerk formula of the
+    /// re-simulation and the reports.
+    pub fn jerk(&self, dq: f64, ddq: f64, dddq: f64) -> f64 {
+        dddq * self.ud * self.b + 3.0 * ddq * self.ud * self.udd + dq * self.uddd
+    }
+}
+
 /// Time taken by each interval of a profile (eq. 43 under its law): `b` at the stations `u`,
 /// and `a` (ü at the stations) for a jerk-limited profile, as in [`Interval::of`]. The one
 /// time integration every stage uses (the schedule, the solvers, the re-simulation, the

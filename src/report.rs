@@ -96,9 +96,7 @@ pub fn jerk_ratios(
             let jets = &p.jets[e];
             for (j, axis) in machine.axes.iter().enumerate().take(kin.n_axes()) {
                 let Some(lim) = axis.jerk else { continue };
-                let q3 = d3[j] * st.ud * st.b
-                    + 3.0 * jets.ddq[j] * st.ud * st.udd
-                    + jets.dq[j] * st.uddd;
+                let q3 = st.jerk(jets.dq[j], jets.ddq[j], d3[j]);
                 let r = lim.ratio(q3);
                 if r > best.0 {
                     best = (r, j);

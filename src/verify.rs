@@ -531,8 +531,7 @@ impl Accumulator {
             self.compare(j, 0, Quantity::Velocity, qd, (span, interval, u, t));
             self.compare(j, 1, Quantity::Acceleration, qdd, (span, interval, u, t));
             if let Some(d3) = &pt.dddq {
-                // q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛.
-                let q3 = d3[j] * r * st.b + 3.0 * jets.ddq[j] * r * st.udd + jets.dq[j] * st.uddd;
+                let q3 = st.jerk(jets.dq[j], jets.ddq[j], d3[j]);
                 self.compare(j, 2, Quantity::Jerk, q3, (span, interval, u, t));
             }
         }
