@@ -677,7 +677,7 @@ fn ratio(x: f64) -> String {
 
 impl CompareOptions {
     /// Checks the solve options (fields under `solve.`) and the junction deviation
-    /// ([`crate::validate`]). [`compare`](crate::compare::compare) calls it before any work.
+    /// ([`crate::validate`]). [`compare`] calls it before any work.
     pub fn validate(&self) -> Result<()> {
         self.solve.validate().map_err(|e| e.within("solve"))?;
         non_negative("junction_deviation", self.junction_deviation, "mm")

@@ -5,8 +5,8 @@
 //!
 //! The schedule fixes b = u̇² at its stations (and ü, for a jerk-limited profile); between
 //! them the motion follows the laws of [`crate::motion`] — for an acceleration-limited profile
-//! b linear in u, ü constant (eq. 40–43) — through [`Interval::at`] (and its inverse,
-//! [`Interval::time_to_x`], for the G-code writer): exactly the motion [`crate::verify`]
+//! b linear in u, ü constant (eq. 40–43) — through [`Interval::at`](crate::motion::Interval::at) (and its inverse,
+//! [`Interval::time_to_x`](crate::motion::Interval::time_to_x), for the G-code writer): exactly the motion [`crate::verify`]
 //! re-simulates.
 //!
 //! # Samples

@@ -698,7 +698,7 @@ fn truncate(s: &str, n: usize) -> String {
 
 impl SweepOptions {
     /// Checks the range and steps of the study and its solve options (fields under `solve.`;
-    /// [`crate::validate`]). [`sweep`](crate::sweep::sweep) calls it, and checks the axis and the range
+    /// [`crate::validate`]). [`sweep`] calls it, and checks the axis and the range
     /// against the machine, before any work.
     pub fn validate(&self) -> Result<()> {
         for (field, v) in [("from", self.from), ("to", self.to)] {

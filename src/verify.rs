@@ -5,7 +5,7 @@
 //! what matters is whether every axis stays within its limits *at every servo instant*. This
 //! module replays the schedule on that clock and checks every limit from scratch:
 //!
-//! - time comes from eq. 43 per interval ([`crate::schedule::interval_times`]); within an
+//! - time comes from eq. 43 per interval ([`crate::motion::interval_times`]); within an
 //!   interval b = u̇² is linear in u, so ü is constant and the motion integrates exactly:
 //!   `√b(t) = √b_i + ü (t − t_i)`, `u(t) = u_i + (t − t_i)(√b_i + √b(t))/2`
 //!   (the second form stays exact and finite for ü → 0 and from rest);

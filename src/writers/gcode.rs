@@ -579,7 +579,7 @@ pub fn programmed_time(toolpath: &Toolpath) -> Result<f64> {
 
 impl GcodeOptions {
     /// Checks the largest rotation per block ([`crate::validate`]).
-    /// [`write_gcode`](crate::writers::gcode::write_gcode) calls it before any work.
+    /// [`write_gcode`] calls it before any work.
     pub fn validate(&self) -> Result<()> {
         match self.max_rotation_deg {
             Some(d) if !(d.is_finite() && d >= MIN_ROTATION_DEG) => Err(Error::option(

@@ -704,7 +704,7 @@ impl crate::sweep::Sweep {
         Ok(svg)
     }
 
-    /// Writes [`Sweep::plot_svg`] to `path`, atomically.
+    /// Writes [`Sweep::plot_svg`](crate::sweep::Sweep::plot_svg) to `path`, atomically.
     pub fn write_plot(&self, path: &Path) -> Result<()> {
         super::write_atomically(path, self.plot_svg()?.as_bytes())
     }
