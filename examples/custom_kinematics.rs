@@ -137,11 +137,11 @@ fn main() -> Result<(), feedopt::error::Error> {
     let binding = feedopt::report::Summary::new(&joint_machine, "custom", &custom).binding;
     for b in binding
         .iter()
-        .filter(|b| b.share_of_path > 0.0 && b.limit != "none")
+        .filter(|b| b.share_of_path > 0.0 && b.limit != feedopt::constraints::Bound::None)
     {
         println!(
             "custom binding        {:<16} {:5.1} % of the path",
-            b.limit,
+            b.name,
             100.0 * b.share_of_path
         );
     }

@@ -36,7 +36,7 @@ fn main() -> Result<(), feedopt::error::Error> {
     for b in summary.binding.iter().filter(|b| b.share_of_path > 0.0) {
         println!(
             "binding         {:<24} {:5.1} % of the path",
-            b.limit,
+            b.name,
             100.0 * b.share_of_path
         );
     }

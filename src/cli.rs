@@ -321,18 +321,6 @@ pub fn name_flag(e: Error) -> Error {
     }
 }
 
-/// `--plot FILE`: a format the plot writer knows (the build has plots).
-fn plot_format(path: &std::path::Path) -> Result<()> {
-    #[cfg(feature = "plot")]
-    return writers::plot::plot_format(path).map(|_| ());
-    #[cfg(not(feature = "plot"))]
-    return Err(Error::Usage(format!(
-        "--plot {}: this feedopt was built without plots (cargo feature `plot`): rebuild with \
-         it, or leave --plot out",
-        path.display()
-    )));
-}
-
 impl SolveArgs {
     /// The inputs an output must not overwrite.
     fn inputs(&self) -> [(&'static str, &std::path::Path); 2] {
@@ -371,11 +359,11 @@ impl SolveArgs {
         o.geometry.tolerance_deg = self.tolerance_deg;
         o.validate()?;
         if let Some(out) = &self.output {
-            writers::schedule_format(out)?;
+            writers::output_format(out, writers::SCHEDULE)?;
             writers::check_output("-o", out, &self.inputs())?;
         }
         if let Some(plot) = &self.plot {
-            plot_format(plot)?;
+            writers::output_format(plot, writers::PLOT)?;
             writers::check_output("--plot", plot, &self.inputs())?;
         }
         Ok(o)
@@ -934,11 +922,11 @@ pub struct InterpolateArgs {
 
 /// `feedopt interpolate`: returns what to print on stdout.
 pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
-    crate::interpolate::setpoint_format(&args.output)?;
+    writers::output_format(&args.output, writers::setpoints::SETPOINTS)?;
     writers::check_output("-o", &args.output, &args.plan.inputs())?;
     let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, args.period))?;
     let sp = crate::interpolate::sample(&machine, &solution, args.period)?;
-    crate::interpolate::write_setpoints(&args.output, &sp)?;
+    writers::setpoints::write_setpoints(&args.output, &sp)?;
     Ok(format!(
         "wrote {}: {} setpoints every {} s over {:.4} s, axes {}\n",
         args.output.display(),

@@ -41,11 +41,13 @@ use crate::kinematics::{Kinematics, MAX_AXES};
 use crate::machine::Machine;
 use crate::motion::Interval;
 use crate::optimize::{self, Options, Solution};
-use crate::schedule::{Schedule, interval_times};
+use crate::schedule::Schedule;
+use crate::solver::interval_times;
 use crate::solver::{SpanSolution, Status};
 use crate::toolpath::Input;
 use crate::verify::{self, VerifyOptions};
 
+use crate::validate::non_negative;
 use baseline::Profile;
 
 /// Options of a comparison.
@@ -670,5 +672,14 @@ fn ratio(x: f64) -> String {
         format!("{x:.1}")
     } else {
         format!("{x:.3e}")
+    }
+}
+
+impl CompareOptions {
+    /// Checks the solve options (fields under `solve.`) and the junction deviation
+    /// ([`crate::validate`]). [`compare`] calls it before any work.
+    pub fn validate(&self) -> Result<()> {
+        self.solve.validate().map_err(|e| e.within("solve"))?;
+        non_negative("junction_deviation", self.junction_deviation, "mm")
     }
 }

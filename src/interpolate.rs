@@ -5,8 +5,8 @@
 //!
 //! The schedule fixes b = u̇² at its stations (and ü, for a jerk-limited profile); between
 //! them the motion follows the laws of [`crate::motion`] — for an acceleration-limited profile
-//! b linear in u, ü constant (eq. 40–43) — through [`Interval::at`] (and its inverse,
-//! [`Interval::time_to_x`], for the G-code writer): exactly the motion [`crate::verify`]
+//! b linear in u, ü constant (eq. 40–43) — through [`Interval::at`](crate::motion::Interval::at) (and its inverse,
+//! [`Interval::time_to_x`](crate::motion::Interval::time_to_x), for the G-code writer): exactly the motion [`crate::verify`]
 //! re-simulates.
 //!
 //! # Samples
@@ -20,118 +20,16 @@
 //!
 //! # Files
 //!
-//! **CSV** ([`setpoints_csv`]): a header naming each column with its unit,
-//! `t_s,s_mm,feed_mm_s,X_mm,Y_mm,Z_mm,C_deg,A_deg` (a joint-space path: `t_s,s,feed,<axis>_mm|
-//! _deg…`, s in the file's own unit), then one row per sample.
-//!
-//! **Binary** ([`setpoints_bin`], read back by [`read_setpoints_bin`]), all little-endian:
-//!
-//! | bytes | content |
-//! |---|---|
-//! | 8 | magic `FOSETPT\0` |
-//! | 4 | u32 version = 1 |
-//! | 4 | u32 flags: bit 0 set = joint-space path (s and feed in the path's own units) |
-//! | 4 | u32 axis count n |
-//! | 8 | f64 period T, s |
-//! | 8 | u64 sample count m |
-//! | per axis | u8 name length, the name (UTF-8), u8 unit: 0 = mm, 1 = degrees |
-//! | m × (3 + n) × 8 | records of f64: t (s), s (mm), feed (mm/s), q₁ … qₙ (mm or °) |
-
-use std::path::Path;
+//! The setpoints are written as CSV or in a compact binary layout by
+//! [`crate::writers::setpoints`].
 
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{Kinematics, MAX_AXES};
 use crate::machine::{AxisKind, Machine};
-use crate::motion::{Interval, State};
+use crate::motion::State;
 use crate::optimize::Solution;
-use crate::schedule::interval_times;
-
-/// The schedule's motion as intervals, span by span, with each interval's start time and the
-/// station's arc length there: what the sampler and the G-code writer walk along.
-#[derive(Debug, Clone)]
-pub struct Timeline {
-    /// Per span: its stations' u, start times t (s) and arc lengths s, and b.
-    pub spans: Vec<SpanTimeline>,
-    /// The schedule's cycle time, s.
-    pub cycle_time: f64,
-}
-
-/// One span's stations on the global clock.
-#[derive(Debug, Clone)]
-pub struct SpanTimeline {
-    /// The stations' u.
-    pub u: Vec<f64>,
-    /// b = u̇² at the stations.
-    pub b: Vec<f64>,
-    /// ü at the stations of a jerk-limited profile.
-    pub a: Option<Vec<f64>>,
-    /// Time at each station, s (the schedule's).
-    pub t: Vec<f64>,
-    /// Arc length at each station, mm (the schedule's).
-    pub s: Vec<f64>,
-}
-
-impl SpanTimeline {
-    /// Interval `i` (stations i, i + 1).
-    pub fn interval(&self, i: usize) -> Interval {
-        Interval::of(&self.u, &self.b, self.a.as_deref(), i)
-    }
-
-    /// The interval containing `u` (the last one at the span's end).
-    pub fn interval_of(&self, u: f64) -> usize {
-        let n = self.u.len() - 1;
-        self.u
-            .partition_point(|&x| x <= u)
-            .saturating_sub(1)
-            .min(n - 1)
-    }
-
-    /// The time (s, global clock) at which the motion passes `u` on this span.
-    pub fn time_at(&self, u: f64) -> f64 {
-        let i = self.interval_of(u);
-        let dt = self.t[i + 1] - self.t[i];
-        self.t[i]
-            + self
-                .interval(i)
-                .time_to_x(u - self.u[i])
-                .unwrap_or(dt)
-                .min(dt)
-    }
-}
-
-impl Timeline {
-    /// The timeline of a solution's schedule. Station times are the schedule's own.
-    pub fn new(solution: &Solution) -> Result<Timeline> {
-        let stations = &solution.schedule.stations;
-        let mut spans = Vec::with_capacity(solution.problems.len());
-        let mut offset = 0;
-        for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
-            let n = p.u.len();
-            if sol.b.len() != n || offset + n > stations.len() || n < 2 {
-                return Err(Error::Solver(format!(
-                    "the schedule does not match its span problems ({} stations, span of {n})",
-                    stations.len()
-                )));
-            }
-            // Checks that the schedule's intervals are traversable (never zero speed).
-            interval_times(p, sol)?;
-            let st = &stations[offset..offset + n];
-            spans.push(SpanTimeline {
-                u: p.u.clone(),
-                b: sol.b.clone(),
-                a: sol.a.clone(),
-                t: st.iter().map(|s| s.t).collect(),
-                s: st.iter().map(|s| s.s).collect(),
-            });
-            offset += n;
-        }
-        Ok(Timeline {
-            spans,
-            cycle_time: solution.schedule.cycle_time,
-        })
-    }
-}
+use crate::schedule::{SpanTimeline, Timeline};
 
 /// One setpoint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -172,7 +70,7 @@ pub const MAX_SAMPLES: usize = 4_000_000;
 /// Samples the solution's motion at period `period` (s): see the module doc.
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
     crate::validate::period("period", period)?;
-    let timeline = Timeline::new(solution)?;
+    let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
     let cycle = timeline.cycle_time;
     let count = (cycle / period).ceil();
     if !(count.is_finite() && count < MAX_SAMPLES as f64) {
@@ -277,205 +175,4 @@ fn point(
         out.qdd[j] = jets.ddq[j] * st.ud * st.ud + jets.dq[j] * st.udd;
     }
     out
-}
-
-fn unit_name(kind: AxisKind) -> &'static str {
-    match kind {
-        AxisKind::Linear => "mm",
-        AxisKind::Rotary => "deg",
-    }
-}
-
-/// The setpoints as CSV: header `t_s,s_mm,feed_mm_s,<axis>_<unit>…`, one row per sample.
-pub fn setpoints_csv(sp: &Setpoints) -> String {
-    use std::fmt::Write as _;
-    let na = sp.axes.len();
-    let mut out = String::with_capacity(sp.samples.len() * (24 * (3 + na)));
-    out.push_str(if sp.joint {
-        "t_s,s,feed"
-    } else {
-        "t_s,s_mm,feed_mm_s"
-    });
-    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
-        let _ = write!(out, ",{name}_{}", unit_name(*kind));
-    }
-    out.push('\n');
-    for s in &sp.samples {
-        let _ = write!(out, "{},{},{}", s.t, s.s, s.feed);
-        for q in &s.q[..na] {
-            let _ = write!(out, ",{q}");
-        }
-        out.push('\n');
-    }
-    out
-}
-
-/// Magic bytes of the binary setpoint file.
-pub const MAGIC: &[u8; 8] = b"FOSETPT\0";
-/// Version of the binary layout.
-pub const VERSION: u32 = 1;
-
-/// The setpoints in the binary layout of the module doc.
-pub fn setpoints_bin(sp: &Setpoints) -> Result<Vec<u8>> {
-    let na = sp.axes.len();
-    let mut out = Vec::with_capacity(64 + sp.samples.len() * 8 * (3 + na));
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&u32::from(sp.joint).to_le_bytes());
-    out.extend_from_slice(&(na as u32).to_le_bytes());
-    out.extend_from_slice(&sp.period.to_le_bytes());
-    out.extend_from_slice(&(sp.samples.len() as u64).to_le_bytes());
-    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
-        let len = u8::try_from(name.len())
-            .map_err(|_| Error::Usage(format!("axis name `{name}` is too long")))?;
-        out.push(len);
-        out.extend_from_slice(name.as_bytes());
-        out.push(u8::from(*kind == AxisKind::Rotary));
-    }
-    for s in &sp.samples {
-        for x in [s.t, s.s, s.feed].iter().chain(&s.q[..na]) {
-            out.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    Ok(out)
-}
-
-/// Reads the binary layout back (positions only: [`Sample::qd`], [`Sample::qdd`] are 0).
-/// `source` names the file in errors.
-pub fn read_setpoints_bin(source: &Path, bytes: &[u8]) -> Result<Setpoints> {
-    let bad = |what: &str| {
-        Error::io(
-            source,
-            std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string()),
-        )
-    };
-    let mut at = 0usize;
-    let mut take = |n: usize| -> Result<&[u8]> {
-        let slice = bytes
-            .get(at..at + n)
-            .ok_or_else(|| bad("truncated setpoint file"))?;
-        at += n;
-        Ok(slice)
-    };
-    if take(8)? != MAGIC {
-        return Err(bad("not a feedopt setpoint file (bad magic bytes)"));
-    }
-    let u32_of = |b: &[u8]| u32::from_le_bytes(b.try_into().unwrap_or([0; 4]));
-    let f64_of = |b: &[u8]| f64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
-    let version = u32_of(take(4)?);
-    if version != VERSION {
-        return Err(bad(&format!(
-            "setpoint file version {version} (expected 1)"
-        )));
-    }
-    let joint = u32_of(take(4)?) & 1 == 1;
-    let na = u32_of(take(4)?) as usize;
-    if na > MAX_AXES {
-        return Err(bad(&format!("{na} axes (at most {MAX_AXES})")));
-    }
-    let period = f64_of(take(8)?);
-    let m = u64::from_le_bytes(take(8)?.try_into().unwrap_or([0; 8]));
-    let mut axes = Vec::with_capacity(na);
-    let mut kinds = Vec::with_capacity(na);
-    for _ in 0..na {
-        let len = take(1)?[0] as usize;
-        let name = std::str::from_utf8(take(len)?).map_err(|_| bad("axis name is not UTF-8"))?;
-        axes.push(name.to_string());
-        kinds.push(match take(1)?[0] {
-            0 => AxisKind::Linear,
-            1 => AxisKind::Rotary,
-            u => return Err(bad(&format!("unknown axis unit code {u}"))),
-        });
-    }
-    let record = 8 * (3 + na);
-    let rest = bytes.len() - at;
-    if (rest as u64) != m.saturating_mul(record as u64) {
-        return Err(bad(&format!(
-            "{m} records of {record} bytes announced, {rest} bytes present"
-        )));
-    }
-    let samples = bytes[at..]
-        .chunks_exact(record)
-        .map(|r| {
-            let x = |k: usize| f64_of(&r[8 * k..8 * k + 8]);
-            let mut q = [0.0; MAX_AXES];
-            for (j, qj) in q.iter_mut().enumerate().take(na) {
-                *qj = x(3 + j);
-            }
-            Sample {
-                t: x(0),
-                s: x(1),
-                feed: x(2),
-                q,
-                qd: [0.0; MAX_AXES],
-                qdd: [0.0; MAX_AXES],
-            }
-        })
-        .collect();
-    Ok(Setpoints {
-        axes,
-        kinds,
-        joint,
-        period,
-        samples,
-    })
-}
-
-/// Output formats of the setpoints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SetpointFormat {
-    /// Comma-separated text.
-    Csv,
-    /// The compact binary layout of the module doc.
-    Bin,
-}
-
-/// The format of an output path by its extension (`.csv` or `.bin`).
-pub fn setpoint_format(path: &Path) -> Result<SetpointFormat> {
-    match path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("csv") => Ok(SetpointFormat::Csv),
-        Some("bin") => Ok(SetpointFormat::Bin),
-        _ => Err(Error::Usage(format!(
-            "{}: unknown setpoint format (use .csv or .bin)",
-            path.display()
-        ))),
-    }
-}
-
-/// Writes the setpoints to `path` (format by extension), atomically.
-pub fn write_setpoints(path: &Path, sp: &Setpoints) -> Result<()> {
-    let bytes = match setpoint_format(path)? {
-        SetpointFormat::Csv => setpoints_csv(sp).into_bytes(),
-        SetpointFormat::Bin => setpoints_bin(sp)?,
-    };
-    crate::writers::write_atomically(path, &bytes)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_law_and_its_inverse_agree() {
-        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, 0);
-        // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
-        let dur = iv.duration().unwrap();
-        assert!((dur - 0.8).abs() < 1e-15);
-        for k in 0..=8 {
-            let tau = 0.1 * k as f64;
-            let st = iv.at(tau, dur);
-            assert!((st.ud - (2.0 + 1.25 * tau).min(3.0)).abs() < 1e-12);
-            assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
-        }
-        // From rest: u = ½ ü τ².
-        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, 0);
-        let st = rest.at(0.5, rest.duration().unwrap());
-        assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
-        assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);
-    }
 }

@@ -85,6 +85,7 @@
 
 #![warn(missing_docs)]
 
+pub mod base;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod compare;
@@ -102,6 +103,7 @@ pub mod material;
 pub mod motion;
 #[allow(missing_docs)]
 pub mod optimize;
+mod parallel;
 #[cfg(feature = "progress")]
 pub mod progress;
 pub mod report;

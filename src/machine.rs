@@ -761,12 +761,12 @@ impl Parser {
         let file_names: Vec<&str> = obj.keys().map(String::as_str).collect();
         let names: &[&str] = match kin {
             KinematicsSpec::Joint => {
-                if file_names.is_empty() || file_names.len() > crate::kinematics::MAX_AXES {
+                if file_names.is_empty() || file_names.len() > crate::base::MAX_AXES {
                     return Err(self.err(
                         "axes",
                         format!(
                             "a joint-space machine needs 1 to {} axes, found {}",
-                            crate::kinematics::MAX_AXES,
+                            crate::base::MAX_AXES,
                             file_names.len()
                         ),
                     ));
@@ -894,7 +894,7 @@ impl Machine {
     /// Checks what [`Machine::from_json`] checks of a file, for a machine built in code: the
     /// kinematics' parameters (finite, plausible lengths; `tool_length` > 0 on a double swivel
     /// head, ≥ 0 on a head-table or dresser), the axes the kinematics needs in its order (a
-    /// joint-space machine: 1 to [`MAX_AXES`](crate::kinematics::MAX_AXES) axes with distinct,
+    /// joint-space machine: 1 to [`MAX_AXES`](crate::base::MAX_AXES) axes with distinct,
     /// non-empty names), every limit finite with `min < 0 < max` and each side within
     /// [`MIN_LIMIT`]…[`MAX_LIMIT`] ([`MAX_JERK_LIMIT`] for jerk), travel `min < max` within
     /// ±[`MAX_LENGTH`], and `feed_max` a plausible limit (none on a joint-space machine).
@@ -953,7 +953,7 @@ impl Machine {
             }
         }
         if *kin == KinematicsSpec::Joint {
-            let max = crate::kinematics::MAX_AXES;
+            let max = crate::base::MAX_AXES;
             if self.axes.is_empty() || self.axes.len() > max {
                 return Err(bad(
                     "axes",

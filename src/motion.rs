@@ -68,6 +68,33 @@ pub struct State {
     pub uddd: f64,
 }
 
+impl State {
+    /// An axis's jerk at this instant from its u-derivatives q' (`dq`), q'' (`ddq`) and q'''
+    /// (`dddq`): `q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛` (u̇³ as u̇·b). The one jerk formula of the
+    /// re-simulation and the reports.
+    pub fn jerk(&self, dq: f64, ddq: f64, dddq: f64) -> f64 {
+        dddq * self.ud * self.b + 3.0 * ddq * self.ud * self.udd + dq * self.uddd
+    }
+}
+
+/// Time taken by each interval of a profile (eq. 43 under its law): `b` at the stations `u`,
+/// and `a` (ü at the stations) for a jerk-limited profile, as in [`Interval::of`]. The one
+/// time integration every stage uses (the schedule, the solvers, the re-simulation, the
+/// setpoints); an interval the profile cannot traverse (b zero on the whole of it) is
+/// [`Error::Infeasible`].
+pub fn interval_times(u: &[f64], b: &[f64], a: Option<&[f64]>) -> Result<Vec<f64>> {
+    (0..u.len().saturating_sub(1))
+        .map(|k| {
+            Interval::of(u, b, a, k).duration().map_err(|_| {
+                Error::Infeasible(format!(
+                    "the feed is zero on a whole interval (station {k}): the path cannot be \
+                     traversed"
+                ))
+            })
+        })
+        .collect()
+}
+
 impl Interval {
     /// Interval `k` of a profile: `b` at the stations `u`, and `a` (ü at the stations) for a
     /// jerk-limited profile (`None`: [`Law::Linear`]). Negative rounding noise in b is
@@ -583,5 +610,24 @@ mod tests {
         assert!(iv.duration().is_err());
         let flat = Interval::of(&[0.0, 1.0], &[0.0, 0.0], None, 0);
         assert!(flat.duration().is_err());
+    }
+
+    #[test]
+    fn the_law_and_its_inverse_agree() {
+        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, 0);
+        // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
+        let dur = iv.duration().unwrap();
+        assert!((dur - 0.8).abs() < 1e-15);
+        for k in 0..=8 {
+            let tau = 0.1 * k as f64;
+            let st = iv.at(tau, dur);
+            assert!((st.ud - (2.0 + 1.25 * tau).min(3.0)).abs() < 1e-12);
+            assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
+        }
+        // From rest: u = ½ ü τ².
+        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, 0);
+        let st = rest.at(0.5, rest.duration().unwrap());
+        assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
+        assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);
     }
 }

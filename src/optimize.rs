@@ -25,12 +25,15 @@ use crate::error::{Error, Result};
 use crate::geometry::{GeometryOptions, Path, Span, SpanKind};
 use crate::kinematics::Kinematics;
 use crate::machine::{KinematicsSpec, Machine};
-use crate::schedule::{Schedule, interval_times};
+use crate::schedule::Schedule;
+use crate::solver::interval_times;
 use crate::solver::jerk::{JerkData, JerkOptions, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
 use crate::verify::{Verification, VerifyOptions, verify};
+
+mod checks;
 
 /// Options of a solve.
 #[derive(Debug, Clone, PartialEq)]
@@ -162,7 +165,7 @@ pub fn optimize_observed(
     options: &Options,
     progress: &dyn Progress,
 ) -> Result<Solution> {
-    crate::validate::inputs(machine, options)?;
+    checks::inputs(machine, options)?;
     if machine.kinematics == KinematicsSpec::Joint {
         return Err(Error::Usage(format!(
             "{}: a CL toolpath needs a machine with kinematics (xyz, head_head), not a \
@@ -206,7 +209,7 @@ pub fn optimize_joint_observed(
     options: &Options,
     progress: &dyn Progress,
 ) -> Result<Solution> {
-    crate::validate::inputs(machine, options)?;
+    checks::inputs(machine, options)?;
     if machine.kinematics != KinematicsSpec::Joint {
         return Err(Error::Usage(format!(
             "{}: a joint-space path needs a machine file with \"kinematics\": {{\"type\": \"joint\"}}",

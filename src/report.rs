@@ -96,9 +96,7 @@ pub fn jerk_ratios(
             let jets = &p.jets[e];
             for (j, axis) in machine.axes.iter().enumerate().take(kin.n_axes()) {
                 let Some(lim) = axis.jerk else { continue };
-                let q3 = d3[j] * st.ud * st.b
-                    + 3.0 * jets.ddq[j] * st.ud * st.udd
-                    + jets.dq[j] * st.uddd;
+                let q3 = st.jerk(jets.dq[j], jets.ddq[j], d3[j]);
                 let r = lim.ratio(q3);
                 if r > best.0 {
                     best = (r, j);
@@ -136,8 +134,13 @@ pub struct AxisPeaks {
 /// Share of the path over which one limit holds the feed down.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct BindingShare {
-    /// e.g. `"feed"`, `"C velocity"`, `"A acceleration"`, `"none"`.
-    pub limit: String,
+    /// The limit ([`Bound::None`]: nothing binds). Not in the JSON, which names it (`name`).
+    #[serde(skip)]
+    pub limit: Bound,
+    /// Its name in reports ([`binding_label`]), e.g. `"feed"`, `"C velocity"`,
+    /// `"A acceleration"`, `"none"`: the JSON's `limit`.
+    #[serde(rename = "limit")]
+    pub name: String,
     /// Share of the tool-tip path length (0–1).
     pub share_of_path: f64,
     /// Share of the cycle time (0–1).
@@ -268,7 +271,8 @@ impl Summary {
         let mut binding: Vec<BindingShare> = by_bound
             .into_iter()
             .map(|(b, (ds, dt))| BindingShare {
-                limit: label(b),
+                limit: b,
+                name: label(b),
                 share_of_path: if length > 0.0 { ds / length } else { 0.0 },
                 share_of_time: if time > 0.0 { dt / time } else { 0.0 },
             })
@@ -485,7 +489,7 @@ impl fmt::Display for Summary {
             writeln!(
                 f,
                 "{:<29} {:>12.1} %  {:>12.1} %",
-                b.limit,
+                b.name,
                 100.0 * b.share_of_path,
                 100.0 * b.share_of_time
             )?;

@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::geometry::Span;
 use crate::kinematics::MAX_AXES;
 use crate::motion::Interval;
-use crate::solver::SpanSolution;
+use crate::solver::{SpanSolution, interval_times};
 
 /// One station of the schedule.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -50,23 +50,6 @@ pub struct Schedule {
     pub stations: Vec<Station>,
     /// Total time, s.
     pub cycle_time: f64,
-}
-
-/// Time taken by each interval of one span (eq. 43 under the profile's law, see
-/// [`crate::motion`]).
-pub fn interval_times(problem: &SpanProblem, sol: &SpanSolution) -> Result<Vec<f64>> {
-    (0..problem.intervals())
-        .map(|k| {
-            Interval::of(&problem.u, &sol.b, sol.a.as_deref(), k)
-                .duration()
-                .map_err(|_| {
-                    Error::Infeasible(format!(
-                        "the feed is zero on a whole interval (station {k}): the path cannot be \
-                         traversed"
-                    ))
-                })
-        })
-        .collect()
 }
 
 /// ü at station `i` (on the interval that starts there; the last station: the one ending
@@ -147,6 +130,97 @@ impl Schedule {
             axes: axes.to_vec(),
             stations,
             cycle_time: t0,
+        })
+    }
+}
+
+/// The schedule's motion as intervals, span by span, with each interval's start time and the
+/// station's arc length there: what the sampler and the G-code writer walk along.
+#[derive(Debug, Clone)]
+pub struct Timeline {
+    /// Per span: its stations' u, start times t (s) and arc lengths s, and b.
+    pub spans: Vec<SpanTimeline>,
+    /// The schedule's cycle time, s.
+    pub cycle_time: f64,
+}
+
+/// One span's stations on the global clock.
+#[derive(Debug, Clone)]
+pub struct SpanTimeline {
+    /// The stations' u.
+    pub u: Vec<f64>,
+    /// b = u̇² at the stations.
+    pub b: Vec<f64>,
+    /// ü at the stations of a jerk-limited profile.
+    pub a: Option<Vec<f64>>,
+    /// Time at each station, s (the schedule's).
+    pub t: Vec<f64>,
+    /// Arc length at each station, mm (the schedule's).
+    pub s: Vec<f64>,
+}
+
+impl SpanTimeline {
+    /// Interval `i` (stations i, i + 1).
+    pub fn interval(&self, i: usize) -> Interval {
+        Interval::of(&self.u, &self.b, self.a.as_deref(), i)
+    }
+
+    /// The interval containing `u` (the last one at the span's end).
+    pub fn interval_of(&self, u: f64) -> usize {
+        let n = self.u.len() - 1;
+        self.u
+            .partition_point(|&x| x <= u)
+            .saturating_sub(1)
+            .min(n - 1)
+    }
+
+    /// The time (s, global clock) at which the motion passes `u` on this span.
+    pub fn time_at(&self, u: f64) -> f64 {
+        let i = self.interval_of(u);
+        let dt = self.t[i + 1] - self.t[i];
+        self.t[i]
+            + self
+                .interval(i)
+                .time_to_x(u - self.u[i])
+                .unwrap_or(dt)
+                .min(dt)
+    }
+}
+
+impl Timeline {
+    /// The timeline of `schedule`, built from the span `problems` and their `solutions`.
+    /// Station times are the schedule's own.
+    pub fn new(
+        schedule: &Schedule,
+        problems: &[SpanProblem],
+        solutions: &[SpanSolution],
+    ) -> Result<Timeline> {
+        let stations = &schedule.stations;
+        let mut spans = Vec::with_capacity(problems.len());
+        let mut offset = 0;
+        for (p, sol) in problems.iter().zip(solutions) {
+            let n = p.u.len();
+            if sol.b.len() != n || offset + n > stations.len() || n < 2 {
+                return Err(Error::Solver(format!(
+                    "the schedule does not match its span problems ({} stations, span of {n})",
+                    stations.len()
+                )));
+            }
+            // Checks that the schedule's intervals are traversable (never zero speed).
+            interval_times(p, sol)?;
+            let st = &stations[offset..offset + n];
+            spans.push(SpanTimeline {
+                u: p.u.clone(),
+                b: sol.b.clone(),
+                a: sol.a.clone(),
+                t: st.iter().map(|s| s.t).collect(),
+                s: st.iter().map(|s| s.s).collect(),
+            });
+            offset += n;
+        }
+        Ok(Timeline {
+            spans,
+            cycle_time: schedule.cycle_time,
         })
     }
 }

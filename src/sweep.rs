@@ -70,12 +70,12 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::path::Path;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::constraints::{Bound, SpanProblem, essential_rows};
+use crate::error::number;
 use crate::error::{Error, Result};
 use crate::machine::{AxisKind, KinematicsSpec, Limit, Machine};
 use crate::optimize::{Options, Solution, optimize_input};
@@ -85,7 +85,6 @@ use crate::solver::clarabel::{Sensitivity, solve_with_sensitivity};
 use crate::solver::{self, SolverKind, Status};
 use crate::toolpath::Input;
 use crate::verify::verify;
-use crate::writers::write_atomically;
 
 /// Which limit of the axis is swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -505,21 +504,24 @@ pub fn sweep(
             _ => return Err(Error::Solver("a sweep step was lost".into())),
         };
         let fd = (plus.cycle_time - minus.cycle_time) / (2.0 * h * v);
-        let label = format!("{} {}", machine.axes[axis].name, which);
-        let binding_set = |e: &Eval| -> Vec<String> {
-            let mut l: Vec<String> = e
+        let swept = match which {
+            SweptLimit::Velocity => Bound::AxisVelocity(axis),
+            SweptLimit::Acceleration => Bound::AxisAcceleration(axis),
+        };
+        let binding_set = |e: &Eval| -> Vec<Bound> {
+            let mut l: Vec<Bound> = e
                 .summary
                 .binding
                 .iter()
-                .filter(|b| b.share_of_path > 0.0 && b.limit != "none")
-                .map(|b| b.limit.clone())
+                .filter(|b| b.share_of_path > 0.0 && b.limit != Bound::None)
+                .map(|b| b.limit)
                 .collect();
             l.sort();
             l
         };
         let same_set =
             binding_set(&minus) == binding_set(&mid) && binding_set(&plus) == binding_set(&mid);
-        let binds = binding_set(&mid).contains(&label);
+        let binds = binding_set(&mid).contains(&swept);
         let is_smooth = same_set
             && match (minus.sensitivity, mid.sensitivity, plus.sensitivity) {
                 (Some(a), Some(b), Some(c)) => smooth(a, b, c),
@@ -583,11 +585,11 @@ pub fn sweep(
 
 impl Sweep {
     /// Binding limits over all steps, the most time-consuming first.
-    fn binding_labels(&self) -> Vec<String> {
+    pub(crate) fn binding_labels(&self) -> Vec<String> {
         let mut most: BTreeMap<&str, f64> = BTreeMap::new();
         for p in &self.points {
             for b in &p.binding {
-                let e = most.entry(b.limit.as_str()).or_insert(0.0);
+                let e = most.entry(b.name.as_str()).or_insert(0.0);
                 *e = e.max(b.share_of_time);
             }
         }
@@ -595,207 +597,6 @@ impl Sweep {
         labels.sort_by(|a, b| b.1.total_cmp(&a.1));
         labels.into_iter().map(|(l, _)| l.to_string()).collect()
     }
-
-    /// The sweep as JSON (the [`Sweep`] fields; `null` where a value does not exist).
-    pub fn to_json(&self) -> Result<String> {
-        let mut s = serde_json::to_string_pretty(self)
-            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
-        s.push('\n');
-        Ok(s)
-    }
-
-    /// The sweep as CSV, one row per step: `limit, cycle_time_s, dT_dlimit_dual,
-    /// dT_dlimit_fd, cycle_time_minus_s, cycle_time_plus_s, binds, smooth, status, verified,
-    /// worst_ratio`, then `path_share_<limit>` and `time_share_<limit>` for every limit that
-    /// binds somewhere (spaces as `_`). An empty cell: no value (no duals with `reach`).
-    pub fn to_csv(&self) -> String {
-        use std::fmt::Write as _;
-        let labels = self.binding_labels();
-        let mut out = String::from(
-            "limit,cycle_time_s,dT_dlimit_dual,dT_dlimit_fd,cycle_time_minus_s,\
-             cycle_time_plus_s,binds,smooth,status,verified,worst_ratio",
-        );
-        for l in &labels {
-            let l = l.replace(' ', "_");
-            let _ = write!(out, ",path_share_{l},time_share_{l}");
-        }
-        out.push('\n');
-        let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
-        for p in &self.points {
-            let status = serde_json::to_value(p.status)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_string))
-                .unwrap_or_default();
-            let _ = write!(
-                out,
-                "{},{},{},{},{},{},{},{},{},{},{}",
-                p.limit,
-                p.cycle_time_s,
-                opt(p.sensitivity_dual),
-                p.sensitivity_fd,
-                p.cycle_time_minus_s,
-                p.cycle_time_plus_s,
-                p.binds,
-                p.smooth,
-                status,
-                p.verified,
-                p.worst_ratio
-            );
-            for l in &labels {
-                let b = p.binding.iter().find(|b| &b.limit == l);
-                let (sp, st) = b.map_or((0.0, 0.0), |b| (b.share_of_path, b.share_of_time));
-                let _ = write!(out, ",{sp},{st}");
-            }
-            out.push('\n');
-        }
-        out
-    }
-
-    /// Writes the table to `path` (`.csv` or `.json`), atomically.
-    pub fn write(&self, path: &Path) -> Result<()> {
-        let bytes = match crate::writers::schedule_format(path)? {
-            crate::writers::ScheduleFormat::Json => self.to_json()?.into_bytes(),
-            crate::writers::ScheduleFormat::Csv => self.to_csv().into_bytes(),
-        };
-        write_atomically(path, &bytes)
-    }
-
-    /// An SVG plot (cargo feature `plot`): cycle time against the limit (top) and the sensitivity, dual and finite
-    /// differences (bottom); axes labelled with units, legends.
-    #[cfg(feature = "plot")]
-    pub fn plot_svg(&self) -> Result<String> {
-        use plotters::prelude::*;
-        let fail = |e: &dyn fmt::Display| Error::Solver(format!("plot: {e}"));
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, (900, 800)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| fail(&e))?;
-            let (top, bottom) = root.split_vertically(400);
-            let xs: Vec<f64> = self.points.iter().map(|p| p.limit).collect();
-            let (x0, x1) = pad_range(&xs);
-            let xlabel = format!("{} {} limit [{}]", self.axis, self.limit, self.unit);
-
-            let ts: Vec<f64> = self.points.iter().map(|p| p.cycle_time_s).collect();
-            let (y0, y1) = pad_range(&ts);
-            let mut chart = ChartBuilder::on(&top)
-                .caption(
-                    format!("Cycle time against the {} {} limit", self.axis, self.limit),
-                    ("sans-serif", 20),
-                )
-                .margin(15)
-                .x_label_area_size(45)
-                .y_label_area_size(80)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(|e| fail(&e))?;
-            chart
-                .configure_mesh()
-                .x_desc(xlabel.as_str())
-                .y_desc("cycle time [s]")
-                .draw()
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(LineSeries::new(
-                    self.points.iter().map(|p| (p.limit, p.cycle_time_s)),
-                    BLUE.stroke_width(2),
-                ))
-                .map_err(|e| fail(&e))?
-                .label("cycle time T")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
-            chart
-                .draw_series(
-                    self.points
-                        .iter()
-                        .map(|p| Circle::new((p.limit, p.cycle_time_s), 3, BLUE.filled())),
-                )
-                .map_err(|e| fail(&e))?;
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(|e| fail(&e))?;
-
-            let mut ss: Vec<f64> = self.points.iter().map(|p| p.sensitivity_fd).collect();
-            ss.extend(self.points.iter().filter_map(|p| p.sensitivity_dual));
-            let (s0, s1) = pad_range(&ss);
-            let mut chart = ChartBuilder::on(&bottom)
-                .caption("Sensitivity dT/d(limit)", ("sans-serif", 20))
-                .margin(15)
-                .x_label_area_size(45)
-                .y_label_area_size(80)
-                .build_cartesian_2d(x0..x1, s0..s1)
-                .map_err(|e| fail(&e))?;
-            chart
-                .configure_mesh()
-                .x_desc(xlabel.as_str())
-                .y_desc(format!("dT/d(limit) [s per {}]", self.unit))
-                .y_label_formatter(&|y| {
-                    // A tick at zero, not at the rounding error next to it.
-                    if y.abs() < 1e-9 * (s1 - s0) {
-                        "0".to_string()
-                    } else {
-                        format!("{y:.2e}")
-                    }
-                })
-                .draw()
-                .map_err(|e| fail(&e))?;
-            if self.points.iter().any(|p| p.sensitivity_dual.is_some()) {
-                chart
-                    .draw_series(LineSeries::new(
-                        self.points
-                            .iter()
-                            .filter_map(|p| p.sensitivity_dual.map(|s| (p.limit, s))),
-                        RED.stroke_width(2),
-                    ))
-                    .map_err(|e| fail(&e))?
-                    .label("from the duals")
-                    .legend(|(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2))
-                    });
-            }
-            chart
-                .draw_series(
-                    self.points
-                        .iter()
-                        .map(|p| Cross::new((p.limit, p.sensitivity_fd), 5, BLACK.stroke_width(2))),
-                )
-                .map_err(|e| fail(&e))?
-                .label(format!("central differences (±{} %)", 100.0 * self.fd_step))
-                .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerRight)
-                .draw()
-                .map_err(|e| fail(&e))?;
-            root.present().map_err(|e| fail(&e))?;
-        }
-        Ok(svg)
-    }
-
-    /// Writes [`Sweep::plot_svg`] to `path`, atomically.
-    #[cfg(feature = "plot")]
-    pub fn write_plot(&self, path: &Path) -> Result<()> {
-        write_atomically(path, self.plot_svg()?.as_bytes())
-    }
-}
-
-#[cfg(feature = "plot")]
-/// A plotting range around `values` with 5 % margins (never empty).
-fn pad_range(values: &[f64]) -> (f64, f64) {
-    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !(lo.is_finite() && hi.is_finite()) {
-        return (0.0, 1.0);
-    }
-    let pad = if hi > lo {
-        0.05 * (hi - lo)
-    } else {
-        0.05 * lo.abs().max(1e-12)
-    };
-    (lo - pad, hi + pad)
 }
 
 impl fmt::Display for Sweep {
@@ -870,7 +671,7 @@ impl fmt::Display for Sweep {
                 let share = p
                     .binding
                     .iter()
-                    .find(|b| &b.limit == l)
+                    .find(|b| &b.name == l)
                     .map_or(0.0, |b| b.share_of_time);
                 write!(f, " {:>15.1}", 100.0 * share)?;
             }
@@ -893,6 +694,53 @@ impl fmt::Display for Sweep {
 
 fn truncate(s: &str, n: usize) -> String {
     s.chars().take(n).collect()
+}
+
+impl SweepOptions {
+    /// Checks the range and steps of the study and its solve options (fields under `solve.`;
+    /// [`crate::validate`]). [`sweep`] calls it, and checks the axis and the range
+    /// against the machine, before any work.
+    pub fn validate(&self) -> Result<()> {
+        for (field, v) in [("from", self.from), ("to", self.to)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::option(
+                    field,
+                    format!("must be a positive limit, got {}", number(v)),
+                ));
+            }
+        }
+        if self.steps == 0 {
+            return Err(Error::option("steps", "must be at least 1"));
+        }
+        if self.steps > MAX_STEPS {
+            return Err(Error::option(
+                "steps",
+                format!(
+                    "{} is more than {MAX_STEPS} (each step is three solves): give at most \
+                     {MAX_STEPS}",
+                    self.steps
+                ),
+            ));
+        }
+        if self.steps > 1 && self.to <= self.from {
+            return Err(Error::option(
+                "to",
+                format!(
+                    "({}) must be greater than from ({}) for more than one step",
+                    number(self.to),
+                    number(self.from)
+                ),
+            ));
+        }
+        let h = self.fd_step;
+        if !(h > 0.0 && h < 0.5) {
+            return Err(Error::option(
+                "fd_step",
+                format!("must be a relative step in (0, 0.5), got {}", number(h)),
+            ));
+        }
+        self.solve.validate().map_err(|e| e.within("solve"))
+    }
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! what matters is whether every axis stays within its limits *at every servo instant*. This
 //! module replays the schedule on that clock and checks every limit from scratch:
 //!
-//! - time comes from eq. 43 per interval ([`crate::schedule::interval_times`]); within an
+//! - time comes from eq. 43 per interval ([`crate::motion::interval_times`]); within an
 //!   interval b = u̇² is linear in u, so ü is constant and the motion integrates exactly:
 //!   `√b(t) = √b_i + ü (t − t_i)`, `u(t) = u_i + (t − t_i)(√b_i + √b(t))/2`
 //!   (the second form stays exact and finite for ü → 0 and from rest);
@@ -23,13 +23,15 @@
 //! the check is at least as strict as the solver's own rows.
 
 use crate::constraints::{Chord, SpanProblem};
+use crate::error::number;
 use crate::error::{Error, Result};
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
 use crate::motion::{Interval, Law, State};
-use crate::schedule::interval_times;
 use crate::solver::SpanSolution;
+use crate::solver::interval_times;
+use crate::validate::{MIN_CHORD_TOLERANCE_MM, non_negative, period};
 
 /// Most servo instants a re-simulation checks (2e9: about 23 days of motion at 1 ms; on two
 /// cores about 10 min). A schedule that would need more is refused before the check starts.
@@ -278,8 +280,8 @@ pub fn verify(
                 .map(|i0| (si, i0, (i0 + CHUNK).min(n))),
         );
     }
-    let threads = crate::solver::resolve_threads(options.threads);
-    let parts = crate::solver::par_map(&chunks, threads, |&(si, i0, i1)| {
+    let threads = crate::parallel::resolve_threads(options.threads);
+    let parts = crate::parallel::par_map(&chunks, threads, |&(si, i0, i1)| {
         let mut acc = Accumulator {
             limits: limits.clone(),
             threshold: 1.0 + options.tolerance,
@@ -529,8 +531,7 @@ impl Accumulator {
             self.compare(j, 0, Quantity::Velocity, qd, (span, interval, u, t));
             self.compare(j, 1, Quantity::Acceleration, qdd, (span, interval, u, t));
             if let Some(d3) = &pt.dddq {
-                // q⃛ = q''' u̇³ + 3 q'' u̇ ü + q' u⃛.
-                let q3 = d3[j] * r * st.b + 3.0 * jets.ddq[j] * r * st.udd + jets.dq[j] * st.uddd;
+                let q3 = st.jerk(jets.dq[j], jets.ddq[j], d3[j]);
                 self.compare(j, 2, Quantity::Jerk, q3, (span, interval, u, t));
             }
         }
@@ -627,6 +628,29 @@ impl Accumulator {
         if let Some(v) = self.current.take() {
             self.violations.push(v);
         }
+    }
+}
+
+impl VerifyOptions {
+    /// Checks every field's range ([`crate::validate`]); the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        period("period", self.period)?;
+        non_negative("tolerance", self.tolerance, "(relative)")?;
+        if let Some(chord) = &self.chord {
+            let d = chord.tolerance;
+            if !(d.is_finite() && d >= MIN_CHORD_TOLERANCE_MM) {
+                return Err(Error::option(
+                    "chord.tolerance",
+                    format!(
+                        "{} mm: give a chord tolerance of at least {MIN_CHORD_TOLERANCE_MM:e} mm \
+                         (1 nm; smaller ones only slow the feed to a crawl)",
+                        number(d)
+                    ),
+                ));
+            }
+            period("chord.period", chord.period)?;
+        }
+        Ok(())
     }
 }
 

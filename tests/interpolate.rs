@@ -6,11 +6,12 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use feedopt::interpolate::{Setpoints, read_setpoints_bin, sample, setpoints_bin, setpoints_csv};
+use feedopt::interpolate::{Setpoints, sample};
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, optimize};
 use feedopt::solver::SolverKind;
 use feedopt::toolpath;
+use feedopt::writers::setpoints::{read_setpoints_bin, setpoints_bin, setpoints_csv};
 use nalgebra::Vector3;
 
 fn root() -> PathBuf {

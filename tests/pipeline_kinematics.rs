@@ -97,7 +97,7 @@ fn a_near_vertical_pass_slows_as_the_rotary_limits_require_and_nothing_is_nan() 
         );
         let summary = feedopt::report::Summary::new(&m, "pass", &close);
         assert!(
-            summary.binding.iter().any(|b| b.limit.starts_with('C')),
+            summary.binding.iter().any(|b| b.name.starts_with('C')),
             "{name}: {:?}",
             summary.binding
         );

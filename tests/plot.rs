@@ -3,7 +3,8 @@
 
 use std::process::Command;
 
-use feedopt::writers::plot::{plot_format, thin};
+use feedopt::writers::plot::thin;
+use feedopt::writers::{PLOT, output_format};
 
 const MACHINE: &str = r#"{"name": "test mill", "kinematics": {"type": "xyz"},
   "axes": {"X": {"velocity": 400, "acceleration": 2000},
@@ -83,7 +84,7 @@ fn bad_plot_paths_fail_before_solving() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(says), "{plot}: {err}");
     }
-    assert!(plot_format("a.SVG".as_ref()).is_ok());
+    assert!(output_format("a.SVG".as_ref(), PLOT).is_ok());
 }
 
 #[test]

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize, optimize_input};
-use feedopt::schedule::interval_times;
+use feedopt::solver::interval_times;
 use feedopt::solver::{SolverKind, SolverSettings, clarabel};
 use feedopt::toolpath;
 use nalgebra::Vector3;

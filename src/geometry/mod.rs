@@ -17,11 +17,13 @@ pub mod spline;
 
 use nalgebra::Vector3;
 
+use crate::base::{PATH_DIM, PathJet};
+use crate::error::number;
 use crate::error::{Error, Result};
-use crate::kinematics::{PATH_DIM, PathJet};
 use crate::machine::Machine;
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Feed, Toolpath};
+use crate::validate::{MAX_FEED_OVERRIDE, MIN_FEED_OVERRIDE, non_negative};
 use spline::CubicSpline;
 
 /// Points closer than this (mm) count as the same tool-tip position.
@@ -102,7 +104,7 @@ pub struct ProcessCaps {
     /// Feed cap of each piece, mm/s.
     pub cap: Vec<f64>,
     /// The process limit that sets each cap (`None`: programmed or maximum feed).
-    pub by: Vec<Option<crate::material::ProcessLimit>>,
+    pub by: Vec<Option<crate::base::ProcessLimit>>,
 }
 
 impl ProcessCaps {
@@ -112,7 +114,7 @@ impl ProcessCaps {
     }
 
     /// The lowest cap at `u`: on a break, the lower of the two pieces that meet there.
-    pub fn at(&self, u: f64) -> (f64, Option<crate::material::ProcessLimit>) {
+    pub fn at(&self, u: f64) -> (f64, Option<crate::base::ProcessLimit>) {
         let k = self.piece(u);
         let here = (self.cap[k], self.by[k]);
         if k > 0 && self.u[k] == u && self.cap[k - 1] < here.0 {
@@ -146,7 +148,7 @@ impl Span {
     /// The feed cap on the interval of stations around `u` (strictly inside one piece, e.g. an
     /// interval's midpoint), and the process limit that sets it (`None`: the programmed or
     /// machine feed).
-    pub fn interval_cap(&self, u: f64) -> (f64, Option<crate::material::ProcessLimit>) {
+    pub fn interval_cap(&self, u: f64) -> (f64, Option<crate::base::ProcessLimit>) {
         match &self.process {
             Some(p) => {
                 let k = p.piece(u);
@@ -595,6 +597,35 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
 /// Angle between two unit vectors, accurate for small angles.
 pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
+}
+
+impl GeometryOptions {
+    /// Checks every field's range ([`crate::validate`]); the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        let a = self.corner_angle_deg;
+        if !(a.is_finite() && a > 0.0 && a < 180.0) {
+            return Err(Error::option(
+                "corner_angle_deg",
+                format!(
+                    "must be between 0 and 180 degrees (exclusive), got {}",
+                    number(a)
+                ),
+            ));
+        }
+        non_negative("tolerance_mm", self.tolerance_mm, "mm")?;
+        non_negative("tolerance_deg", self.tolerance_deg, "degrees")?;
+        if !(MIN_FEED_OVERRIDE..=MAX_FEED_OVERRIDE).contains(&self.feed_override) {
+            return Err(Error::option(
+                "feed_override",
+                format!(
+                    "{}: give a factor from {MIN_FEED_OVERRIDE} to {MAX_FEED_OVERRIDE} (1: the \
+                     programmed feeds)",
+                    number(self.feed_override)
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

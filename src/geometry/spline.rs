@@ -10,16 +10,7 @@
 //!
 //! Both are stored alike: per segment, polynomial coefficients in h = u − u_k.
 
-/// Value and first two derivatives of every coordinate at one parameter value.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Jet<const D: usize> {
-    /// The value.
-    pub value: [f64; D],
-    /// The first derivative.
-    pub d1: [f64; D],
-    /// The second derivative.
-    pub d2: [f64; D],
-}
+pub use crate::base::Jet;
 
 /// A piecewise polynomial curve through `D`-dimensional points (cubic spline or Hermite).
 #[derive(Debug, Clone)]

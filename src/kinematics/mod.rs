@@ -43,22 +43,12 @@ pub mod trunnion;
 use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
-use crate::geometry::spline::Jet;
 use crate::machine::{Axis, KinematicsSpec, Machine, TrunnionTilt};
 use crate::toolpath::ClPoint;
 use branch::{Layout, Target};
 use dual::{Dual2, Dual3, Real};
 
-/// Largest number of machine axes.
-pub const MAX_AXES: usize = 8;
-
-/// Number of path coordinates: for a CL path the tool tip x, y, z (mm) and two rotary angles
-/// (radians), the rest zero; for a joint-space path the axis positions themselves.
-pub const PATH_DIM: usize = MAX_AXES;
-
-/// Path coordinates w = (Px, Py, Pz, θ1, θ2, 0, …) or (q_1, …, q_n) and their first two
-/// u-derivatives.
-pub type PathJet = Jet<PATH_DIM>;
+pub use crate::base::{MAX_AXES, PATH_DIM, PathJet};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 

@@ -18,31 +18,7 @@
 
 use super::cut::Sample;
 
-/// The process limit that sets a feed bound (reports and plots name them).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ProcessLimit {
-    /// Chip load per tooth ("chip load").
-    ChipLoad,
-    /// Material removal rate ("MRR").
-    Mrr,
-    /// Spindle power ("power").
-    Power,
-    /// The air-cut feed where the tool removes nothing ("air").
-    Air,
-}
-
-impl ProcessLimit {
-    /// The name in reports: "chip load", "MRR", "power", "air".
-    pub fn label(self) -> &'static str {
-        match self {
-            ProcessLimit::ChipLoad => "chip load",
-            ProcessLimit::Mrr => "MRR",
-            ProcessLimit::Power => "power",
-            ProcessLimit::Air => "air",
-        }
-    }
-}
+pub use crate::base::ProcessLimit;
 
 /// The process limits (each optional) and the spindle speed they need.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]

@@ -74,7 +74,7 @@ use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
 use crate::motion::Interval;
-use crate::schedule::interval_times;
+use crate::solver::interval_times;
 
 /// Settings of the sequential convex programme.
 #[derive(Debug, Clone, Copy, PartialEq)]

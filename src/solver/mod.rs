@@ -12,6 +12,12 @@ pub mod clarabel;
 pub mod jerk;
 pub mod reach;
 
+use crate::error::{Error, Result, number};
+// The windows' workers (`super::par_map` in the solvers).
+pub(crate) use crate::parallel::par_map;
+use crate::parallel::resolve_threads;
+use crate::validate::{at_least, positive};
+
 /// Which solver computes the profile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SolverKind {
@@ -129,15 +135,6 @@ pub(crate) fn run_clarabel(solver: &mut ::clarabel::solver::DefaultSolver<f64>) 
     }
 }
 
-/// A thread count as the options give it: 0 means as many as the machine has.
-pub(crate) fn resolve_threads(threads: usize) -> usize {
-    if threads == 0 {
-        std::thread::available_parallelism().map_or(1, |t| t.get())
-    } else {
-        threads
-    }
-}
-
 /// The scale B of a cone program's variables (x = b/B): the median of the finite positive
 /// `values` (robust against stations where an axis barely moves), 1 if there are none.
 pub(crate) fn median_scale(values: &[f64]) -> f64 {
@@ -151,44 +148,6 @@ pub(crate) fn median_scale(values: &[f64]) -> f64 {
     }
     let mid = finite.len() / 2;
     *finite.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
-/// `f` applied to every item on `threads` scoped workers, each taking the next item not yet
-/// taken (windows differ in cost); results in item order.
-pub(crate) fn par_map<T: Sync, R: Send>(
-    items: &[T],
-    threads: usize,
-    f: impl Fn(&T) -> R + Sync,
-) -> Vec<R> {
-    let workers = threads.min(items.len()).max(1);
-    if workers == 1 {
-        return items.iter().map(f).collect();
-    }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut out: Vec<(usize, R)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut done = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(item) = items.get(i) else { break };
-                        done.push((i, f(item)));
-                    }
-                    done
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| match h.join() {
-                Ok(done) => done,
-                Err(panic) => std::panic::resume_unwind(panic),
-            })
-            .collect()
-    });
-    out.sort_by_key(|(i, _)| *i);
-    out.into_iter().map(|(_, r)| r).collect()
 }
 
 /// The optimal profile of one span.
@@ -209,6 +168,15 @@ pub struct SpanSolution {
     /// Convex subproblems of a jerk-limited solve (the most any window of the span took); 0
     /// for the other solvers.
     pub scp_iterations: u32,
+}
+
+/// Time taken by each interval of one span's profile: [`crate::motion::interval_times`] at
+/// the problem's stations.
+pub fn interval_times(
+    problem: &crate::constraints::SpanProblem,
+    sol: &SpanSolution,
+) -> crate::error::Result<Vec<f64>> {
+    crate::motion::interval_times(&problem.u, &sol.b, sol.a.as_deref())
 }
 
 /// A sparse row block under construction (triplets in row order), with its right-hand side.
@@ -353,4 +321,34 @@ pub fn optimal(
         solve_time: t0.elapsed().as_secs_f64(),
         scp_iterations: 0,
     })
+}
+
+impl SolverSettings {
+    /// Checks every field's range ([`crate::validate`]); the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        at_least("max_iter", self.max_iter as usize, 1, "iterations")?;
+        positive("tol_gap", self.tol_gap)?;
+        positive("tol_feas", self.tol_feas)?;
+        at_least("window", self.window, 2, "stations per window")?;
+        // 0 is allowed: Clarabel stops at once and every window keeps the reach profile.
+        if self.time_limit.is_nan() || self.time_limit < 0.0 {
+            return Err(Error::option(
+                "time_limit",
+                format!(
+                    "must be 0 s or more (0: the reach profile; infinite: no limit), got {}",
+                    number(self.time_limit)
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl jerk::JerkOptions {
+    /// Checks every field's range ([`crate::validate`]); the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        positive("convergence", self.convergence)?;
+        at_least("max_iterations", self.max_iterations, 1, "subproblems")?;
+        at_least("window", self.window, 2, "stations per window")
+    }
 }

@@ -24,8 +24,8 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::base::MAX_AXES;
 use crate::error::{Error, Result};
-use crate::kinematics::MAX_AXES;
 
 /// Per-row values of every axis, in [`JointPath::axes`] order (unused entries zero).
 pub type Row = [f64; MAX_AXES];

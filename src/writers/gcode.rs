@@ -70,14 +70,16 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::error::number;
 use crate::error::{Error, Result};
 use crate::geometry::{GeometryOptions, Span, span_points};
-use crate::interpolate::Timeline;
 use crate::kinematics::Kinematics;
 use crate::machine::Machine;
 use crate::optimize::Solution;
+use crate::schedule::Timeline;
 use crate::toolpath::gcode::Dialect;
 use crate::toolpath::{Feed, Toolpath};
+use crate::validate::MIN_ROTATION_DEG;
 
 /// Blocks shorter than this (s) are merged with the next one.
 pub const MIN_BLOCK_TIME_S: f64 = 1e-5;
@@ -217,7 +219,7 @@ fn nodes(
         geometry.corner_angle_deg,
     );
     let spans = &solution.path.spans;
-    let timeline = Timeline::new(solution)?;
+    let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
     if plan.len() != spans.len() {
         return Err(Error::Usage(format!(
             "{}: the solution has {} spans, the toolpath {}: was it solved with other options?",
@@ -573,4 +575,22 @@ pub fn programmed_time(toolpath: &Toolpath) -> Result<f64> {
         };
     }
     Ok(total)
+}
+
+impl GcodeOptions {
+    /// Checks the largest rotation per block ([`crate::validate`]).
+    /// [`write_gcode`] calls it before any work.
+    pub fn validate(&self) -> Result<()> {
+        match self.max_rotation_deg {
+            Some(d) if !(d.is_finite() && d >= MIN_ROTATION_DEG) => Err(Error::option(
+                "max_rotation_deg",
+                format!(
+                    "{}: give at least {MIN_ROTATION_DEG}° (a rotary axis's resolution; smaller \
+                     steps only multiply the blocks)",
+                    number(d)
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
 }

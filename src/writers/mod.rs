@@ -1,9 +1,14 @@
-//! Writers: the schedule as JSON or CSV. Every file is written to a temporary file in the
+//! Writers: everything feedopt writes — the schedule as JSON or CSV (here), G-code
+//! ([`gcode`]), plots ([`plot`], cargo feature `plot`), setpoints ([`setpoints`]) and a
+//! sweep's table ([`sweep`]); one check of an output's format by its extension
+//! ([`output_format`]). Every file is written to a temporary file in the
 //! target's directory and renamed into place, so no half-written output is ever left behind.
 
 pub mod gcode;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod setpoints;
+pub mod sweep;
 
 use std::io::Write;
 use std::path::Path;
@@ -11,30 +16,83 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::schedule::Schedule;
 
-/// Formats a schedule can be written in.
+/// The formats feedopt writes, told by a file's extension ([`output_format`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScheduleFormat {
-    /// `.json`: [`schedule_json`].
+pub enum Format {
+    /// `.json`.
     Json,
-    /// `.csv`: [`schedule_csv`].
+    /// `.csv`.
     Csv,
+    /// `.bin`: the setpoints' binary layout ([`setpoints`]).
+    Bin,
+    /// `.svg`: a plot (cargo feature `plot`).
+    Svg,
 }
 
-/// Checks an output path before any work is done: a known extension and an existing directory.
-pub fn schedule_format(path: &Path) -> Result<ScheduleFormat> {
+impl Format {
+    /// The extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Csv => "csv",
+            Format::Bin => "bin",
+            Format::Svg => "svg",
+        }
+    }
+}
+
+/// The formats a schedule (and a sweep's table) is written in: `.json` ([`schedule_json`]) or
+/// `.csv` ([`schedule_csv`]).
+pub const SCHEDULE: &[Format] = &[Format::Json, Format::Csv];
+
+/// The format of a plot: `.svg`.
+pub const PLOT: &[Format] = &[Format::Svg];
+
+/// The one check of an output path's format, made before any work is done: its extension
+/// (in any case) names one of the `accepted` formats, and its directory takes a new file
+/// ([`check_directory`]). A plot needs the cargo feature `plot`; `.png` is refused with the
+/// way to convert an SVG.
+pub fn output_format(path: &Path, accepted: &[Format]) -> Result<Format> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    let format = match ext.as_deref() {
-        Some("json") => ScheduleFormat::Json,
-        Some("csv") => ScheduleFormat::Csv,
-        _ => {
+    let plot = accepted == PLOT;
+    if plot && !cfg!(feature = "plot") {
+        return Err(Error::Usage(format!(
+            "--plot {}: this feedopt was built without plots (cargo feature `plot`): rebuild \
+             with it, or leave --plot out",
+            path.display()
+        )));
+    }
+    let format = accepted
+        .iter()
+        .copied()
+        .find(|f| ext.as_deref() == Some(f.extension()));
+    let Some(format) = format else {
+        if plot && ext.as_deref() == Some("png") {
             return Err(Error::Usage(format!(
-                "{}: unknown output format (use .json or .csv)",
+                "{}: PNG plots are not supported (they need font files feedopt does not \
+                 bundle); write .svg (e.g. `rsvg-convert plot.svg -o plot.png` converts it)",
                 path.display()
             )));
         }
+        let what = if plot {
+            "plot"
+        } else if accepted == setpoints::SETPOINTS {
+            "setpoint"
+        } else {
+            "output"
+        };
+        let names: Vec<String> = accepted
+            .iter()
+            .map(|f| format!(".{}", f.extension()))
+            .collect();
+        return Err(Error::Usage(format!(
+            "{}: unknown {what} format (use {})",
+            path.display(),
+            names.join(" or ")
+        )));
     };
     check_directory(path)?;
     Ok(format)
@@ -110,9 +168,9 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 /// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).
 pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
-    let bytes = match schedule_format(path)? {
-        ScheduleFormat::Json => schedule_json(schedule)?,
-        ScheduleFormat::Csv => schedule_csv(schedule).into_bytes(),
+    let bytes = match output_format(path, SCHEDULE)? {
+        Format::Json => schedule_json(schedule)?,
+        _ => schedule_csv(schedule).into_bytes(),
     };
     write_atomically(path, &bytes)
 }

@@ -31,39 +31,6 @@ use crate::optimize::Solution;
 use crate::report::{binding_label, interval_binding};
 use crate::schedule::Schedule;
 
-/// Formats a plot can be written in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlotFormat {
-    /// Scalable vector graphics (`.svg`).
-    Svg,
-}
-
-/// Checks a plot path before any work is done: a known extension and an existing directory.
-pub fn plot_format(path: &Path) -> Result<PlotFormat> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    let format = match ext.as_deref() {
-        Some("svg") => PlotFormat::Svg,
-        Some("png") => {
-            return Err(Error::Usage(format!(
-                "{}: PNG plots are not supported (they need font files feedopt does not \
-                 bundle); write .svg (e.g. `rsvg-convert plot.svg -o plot.png` converts it)",
-                path.display()
-            )));
-        }
-        _ => {
-            return Err(Error::Usage(format!(
-                "{}: unknown plot format (use .svg)",
-                path.display()
-            )));
-        }
-    };
-    super::check_directory(path)?;
-    Ok(format)
-}
-
 /// Bins along the horizontal axis beyond which a series is thinned.
 const BINS: usize = 2000;
 const WIDTH: u32 = 1400;
@@ -181,7 +148,7 @@ pub fn write_solution_plot(
     machine: &Machine,
     solution: &Solution,
 ) -> Result<()> {
-    plot_format(path)?;
+    super::output_format(path, super::PLOT)?;
     let mut svg = String::new();
     draw_solution(&mut svg, name, machine, solution).map_err(draw_err(path))?;
     super::write_atomically(path, svg.as_bytes())
@@ -563,7 +530,7 @@ pub fn write_profiles_plot(
     joint_space: bool,
     curves: &[ProfileCurve],
 ) -> Result<()> {
-    plot_format(path)?;
+    super::output_format(path, super::PLOT)?;
     let mut svg = String::new();
     draw_profiles(&mut svg, title, joint_space, curves).map_err(draw_err(path))?;
     super::write_atomically(path, svg.as_bytes())
@@ -620,4 +587,140 @@ fn draw_profiles(
         .map_err(|x| e(&x))?;
     root.present().map_err(|x| e(&x))?;
     Ok(())
+}
+
+impl crate::sweep::Sweep {
+    /// An SVG plot (cargo feature `plot`): cycle time against the limit (top) and the sensitivity, dual and finite
+    /// differences (bottom); axes labelled with units, legends.
+    pub fn plot_svg(&self) -> Result<String> {
+        use plotters::prelude::*;
+        let fail = |e: &dyn std::fmt::Display| Error::Solver(format!("plot: {e}"));
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (900, 800)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(&e))?;
+            let (top, bottom) = root.split_vertically(400);
+            let xs: Vec<f64> = self.points.iter().map(|p| p.limit).collect();
+            let (x0, x1) = pad_range(&xs);
+            let xlabel = format!("{} {} limit [{}]", self.axis, self.limit, self.unit);
+
+            let ts: Vec<f64> = self.points.iter().map(|p| p.cycle_time_s).collect();
+            let (y0, y1) = pad_range(&ts);
+            let mut chart = ChartBuilder::on(&top)
+                .caption(
+                    format!("Cycle time against the {} {} limit", self.axis, self.limit),
+                    ("sans-serif", 20),
+                )
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(xlabel.as_str())
+                .y_desc("cycle time [s]")
+                .draw()
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(LineSeries::new(
+                    self.points.iter().map(|p| (p.limit, p.cycle_time_s)),
+                    BLUE.stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?
+                .label("cycle time T")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+            chart
+                .draw_series(
+                    self.points
+                        .iter()
+                        .map(|p| Circle::new((p.limit, p.cycle_time_s), 3, BLUE.filled())),
+                )
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(|e| fail(&e))?;
+
+            let mut ss: Vec<f64> = self.points.iter().map(|p| p.sensitivity_fd).collect();
+            ss.extend(self.points.iter().filter_map(|p| p.sensitivity_dual));
+            let (s0, s1) = pad_range(&ss);
+            let mut chart = ChartBuilder::on(&bottom)
+                .caption("Sensitivity dT/d(limit)", ("sans-serif", 20))
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, s0..s1)
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(xlabel.as_str())
+                .y_desc(format!("dT/d(limit) [s per {}]", self.unit))
+                .y_label_formatter(&|y| {
+                    // A tick at zero, not at the rounding error next to it.
+                    if y.abs() < 1e-9 * (s1 - s0) {
+                        "0".to_string()
+                    } else {
+                        format!("{y:.2e}")
+                    }
+                })
+                .draw()
+                .map_err(|e| fail(&e))?;
+            if self.points.iter().any(|p| p.sensitivity_dual.is_some()) {
+                chart
+                    .draw_series(LineSeries::new(
+                        self.points
+                            .iter()
+                            .filter_map(|p| p.sensitivity_dual.map(|s| (p.limit, s))),
+                        RED.stroke_width(2),
+                    ))
+                    .map_err(|e| fail(&e))?
+                    .label("from the duals")
+                    .legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2))
+                    });
+            }
+            chart
+                .draw_series(
+                    self.points
+                        .iter()
+                        .map(|p| Cross::new((p.limit, p.sensitivity_fd), 5, BLACK.stroke_width(2))),
+                )
+                .map_err(|e| fail(&e))?
+                .label(format!("central differences (±{} %)", 100.0 * self.fd_step))
+                .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::LowerRight)
+                .draw()
+                .map_err(|e| fail(&e))?;
+            root.present().map_err(|e| fail(&e))?;
+        }
+        Ok(svg)
+    }
+
+    /// Writes [`Sweep::plot_svg`](crate::sweep::Sweep::plot_svg) to `path`, atomically.
+    pub fn write_plot(&self, path: &Path) -> Result<()> {
+        super::write_atomically(path, self.plot_svg()?.as_bytes())
+    }
+}
+
+/// A plotting range around `values` with 5 % margins (never empty).
+fn pad_range(values: &[f64]) -> (f64, f64) {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        0.05 * lo.abs().max(1e-12)
+    };
+    (lo - pad, hi + pad)
 }

@@ -1,0 +1,53 @@
+//! The base types every stage shares, below all of them: the axis count, the jets of the path
+//! coordinates (value and two derivatives in the path parameter) and the process limits that
+//! name a feed bound. They sit here, not in the stage that computes them, so that the machine,
+//! the readers, the geometry and the kinematics can all name them without depending on each
+//! other (issue 15: no loop between modules).
+
+/// Largest number of machine axes.
+pub const MAX_AXES: usize = 8;
+
+/// Number of path coordinates: for a CL path the tool tip x, y, z (mm) and two rotary angles
+/// (radians), the rest zero; for a joint-space path the axis positions themselves.
+pub const PATH_DIM: usize = MAX_AXES;
+
+/// Path coordinates w = (Px, Py, Pz, θ1, θ2, 0, …) or (q_1, …, q_n) and their first two
+/// u-derivatives.
+pub type PathJet = Jet<PATH_DIM>;
+
+/// Value and first two derivatives of every coordinate at one parameter value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jet<const D: usize> {
+    /// The value.
+    pub value: [f64; D],
+    /// The first derivative.
+    pub d1: [f64; D],
+    /// The second derivative.
+    pub d2: [f64; D],
+}
+
+/// The process limit that sets a feed bound (reports and plots name them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProcessLimit {
+    /// Chip load per tooth ("chip load").
+    ChipLoad,
+    /// Material removal rate ("MRR").
+    Mrr,
+    /// Spindle power ("power").
+    Power,
+    /// The air-cut feed where the tool removes nothing ("air").
+    Air,
+}
+
+impl ProcessLimit {
+    /// The name in reports: "chip load", "MRR", "power", "air".
+    pub fn label(self) -> &'static str {
+        match self {
+            ProcessLimit::ChipLoad => "chip load",
+            ProcessLimit::Mrr => "MRR",
+            ProcessLimit::Power => "power",
+            ProcessLimit::Air => "air",
+        }
+    }
+}

@@ -1,0 +1,181 @@
+//! The setpoints of [`crate::interpolate::sample`] as files.
+//!
+//! **CSV** ([`setpoints_csv`]): a header naming each column with its unit,
+//! `t_s,s_mm,feed_mm_s,X_mm,Y_mm,Z_mm,C_deg,A_deg` (a joint-space path: `t_s,s,feed,<axis>_mm|
+//! _deg…`, s in the file's own unit), then one row per sample.
+//!
+//! **Binary** ([`setpoints_bin`], read back by [`read_setpoints_bin`]), all little-endian:
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `FOSETPT\0` |
+//! | 4 | u32 version = 1 |
+//! | 4 | u32 flags: bit 0 set = joint-space path (s and feed in the path's own units) |
+//! | 4 | u32 axis count n |
+//! | 8 | f64 period T, s |
+//! | 8 | u64 sample count m |
+//! | per axis | u8 name length, the name (UTF-8), u8 unit: 0 = mm, 1 = degrees |
+//! | m × (3 + n) × 8 | records of f64: t (s), s (mm), feed (mm/s), q₁ … qₙ (mm or °) |
+
+use std::path::Path;
+
+use super::Format;
+use crate::error::{Error, Result};
+use crate::interpolate::{Sample, Setpoints};
+use crate::kinematics::MAX_AXES;
+use crate::machine::AxisKind;
+
+/// The formats setpoints are written in: `.csv` ([`setpoints_csv`]) or `.bin`
+/// ([`setpoints_bin`]).
+pub const SETPOINTS: &[Format] = &[Format::Csv, Format::Bin];
+
+fn unit_name(kind: AxisKind) -> &'static str {
+    match kind {
+        AxisKind::Linear => "mm",
+        AxisKind::Rotary => "deg",
+    }
+}
+
+/// The setpoints as CSV: header `t_s,s_mm,feed_mm_s,<axis>_<unit>…`, one row per sample.
+pub fn setpoints_csv(sp: &Setpoints) -> String {
+    use std::fmt::Write as _;
+    let na = sp.axes.len();
+    let mut out = String::with_capacity(sp.samples.len() * (24 * (3 + na)));
+    out.push_str(if sp.joint {
+        "t_s,s,feed"
+    } else {
+        "t_s,s_mm,feed_mm_s"
+    });
+    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
+        let _ = write!(out, ",{name}_{}", unit_name(*kind));
+    }
+    out.push('\n');
+    for s in &sp.samples {
+        let _ = write!(out, "{},{},{}", s.t, s.s, s.feed);
+        for q in &s.q[..na] {
+            let _ = write!(out, ",{q}");
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Magic bytes of the binary setpoint file.
+pub const MAGIC: &[u8; 8] = b"FOSETPT\0";
+/// Version of the binary layout.
+pub const VERSION: u32 = 1;
+
+/// The setpoints in the binary layout of the module doc.
+pub fn setpoints_bin(sp: &Setpoints) -> Result<Vec<u8>> {
+    let na = sp.axes.len();
+    let mut out = Vec::with_capacity(64 + sp.samples.len() * 8 * (3 + na));
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&u32::from(sp.joint).to_le_bytes());
+    out.extend_from_slice(&(na as u32).to_le_bytes());
+    out.extend_from_slice(&sp.period.to_le_bytes());
+    out.extend_from_slice(&(sp.samples.len() as u64).to_le_bytes());
+    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
+        let len = u8::try_from(name.len())
+            .map_err(|_| Error::Usage(format!("axis name `{name}` is too long")))?;
+        out.push(len);
+        out.extend_from_slice(name.as_bytes());
+        out.push(u8::from(*kind == AxisKind::Rotary));
+    }
+    for s in &sp.samples {
+        for x in [s.t, s.s, s.feed].iter().chain(&s.q[..na]) {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    Ok(out)
+}
+
+/// Reads the binary layout back (positions only: [`Sample::qd`], [`Sample::qdd`] are 0).
+/// `source` names the file in errors.
+pub fn read_setpoints_bin(source: &Path, bytes: &[u8]) -> Result<Setpoints> {
+    let bad = |what: &str| {
+        Error::io(
+            source,
+            std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string()),
+        )
+    };
+    let mut at = 0usize;
+    let mut take = |n: usize| -> Result<&[u8]> {
+        let slice = bytes
+            .get(at..at + n)
+            .ok_or_else(|| bad("truncated setpoint file"))?;
+        at += n;
+        Ok(slice)
+    };
+    if take(8)? != MAGIC {
+        return Err(bad("not a feedopt setpoint file (bad magic bytes)"));
+    }
+    let u32_of = |b: &[u8]| u32::from_le_bytes(b.try_into().unwrap_or([0; 4]));
+    let f64_of = |b: &[u8]| f64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
+    let version = u32_of(take(4)?);
+    if version != VERSION {
+        return Err(bad(&format!(
+            "setpoint file version {version} (expected 1)"
+        )));
+    }
+    let joint = u32_of(take(4)?) & 1 == 1;
+    let na = u32_of(take(4)?) as usize;
+    if na > MAX_AXES {
+        return Err(bad(&format!("{na} axes (at most {MAX_AXES})")));
+    }
+    let period = f64_of(take(8)?);
+    let m = u64::from_le_bytes(take(8)?.try_into().unwrap_or([0; 8]));
+    let mut axes = Vec::with_capacity(na);
+    let mut kinds = Vec::with_capacity(na);
+    for _ in 0..na {
+        let len = take(1)?[0] as usize;
+        let name = std::str::from_utf8(take(len)?).map_err(|_| bad("axis name is not UTF-8"))?;
+        axes.push(name.to_string());
+        kinds.push(match take(1)?[0] {
+            0 => AxisKind::Linear,
+            1 => AxisKind::Rotary,
+            u => return Err(bad(&format!("unknown axis unit code {u}"))),
+        });
+    }
+    let record = 8 * (3 + na);
+    let rest = bytes.len() - at;
+    if (rest as u64) != m.saturating_mul(record as u64) {
+        return Err(bad(&format!(
+            "{m} records of {record} bytes announced, {rest} bytes present"
+        )));
+    }
+    let samples = bytes[at..]
+        .chunks_exact(record)
+        .map(|r| {
+            let x = |k: usize| f64_of(&r[8 * k..8 * k + 8]);
+            let mut q = [0.0; MAX_AXES];
+            for (j, qj) in q.iter_mut().enumerate().take(na) {
+                *qj = x(3 + j);
+            }
+            Sample {
+                t: x(0),
+                s: x(1),
+                feed: x(2),
+                q,
+                qd: [0.0; MAX_AXES],
+                qdd: [0.0; MAX_AXES],
+            }
+        })
+        .collect();
+    Ok(Setpoints {
+        axes,
+        kinds,
+        joint,
+        period,
+        samples,
+    })
+}
+
+/// Writes the setpoints to `path` (format by extension), atomically.
+pub fn write_setpoints(path: &Path, sp: &Setpoints) -> Result<()> {
+    let bytes = match super::output_format(path, SETPOINTS)? {
+        Format::Bin => setpoints_bin(sp)?,
+        _ => setpoints_csv(sp).into_bytes(),
+    };
+    super::write_atomically(path, &bytes)
+}
