@@ -21,7 +21,8 @@
 #   configuration's tool-table T2 (D 8 "end mill") instead.
 #
 # Prints per row and run: samples, dexels, removed volume (check) or stations and cycle time
-# (solve), wall time (s) and peak resident memory (MB, GNU time's -v). The machine is assumed
+# (solve), wall time and CPU time (user + system, s) and peak resident memory (MB, GNU time's
+# -v). The machine is assumed
 # shared: compare the two runs of a row, measured minutes apart, not rows of other days.
 # Needs GNU time (/usr/bin/time) and python3; skips a row whose inputs in ../shared are absent.
 set -euo pipefail
@@ -66,9 +67,10 @@ run() {
   fi
   wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, p, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + p[i]; print s}' "$tmp/time.txt")
   rss=$(awk -F': ' '/Maximum resident set size/ {printf "%.0f", $2 / 1024}' "$tmp/time.txt")
+  cpu=$(awk -F': ' '/(User|System) time \(seconds\)/ {s += $2} END {printf "%.2f", s}' "$tmp/time.txt")
 }
 
-printf '%-18s %-6s %-44s %8s %8s\n' program run result wall_s rss_MB
+printf '%-18s %-6s %-50s %8s %8s %8s\n' program run result wall_s cpu_s rss_MB
 for row in "${rows[@]}"; do
   IFS='|' read -r name machine stocked program tool <<< "$row"
   [[ -n "${1:-}" && "$name" != *"$1"* ]] && continue
@@ -87,7 +89,7 @@ print("%d samples, %dx%d dexels, removed %.0f mm3" % (r["samples"], r["dexels"][
   else
     result="error: $(grep -v '^\s' "$tmp/time.txt" | head -1 | cut -c1-60)"
   fi
-  printf '%-18s %-6s %-44s %8s %8s\n' "$name" check "$result" "$wall" "$rss"
+  printf '%-18s %-6s %-50s %8s %8s %8s\n' "$name" check "$result" "$wall" "$cpu" "$rss"
   run solve --json --machine "$machine" "$program"
   if [ "$ok" = 1 ]; then
     result=$(python3 -c '
@@ -98,5 +100,5 @@ print("%d stations, cycle %.4f s, verified %s" % (s["stations"], s["cycle_time_s
   else
     result="error: $(grep -v '^\s' "$tmp/time.txt" | head -1 | cut -c1-60)"
   fi
-  printf '%-18s %-6s %-44s %8s %8s\n' "$name" solve "$result" "$wall" "$rss"
+  printf '%-18s %-6s %-50s %8s %8s %8s\n' "$name" solve "$result" "$wall" "$cpu" "$rss"
 done
