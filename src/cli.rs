@@ -507,7 +507,9 @@ fn apply_material(
         }
         return Ok(None);
     };
-    let sim = material::simulate(tp, &m)?;
+    let machine = Machine::from_file(machine_file)?;
+    let tp = material::tool_axes(tp, &machine)?;
+    let sim = material::simulate(&tp, &m)?;
     let findings = material::check::overloads(&sim, &m, options.geometry.feed_override);
     if m.process.any() {
         let limits = material::FeedLimits::new(&sim, &m, tp.points.len());

@@ -635,3 +635,72 @@ fn bad_material_sections_name_the_field() {
         .to_string();
     assert!(e.contains("flutes"), "{e}");
 }
+
+/// The row interval of a capsule: a horizontal segment's end discs and band, and a diagonal
+/// segment's band (the points within r of the line y = x: |x − y|/√2 ≤ r).
+#[test]
+fn capsule_rows_are_the_closed_form_intervals() {
+    use material::cut::capsule_row;
+    let near = |a: Option<[f64; 2]>, b: [f64; 2]| {
+        a.is_some_and(|a| (a[0] - b[0]).abs() < 1e-8 && (a[1] - b[1]).abs() < 1e-8)
+    };
+    let r = capsule_row([0.0, 0.0], [10.0, 0.0], 2.0, 1.0);
+    assert!(near(r, [-3f64.sqrt(), 10.0 + 3f64.sqrt()]), "{r:?}");
+    assert_eq!(capsule_row([0.0, 0.0], [10.0, 0.0], 2.0, 2.5), None);
+    let r = capsule_row([0.0, 0.0], [10.0, 10.0], 1.0, 5.0);
+    assert!(near(r, [5.0 - 2f64.sqrt(), 5.0 + 2f64.sqrt()]), "{r:?}");
+    // A point (vertical tool standing still): its disc.
+    let r = capsule_row([1.0, 1.0], [1.0, 1.0], 5.0, 4.0);
+    assert!(near(r, [-3.0, 5.0]), "{r:?}");
+}
+
+/// Poses of a tilted step keep the scallop at h/8: δ = √(8 r_c h/8) = √(r_c h) for a ball
+/// or bull-nose tool, h/2 for a flat end mill's sharp rim.
+#[test]
+fn pose_spacing_keeps_the_scallop_at_an_eighth_of_a_cell() {
+    use material::cut::pose_spacing;
+    let ball = Tool::new(6.0, 3.0, 12.0, 2).unwrap();
+    assert!((pose_spacing(&ball, 0.1) - 0.3f64.sqrt()).abs() < 1e-12);
+    assert_eq!(pose_spacing(&flat10(), 0.1), 0.05);
+    let bull = Tool::new(10.0, 0.01, 20.0, 4).unwrap();
+    assert_eq!(pose_spacing(&bull, 0.1), 0.05);
+}
+
+/// A G-code program in tool-tip mode gives rotary words, not a tool vector: on a table-table
+/// A/C machine the tool axis in workpiece coordinates is tilted by |A| from +Z, and turning C
+/// by 90° turns it by 90° about Z.
+#[test]
+fn rotary_words_give_the_tool_axis_in_workpiece_coordinates() {
+    let m = machine(
+        r#"{"name": "trt", "kinematics": {"type": "table_table_ac", "x-rot-point": 0,
+            "y-rot-point": 0, "z-rot-point": 0, "y-offset": 0, "z-offset": 0, "tool-offset": 0,
+            "conventional-directions": false, "work-offset": [0, 0, 0]},
+        "axes": {"X": {"velocity": 20, "acceleration": 300},
+                 "Y": {"velocity": 20, "acceleration": 300},
+                 "Z": {"velocity": 20, "acceleration": 300},
+                 "A": {"velocity": 30, "acceleration": 300, "min": -100, "max": 50},
+                 "C": {"velocity": 30, "acceleration": 300}}}"#,
+    );
+    let mut tp = toolpath(
+        &[
+            (Vector3::new(0.0, 0.0, 10.0), UP),
+            (Vector3::new(5.0, 0.0, 10.0), UP),
+        ],
+        Some(5.0),
+    );
+    tp.points[0].rotary = Some([-30.0, 0.0, 0.0]);
+    tp.points[1].rotary = Some([-30.0, 0.0, 90.0]);
+    let axes = material::tool_axes(&tp, &m).unwrap();
+    let (o0, o1) = (axes.points[0].o, axes.points[1].o);
+    for o in [o0, o1] {
+        assert!((o.norm() - 1.0).abs() < 1e-12);
+        assert!((o.z - 30f64.to_radians().cos()).abs() < 1e-12, "{o}");
+    }
+    assert!(o0.x * o1.x + o0.y * o1.y < 1e-12, "{o0} {o1}");
+    // Without rotary words the points are borrowed unchanged.
+    let plain = toolpath(&[(Vector3::zeros(), UP), (Vector3::x(), UP)], Some(5.0));
+    assert!(matches!(
+        material::tool_axes(&plain, &m).unwrap(),
+        std::borrow::Cow::Borrowed(_)
+    ));
+}

@@ -19,14 +19,24 @@
 //!
 //! **Removal, tilted tool** (sound, conservative). The tool passes through poses at
 //! t = j/m (P linear, the axis interpolated and normalised) with m chosen so that no point of
-//! the cutting part moves more than half a cell between poses. Each pose's crossing with a
-//! dexel line is exact ([`Tool::line_hit`]); consecutive poses that both cross a dexel are
-//! joined into `[min lo, max hi]`. The union of the continuous family of crossings between two
-//! such poses is connected and contains both, so the joined interval lies inside the true swept
-//! volume: material is never removed that the tool does not reach. What may be left is the
-//! sliver the swept surface bulges past the chord between poses, a sagitta of the order of
-//! (half a cell)² / (8 r) for a surface of curvature radius r: it can only make the engagement
-//! look larger, hence the feed lower (safe).
+//! the cutting part moves more than δ between poses ([`pose_spacing`]). Each pose's crossing
+//! with a dexel line is exact ([`Tool::line_hit`]); consecutive poses that both cross a dexel
+//! are joined into `[min lo, max hi]`. The union of the continuous family of crossings between
+//! two such poses is connected and contains both (for a translation exactly: the tool is
+//! convex, so the line meets it on one interval of t), so the joined interval lies inside the
+//! true swept volume: material is never removed that the tool does not reach. What may be left
+//! is the sliver the swept surface bulges past the chord between poses, a scallop of depth
+//! δ²/(8ρ) for a tool surface of smallest curvature radius ρ: the corner radius r_c of a ball
+//! or bull-nose tool (whose lower surface is smooth), so δ = √(8 ρ ε) keeps the scallop at
+//! ε = h/8 (h the cell size, [`SCALLOP_PER_CELL`]), well inside the grid's own error of h/2 at
+//! a wall; a flat end mill's rim is a sharp edge (ρ = 0), so there δ = h/2. A scallop can only
+//! make the engagement look larger, hence the feed lower (safe).
+//!
+//! **Which dexels.** Each pose's tool lies inside the cylinder of radius R about its axis
+//! from h = 0 to L_f, so its XY footprint lies inside the capsule of radius R about the
+//! projected axis segment; each grid row visits only the cells of that capsule
+//! ([`capsule_row`]), pose by pose (tilted) or for the segment P₀P₁ (vertical). The work of a
+//! step is thus its footprint's cells times its poses, not its bounding box's.
 //!
 //! **Engagement of a sample** (the tool at the step's end pose P, axis O, feed direction f):
 //! - removed volume ΔV (mm³) and engaged cross-section `A = ΔV / Δs` (mm²) normal to the feed,
@@ -244,20 +254,110 @@ fn golden_min(g: impl Fn(f64) -> f64, a0: f64, b0: f64) -> f64 {
     f1.min(f2).min(g(a0)).min(g(b0))
 }
 
+/// The scallop a tilted tool's sampled poses may leave, as a fraction of the cell size
+/// (module doc).
+pub const SCALLOP_PER_CELL: f64 = 0.125;
+
+/// δ, mm: how far a point of the cutting part may move between two poses of a tilted step on
+/// cells of `cell` mm: √(8 r_c ε) with ε = [`SCALLOP_PER_CELL`]·h, at least h/2 (module doc).
+pub fn pose_spacing(tool: &Tool, cell: f64) -> f64 {
+    (8.0 * tool.corner_radius * SCALLOP_PER_CELL * cell)
+        .sqrt()
+        .max(0.5 * cell)
+}
+
+/// The x interval where the line at `y` meets the capsule of radius `r` about the segment
+/// from `a` to `b` (XY), if it does: the two end discs and the band between them, each a
+/// convex set meeting the line in one interval, joined (they overlap). Widened by 1e-9 mm so
+/// that a cell the tool only touches is still visited.
+pub fn capsule_row(a: [f64; 2], b: [f64; 2], r: f64, y: f64) -> Option<[f64; 2]> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for c in [a, b] {
+        let e = r * r - (y - c[1]) * (y - c[1]);
+        if e >= 0.0 {
+            let s = e.sqrt();
+            lo = lo.min(c[0] - s);
+            hi = hi.max(c[0] + s);
+        }
+    }
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    if len2 > 0.0 {
+        // With q = (x, y): 0 ≤ (q − a)·d ≤ |d|² and |(q − a) × d| ≤ r |d|, each k x + m in a
+        // range.
+        let mut band = [f64::NEG_INFINITY, f64::INFINITY];
+        let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
+            if k == 0.0 {
+                if m < c0 || m > c1 {
+                    band = [f64::INFINITY, f64::NEG_INFINITY];
+                }
+            } else {
+                let (u, v) = ((c0 - m) / k, (c1 - m) / k);
+                band[0] = band[0].max(u.min(v));
+                band[1] = band[1].min(u.max(v));
+            }
+        };
+        let w = r * len2.sqrt();
+        clip(dx, (y - a[1]) * dy - a[0] * dx, 0.0, len2);
+        clip(dy, -(y - a[1]) * dx - a[0] * dy, -w, w);
+        if band[0] <= band[1] {
+            lo = lo.min(band[0]);
+            hi = hi.max(band[1]);
+        }
+    }
+    (lo <= hi).then_some([lo - 1e-9, hi + 1e-9])
+}
+
+/// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule of
+/// [`capsule_row`].
+fn capsule_cells(
+    d: (f64, f64),
+    a: [f64; 2],
+    b: [f64; 2],
+    r: f64,
+    y: f64,
+    range: (usize, usize),
+) -> Option<(usize, usize)> {
+    let [x0, x1] = capsule_row(a, b, r, y)?;
+    let (ox, hx) = d;
+    let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
+    let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
+    (i0 <= i1).then_some((i0 as usize, i1 as usize))
+}
+
 /// Removes one step's swept volume from the dexels (rows in parallel) and returns the sample's
-/// engagement (its `point`, `t`, `line`, `rapid` and feed are the caller's to fill).
+/// engagement (its `point`, `t`, `line`, `rapid` and feed are the caller's to fill). `delta`:
+/// [`pose_spacing`].
 pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64) -> Sample {
     let poses = step.poses(tool, delta);
     let bounds = step.bounds(tool, poses);
     let (pe, oe) = (step.p1, step.o1.normalize());
     let f = step.p1 - step.p0;
     let plunge = oe.cross(&f).norm() <= 1e-9 * f.norm();
+    let r = tool.radius();
+    let vertical = poses == 1;
+    // Every pose once (tilted): tip, axis and the projected axis segment.
+    type Pose = (Vector3<f64>, Vector3<f64>, [f64; 2], [f64; 2], [f64; 2]);
+    let pose_list: Vec<Pose> = if vertical {
+        Vec::new()
+    } else {
+        (0..poses)
+            .map(|j| {
+                let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
+                let top = p + o * tool.flute_length;
+                // The tool lies in the cylinder of radius R about [p, top]: its z range.
+                let drop = r * (1.0 - o.z * o.z).max(0.0).sqrt();
+                let z = [p.z.min(top.z) - drop, p.z.max(top.z) + drop];
+                (p, o, [p.x, p.y], [top.x, top.y], z)
+            })
+            .collect()
+    };
     let acc = match cell_range(dexels, &bounds) {
         None => Acc::ZERO,
         Some((i0, i1, j0, j1)) => {
             let nx = dexels.nx;
             let (x0, y0, hx, hy) = (dexels.x0, dexels.y0, dexels.hx, dexels.hy);
-            let vertical = poses == 1;
+            let pose_list = &pose_list;
             dexels.cells[j0 * nx..(j1 + 1) * nx]
                 .par_chunks_mut(nx)
                 .enumerate()
@@ -273,35 +373,66 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                         acc.length += c.length;
                         acc.axial_max = acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
                     };
-                    for i in i0..=i1 {
-                        let x = x0 + (i as f64 + 0.5) * hx;
-                        let cell = &mut row[i];
-                        if cell.is_empty() {
-                            continue;
-                        }
-                        if vertical {
+                    let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
+                    if vertical {
+                        let (a, b) = ([step.p0.x, step.p0.y], [step.p1.x, step.p1.y]);
+                        let Some((ia, ib)) = capsule_cells((x0, hx), a, b, r, y, (i0, i1)) else {
+                            return acc;
+                        };
+                        for (i, cell) in row.iter_mut().enumerate().take(ib + 1).skip(ia) {
+                            if cell.is_empty() {
+                                continue;
+                            }
+                            let x = cx(i);
                             if let Some([lo, hi]) = vertical_sweep(tool, &step.p0, &step.p1, x, y) {
                                 note(x, remove(cell, lo, hi));
                             }
-                        } else {
-                            let mut run: Option<[f64; 2]> = None;
-                            for j in 0..poses {
-                                let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
-                                match (tool.line_hit(&p, &o, x, y), run) {
-                                    (Some(h), Some(r)) => {
-                                        run = Some([r[0].min(h[0]), r[1].max(h[1])]);
-                                    }
-                                    (Some(h), None) => run = Some(h),
-                                    (None, Some(r)) => {
-                                        note(x, remove(cell, r[0], r[1]));
-                                        run = None;
-                                    }
-                                    (None, None) => {}
+                        }
+                        return acc;
+                    }
+                    // Pose by pose over the cells of its capsule; per cell the run of
+                    // consecutive poses crossing it (`last`: the latest such pose).
+                    let width = i1 - i0 + 1;
+                    let mut run = vec![[0.0f64; 2]; width];
+                    let mut last = vec![usize::MAX; width];
+                    for (j, (p, o, a, b, z)) in pose_list.iter().enumerate() {
+                        let Some((ia, ib)) = capsule_cells((x0, hx), *a, *b, r, y, (i0, i1)) else {
+                            continue;
+                        };
+                        for i in ia..=ib {
+                            let cell = &mut row[i];
+                            if cell.is_empty() {
+                                continue;
+                            }
+                            let k = i - i0;
+                            // Material all below or all above the tool's z range: nothing to
+                            // cut at this pose, and a run through it goes on (a convex tool
+                            // crosses the line at every pose between two that cross it).
+                            if cell[cell.len() - 1][1] <= z[0] || cell[0][0] >= z[1] {
+                                if last[k] != usize::MAX && last[k] + 1 == j {
+                                    last[k] = j;
                                 }
+                                continue;
                             }
-                            if let Some(r) = run {
-                                note(x, remove(cell, r[0], r[1]));
+                            let x = cx(i);
+                            let Some(h) = tool.line_hit(p, o, x, y) else {
+                                continue;
+                            };
+                            if last[k] != usize::MAX && last[k] + 1 == j {
+                                run[k] = [run[k][0].min(h[0]), run[k][1].max(h[1])];
+                            } else {
+                                if last[k] != usize::MAX {
+                                    note(x, remove(cell, run[k][0], run[k][1]));
+                                }
+                                run[k] = h;
                             }
+                            last[k] = j;
+                        }
+                    }
+                    for k in 0..width {
+                        if last[k] != usize::MAX {
+                            let i = i0 + k;
+                            note(cx(i), remove(&mut row[i], run[k][0], run[k][1]));
                         }
                     }
                     acc

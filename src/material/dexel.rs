@@ -124,7 +124,6 @@ pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
     if first >= last {
         return cut;
     }
-    let mut keep: [Option<[f64; 2]>; 2] = [None, None];
     for iv in &intervals[first..last] {
         let (a, b) = (iv[0].max(lo), iv[1].min(hi));
         if b - a >= MIN_CUT_MM {
@@ -136,14 +135,28 @@ pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
     if cut.length == 0.0 {
         return cut;
     }
+    // What stays of the first and last overlapping intervals replaces them in place (the
+    // common cases, a trimmed top or a split, move nothing or one element).
     let (f, l) = (intervals[first], intervals[last - 1]);
+    let mut keep = [[0.0; 2]; 2];
+    let mut n = 0;
     if f[0] < lo {
-        keep[0] = Some([f[0], lo]);
+        keep[n] = [f[0], lo];
+        n += 1;
     }
     if l[1] > hi {
-        keep[1] = Some([hi, l[1]]);
+        keep[n] = [hi, l[1]];
+        n += 1;
     }
-    intervals.splice(first..last, keep.into_iter().flatten());
+    let old = last - first;
+    if n <= old {
+        intervals[first..first + n].copy_from_slice(&keep[..n]);
+        intervals.drain(first + n..last);
+    } else {
+        // One interval split in two.
+        intervals[first] = keep[0];
+        intervals.insert(first + 1, keep[1]);
+    }
     cut
 }
 

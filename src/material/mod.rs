@@ -116,6 +116,32 @@ pub struct Simulation {
     pub work: f64,
 }
 
+/// The toolpath with every CL point's tool axis in workpiece coordinates. A G-code program in
+/// tool-tip mode gives rotary words, not a tool vector (its reader leaves +Z in the points),
+/// so the machine's kinematics turn the programmed angles into the axis, on the branch the
+/// solve follows ([`crate::kinematics::Kinematics::rotary_angles`]); between CL points the cut interpolates the
+/// axis as for APT vectors. Borrowed unchanged when no point has rotary words.
+pub fn tool_axes<'a>(
+    tp: &'a Toolpath,
+    machine: &crate::machine::Machine,
+) -> Result<std::borrow::Cow<'a, Toolpath>> {
+    use crate::kinematics::Kinematics;
+    if machine.kinematics == crate::machine::KinematicsSpec::Joint
+        || !tp.points.iter().any(|p| p.rotary.is_some())
+    {
+        return Ok(std::borrow::Cow::Borrowed(tp));
+    }
+    let kin = Kinematics::new(machine);
+    let angles = kin.rotary_angles(&tp.points, &machine.axes)?;
+    let mut out = tp.clone();
+    for (p, a) in out.points.iter_mut().zip(&angles) {
+        if p.rotary.is_some() {
+            p.o = kin.tool_axis(*a);
+        }
+    }
+    Ok(std::borrow::Cow::Owned(out))
+}
+
 /// Checks the resolution and estimates the work of cutting `tp` with `m` (module doc),
 /// refusing what exceeds the bounds before anything is allocated.
 pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
@@ -163,7 +189,7 @@ pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
              {MAX_SAMPLES:e}): give a longer sample step"
         )));
     }
-    let delta = 0.5 * cell;
+    let delta = cut::pose_spacing(&m.tool, cell);
     let mut work = 0.0;
     for k in 1..tp.points.len() {
         let n = cut::steps_of_move(tp, k, &m.tool, step);
@@ -196,7 +222,7 @@ pub fn simulate(tp: &Toolpath, m: &Material) -> Result<Simulation> {
     let step = m.options.step_for(&m.tool);
     let mut dexels = Dexels::new(&m.stock, cell);
     let initial_volume = dexels.volume();
-    let delta = 0.5 * dexels.hx.min(dexels.hy);
+    let delta = cut::pose_spacing(&m.tool, dexels.hx.min(dexels.hy));
     let mut samples = Vec::new();
     for k in 1..tp.points.len() {
         let n = cut::steps_of_move(tp, k, &m.tool, step);
