@@ -166,7 +166,7 @@ pub struct SweepArgs {
 }
 
 #[derive(Debug, Args)]
-/// Arguments of `feedopt solve`, and the solve options every subcommand shares.
+/// Arguments of `feedopt solve` (also `compare` and `sweep`).
 pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
@@ -186,6 +186,23 @@ pub struct SolveArgs {
     /// sensitivity against the limit).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// G-code dialect: linuxcnc, fanuc, sinumerik or heidenhain (default: detected from the
+    /// program).
+    #[arg(long)]
+    pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
+    /// (seconds); 1 µs to 1 s.
+    #[arg(long, default_value = "1ms", value_parser = parse_period)]
+    pub period: f64,
+    #[command(flatten)]
+    /// The solve options every subcommand shares.
+    pub opts: SolveOptions,
+}
+
+#[derive(Debug, Clone, Args)]
+/// The solve options every subcommand that solves shares (`solve`, `compare`, `sweep`,
+/// `gcode`, `interpolate`): one declaration, flattened into each.
+pub struct SolveOptions {
     /// Total station count, 2 to 4,000,000 (default: refined automatically until doubling
     /// changes the cycle time by less than 0.01 %).
     #[arg(long)]
@@ -209,10 +226,6 @@ pub struct SolveArgs {
     /// Input format instead of the file's extension: apt, gcode or csv.
     #[arg(long, value_enum)]
     pub format: Option<FormatChoice>,
-    /// G-code dialect: linuxcnc, fanuc, sinumerik or heidenhain (default: detected from the
-    /// program).
-    #[arg(long)]
-    pub dialect: Option<crate::toolpath::gcode::Dialect>,
     /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
     /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable; the target one of CYCLE81–CYCLE89).
     #[arg(long = "cycle-alias", value_name = "FROM=TO")]
@@ -234,10 +247,6 @@ pub struct SolveArgs {
     /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
     #[arg(long)]
     pub no_jerk: bool,
-    /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
-    /// (seconds); 1 µs to 1 s.
-    #[arg(long, default_value = "1ms", value_parser = parse_period)]
-    pub period: f64,
     #[command(flatten)]
     /// Stock, tool and process limits beyond the machine file.
     pub material: MaterialArgs,
@@ -334,29 +343,32 @@ impl SolveArgs {
     /// the outputs checked before any work.
     fn options(&self) -> Result<Options> {
         let mut o = Options {
-            stations: self.stations,
-            solver_kind: match self.solver {
+            stations: self.opts.stations,
+            solver_kind: match self.opts.solver {
                 SolverChoice::Clarabel => SolverKind::Clarabel,
                 SolverChoice::Reach => SolverKind::Reach,
             },
-            start_feed: self.start_feed,
-            end_feed: self.end_feed,
+            start_feed: self.opts.start_feed,
+            end_feed: self.opts.end_feed,
             verify: crate::verify::VerifyOptions {
                 period: self.period,
-                chord: self.chord_tolerance.map(|d| crate::constraints::Chord {
-                    tolerance: d,
-                    period: self.period,
-                }),
+                chord: self
+                    .opts
+                    .chord_tolerance
+                    .map(|d| crate::constraints::Chord {
+                        tolerance: d,
+                        period: self.period,
+                    }),
                 ..Default::default()
             },
-            jerk_limited: !self.no_jerk,
+            jerk_limited: !self.opts.no_jerk,
             ..Options::default()
         };
-        o.geometry.corner_angle_deg = self.corner_angle;
-        o.geometry.feed_override = self.feed_override;
-        o.geometry.ignore_programmed_feed = self.ignore_programmed_feed;
-        o.geometry.tolerance_mm = self.tolerance;
-        o.geometry.tolerance_deg = self.tolerance_deg;
+        o.geometry.corner_angle_deg = self.opts.corner_angle;
+        o.geometry.feed_override = self.opts.feed_override;
+        o.geometry.ignore_programmed_feed = self.opts.ignore_programmed_feed;
+        o.geometry.tolerance_mm = self.opts.tolerance;
+        o.geometry.tolerance_deg = self.opts.tolerance_deg;
         o.validate()?;
         if let Some(out) = &self.output {
             writers::output_format(out, writers::SCHEDULE)?;
@@ -398,7 +410,7 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     let material = apply_material(
         &args.machine,
         &args.toolpath,
-        &args.material,
+        &args.opts.material,
         &input,
         &mut options,
     )?;
@@ -581,9 +593,9 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
     read_input_from(
         &args.machine,
         &args.toolpath,
-        args.format,
+        args.opts.format,
         args.dialect,
-        &args.cycle_alias,
+        &args.opts.cycle_alias,
     )
 }
 
@@ -650,7 +662,7 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
     apply_material(
         &a.machine,
         &a.toolpath,
-        &a.material,
+        &a.opts.material,
         &input,
         &mut options.solve,
     )?;
@@ -701,7 +713,7 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     apply_material(
         &solve.machine,
         &solve.toolpath,
-        &solve.material,
+        &solve.opts.material,
         &input,
         &mut o.solve,
     )?;
@@ -734,7 +746,8 @@ pub fn run(cli: &Cli) -> Result<String> {
     .map_err(name_flag)
 }
 
-/// The solve options of `feedopt gcode` and `feedopt interpolate` (as `feedopt solve`'s).
+/// Machine, toolpath and the solve options of `feedopt gcode` and `feedopt interpolate` (as
+/// `feedopt solve`'s).
 #[derive(Debug, Clone, Args)]
 pub struct PlanArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
@@ -742,50 +755,9 @@ pub struct PlanArgs {
     pub machine: PathBuf,
     /// Toolpath file (APT CL: .cls, .apt; G-code: .ngc, .nc, .gcode, .tap).
     pub toolpath: PathBuf,
-    /// Total station count, 2 to 4,000,000 (default: refined automatically).
-    #[arg(long)]
-    pub stations: Option<usize>,
-    /// Turning angle between CL moves (degrees) above which the path stops exactly.
-    #[arg(long, default_value_t = 10.0)]
-    pub corner_angle: f64,
-    /// How far the fitted path may stray from the programmed tool-tip positions, mm.
-    #[arg(long, default_value_t = 0.005, value_name = "MM")]
-    pub tolerance: f64,
-    /// How far the fitted rotary angles may stray from the programmed ones, degrees.
-    #[arg(long, default_value_t = 0.01, value_name = "DEG")]
-    pub tolerance_deg: f64,
-    /// Cap every programmed feed at this multiple of it (a feed override), 0.001 to 1000.
-    #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
-    pub feed_override: f64,
-    /// Ignore the program's feeds: only the machine's limits apply.
-    #[arg(long)]
-    pub ignore_programmed_feed: bool,
-    /// Input format instead of the file's extension: apt, gcode or csv.
-    #[arg(long, value_enum)]
-    pub format: Option<FormatChoice>,
-    /// Read a machine builder's (or a post's) Sinumerik cycle as the standard one it works
-    /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable).
-    #[arg(long = "cycle-alias", value_name = "FROM=TO")]
-    pub cycle_alias: Vec<String>,
-    /// Solver: `clarabel` or `reach`.
-    #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
-    pub solver: SolverChoice,
-    /// Tool-tip feed at the start of the path, mm/s (default: at rest); at most feed.max.
-    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
-    pub start_feed: f64,
-    /// Tool-tip feed at the end of the path, mm/s (default: at rest); at most feed.max.
-    #[arg(long, default_value_t = 0.0, value_name = "MM_PER_S")]
-    pub end_feed: f64,
-    /// Bound the chord error of each interpolation period (`--period`) by this, mm (seed 004:
-    /// V² ≤ 8δ/(κT²) on a path of curvature κ), checked by the re-simulation.
-    #[arg(long, value_name = "MM")]
-    pub chord_tolerance: Option<f64>,
-    /// Ignore the machine file's jerk limits: an acceleration-limited schedule.
-    #[arg(long)]
-    pub no_jerk: bool,
     #[command(flatten)]
-    /// Stock, tool and process limits beyond the machine file.
-    pub material: MaterialArgs,
+    /// The solve options every subcommand shares.
+    pub opts: SolveOptions,
 }
 
 impl PlanArgs {
@@ -804,23 +776,10 @@ impl PlanArgs {
             toolpath: self.toolpath.clone(),
             json: false,
             output: None,
-            stations: self.stations,
-            corner_angle: self.corner_angle,
-            tolerance: self.tolerance,
-            tolerance_deg: self.tolerance_deg,
-            feed_override: self.feed_override,
-            ignore_programmed_feed: self.ignore_programmed_feed,
-            format: self.format,
-            dialect: Some(dialect),
-            cycle_alias: self.cycle_alias.clone(),
-            solver: self.solver,
-            start_feed: self.start_feed,
-            end_feed: self.end_feed,
-            period,
             plot: None,
-            chord_tolerance: self.chord_tolerance,
-            no_jerk: self.no_jerk,
-            material: self.material.clone(),
+            dialect: Some(dialect),
+            period,
+            opts: self.opts.clone(),
         }
     }
 }
@@ -833,7 +792,7 @@ fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize
     apply_material(
         &args.machine,
         &args.toolpath,
-        &args.material,
+        &args.opts.material,
         &input,
         &mut options,
     )?;

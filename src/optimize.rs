@@ -1093,6 +1093,10 @@ impl Plan<'_> {
             let l = un - p.u[n - 3];
             u.extend((1..=GRADING).map(|k| un - l / f64::powi(2.0, k as i32)));
         }
+        // The stations inside the phase go: the profile there stays below a quarter of the
+        // lowest velocity bound on that half (V in [`solver::jerk::rest_phase_length`]), and
+        // its jerk is bounded along the whole interval ([`solver::jerk::rest_bounds`]); the
+        // re-simulation checks the rest, as everywhere.
         if let Some(d) = first {
             u.retain(|&x| x == u0 || x > u0 + d * (1.0 + 1e-9));
             u.push(u0 + d);

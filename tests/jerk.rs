@@ -349,19 +349,25 @@ fn a_linuxcnc_program_with_jerk_limits_solves_without_stalls_or_cycles() {
     };
     let jerk = optimize(&m, &t, &o).expect("solves");
     let most = jerk.solutions.iter().map(|s| s.scp_iterations).max();
+    // The acceleration-limited optimum, converged (a fixed coarse grid is slower than it by
+    // several per cent, more than the jerk limit costs: not a bound on the jerk-limited time).
     let accel = optimize(
         &m,
         &t,
         &Options {
             jerk_limited: false,
-            ..o.clone()
+            ..Options::default()
         },
     )
     .expect("solves");
     let (tj, ta) = (jerk.schedule.cycle_time, accel.schedule.cycle_time);
-    eprintln!("boat-xyzbc: jerk-limited {tj:.3} s, acceleration-limited {ta:.3} s, SCP ≤ {most:?}");
+    let ea = accel.error_estimate.expect("adaptive");
+    eprintln!(
+        "boat-xyzbc: jerk-limited {tj:.3} s, acceleration-limited {ta:.3} s (±{ea:.1e}), SCP ≤ \
+         {most:?}"
+    );
     assert!(most.is_some_and(|k| (2..=12).contains(&k)), "{most:?}");
-    assert!(tj.is_finite() && tj >= ta * (1.0 - 1e-4), "{tj} vs {ta}");
+    assert!(tj.is_finite() && tj >= ta * (1.0 - ea), "{tj} vs {ta}");
 }
 
 /// A rest-to-rest line of 100 mm at F3000 (50 mm/s) with only the jerk limit J binding on the
