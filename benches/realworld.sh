@@ -7,7 +7,8 @@
 #
 # Builds the release binary, then for each program prints: lines, stations, cycle time, the
 # estimated relative error of the cycle time, whether the 1 ms re-simulation verified it, wall
-# time and peak resident memory (GNU time's -v). The impeller's body (program lines 7-4502) is
+# time, user CPU time (the steadier figure on a busy machine) and peak resident memory (GNU
+# time -v). The impeller's body (program lines 7-4502) is
 # repeated 8 and 32 times between its header and footer, in a temporary folder; the jerk-limited
 # impeller uses its machine file with jerk = 10 x acceleration on every axis. Nothing from
 # ../shared is written into the crate. Needs GNU time (/usr/bin/time) and python3 (reads --json).
@@ -41,15 +42,15 @@ rows=(
   "boat_xyzbc|$lnx/boat-xyzbc.machine.json|$lnx/boat-xyzbc.ngc|"
   "camotics_bear|$cam/machines/xyz_mill.json|$cam/camotics_bear.nc|"
   "camotics_flower_mold|$cam/machines/xyz_mill.json|$cam/camotics_flower_mold.nc|"
-  "nx_roeders_rfm600|$cam/machines/xyz_mill.json|$cam/nx_roeders_rfm600_finish.nc|--dialect fanuc"
+  "nx_roeders_rfm600|$cam/machines/xyz_mill.json|$cam/nx_roeders_rfm600_finish.nc|"
   "aamorim_boss|$cam/machines/xyz_mill.json|$cam/aamorim_boss.apt|"
   "aamorim_basemach|$cam/machines/xyz_mill.json|$cam/aamorim_basemach.apt|"
-  "nx_mori_nmv5000|$cam/machines/trt_bc_mori_nmv5000.json|$cam/nx_mori_nmv5000_mm.nc|--dialect fanuc"
-  "nx_dmu70evo_840d|$cam/machines/headtable_dmu70.json|$cam/nx_dmu70evo_840d.mpf|--dialect sinumerik"
-  "elmoe_keychain|$cam/machines/trt_bc_spinner_u5.json|$cam/elmoe_keychain.mpf|--dialect sinumerik"
+  "nx_mori_nmv5000|$cam/machines/trt_bc_mori_nmv5000.json|$cam/nx_mori_nmv5000_mm.nc|"
+  "nx_dmu70evo_840d|$cam/machines/headtable_dmu70.json|$cam/nx_dmu70evo_840d.mpf|"
+  "elmoe_keychain|$cam/machines/trt_bc_spinner_u5.json|$cam/elmoe_keychain.mpf|"
 )
 
-printf '%-22s %8s %9s %14s %9s %8s %8s %8s\n' program lines stations cycle_time_s estimate verified wall_s rss_MB
+printf '%-22s %8s %9s %14s %9s %8s %8s %8s %8s\n' program lines stations cycle_time_s estimate verified wall_s user_s rss_MB
 for row in "${rows[@]}"; do
   IFS='|' read -r name machine program extra <<< "$row"
   [[ -n "${1:-}" && "$name" != *"$1"* ]] && continue
@@ -67,6 +68,7 @@ print(s["stations"], "%.4f" % s["cycle_time_s"], "-" if e is None else "%.1e" % 
     stations=- cycle=- estimate=- verified="error: $(grep -v '^\s' "$tmp/time.txt" | head -1 | cut -c1-60)"
   fi
   wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, p, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + p[i]; print s}' "$tmp/time.txt")
+  user=$(awk -F': ' '/User time \(seconds\)/ {print $2}' "$tmp/time.txt")
   rss=$(awk -F': ' '/Maximum resident set size/ {printf "%.0f", $2 / 1024}' "$tmp/time.txt")
-  printf '%-22s %8s %9s %14s %9s %8s %8s %8s\n' "$name" "$lines" "$stations" "$cycle" "$estimate" "$verified" "$wall" "$rss"
+  printf '%-22s %8s %9s %14s %9s %8s %8s %8s %8s\n' "$name" "$lines" "$stations" "$cycle" "$estimate" "$verified" "$wall" "$user" "$rss"
 done
