@@ -228,15 +228,7 @@ impl JerkData {
         let na = p.n_axes();
         let limits: Vec<Option<Limit>> = machine.axes.iter().take(na).map(|a| a.jerk).collect();
         let n = p.intervals();
-        let mut rest = (f64::INFINITY, f64::INFINITY);
-        if n >= 2 {
-            if p.b_start == 0.0 {
-                rest.0 = rest_bound(span, kin, &limits, p.u[0], p.u[1], false);
-            }
-            if p.b_end == 0.0 {
-                rest.1 = rest_bound(span, kin, &limits, p.u[n], p.u[n - 1], true);
-            }
-        }
+        let rest = rest_bounds(span, kin, machine, p);
         let moving = span.kind == SpanKind::Moving;
         let (rs, re) = (p.b_start == 0.0, p.b_end == 0.0);
         let mut mid_start = Vec::with_capacity(n + 1);
