@@ -394,7 +394,7 @@ fn judge_error(e: &Error, file: &str, lines: usize) -> Outcome {
 /// vectors, feeds and dwells that are numbers of the right sign, every line within the file.
 fn judge_toolpath(t: &toolpath::Toolpath, lines: usize) -> Result<(), String> {
     use toolpath::Feed;
-    for p in &t.points {
+    for (k, p) in t.points.iter().enumerate() {
         let at = format!("point from line {}", p.line);
         if !(1..=lines).contains(&p.line) {
             return Err(format!("{at}: the line is not in the file ({lines} lines)"));
@@ -416,7 +416,9 @@ fn judge_toolpath(t: &toolpath::Toolpath, lines: usize) -> Result<(), String> {
             return Err(format!("{at}: rotary positions {:?}", p.rotary));
         }
         match p.feed {
-            Feed::Programmed(f) if !(f.is_finite() && f >= toolpath::MIN_FEED_MM_S) => {
+            // The first point's feed moves nothing (no move ends there): unused, and not
+            // checked by `toolpath::plausible` either.
+            Feed::Programmed(f) if k > 0 && !(f.is_finite() && f >= toolpath::MIN_FEED_MM_S) => {
                 return Err(format!("{at}: feed {f} mm/s"));
             }
             Feed::BlockTime(s) if !(s.is_finite() && s > 0.0) => {
