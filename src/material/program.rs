@@ -1,5 +1,6 @@
 //! What a program says about the process: spindle speed (G-code `S` words, APT `SPINDL/`) and
-//! the cutter (APT `CUTTER/d, r`), read from the program text with their lines.
+//! the cutter (APT `CUTTER/d, r` or NX's `TLDATA/MILL, d, r, …`), read from the program text
+//! with their lines.
 //!
 //! The material model takes one tool and one spindle speed: a program with several different
 //! `CUTTER/` records is an error naming both lines; where the spindle speed changes, the
@@ -17,7 +18,8 @@ pub struct ProgramProcess {
     pub spindle_speed: Option<(f64, usize)>,
     /// How many different spindle speeds the program gives.
     pub spindle_speeds: usize,
-    /// The cutter's diameter and corner radius (mm) and the line of its `CUTTER/`.
+    /// The cutter's diameter and corner radius (mm) and the line of its `CUTTER/` (or
+    /// `TLDATA/MILL`).
     pub cutter: Option<(f64, f64, usize)>,
 }
 
@@ -74,11 +76,18 @@ pub fn scan(source: &Path, text: &str) -> Result<ProgramProcess> {
                 .filter_map(|a| a.trim().parse::<f64>().ok())
                 .filter(|x| x.is_finite())
                 .collect();
-            match word.trim() {
-                "CUTTER" => {
+            let word = word.trim();
+            // NX's `TLDATA/MILL, D, R, length, taper, tip` gives the same D and R as CUTTER/.
+            let mill = word == "TLDATA" && args.trim_start().starts_with("MILL");
+            match word {
+                _ if word == "CUTTER" || mill => {
                     let scale = if inches { 25.4 } else { 1.0 };
                     let Some(&d) = nums.first() else {
-                        return Err(Error::parse(source, line, "CUTTER/ without a diameter"));
+                        return Err(Error::parse(
+                            source,
+                            line,
+                            format!("{word}/ without a diameter"),
+                        ));
                     };
                     let r = nums.get(1).copied().unwrap_or(0.0);
                     let c = (d * scale, r * scale, line);
@@ -149,6 +158,27 @@ mod tests {
         let bad = "CUTTER/10\nGOTO/0,0,0\nCUTTER/6\n";
         let e = scan(Path::new("a.cls"), bad).unwrap_err().to_string();
         assert!(e.starts_with("a.cls:3:"), "{e}");
+    }
+
+    #[test]
+    fn nx_tldata_mill_is_a_cutter() {
+        // NX CLSF: TLDATA/MILL, diameter, lower radius, length, taper, tip (a 6 mm ball).
+        let t = "TOOL PATH/BLADE,TOOL,BALL6\nTLDATA/MILL,6.0000,3.0000,50.0000,2.0000,0.0000\n\
+                 GOTO/0,0,0\n";
+        let p = scan(Path::new("a.cls"), t).unwrap();
+        assert_eq!(p.cutter, Some((6.0, 3.0, 2)));
+        // The same tool again as CUTTER/: one tool; another size: an error naming both lines.
+        let same = format!("{t}CUTTER/6,3\n");
+        assert_eq!(
+            scan(Path::new("a.cls"), &same).unwrap().cutter,
+            Some((6.0, 3.0, 2))
+        );
+        let other = format!("{t}TLDATA/MILL,10.0000,0.0000,40.0000,0.0000,0.0000\n");
+        let e = scan(Path::new("a.cls"), &other).unwrap_err().to_string();
+        assert!(e.starts_with("a.cls:4:") && e.contains("line 2"), "{e}");
+        // Other TLDATA kinds (a lathe tool) are not a milling cutter.
+        let lathe = "TLDATA/TURN,0.4\nGOTO/0,0,0\n";
+        assert_eq!(scan(Path::new("a.cls"), lathe).unwrap().cutter, None);
     }
 
     #[test]
