@@ -431,8 +431,8 @@ impl fmt::Display for Summary {
         if let Some(e) = self.error_estimate {
             writeln!(
                 f,
-                "converged     within {e:.1e} of the continuous optimum (estimated: the change \
-                 under one more halving)"
+                "converged     within {e:.1e} of the continuous optimum (estimated from how \
+                 each interval's time changed when it was halved)"
             )?;
         }
         let status = match self.status {
