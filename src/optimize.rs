@@ -769,12 +769,7 @@ impl Plan<'_> {
             .into_iter()
             .collect::<Result<_>>()?;
         let (problems, solutions): (Vec<_>, Vec<_>) = solved.into_iter().unzip();
-        let lv = self.level(problems, solutions)?;
-        let estimate = if lv.schedule.cycle_time > 0.0 {
-            estimate_s / lv.schedule.cycle_time
-        } else {
-            0.0
-        };
+        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
         Ok((lv, refinement, estimate))
     }
 
@@ -938,12 +933,7 @@ impl Plan<'_> {
             .into_iter()
             .map(|r| (r.fine, r.fine_solution))
             .unzip();
-        let lv = self.level(problems, solutions)?;
-        let estimate = if lv.schedule.cycle_time > 0.0 {
-            estimate_s / lv.schedule.cycle_time
-        } else {
-            0.0
-        };
+        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
         Ok((lv, refinement, estimate))
     }
 
@@ -1036,6 +1026,23 @@ impl Plan<'_> {
             split,
             eps,
         })
+    }
+
+    /// The final level of an adaptive refinement, and its error estimate `estimate_s` (s)
+    /// relative to its cycle time.
+    fn estimated_level(
+        &self,
+        problems: Vec<SpanProblem>,
+        solutions: Vec<SpanSolution>,
+        estimate_s: f64,
+    ) -> Result<(Level, f64)> {
+        let lv = self.level(problems, solutions)?;
+        let estimate = if lv.schedule.cycle_time > 0.0 {
+            estimate_s / lv.schedule.cycle_time
+        } else {
+            0.0
+        };
+        Ok((lv, estimate))
     }
 
     /// Assembles a level from every span's problem and solution.
