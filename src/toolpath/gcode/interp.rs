@@ -93,7 +93,8 @@ struct CycleMode {
 #[derive(Debug, Clone)]
 struct ModalCall {
     number: u32,
-    args: Vec<Option<f64>>,
+    /// Its moves along the drilling axis, which depend on its arguments only.
+    steps: Vec<cycles::Step>,
 }
 
 /// A subprogram call a block makes, run after the block's own words.
@@ -727,14 +728,14 @@ impl<'a> Interpreter<'a> {
             if modal_call {
                 // The call's errors and notes depend on its arguments only: said once, where
                 // the program calls it, not at every position after it.
-                let (_, notes) = cycles::sinumerik_steps(number, &args)
+                let (steps, notes) = cycles::sinumerik_steps(number, &args)
                     .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
                 for n in notes {
                     self.warn(line, format!("MCALL {text}: {n}"));
                 }
-                self.mcall = Some(ModalCall { number, args });
+                self.mcall = Some(ModalCall { number, steps });
             } else {
-                self.run_sinumerik_cycle(line, &text, number, &args, true)?;
+                self.run_sinumerik_cycle(line, &text, number, &args)?;
             }
         } else if modal_call {
             self.mcall = None;
@@ -759,16 +760,14 @@ impl<'a> Interpreter<'a> {
             && (has_axes || has_vector || (has_centre && (ijk_vector || is_arc)));
         if moves {
             self.motion_block(line, &block, machine)?;
-            if let Some(call) = self.mcall.clone()
+            if let Some(call) = self.mcall.take()
                 && block.axes[..2].iter().any(Option::is_some)
             {
-                self.run_sinumerik_cycle(
-                    line,
-                    &format!("MCALL CYCLE{}", call.number),
-                    call.number,
-                    &call.args,
-                    false,
-                )?;
+                let run = self
+                    .cycle_plane(line, &format!("MCALL CYCLE{}", call.number))
+                    .and_then(|()| self.run_steps(line, &call.steps));
+                self.mcall = Some(call);
+                run?;
             }
         } else if no_motion.is_none() && (has_centre || block.radius.is_some()) {
             self.warn(line, "I/J/K or R without a move: ignored");
@@ -1211,22 +1210,25 @@ impl<'a> Interpreter<'a> {
         text: &str,
         number: u32,
         args: &[Option<f64>],
-        warn: bool,
     ) -> Result<()> {
+        self.cycle_plane(line, text)?;
+        let (steps, notes) = cycles::sinumerik_steps(number, args)
+            .map_err(|e| self.error(line, format!("{text}: {e}")))?;
+        for n in notes {
+            self.warn(line, format!("{text}: {n}"));
+        }
+        self.run_steps(line, &steps)
+    }
+
+    /// Cycles are read in the XY plane only.
+    fn cycle_plane(&self, line: usize, text: &str) -> Result<()> {
         if self.plane != Plane::Xy {
             return Err(self.error(
                 line,
                 format!("{text} outside G17: cycles are read in the XY plane only"),
             ));
         }
-        let (steps, notes) = cycles::sinumerik_steps(number, args)
-            .map_err(|e| self.error(line, format!("{text}: {e}")))?;
-        if warn {
-            for n in notes {
-                self.warn(line, format!("{text}: {n}"));
-            }
-        }
-        self.run_steps(line, &steps)
+        Ok(())
     }
 
     /// A motion block: resolves the target and emits its point(s).
