@@ -148,34 +148,15 @@ impl SpanProblem {
         u: f64,
         cap: (f64, Option<crate::material::ProcessLimit>),
     ) {
-        let na = kin.n_axes();
         let w = span.eval(u);
         let jet = kin.axis_jets(&w);
-        let tip_speed = match span.kind {
-            SpanKind::Moving => (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt(),
-            SpanKind::Reorientation | SpanKind::Joint => 0.0,
-        };
-        let mut best = velocity_bound(machine, na, &jet, tip_speed, cap.0);
-        if let (Bound::Feed, Some(limit)) = (best.1, cap.1) {
-            best.1 = Bound::Process(limit);
-        }
-        let (rows, b_star, by) = essential_rows(&jet, &self.acceleration, best.0);
-        // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
-        if b_star < best.0 {
-            best = (b_star, by);
-        }
-        if let Some(c) = chord.filter(|_| span.kind == SpanKind::Moving) {
-            let b = c.b_max(&w);
-            if b < best.0 {
-                best = (b, Bound::Chord);
-            }
-        }
+        let pb = point_bound(machine, &self.acceleration, &jet, &w, span.kind, cap, chord);
         self.u.push(u);
-        self.b_max.push(best.0);
-        self.b_max_by.push(best.1);
-        self.tip_speed.push(tip_speed);
+        self.b_max.push(pb.b_max);
+        self.b_max_by.push(pb.by);
+        self.tip_speed.push(pb.tip_speed);
         self.jets.push(jet);
-        self.essential.push(rows);
+        self.essential.push(pb.essential);
     }
 
     /// The same problem with a station added inside every interval `k` of `split` (sorted,
@@ -313,6 +294,64 @@ impl SpanProblem {
     /// (`k` is `i − 1` or `i`).
     pub fn axis_acceleration(&self, b: &[f64], k: usize, i: usize, j: usize) -> f64 {
         self.jets[i].ddq[j] * b[i] + self.jets[i].dq[j] * self.path_acceleration(b, k)
+    }
+}
+
+/// Every velocity bound of one path point merged: what [`point_bound`] finds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointBound {
+    /// The tightest bound on b there (`f64::INFINITY`: none).
+    pub b_max: f64,
+    /// The limit that sets it.
+    pub by: Bound,
+    /// The acceleration rows that are edges of the feasible polygon there
+    /// ([`essential_rows`]).
+    pub essential: u16,
+    /// |P'| there (0 off a moving span).
+    pub tip_speed: f64,
+}
+
+/// The one merge of a path point's velocity bounds, for the stations and for the jerk
+/// solver's collocation points alike: the axes' velocity rows and the feed cap
+/// ([`velocity_bound`]; the cap named by its process limit when the material model set it),
+/// the acceleration polygon's largest b* under them ([`essential_rows`], which also picks the
+/// rows that stay), then, on a moving span, the chord bound of `chord` (a lower bound on b
+/// only adds implied rows, so the rows stay valid).
+pub fn point_bound(
+    machine: &Machine,
+    acceleration: &[Limit],
+    jet: &AxisJets,
+    w: &crate::kinematics::PathJet,
+    kind: SpanKind,
+    cap: (f64, Option<crate::material::ProcessLimit>),
+    chord: Option<&Chord>,
+) -> PointBound {
+    let moving = kind == SpanKind::Moving;
+    let tip_speed = if moving {
+        (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt()
+    } else {
+        0.0
+    };
+    let mut best = velocity_bound(machine, acceleration.len(), jet, tip_speed, cap.0);
+    if let (Bound::Feed, Some(limit)) = (best.1, cap.1) {
+        best.1 = Bound::Process(limit);
+    }
+    let (essential, b_star, by) = essential_rows(jet, acceleration, best.0);
+    // b* is implied by the rows kept; stating it as the bound helps the solver's scaling.
+    if b_star < best.0 {
+        best = (b_star, by);
+    }
+    if let Some(c) = chord.filter(|_| moving) {
+        let b = c.b_max(w);
+        if b < best.0 {
+            best = (b, Bound::Chord);
+        }
+    }
+    PointBound {
+        b_max: best.0,
+        by: best.1,
+        essential,
+        tip_speed,
     }
 }
 

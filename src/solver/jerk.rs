@@ -68,9 +68,9 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSolver, SolverStatus, SupportedConeT};
 
 use super::{Rows, SolverSettings, SpanSolution, Status};
-use crate::constraints::{Chord, SpanProblem, essential_rows};
+use crate::constraints::{Chord, SpanProblem, point_bound};
 use crate::error::{Error, Result};
-use crate::geometry::{Span, SpanKind};
+use crate::geometry::Span;
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
 use crate::motion::Interval;
@@ -229,7 +229,6 @@ impl JerkData {
         let limits: Vec<Option<Limit>> = machine.axes.iter().take(na).map(|a| a.jerk).collect();
         let n = p.intervals();
         let rest = rest_bounds(span, kin, machine, p);
-        let moving = span.kind == SpanKind::Moving;
         let (rs, re) = (p.b_start == 0.0, p.b_end == 0.0);
         let mut mid_start = Vec::with_capacity(n + 1);
         mid_start.push(0);
@@ -242,22 +241,21 @@ impl JerkData {
             let w = span.spline.eval_in(seg, um);
             let jets = kin.axis_jets(&w);
             let cap = span.feed_cap(seg, um);
-            let speed = if moving {
-                (w.d1[0].powi(2) + w.d1[1].powi(2) + w.d1[2].powi(2)).sqrt()
-            } else {
-                0.0
-            };
-            let mut b_max = crate::constraints::velocity_bound(machine, na, &jets, speed, cap).0;
-            if let (true, Some(c)) = (moving, chord) {
-                b_max = b_max.min(c.b_max(&w));
-            }
-            let (essential, b_star, _) = essential_rows(&jets, &p.acceleration, b_max);
+            let pb = point_bound(
+                machine,
+                &p.acceleration,
+                &jets,
+                &w,
+                span.kind,
+                (cap, None),
+                chord,
+            );
             Midpoint {
                 theta: th,
                 d3: kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, um)),
                 jets,
-                b_max: b_max.min(b_star),
-                essential,
+                b_max: pb.b_max,
+                essential: pb.essential,
             }
         };
         // Chunks of intervals (their first stations and collocation points) in parallel.
