@@ -36,8 +36,7 @@ use std::fmt;
 
 use crate::constraints::SpanProblem;
 use crate::error::{Error, Result};
-use crate::geometry::Span;
-use crate::kinematics::{Kinematics, MAX_AXES};
+use crate::kinematics::MAX_AXES;
 use crate::machine::Machine;
 use crate::motion::Interval;
 use crate::optimize::{self, Options, Solution};
@@ -45,7 +44,7 @@ use crate::schedule::Schedule;
 use crate::solver::interval_times;
 use crate::solver::{SpanSolution, Status};
 use crate::toolpath::Input;
-use crate::verify::{self, VerifyOptions};
+use crate::verify;
 
 use crate::validate::non_negative;
 use baseline::Profile;
@@ -397,14 +396,7 @@ fn evaluate(ctx: &Context, entry: &Entry, c: Candidate) -> Result<Row> {
         &c.solutions,
         &vopt,
     )?;
-    let d = dynamics(
-        ctx.machine,
-        kin,
-        &path.spans,
-        &c.problems,
-        &c.solutions,
-        &vopt,
-    )?;
+    let d = dynamics(ctx, &c)?;
     let names: Vec<String> = ctx.machine.axes.iter().map(|a| a.name.clone()).collect();
     let schedule = Schedule::build(&names, &path.spans, &c.problems, &c.solutions)?;
     let mut worst = (v.worst_feed, "feed".to_string());
@@ -466,17 +458,14 @@ struct Dynamics {
 /// difference of successive samples over the period. At a corner between spans passed at
 /// speed, the axes' velocity jump Δq̇ becomes one period's acceleration pulse Δq̇ / T.
 ///
-/// [`verify::verify`] keeps no samples, hence this loop; it reuses eq. 43's interval times
-/// ([`interval_times`]) and the kinematics ([`Kinematics::axis_jets`]).
-fn dynamics(
-    machine: &Machine,
-    kin: &Kinematics,
-    spans: &[Span],
-    problems: &[SpanProblem],
-    solutions: &[SpanSolution],
-    options: &VerifyOptions,
-) -> Result<Dynamics> {
-    let period = options.period;
+/// The instants and the motion at each come from verify's own sampler
+/// (`verify::servo_instants`), here at every instant (the differences need successive ones);
+/// eq. 43's interval times ([`interval_times`]) and the kinematics
+/// ([`crate::kinematics::Kinematics::axis_jets`]) are the ones every other check uses.
+fn dynamics(ctx: &Context, c: &Candidate) -> Result<Dynamics> {
+    let (machine, kin) = (ctx.machine, &ctx.reference.kinematics);
+    let (spans, problems, solutions) = (&ctx.reference.path.spans, &c.problems, &c.solutions);
+    let period = ctx.options.solve.verify.period;
     let na = kin.n_axes().min(machine.axes.len());
     let mut d = Dynamics {
         peak_jerk: vec![0.0; na],
@@ -526,28 +515,28 @@ fn dynamics(
                 prev = Some(pulse);
             }
         }
-        let mut jj = (t0 / period).ceil().max(0.0) as u64;
+        let mut jj = verify::first_instant(t0, period);
         let mut ta = t0;
         for i in 0..p.intervals() {
             let iv = Interval::of(&p.u, b, sol.a.as_deref(), i);
-            let tb = ta + dt[i];
-            loop {
-                let t = jj as f64 * period;
-                if t >= tb {
-                    break;
-                }
-                let st = iv.at(t - ta, dt[i]);
-                let u = (p.u[i] + st.x).min(p.u[i + 1]);
-                let w = jets_at(u);
-                let mut qdd = [0.0; MAX_AXES];
-                for j in 0..na {
-                    qdd[j] = w.ddq[j] * st.b + w.dq[j] * st.udd;
-                }
-                jerk(&mut d, &prev, &qdd);
-                prev = Some(qdd);
-                jj += 1;
-            }
-            ta = tb;
+            jj = verify::servo_instants(
+                &iv,
+                (p.u[i], p.u[i + 1]),
+                (ta, dt[i]),
+                jj,
+                period,
+                None,
+                |_, st, u| {
+                    let w = jets_at(u);
+                    let mut qdd = [0.0; MAX_AXES];
+                    for j in 0..na {
+                        qdd[j] = w.ddq[j] * st.b + w.dq[j] * st.udd;
+                    }
+                    jerk(&mut d, &prev, &qdd);
+                    prev = Some(qdd);
+                },
+            );
+            ta += dt[i];
         }
         let n = p.intervals();
         let r = b[n].max(0.0).sqrt();

@@ -45,13 +45,49 @@ pub const MAX_SAMPLES: f64 = 2e9;
 pub const MAX_INTERVAL_SAMPLES: u64 = 4096;
 
 /// The first instant `j · period` of the global clock at or after `t`.
-fn first_instant(t: f64, period: f64) -> u64 {
+pub(crate) fn first_instant(t: f64, period: f64) -> u64 {
     let mut j = (t / period).ceil().max(0.0) as u64;
     while j > 0 && (j - 1) as f64 * period >= t {
         j -= 1;
     }
     while (j as f64) * period < t {
         j += 1;
+    }
+    j
+}
+
+/// Walks the servo instants `j · period` of the global clock inside one station interval,
+/// from instant `j` (the first at or after its start `ta`) to before its end `ta + dt`:
+/// calls `f(t, state, u)` at each, with the motion of [`Interval::at`] and the path
+/// parameter `u` (kept within `[ua, ub]`). With `max`, an interval holding more instants is
+/// walked at `max` of them, every k-th, evenly spread. Returns the first instant at or after
+/// the interval's end, where the next interval's walk starts.
+///
+/// The one sampler of a schedule on the servo clock: [`verify`] checks every limit at these
+/// instants, and `compare` takes its finite-difference jerk from them (every instant).
+pub(crate) fn servo_instants(
+    iv: &Interval,
+    (ua, ub): (f64, f64),
+    (ta, dt): (f64, f64),
+    mut j: u64,
+    period: f64,
+    max: Option<u64>,
+    mut f: impl FnMut(f64, &State, f64),
+) -> u64 {
+    let tb = ta + dt;
+    let inside = ((tb / period).ceil() - j as f64).max(0.0);
+    let stride = max.map_or(1, |m| (inside / m as f64).ceil().max(1.0) as u64);
+    loop {
+        let t = j as f64 * period;
+        if t >= tb {
+            break;
+        }
+        let st = iv.at(t - ta, dt);
+        f(t, &st, (ua + st.x).min(ub));
+        j += stride;
+    }
+    if stride > 1 {
+        j = first_instant(tb, period);
     }
     j
 }
@@ -420,28 +456,24 @@ fn check_intervals(
         station_checks += 1;
         // Servo instants strictly inside the interval (and at its start); past
         // MAX_INTERVAL_SAMPLES of them, every k-th, evenly spread.
-        let inside = ((tb / period).ceil() - j as f64).max(0.0);
-        let stride = (inside / MAX_INTERVAL_SAMPLES as f64).ceil().max(1.0) as u64;
-        loop {
-            let t = j as f64 * period;
-            if t >= tb {
-                break;
-            }
-            let st = iv.at(t - ta, dt[i]);
-            let u = (ua + st.x).min(ub);
-            // Stay in the left segment at a knot: the interval's own side.
-            while seg < last_seg && knots[seg + 1] < u {
-                seg += 1;
-            }
-            let cap = span.feed_cap(seg, u);
-            let pt = Point::new(span, kin, seg, u, moving, jerk);
-            acc.check(&pt, &st, cap, u, t, si, i);
-            samples += 1;
-            j += stride;
-        }
-        if stride > 1 {
-            j = first_instant(tb, period);
-        }
+        j = servo_instants(
+            &iv,
+            (ua, ub),
+            (ta, dt[i]),
+            j,
+            period,
+            Some(MAX_INTERVAL_SAMPLES),
+            |t, st, u| {
+                // Stay in the left segment at a knot: the interval's own side.
+                while seg < last_seg && knots[seg + 1] < u {
+                    seg += 1;
+                }
+                let cap = span.feed_cap(seg, u);
+                let pt = Point::new(span, kin, seg, u, moving, jerk);
+                acc.check(&pt, st, cap, u, t, si, i);
+                samples += 1;
+            },
+        );
         // The interval's end, with this interval's ü.
         while seg < last_seg && knots[seg + 1] < ub {
             seg += 1;
