@@ -416,6 +416,41 @@ struct JerkRound {
     eps: Vec<f64>,
 }
 
+/// One span's state between the rounds of an adaptive refinement ([`Plan::refine_rounds`]).
+trait AdaptiveRound: Send {
+    /// The cycle time on its finest grid F, s.
+    fn time(&self) -> f64;
+    /// F's stations.
+    fn stations(&self) -> usize;
+    /// The error each interval of its grid G carries (e_k or ε_k), s: what the threshold
+    /// marks for refinement.
+    fn errors(&self) -> &[f64];
+}
+
+impl AdaptiveRound for Round {
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn stations(&self) -> usize {
+        self.fine.u.len()
+    }
+    fn errors(&self) -> &[f64] {
+        &self.e
+    }
+}
+
+impl AdaptiveRound for JerkRound {
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn stations(&self) -> usize {
+        self.fine.u.len()
+    }
+    fn errors(&self) -> &[f64] {
+        &self.eps
+    }
+}
+
 /// The most parts one round divides an interval of the jerk-limited refinement into. Halving
 /// (2) is the cheapest measured: on the jerk-limited impeller, up to 4 parts as a first-order
 /// prediction asks takes one round less but 106k stations instead of 88k and 1.3× the CPU
@@ -694,65 +729,32 @@ impl Plan<'_> {
     /// refined: the stations go to ramps, rest ends, corners and curvature peaks.
     fn solve_adaptive(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
         use rayon::prelude::*;
-        let ns = self.path.spans.len();
-        let tol = options.convergence;
         self.progress.stage("refining stations");
-        let mut rounds: Vec<Round> = (0..ns)
-            .into_par_iter()
-            .map(|si| {
+        let (rounds, refinement, estimate_s) = self.refine_rounds(
+            options,
+            options.convergence,
+            |si| {
                 self.bisect(
                     si,
                     options,
                     self.uniform_problem(si, options.initial_stations, options)?,
                 )
-            })
-            .collect::<Vec<Result<_>>>()
-            .into_iter()
-            .collect::<Result<_>>()?;
-        let mut refinement = Vec::new();
-        loop {
-            let time: f64 = rounds.iter().map(|r| r.time).sum();
-            let estimate: f64 = rounds.iter().map(|r| r.estimate).sum();
-            let stations: usize = rounds.iter().map(|r| r.fine.u.len()).sum();
-            refinement.push(Refinement {
-                stations,
-                cycle_time_s: time,
-            });
-            self.progress.round(stations, estimate / time, tol);
-            if estimate <= tol * time || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
-                break;
-            }
-            if 2 * stations > options.max_stations {
-                return Err(Error::Solver(format!(
-                    "the cycle time is still {:.1e} (relative) from converged with {stations} \
-                     stations, and halving the intervals that carry that error would pass the \
-                     limit of {} stations; try a looser --tolerance (a smoother fitted path), \
-                     or --stations N for a fixed grid",
-                    estimate / time,
+            },
+            // Richardson's bound holds from the first round on.
+            |rounds: &[Round], _: &[Refinement], _| (rounds.iter().map(|r| r.estimate).sum(), true),
+            |si, r, threshold| {
+                self.bisect(si, options, self.refined_grid(si, options, r, threshold))
+            },
+            |estimate, stations| {
+                format!(
+                    "the cycle time is still {estimate:.1e} (relative) from converged with \
+                     {stations} stations, and halving the intervals that carry that error would \
+                     pass the limit of {} stations; try a looser --tolerance (a smoother fitted \
+                     path), or --stations N for a fixed grid",
                     options.max_stations
-                )));
-            }
-            let threshold = threshold(rounds.iter().flat_map(|r| r.e.iter().copied()), tol * time);
-            let next: Vec<Option<Round>> = rounds
-                .par_iter()
-                .enumerate()
-                .map(|(si, r)| {
-                    if r.e.iter().all(|&e| e <= threshold) {
-                        return Ok(None);
-                    }
-                    let p = self.refined_grid(si, options, r, threshold);
-                    self.bisect(si, options, p).map(Some)
-                })
-                .collect::<Vec<Result<_>>>()
-                .into_iter()
-                .collect::<Result<_>>()?;
-            for (r, n) in rounds.iter_mut().zip(next) {
-                if let Some(n) = n {
-                    *r = n;
-                }
-            }
-        }
-        let estimate_s: f64 = rounds.iter().map(|r| r.estimate).sum();
+                )
+            },
+        )?;
         self.progress.stage(&format!(
             "solving {} stations",
             rounds.iter().map(|r| r.fine.u.len()).sum::<usize>()
@@ -809,14 +811,12 @@ impl Plan<'_> {
     /// the last F ([`Warm`]); a window with no new station keeps its profile, so a round costs
     /// what it refines.
     fn solve_adaptive_jerk(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
-        use rayon::prelude::*;
-        let ns = self.path.spans.len();
-        let tol = options.convergence.max(10.0 * options.jerk.convergence);
         self.progress.stage("refining stations (jerk-limited)");
-        let t0 = std::time::Instant::now();
-        let mut rounds: Vec<JerkRound> = (0..ns)
-            .into_par_iter()
-            .map(|si| {
+        let mut rho = 0.5;
+        let (rounds, refinement, estimate_s) = self.refine_rounds(
+            options,
+            options.convergence.max(10.0 * options.jerk.convergence),
+            |si| {
                 let p = self.final_grid(
                     si,
                     self.uniform_problem(si, options.initial_stations, options)?,
@@ -826,99 +826,111 @@ impl Plan<'_> {
                 let coarse = self.times(si, &p, &s)?;
                 let split = self.rest_split(si, &p, &s);
                 self.refine_jerk(si, options, &p, split, coarse, (&p, &s))
-            })
+            },
+            |rounds: &[JerkRound], refinement: &[Refinement], time| {
+                // The order the rounds show: ρ, the ratio of successive changes of T.
+                if let [.., a, b] = refinement {
+                    let (d0, d1) = (a.cycle_time_s - b.cycle_time_s, b.cycle_time_s - time);
+                    if d0 > 0.0 && d1 > 0.0 {
+                        rho = (d1 / d0).clamp(0.5, 0.9);
+                    }
+                }
+                let raw: f64 = rounds.iter().map(|r| r.eps.iter().sum::<f64>()).sum();
+                // ρ is observed from the third round on; before, the estimate assumes p = 1.
+                (raw * rho / (1.0 - rho), refinement.len() >= 2)
+            },
+            |si, r, threshold| self.next_jerk_round(si, options, r, threshold),
+            |estimate, stations| {
+                format!(
+                    "the jerk-limited cycle time is still {estimate:.1e} (relative) from \
+                     converged with {stations} stations, and refining the intervals that carry \
+                     that error would pass the limit of {} stations; try --stations N for a \
+                     fixed grid, or --no-jerk",
+                    options.max_stations
+                )
+            },
+        )?;
+        let (problems, solutions): (Vec<_>, Vec<_>) = rounds
+            .into_iter()
+            .map(|r| (r.fine, r.fine_solution))
+            .unzip();
+        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
+        Ok((lv, refinement, estimate))
+    }
+
+    /// The rounds both adaptive refinements share. Every span's first round comes from
+    /// `first` (spans in parallel: rest stops decouple them exactly); then, per round, T and the
+    /// error estimate of the whole path (`estimate(rounds, refinement so far, T)`: the
+    /// estimate, s, and whether it may end the refinement yet) are recorded as a
+    /// [`Refinement`] and reported. The rounds end when a settled estimate is within
+    /// `tol` · T, or after [`MAX_ADAPTIVE_ROUNDS`]; a round that would pass
+    /// `options.max_stations` is an error (`too_many(relative estimate, stations)` says what
+    /// to do). Otherwise every interval whose error exceeds one path-wide [`threshold`] (the
+    /// smallest errors summing to half the allowance stay; 0, every interval, while an
+    /// estimate within `tol` is not settled yet) is refined: `next(span, its round,
+    /// threshold)` for the spans that have such intervals, the others keep theirs. Returns
+    /// the last rounds, the refinement history and the last estimate, s.
+    fn refine_rounds<R: AdaptiveRound>(
+        &self,
+        options: &Options,
+        tol: f64,
+        first: impl Fn(usize) -> Result<R> + Sync,
+        mut estimate: impl FnMut(&[R], &[Refinement], f64) -> (f64, bool),
+        next: impl Fn(usize, &R, f64) -> Result<R> + Sync,
+        too_many: impl Fn(f64, usize) -> String,
+    ) -> Result<(Vec<R>, Vec<Refinement>, f64)>
+    where
+        R: Sync,
+    {
+        use rayon::prelude::*;
+        let t0 = std::time::Instant::now();
+        let mut rounds: Vec<R> = (0..self.path.spans.len())
+            .into_par_iter()
+            .map(&first)
             .collect::<Vec<Result<_>>>()
             .into_iter()
             .collect::<Result<_>>()?;
         let mut refinement: Vec<Refinement> = Vec::new();
-        let mut rho = 0.5;
-        let mut estimate_s;
         loop {
-            let time: f64 = rounds.iter().map(|r| r.time).sum();
-            // The order the rounds show: ρ, the ratio of successive changes of T.
-            if let [.., a, b] = refinement.as_slice() {
-                let (d0, d1) = (a.cycle_time_s - b.cycle_time_s, b.cycle_time_s - time);
-                if d0 > 0.0 && d1 > 0.0 {
-                    rho = (d1 / d0).clamp(0.5, 0.9);
-                }
-            }
-            let raw: f64 = rounds.iter().map(|r| r.eps.iter().sum::<f64>()).sum();
-            estimate_s = raw * rho / (1.0 - rho);
-            let estimate = estimate_s;
-            let stations: usize = rounds.iter().map(|r| r.fine.u.len()).sum();
+            let time: f64 = rounds.iter().map(|r| r.time()).sum();
+            let stations: usize = rounds.iter().map(|r| r.stations()).sum();
+            let (estimate_s, settled) = estimate(&rounds, &refinement, time);
             tracing::debug!(
-                "jerk round {}: {stations} stations, T = {time:.6}, estimate {:.2e}, {:.2} s",
+                "adaptive round {}: {stations} stations, T = {time:.6}, estimate {:.2e}, {:.2} s",
                 refinement.len(),
-                estimate / time,
+                estimate_s / time,
                 t0.elapsed().as_secs_f64()
             );
             refinement.push(Refinement {
                 stations,
                 cycle_time_s: time,
             });
-            self.progress.round(stations, estimate / time, tol);
-            // ρ is observed from the third round on; before, the estimate assumes p = 1.
-            let observed = refinement.len() >= 3;
-            if (observed && estimate <= tol * time) || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
-                break;
+            self.progress.round(stations, estimate_s / time, tol);
+            let within = estimate_s <= tol * time;
+            if (settled && within) || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
+                return Ok((rounds, refinement, estimate_s));
             }
             if 2 * stations > options.max_stations {
-                return Err(Error::Solver(format!(
-                    "the jerk-limited cycle time is still {:.1e} (relative) from converged \
-                     with {stations} stations, and refining the intervals that carry that \
-                     error would pass the limit of {} stations; try --stations N for a fixed \
-                     grid, or --no-jerk",
-                    estimate / time,
-                    options.max_stations
-                )));
+                return Err(Error::Solver(too_many(estimate_s / time, stations)));
             }
-            // Within tol before ρ is observed: halve every interval of F (keeping F's
-            // stations), so that the next changes of T are those of uniform halvings and show
-            // the order the estimate assumes (p = 1, ρ = 0.5) or a slower one.
-            let threshold = if estimate <= tol * time {
+            // Within tol but not settled: refine every interval, so that the next changes of
+            // T are those of uniform halvings and show the order the estimate assumes.
+            let threshold = if within {
                 0.0
             } else {
                 threshold(
-                    rounds.iter().flat_map(|r| r.eps.iter().copied()),
+                    rounds.iter().flat_map(|r| r.errors().iter().copied()),
                     tol * time,
                 )
             };
-            let next: Vec<Option<JerkRound>> = rounds
+            let next: Vec<Option<R>> = rounds
                 .par_iter()
                 .enumerate()
                 .map(|(si, r)| {
-                    if r.eps.iter().all(|&e| e <= threshold) {
+                    if r.errors().iter().all(|&e| e <= threshold) {
                         return Ok(None);
                     }
-                    // The next G: F with the parts of the unmarked intervals merged again.
-                    let mut keep = vec![false; r.fine.u.len()];
-                    let (mut coarse, mut split) = (Vec::new(), Vec::new());
-                    let mut at = 0;
-                    for (k, &eps) in r.eps.iter().enumerate() {
-                        let s = r.split[k];
-                        keep[at] = true;
-                        if s == 1 {
-                            // A rest end's interval kept whole: its time is F's.
-                            coarse.push(r.fine_times[at]);
-                            split.push(1);
-                        } else if eps > threshold {
-                            let part = eps / s as f64;
-                            let more = (part / threshold).ceil().max(2.0).min(MAX_SPLIT as f64);
-                            for j in 0..s {
-                                keep[at + j] = true;
-                                coarse.push(r.fine_times[at + j]);
-                                split.push((more as usize).next_power_of_two().min(MAX_SPLIT));
-                            }
-                        } else {
-                            coarse.push(r.coarse_times[k]);
-                            split.push(s);
-                        }
-                        at += s;
-                    }
-                    keep[at] = true;
-                    let g = r.fine.select(&keep);
-                    self.refine_jerk(si, options, &g, split, coarse, (&r.fine, &r.fine_solution))
-                        .map(Some)
+                    next(si, r, threshold).map(Some)
                 })
                 .collect::<Vec<Result<_>>>()
                 .into_iter()
@@ -929,12 +941,46 @@ impl Plan<'_> {
                 }
             }
         }
-        let (problems, solutions): (Vec<_>, Vec<_>) = rounds
-            .into_iter()
-            .map(|r| (r.fine, r.fine_solution))
-            .unzip();
-        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
-        Ok((lv, refinement, estimate))
+    }
+
+    /// The next jerk-limited round of span `si`: its next G is F with the parts of the
+    /// unmarked intervals (ε_k ≤ `threshold`) merged again, each marked interval's parts
+    /// divided as their share of ε_k asks ([`Plan::solve_adaptive_jerk`]); a rest end's
+    /// interval kept whole stays whole.
+    fn next_jerk_round(
+        &self,
+        si: usize,
+        options: &Options,
+        r: &JerkRound,
+        threshold: f64,
+    ) -> Result<JerkRound> {
+        let mut keep = vec![false; r.fine.u.len()];
+        let (mut coarse, mut split) = (Vec::new(), Vec::new());
+        let mut at = 0;
+        for (k, &eps) in r.eps.iter().enumerate() {
+            let s = r.split[k];
+            keep[at] = true;
+            if s == 1 {
+                // A rest end's interval kept whole: its time is F's.
+                coarse.push(r.fine_times[at]);
+                split.push(1);
+            } else if eps > threshold {
+                let part = eps / s as f64;
+                let more = (part / threshold).ceil().max(2.0).min(MAX_SPLIT as f64);
+                for j in 0..s {
+                    keep[at + j] = true;
+                    coarse.push(r.fine_times[at + j]);
+                    split.push((more as usize).next_power_of_two().min(MAX_SPLIT));
+                }
+            } else {
+                coarse.push(r.coarse_times[k]);
+                split.push(s);
+            }
+            at += s;
+        }
+        keep[at] = true;
+        let g = r.fine.select(&keep);
+        self.refine_jerk(si, options, &g, split, coarse, (&r.fine, &r.fine_solution))
     }
 
     /// Round 0's division of every interval of a jerk-limited span's grid `p` (solved: `s`):
