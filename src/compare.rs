@@ -344,11 +344,7 @@ pub fn compare(
     options: &CompareOptions,
 ) -> Result<Comparison> {
     options.validate()?;
-    machine.validate()?;
-    options
-        .solve
-        .validate_for(machine)
-        .map_err(|e| e.within("solve"))?;
+    optimize::check_inputs(machine, &options.solve).map_err(|e| e.within("solve"))?;
     // The reference (c) is acceleration-limited; (d) adds the jerk limits.
     let accel_only = Options {
         jerk_limited: false,

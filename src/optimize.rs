@@ -34,6 +34,7 @@ use crate::toolpath::{Input, Toolpath};
 use crate::verify::{Verification, VerifyOptions, verify};
 
 mod checks;
+pub(crate) use checks::inputs as check_inputs;
 
 /// Options of a solve.
 #[derive(Debug, Clone, PartialEq)]

@@ -78,7 +78,7 @@ use crate::constraints::{Bound, SpanProblem, essential_rows};
 use crate::error::number;
 use crate::error::{Error, Result};
 use crate::machine::{AxisKind, KinematicsSpec, Limit, Machine};
-use crate::optimize::{Options, Solution, optimize_input};
+use crate::optimize::{self, Options, Solution, optimize_input};
 use crate::report::{BindingShare, Summary};
 use crate::schedule::Schedule;
 use crate::solver::clarabel::{Sensitivity, solve_with_sensitivity};
@@ -405,11 +405,7 @@ pub fn sweep(
     options: &SweepOptions,
 ) -> Result<Sweep> {
     options.validate()?;
-    machine.validate()?;
-    options
-        .solve
-        .validate_for(machine)
-        .map_err(|e| e.within("solve"))?;
+    optimize::check_inputs(machine, &options.solve).map_err(|e| e.within("solve"))?;
     let axis = machine
         .axes
         .iter()
