@@ -38,7 +38,7 @@ pub fn arc_chords(sweep: f64, radius: f64) -> std::result::Result<usize, String>
 /// path could not be solved at the default anyway). It bounds the work that grows with what a
 /// program asks for rather than with its length: arcs with many turns, cycles, repeats,
 /// subprogram calls and jumps, which a few lines can multiply into any number of points.
-/// Every reader checks it *before* it makes a run of points ([`check_room`]), so the error
+/// Every reader checks it *before* it makes a run of points (`check_room`), so the error
 /// comes before the work and the memory, never after.
 pub const MAX_POINTS: usize = 4_000_000;
 
