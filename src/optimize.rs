@@ -418,7 +418,7 @@ struct JerkRound {
 }
 
 /// One span's state between the rounds of an adaptive refinement ([`Plan::refine_rounds`]).
-trait AdaptiveRound: Send {
+trait AdaptiveRound: Send + Sync {
     /// The cycle time on its finest grid F, s.
     fn time(&self) -> f64;
     /// F's stations.
@@ -879,10 +879,7 @@ impl Plan<'_> {
         mut estimate: impl FnMut(&[R], &[Refinement], f64) -> (f64, bool),
         next: impl Fn(usize, &R, f64) -> Result<R> + Sync,
         too_many: impl Fn(f64, usize) -> String,
-    ) -> Result<(Vec<R>, Vec<Refinement>, f64)>
-    where
-        R: Sync,
-    {
+    ) -> Result<(Vec<R>, Vec<Refinement>, f64)> {
         use rayon::prelude::*;
         let t0 = std::time::Instant::now();
         let mut rounds: Vec<R> = (0..self.path.spans.len())
