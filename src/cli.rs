@@ -118,6 +118,10 @@ pub struct CheckArgs {
     /// Factor on every programmed feed, as the machine would run it (0.001 to 1000).
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
+    /// Skip the G-code blocks that start with `/` (the control's block-skip switch on;
+    /// default: run them).
+    #[arg(long)]
+    pub block_delete: bool,
     #[command(flatten)]
     /// Stock, tool and process limits beyond the machine file.
     pub material: MaterialArgs,
@@ -230,6 +234,10 @@ pub struct SolveOptions {
     /// like: `--cycle-alias CYCLE76=CYCLE86` (repeatable; the target one of CYCLE81–CYCLE89).
     #[arg(long = "cycle-alias", value_name = "FROM=TO")]
     pub cycle_alias: Vec<String>,
+    /// Skip the G-code blocks that start with `/`, as a control with its block-skip (block
+    /// delete) switch on does (default: run them, the program as posted).
+    #[arg(long)]
+    pub block_delete: bool,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -543,6 +551,7 @@ pub fn check(args: &CheckArgs) -> Result<String> {
         args.format,
         args.dialect,
         &[],
+        args.block_delete,
     )?;
     let Some(report) = apply_material(
         &args.machine,
@@ -596,6 +605,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
         args.opts.format,
         args.dialect,
         &args.opts.cycle_alias,
+        args.opts.block_delete,
     )
 }
 
@@ -607,6 +617,7 @@ fn read_input_from(
     format: Option<FormatChoice>,
     dialect: Option<crate::toolpath::gcode::Dialect>,
     cycle_alias: &[String],
+    block_delete: bool,
 ) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
@@ -624,6 +635,7 @@ fn read_input_from(
         dialect,
         machine: Some(toolpath::MachineContext::new(&machine, &references)),
         cycle_aliases,
+        block_delete,
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.

@@ -30,7 +30,9 @@
 //! say so (a warning naming `axes.Z.reference`, the summary's `reference` line). Machine
 //! coordinates (`G28`, `G53`, Sinumerik `SUPA`, Heidenhain `M91`) are program coordinates plus
 //! the kinematics' `work-offset` (trunnion tables) or, for every other kinematics, the program
-//! coordinates themselves.
+//! coordinates themselves. X, Y and Z may give Heidenhain's **M92 datum**, `"m92": 180.0`
+//! (machine coordinates, mm), the machine builder's: an `M92` block's coordinates are relative
+//! to it (machine zero, with a warning, where the file gives none).
 //!
 //! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
 //!
@@ -295,6 +297,9 @@ pub struct References {
     pub file: PathBuf,
     /// Per axis: its name and reference positions.
     pub axes: Vec<(String, Vec<f64>)>,
+    /// The axes that give Heidenhain's M92 datum (`"m92"`, machine coordinates, mm): name and
+    /// datum.
+    pub m92: Vec<(String, f64)>,
 }
 
 impl Machine {
@@ -320,7 +325,29 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         file: source.to_path_buf(),
     };
     let mut axes = Vec::new();
+    let mut m92 = Vec::new();
     for axis in &machine.axes {
+        let field = format!("axes.{}.m92", axis.name);
+        if let Some(v) = value
+            .get("axes")
+            .and_then(|a| a.get(&axis.name))
+            .and_then(|a| a.get("m92"))
+        {
+            if !matches!(axis.name.as_str(), "X" | "Y" | "Z") {
+                return Err(parser.err(&field, "only X, Y and Z have an M92 datum"));
+            }
+            let d = parser.number(Some(v), &field)?;
+            if d.abs() > MAX_LENGTH {
+                return Err(parser.err(
+                    &field,
+                    format!(
+                        "{} mm is beyond ±{MAX_LENGTH:e} mm",
+                        crate::error::number(d)
+                    ),
+                ));
+            }
+            m92.push((axis.name.clone(), d));
+        }
         let field = format!("axes.{}.reference", axis.name);
         let given = value
             .get("axes")
@@ -345,6 +372,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
     Ok(References {
         file: source.to_path_buf(),
         axes,
+        m92,
     })
 }
 
@@ -797,6 +825,7 @@ impl Parser {
                         "min",
                         "max",
                         "reference",
+                        "m92",
                     ],
                 )?;
                 let kind = if *kin == KinematicsSpec::Joint {

@@ -122,6 +122,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         reference,
         work_offset,
         travel: Default::default(),
+        m92: [None; 3],
     }
 }
 

@@ -1238,3 +1238,39 @@ fn g28_reference_default_and_cycle_alias_on_the_command_line() {
         stderr(&out)
     );
 }
+
+#[test]
+fn block_delete_on_the_command_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    // A `/` block runs by default (the block-skip switch off) and is skipped with
+    // --block-delete: 50 mm more or less of path, and a warning at its line either way.
+    w.write(
+        "skip.nc",
+        "G21 G90 G0 X0 Y0 Z5\nG1 X50 F3000\n/G1 Y50\nM30\n",
+    );
+    let args = [
+        "solve",
+        "-m",
+        "machine.json",
+        "skip.nc",
+        "--stations",
+        STATIONS,
+        "--json",
+    ];
+    let length = |extra: &[&str]| {
+        let out = w.run(&[&args[..], extra].concat());
+        assert_success(&out);
+        assert!(
+            stderr(&out).contains("skip.nc:3: block delete"),
+            "{}",
+            stderr(&out)
+        );
+        num(
+            &parse_json(&stdout(&out), "stdout")["path_length_mm"],
+            "path_length_mm",
+        )
+    };
+    let (run, skipped) = (length(&[]), length(&["--block-delete"]));
+    assert!((run - skipped - 50.0).abs() < 1e-6, "{run} {skipped}");
+}

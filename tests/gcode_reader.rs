@@ -545,14 +545,16 @@ fn comments_of_both_kinds_and_skipped_lines() {
         vec![
             v(1.0, 1.0, 1.0),
             v(2.0, 1.0, 1.0),
-            v(2.0, 2.0, 1.0),
+            v(50.0, 1.0, 1.0),
+            v(50.0, 2.0, 1.0),
             v(3.0, 2.0, 1.0)
         ]
     );
     assert_eq!(tp.points[1].line, 4);
-    // The block-delete line is skipped with a warning.
+    // The block-delete line runs (the block-skip switch off, the default), with a warning.
     assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
     assert_eq!(tp.warnings[0].line, 5);
+    assert!(tp.warnings[0].message.contains("block run"));
     // Sinumerik: `;` comments only.
     let tp = ok_in(
         Dialect::Sinumerik,

@@ -615,3 +615,135 @@ fn a_program_with_every_construct_reads() {
     assert_eq!(repeat.len(), 4);
     assert!(tp.points.len() > 100);
 }
+
+/// hyperMILL's TNC posts go to the tool-change height with `L Z+0 R0 FMAX M92`: Z relative to
+/// the machine builder's datum. With the datum in the machine file (`axes.Z.m92`, machine
+/// coordinates), the move ends there; without it, at machine zero (M91's), with a warning that
+/// names the field. Only X, Y and Z have one.
+#[test]
+fn m92_moves_relative_to_the_builders_datum_from_the_machine_file() {
+    let json = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
+        "axes": {"X": {"velocity": 400, "acceleration": 2000, "m92": -250},
+                 "Y": {"velocity": 400, "acceleration": 2000},
+                 "Z": {"velocity": 400, "acceleration": 2000, "m92": 180.5}}}"#;
+    let m = common::machine(json);
+    let refs = feedopt::machine::references_from_json(Path::new("m.json"), json, &m).unwrap();
+    let ctx = MachineContext::new(&m, &refs);
+    let text = format!(
+        "{HEADER}4 L X+5 Y+5 Z+2 FMAX\n5 L Z+0 R0 FMAX M92\n6 L X+10 Y+3 R0 FMAX M92\n\
+         7 L X+20 Y+20 FMAX\n"
+    );
+    let tp = parse_for(
+        Path::new("t.h"),
+        &text,
+        Dialect::Heidenhain.spec(),
+        Some(&ctx),
+    )
+    .unwrap();
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    assert_eq!(
+        p,
+        [
+            v(5.0, 5.0, 2.0),
+            v(5.0, 5.0, 180.5),
+            // X from its datum; Y has none: machine zero.
+            v(-240.0, 3.0, 180.5),
+            v(20.0, 20.0, 180.5)
+        ]
+    );
+    let notes: Vec<&str> = tp.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert!(notes.iter().any(|w| w.contains("axes.Y.m92")), "{notes:?}");
+    assert!(
+        !notes
+            .iter()
+            .any(|w| w.contains("axes.Z.m92") || w.contains("axes.X.m92"))
+    );
+    // Only X, Y and Z have an M92 datum.
+    let bad = r#"{"name": "hh", "kinematics": {"type": "head_head", "tool_length": 100},
+        "axes": {"X": {"velocity": 400, "acceleration": 2000},
+                 "Y": {"velocity": 400, "acceleration": 2000},
+                 "Z": {"velocity": 400, "acceleration": 2000},
+                 "C": {"velocity": 400, "acceleration": 2000, "m92": 0},
+                 "A": {"velocity": 400, "acceleration": 2000}}}"#;
+    let m = feedopt::machine::Machine::from_json(Path::new("m.json"), bad).unwrap();
+    let e = feedopt::machine::references_from_json(Path::new("m.json"), bad, &m)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("axes.C.m92"), "{e}");
+}
+
+/// The block-skip switch: off by default, so a `/` block runs (hyperMILL's `/80 M30` ends the
+/// program before its subprograms); `--block-delete` (on) skips it, and the program runs on
+/// into them. Either way each such block is a warning.
+#[test]
+fn block_delete_runs_slash_blocks_unless_the_switch_is_on() {
+    let text = format!(
+        "{HEADER}4 L X+5 Y+5 Z+2 FMAX\n5 CALL LBL 1\n/6 M30\n7 LBL 1\n8 L X+50 F600\n9 LBL 0\n\
+         10 END PGM T MM\n"
+    );
+    let read = |block_delete: bool| {
+        let settings = feedopt::toolpath::gcode::Settings {
+            block_delete,
+            ..Default::default()
+        };
+        feedopt::toolpath::gcode::parse_configured(
+            Path::new("t.h"),
+            &text,
+            Dialect::Heidenhain.spec(),
+            None,
+            &settings,
+        )
+        .unwrap()
+        .0
+    };
+    let run = read(false);
+    // LBL 1 once (called), then M30.
+    let x: Vec<f64> = run.points.iter().map(|p| p.p.x).collect();
+    assert_eq!(x, [5.0, 50.0]);
+    assert!(
+        run.warnings
+            .iter()
+            .any(|w| w.line == 7 && w.message.contains("block run"))
+    );
+    let skipped = read(true);
+    // M30 skipped: the label's body runs again, as the control runs through it.
+    let x: Vec<f64> = skipped.points.iter().map(|p| p.p.x).collect();
+    assert_eq!(x, [5.0, 50.0, 50.0]);
+    assert!(
+        skipped
+            .warnings
+            .iter()
+            .any(|w| w.line == 7 && w.message.contains("block skipped"))
+    );
+    // Outside Klartext a skip level may follow the mark: `/2 G1 X10`.
+    let g = "G21 G90 G17\nG0 X0. Y0. Z5.\n/2 G1 X10. F600.\nG1 Y10.\nM30\n";
+    for (block_delete, want) in [(false, vec![0.0, 10.0, 10.0]), (true, vec![0.0, 0.0])] {
+        let settings = feedopt::toolpath::gcode::Settings {
+            block_delete,
+            ..Default::default()
+        };
+        let (tp, _) = feedopt::toolpath::gcode::parse_configured(
+            Path::new("t.ngc"),
+            g,
+            Dialect::Fanuc.spec(),
+            None,
+            &settings,
+        )
+        .unwrap();
+        let x: Vec<f64> = tp.points.iter().map(|p| p.p.x).collect();
+        assert_eq!(x, want, "block delete {block_delete}");
+    }
+}
+
+/// A post that writes the cycle number against `DEF` and its decimal part apart
+/// (`CYCL DEF9 .0 VARAKOZASI IDO`, `CYCL DEF9.1 V.IDO5`: a Hungarian TNC's dwell time) defines
+/// the same cycle as `CYCL DEF 9.0 DWELL TIME` / `9.1 DWELL 5`.
+#[test]
+fn cycle_def_with_the_number_against_def_and_a_localised_dwell() {
+    let text = format!(
+        "{HEADER}4 L X+5 Y+5 Z+2 FMAX\n5 CYCL DEF9 .0 VARAKOZASI IDO\n6 CYCL DEF9.1 V.IDO5\n\
+         7 L X+10 F600\n8 CYCL DEF 9 .1 DWELL 1.5\n"
+    );
+    let tp = read(&text);
+    assert!((tp.dwell_time() - 6.5).abs() < 1e-12, "{:?}", tp.dwells);
+}

@@ -192,6 +192,9 @@ pub struct MachineContext {
     /// Travel `(min, max)` per axis X Y Z A B C, machine coordinates (mm, degrees), where the
     /// machine file gives it (Heidenhain `M140 MB MAX` retracts Z to its max).
     pub travel: [Option<(f64, f64)>; 6],
+    /// Heidenhain's M92 datum per axis X Y Z, machine coordinates (mm), where the machine file
+    /// gives it (`axes.Z.m92`).
+    pub m92: [Option<f64>; 3],
 }
 
 impl MachineContext {
@@ -230,6 +233,13 @@ impl MachineContext {
             reference,
             work_offset,
             travel,
+            m92: std::array::from_fn(|i| {
+                references
+                    .m92
+                    .iter()
+                    .find(|(n, _)| n == NAMES[i])
+                    .map(|(_, d)| *d)
+            }),
         }
     }
 
@@ -248,6 +258,9 @@ pub struct ReadOptions {
     /// Cycles read under another name ([`gcode::parse_cycle_alias`]: `("CYCLE76",
     /// "CYCLE86")` reads a machine builder's CYCLE76 as the standard CYCLE86).
     pub cycle_aliases: Vec<(String, String)>,
+    /// The block-skip switch ([`gcode::Settings::block_delete`]): skip the blocks that start
+    /// with `/` (default: run them).
+    pub block_delete: bool,
 }
 
 /// What a reader was used, and why.
@@ -395,12 +408,16 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
             options.machine.as_ref(),
         )?)?),
         Format::Gcode => {
-            let (toolpath, assumed) = gcode::parse_assumed(
+            let settings = gcode::Settings {
+                cycle_aliases: options.cycle_aliases.clone(),
+                block_delete: options.block_delete,
+            };
+            let (toolpath, assumed) = gcode::parse_configured(
                 path,
                 &text,
                 detected.dialect.unwrap_or_default().spec(),
                 options.machine.as_ref(),
-                &options.cycle_aliases,
+                &settings,
             )?;
             detected.assumed = assumed;
             Input::Cl(plausible(toolpath)?)

@@ -492,7 +492,7 @@ fn toolpath_case(
         format: Some(format),
         dialect,
         machine,
-        cycle_aliases: Vec::new(),
+        ..Default::default()
     };
     match toolpath::read_with(&path, &options) {
         Err(e) => judge_error(&e, &name, lines),

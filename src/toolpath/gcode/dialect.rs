@@ -233,6 +233,9 @@ pub enum Action {
     Tcp(Tcp),
     /// G53: this block's axis words are machine coordinates.
     MachineCoordinates,
+    /// Heidenhain M92: this block's X Y Z are relative to the machine builder's M92 datum
+    /// (machine coordinates from the machine file's `axes.<X|Y|Z>.m92`).
+    BuilderDatum,
     /// The block's axis words belong to this code, not to a move (dwell `G4`); the warning
     /// text says what is not modelled.
     NoMotion(&'static str),
@@ -401,8 +404,8 @@ pub struct DialectSpec {
 }
 
 use Action::{
-    ArcDistance, Distance as Dist, FeedMode as Fm, MachineCoordinates, Motion as Mo, MotionCancel,
-    NoMotion, Note, ProgramEnd, Return, Unsupported as Unsup,
+    ArcDistance, BuilderDatum, Distance as Dist, FeedMode as Fm, MachineCoordinates, Motion as Mo,
+    MotionCancel, NoMotion, Note, ProgramEnd, Return, Unsupported as Unsup,
 };
 use Address::{ArcCentre, Axis, Unmodelled};
 
@@ -1011,13 +1014,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
         ("30", ProgramEnd),
         ("89", Action::CycleCallAt(false)),
         ("91", MachineCoordinates),
-        (
-            "92",
-            Unsup(
-                "M92 (coordinates from the machine builder's second datum) is not supported: \
-                 that datum is machine data; post the move with M91 or in program coordinates",
-            ),
-        ),
+        ("92", BuilderDatum),
         (
             "94",
             Unsup(

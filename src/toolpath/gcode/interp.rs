@@ -172,6 +172,12 @@ pub(super) struct Interpreter<'a> {
     /// Cycle aliases (`CYCLE76` read as `CYCLE86`), and those a warning has named.
     pub(super) cycle_aliases: Vec<(String, String)>,
     aliases_used: Vec<String>,
+    /// The block-skip switch ([`super::Settings::block_delete`]).
+    pub(super) block_delete: bool,
+    /// This block's machine coordinates are M92's (relative to the builder's datum).
+    m92: bool,
+    /// Axes X Y Z whose missing M92 datum a warning has named.
+    m92_warned: [bool; 3],
 }
 
 impl<'a> Interpreter<'a> {
@@ -219,6 +225,9 @@ impl<'a> Interpreter<'a> {
             assumed: Assumed::default(),
             cycle_aliases: Vec::new(),
             aliases_used: Vec::new(),
+            block_delete: false,
+            m92: false,
+            m92_warned: [false; 3],
         }
     }
 
@@ -544,6 +553,7 @@ impl<'a> Interpreter<'a> {
     /// Interprets one block.
     pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let block = self.collect(line, items)?;
+        self.m92 = false;
 
         // Modal settings first (feed mode, F, units, plane, distance, TCP), then the motion.
         let mut motion_code: Option<(&str, Motion)> = None;
@@ -619,6 +629,10 @@ impl<'a> Interpreter<'a> {
                     self.tcp = t;
                 }
                 Action::MachineCoordinates => machine = true,
+                Action::BuilderDatum => {
+                    machine = true;
+                    self.m92 = true;
+                }
                 Action::Reference(k) => reference = Some(k),
                 Action::Dwell => dwell = true,
                 Action::Frame(op) => frame_op = Some((text.as_str(), op)),
@@ -870,6 +884,30 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Machine coordinates → program (frame) coordinates, X Y Z.
+    /// The M92 datum of axis `i` (X Y Z), machine coordinates: the machine file's
+    /// `axes.<X|Y|Z>.m92`, or machine zero (M91's datum) with a warning where it gives none.
+    fn m92_datum(&mut self, line: usize, i: usize) -> f64 {
+        if let Some(d) = self.machine.and_then(|c| c.m92[i]) {
+            return d;
+        }
+        if !self.m92_warned[i] {
+            self.m92_warned[i] = true;
+            let file = self.machine.map_or("the machine file".to_string(), |c| {
+                c.file.display().to_string()
+            });
+            self.warn(
+                line,
+                format!(
+                    "M92: the machine builder's datum of {} is machine data feedopt does not \
+                     know: taken as machine zero (M91's); give it as axes.{}.m92 (machine \
+                     coordinates, mm) in {file}",
+                    AXIS_NAMES[i], AXIS_NAMES[i]
+                ),
+            );
+        }
+        0.0
+    }
+
     fn machine_to_program(&self, m: Vector3<f64>) -> Vector3<f64> {
         let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
         self.frame_now().invert(&(m - Vector3::from(offset)))
@@ -1277,7 +1315,12 @@ impl<'a> Interpreter<'a> {
                 ));
             }
             if machine && i < 3 {
-                machine_xyz[i] = value;
+                machine_xyz[i] = value
+                    + if self.m92 {
+                        self.m92_datum(line, i)
+                    } else {
+                        0.0
+                    };
                 self.known[i] = true;
                 continue;
             }
@@ -1300,11 +1343,16 @@ impl<'a> Interpreter<'a> {
         }
         if machine {
             let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
+            let what = if self.m92 {
+                "M92: a move relative to the machine builder's datum (machine coordinates), \
+                 taken as"
+            } else {
+                "G53/SUPA/M91: machine-coordinate move, taken as"
+            };
             self.warn(
                 line,
                 format!(
-                    "G53/SUPA/M91: machine-coordinate move, taken as program coordinates + the \
-                     work offset ({}, {}, {}) mm",
+                    "{what} program coordinates + the work offset ({}, {}, {}) mm",
                     offset[0], offset[1], offset[2]
                 ),
             );

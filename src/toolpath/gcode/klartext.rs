@@ -61,7 +61,10 @@
 //!   first axis: +X in XY, +Y in YZ, +Z in ZX) or by a (turns included, a helix with `IZ`);
 //!   `LP PR PA` is a line to polar coordinates about the pole. The axis normal to the arc
 //!   plane moves linearly (a helix). Arcs are chords as in G-code ([`super`]).
-//! * **Machine coordinates** `M91`: as G53. **Rotary** `M126`: an absolute rotary word goes
+//! * **Machine coordinates** `M91`: as G53. `M92`: relative to the machine builder's datum,
+//!   the machine file's `axes.<X|Y|Z>.m92` (machine zero, with a warning, where it gives
+//!   none). `CYCL DEF9.1` (the number against `DEF`, as some posts write it) is
+//!   `CYCL DEF 9.1`. **Rotary** `M126`: an absolute rotary word goes
 //!   the shorter way (`M127`: as written). **TCP** `M128`, `FUNCTION TCPM F TCP AXIS POS`:
 //!   on; `M129`, `FUNCTION RESET TCPM`: off (`AXIS SPAT` and `REFPNT CENTER-CENTER` are
 //!   errors; `F CONT` and `PATHCTRL VECTOR` are warnings: the tip feed and axis
@@ -219,7 +222,19 @@ pub(super) fn lex(
         vars.set(&name, v);
         return Ok(vec![Item::Skipped]);
     }
-    let words = split_words(text);
+    let mut words = split_words(text);
+    // `CYCL DEF9.1 …` (a post that writes the cycle number against DEF): `CYCL DEF 9.1 …`.
+    if words.len() >= 2 && words[0].eq_ignore_ascii_case("CYCL") {
+        let w = &words[1];
+        if w.len() > 3
+            && w[..3].eq_ignore_ascii_case("DEF")
+            && w[3..].starts_with(|c: char| c.is_ascii_digit())
+        {
+            let number = w[3..].to_string();
+            words[1] = "DEF".to_string();
+            words.insert(2, number);
+        }
+    }
     let mut items = Vec::new();
     let mut i = 0;
     if let Some((n, key, action)) = keyword_at(spec, &words) {

@@ -117,8 +117,9 @@
 //! end (`M2`, `M30`; in the main program also Sinumerik `M17`, `RET`, Fanuc `M99`) stops
 //! reading: later lines are not parsed. These codes are accepted with a warning because the toolpath does not carry them:
 //! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
-//! moves nothing: its axis words are not a move). A block starting with `/` (block delete) is skipped with a
-//! warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
+//! moves nothing: its axis words are not a move). A block starting with `/` (block delete, or `/1` … `/9`)
+//! runs, as on a control whose block-skip switch is off, or is skipped under
+//! [`Settings::block_delete`]; either way with a warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
 //! move, are skipped with a warning.
 //!
 //! # What is rejected
@@ -257,11 +258,39 @@ pub fn parse_assumed(
     machine: Option<&MachineContext>,
     cycle_aliases: &[(String, String)],
 ) -> Result<(Toolpath, Assumed)> {
+    let settings = Settings {
+        cycle_aliases: cycle_aliases.to_vec(),
+        ..Settings::default()
+    };
+    parse_configured(source, text, spec, machine, &settings)
+}
+
+/// What a control's operator sets rather than the program, and feedopt cannot read from it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Settings {
+    /// Cycles read under another name ([`parse_cycle_alias`]).
+    pub cycle_aliases: Vec<(String, String)>,
+    /// The block-skip switch (block delete): `true` skips every block that starts with `/`
+    /// (any skip level: `/`, `/1` … `/9`), as a control with the switch on does; `false`, the
+    /// default, runs them, as with the switch off (a program run once, as posted: a post's
+    /// `/M30` ends it). Each such block is a warning either way, naming what was done.
+    pub block_delete: bool,
+}
+
+/// As [`parse_assumed`], under the operator's `settings`.
+pub fn parse_configured(
+    source: &Path,
+    text: &str,
+    spec: &DialectSpec,
+    machine: Option<&MachineContext>,
+    settings: &Settings,
+) -> Result<(Toolpath, Assumed)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let program = Program::scan(spec, source, text)?;
     let mut interp = Interpreter::new(spec, source, machine);
     interp.procs = program.proc_names();
-    interp.cycle_aliases = cycle_aliases.to_vec();
+    interp.cycle_aliases = settings.cycle_aliases.clone();
+    interp.block_delete = settings.block_delete;
     program.run(spec, &mut interp, source)?;
     let assumed = interp.assumed;
     interp

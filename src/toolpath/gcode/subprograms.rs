@@ -541,13 +541,27 @@ impl Program {
             {
                 return Err(self.too_many(source, number, &stack, jumps));
             }
-            if text.starts_with('/')
-                || (self.style == Subprograms::Labels
-                    && klartext::strip_block_number(text).starts_with('/'))
-            {
-                interp.warn(number, "block delete `/`: block skipped");
-                continue;
-            }
+            let run_deleted;
+            let text = match self.block_delete_mark(text) {
+                None => text,
+                Some(_) if interp.block_delete => {
+                    interp.warn(
+                        number,
+                        "block delete `/`: block skipped (--block-delete: the control's \
+                         block-skip switch on)",
+                    );
+                    continue;
+                }
+                Some(rest) => {
+                    interp.warn(
+                        number,
+                        "block delete `/`: block run, as with the control's block-skip switch \
+                         off (--block-delete skips it)",
+                    );
+                    run_deleted = rest;
+                    run_deleted.as_str()
+                }
+            };
             if self.style == Subprograms::Labels {
                 let body = klartext::strip_block_number(text);
                 let op = klartext::label_op(body)
@@ -652,6 +666,26 @@ impl Program {
             }
         }
         Ok(())
+    }
+
+    /// A block that starts with the block-delete mark `/` (after its block number, in
+    /// Klartext): the block without it (and without a skip level `/1` … `/9`, outside
+    /// Klartext, whose `/80 M30` puts the block number right after the mark).
+    fn block_delete_mark(&self, text: &str) -> Option<String> {
+        if self.style == Subprograms::Labels {
+            if let Some(rest) = text.strip_prefix('/') {
+                return Some(rest.trim_start().to_string());
+            }
+            let body = klartext::strip_block_number(text);
+            let rest = body.strip_prefix('/')?;
+            let number = &text[..text.len() - body.len()];
+            return Some(format!("{number}{rest}"));
+        }
+        let rest = text.strip_prefix('/')?;
+        let rest = rest
+            .strip_prefix(|c: char| c.is_ascii_digit())
+            .unwrap_or(rest);
+        Some(rest.trim_start().to_string())
     }
 
     /// Returns from the running (sub)program: runs it again while repeats remain, else pops

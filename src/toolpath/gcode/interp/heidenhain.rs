@@ -793,7 +793,17 @@ impl Interpreter<'_> {
     }
 
     fn cycle_def(&mut self, line: usize, args: &str) -> Result<()> {
-        let words = klartext::words(args);
+        let mut words = klartext::words(args);
+        // `CYCL DEF 9 .1 …`: the number's decimal part written apart.
+        if words.len() >= 2
+            && !words[0].contains(['.', ','])
+            && words[1].len() > 1
+            && words[1].starts_with(['.', ','])
+            && words[1][1..].bytes().all(|b| b.is_ascii_digit())
+        {
+            let part = words.remove(1);
+            words[0].push_str(&part);
+        }
         let Some(first) = words.first() else {
             return Err(self.error(line, "CYCL DEF without a cycle number"));
         };
