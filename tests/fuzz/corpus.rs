@@ -82,7 +82,7 @@ pub const TRUNNION_AC: &str = r#"{
   "axes": {
     "X": {"velocity": 200, "acceleration": 1000, "min": -500, "max": 500, "reference": [0, -100]},
     "Y": {"velocity": 200, "acceleration": 1000, "reference": [0, 0]},
-    "Z": {"velocity": 150, "acceleration": 800, "reference": [100, 50]},
+    "Z": {"velocity": 150, "acceleration": 800, "reference": [100, 50], "m92": 250},
     "A": {"velocity": 60, "acceleration": 300, "min": -120, "max": 120, "reference": [0, 0]},
     "C": {"velocity": 90, "acceleration": 400, "reference": [0, 0]}
   },

@@ -492,6 +492,8 @@ fn toolpath_case(
         format: Some(format),
         dialect,
         machine,
+        // The block-skip switch both ways (`/` blocks run or skipped), case by case.
+        block_delete: bytes.len() % 2 == 1,
         ..Default::default()
     };
     match toolpath::read_with(&path, &options) {
