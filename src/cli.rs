@@ -80,7 +80,9 @@ pub struct MaterialArgs {
     /// `process.spindle_speed`).
     #[arg(long, value_name = "RPM")]
     pub spindle_speed: Option<f64>,
-    /// Tool diameter, mm (instead of the program's CUTTER/ or the machine file's `tool`).
+    /// Tool diameter, mm (instead of the program's CUTTER/ or the machine file's `tool`). Also
+    /// what a Klartext bore-milling cycle (CYCL DEF 208) mills with, which the control takes
+    /// from its tool table; alone (without a stock) it asks for no material stage.
     #[arg(long, value_name = "MM")]
     pub tool_diameter: Option<f64>,
     /// Tool corner radius, mm (0: flat, D/2: ball-nose).
@@ -481,7 +483,6 @@ fn apply_material(
     let given = args.cell.is_some()
         || args.sample_step.is_some()
         || args.spindle_speed.is_some()
-        || args.tool_diameter.is_some()
         || args.tool_corner_radius.is_some()
         || args.tool_flute_length.is_some()
         || args.tool_flutes.is_some();
@@ -552,6 +553,7 @@ pub fn check(args: &CheckArgs) -> Result<String> {
         args.dialect,
         &[],
         args.block_delete,
+        args.material.tool_diameter,
     )?;
     let Some(report) = apply_material(
         &args.machine,
@@ -606,6 +608,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
         args.dialect,
         &args.opts.cycle_alias,
         args.opts.block_delete,
+        args.opts.material.tool_diameter,
     )
 }
 
@@ -618,6 +621,7 @@ fn read_input_from(
     dialect: Option<crate::toolpath::gcode::Dialect>,
     cycle_alias: &[String],
     block_delete: bool,
+    tool_diameter: Option<f64>,
 ) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
@@ -636,6 +640,14 @@ fn read_input_from(
         machine: Some(toolpath::MachineContext::new(&machine, &references)),
         cycle_aliases,
         block_delete,
+        // The tool's diameter for the cycles whose path needs it: the option, else the machine
+        // file's `tool` (its errors are the material stage's to report).
+        tool_diameter: tool_diameter.or_else(|| {
+            crate::material::from_machine_file(machine_file)
+                .ok()
+                .flatten()
+                .and_then(|s| s.tool.diameter)
+        }),
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.

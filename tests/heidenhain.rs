@@ -747,3 +747,74 @@ fn cycle_def_with_the_number_against_def_and_a_localised_dwell() {
     let tp = read(&text);
     assert!((tp.dwell_time() - 6.5).abs() < 1e-12, "{:?}", tp.dwells);
 }
+
+/// Cycle 208 (bore milling) on a 10 mm hole with a 6 mm tool: a helix of radius 2 mm from the
+/// set-up clearance (Z 2) down to −10 at 2 mm a turn (6 turns), a full circle there, back to
+/// the centre, up at rapid. Its feed length against the closed form; with Q335 equal to the
+/// tool's diameter a straight plunge; without the tool's diameter an error saying where to
+/// give it.
+#[test]
+fn cycle_208_mills_a_helix_of_the_hole_radius_minus_the_tool_radius() {
+    let def = |nominal: f64| {
+        format!(
+            "{HEADER}4 L X+30 Y+40 Z+50 R0 FMAX\n5 CYCL DEF 208 BORE MILLING~\n  Q200=2 ;SET-UP \
+             CLEARANCE~\n  Q201=-10 ;DEPTH~\n  Q206=600 ;FEED~\n  Q334=2 ;PLUNGING DEPTH~\n  \
+             Q203=0 ;SURFACE~\n  Q204=20 ;2ND SET-UP CLEARANCE~\n  Q335={nominal} ;NOMINAL \
+             DIAMETER~\n  Q342=0 ;ROUGHING DIAMETER~\n  Q351=+1 ;CLIMB OR UP-CUT\n\
+             6 L X+30 Y+40 R0 FMAX M99\n"
+        )
+    };
+    let read = |text: &str, tool: Option<f64>| {
+        let settings = feedopt::toolpath::gcode::Settings {
+            tool_diameter: tool,
+            ..Default::default()
+        };
+        feedopt::toolpath::gcode::parse_configured(
+            Path::new("t.h"),
+            text,
+            Dialect::Heidenhain.spec(),
+            None,
+            &settings,
+        )
+        .map(|(tp, _)| tp)
+    };
+    let tp = read(&def(10.0), Some(6.0)).unwrap();
+    let (r, turns, drop) = (2.0, 6.0, 12.0);
+    let helix = ((turns * 2.0 * PI * r).powi(2) + drop * drop).sqrt();
+    let want = r + helix + 2.0 * PI * r + r;
+    let fed: f64 = tp
+        .points
+        .windows(2)
+        .filter(|w| w[1].feed == Feed::Programmed(10.0))
+        .map(|w| (w[1].p - w[0].p).norm())
+        .sum();
+    // Chords within 1 µm of a 2 mm circle are shorter by at most e/(3r) = 1.7e-4 relative.
+    assert!(
+        fed <= want + 1e-9 && want - fed <= 1e-3 / (3.0 * r) * want,
+        "fed {fed}, closed form {want}"
+    );
+    // Every helix point on the circle of radius 2 about the hole, Z falling; then up to 20.
+    for p in tp
+        .points
+        .iter()
+        .filter(|p| p.feed == Feed::Programmed(10.0))
+    {
+        let d = (p.p.x - 30.0).hypot(p.p.y - 40.0);
+        assert!((d - 2.0).abs() < 1e-9 || d < 1e-9, "{:?}", p.p);
+    }
+    assert_eq!(tp.points.last().unwrap().p, v(30.0, 40.0, 20.0));
+    // Climb milling with M3: counter-clockwise (the first helix point turns towards +Y).
+    let first = tp
+        .points
+        .iter()
+        .position(|p| p.p.z < 2.0 && p.feed == Feed::Programmed(10.0))
+        .unwrap();
+    assert!(tp.points[first].p.y > 40.0);
+    // The tool as wide as the hole: straight down and up.
+    let tp = read(&def(6.0), Some(6.0)).unwrap();
+    assert!(tp.points.iter().all(|p| p.p.x == 30.0 && p.p.y == 40.0));
+    assert!(tp.points.iter().any(|p| p.p.z == -10.0));
+    // No tool diameter: the error says where to give it.
+    let e = read(&def(10.0), None).unwrap_err().to_string();
+    assert!(e.contains(":16:") && e.contains("--tool-diameter"), "{e}");
+}

@@ -261,6 +261,8 @@ pub struct ReadOptions {
     /// The block-skip switch ([`gcode::Settings::block_delete`]): skip the blocks that start
     /// with `/` (default: run them).
     pub block_delete: bool,
+    /// The tool's diameter, mm ([`gcode::Settings::tool_diameter`]).
+    pub tool_diameter: Option<f64>,
 }
 
 /// What a reader was used, and why.
@@ -411,6 +413,7 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
             let settings = gcode::Settings {
                 cycle_aliases: options.cycle_aliases.clone(),
                 block_delete: options.block_delete,
+                tool_diameter: options.tool_diameter,
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

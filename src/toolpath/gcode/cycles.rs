@@ -93,6 +93,18 @@ pub enum Step {
     Dwell(f64),
     /// Rapid shift in X by this much (mm), at the current Z.
     ShiftX(f64),
+    /// A straight move in the working plane to the hole centre plus (dx, dy), mm, at the
+    /// current Z, at this feed (mm/min).
+    Across(f64, f64, f64),
+    /// A helix about the hole centre: radius (mm), from the current point (on the circle) by
+    /// `sweep` radians (counter-clockwise when positive) while Z goes to `z`, at `feed`
+    /// (mm/min).
+    Helix {
+        radius: f64,
+        sweep: f64,
+        z: f64,
+        feed: f64,
+    },
 }
 
 /// Fanuc / LinuxCNC cycles.
@@ -226,21 +238,29 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
     Ok((s, note))
 }
 
-/// Heidenhain drilling cycle `number` (200, 203, 207) from its Q parameters (`q(200)` …),
-/// the spindle speed (rpm, for 207) and a raise of the surface Q203 by `offset` mm (a
-/// pattern point's Z). Starts from where the tool is (over the hole). The second value names
-/// assumptions, for warnings.
+/// Heidenhain drilling cycle `number` (200, 203, 207, 208) from its Q parameters (`q(200)`
+/// …), the spindle speed (rpm, for 207), the tool's diameter (mm, for 208: the control takes it
+/// from its tool table) and a raise of the surface Q203 by `offset` mm (a pattern point's Z).
+/// Starts from where the tool is (over the hole). The second value names assumptions, for
+/// warnings.
+///
+/// Cycle 208 (bore milling), as the TNC 640 runs it with one pass (no Q370): rapid to the
+/// set-up clearance, over to the circle of radius (Q335 − D)/2 about the hole, a helix down
+/// at Q206 with Q334 per turn to the depth, one more full circle there, back to the centre and
+/// up at rapid to the set-up clearance (or the second, Q204). Where Q335 equals the tool's
+/// diameter the tool bores straight down. Climb (Q351 = +1) runs counter-clockwise with M3.
 pub fn heidenhain_steps(
     number: u32,
     q: &dyn Fn(u32) -> Option<f64>,
     spindle_rpm: Option<f64>,
+    tool_diameter: Option<f64>,
     offset: f64,
 ) -> Result<(Vec<Step>, Vec<&'static str>), String> {
     use Step::*;
-    if !matches!(number, 200 | 203 | 207) {
+    if !matches!(number, 200 | 203 | 207 | 208) {
         return Err(format!(
-            "cycle {number} is not a cycle feedopt can expand (200, 203 and 207 are): post the \
-             operation as L moves"
+            "cycle {number} is not a cycle feedopt can expand (200, 203, 207 and 208 are): post \
+             the operation as L moves"
         ));
     }
     let need = |n: u32| {
@@ -373,6 +393,73 @@ pub fn heidenhain_steps(
                 }
             } else {
                 s.push(Rapid(surface + clearance.max(second)));
+            }
+        }
+        208 => {
+            let f = feed(206)?;
+            let nominal = finite(335, need(335)?)?.abs();
+            if q(370).is_some_and(|v| v != 0.0) {
+                return Err(
+                    "cycle 208: Q370 (path overlap: several passes out to the diameter) is not \
+                     supported; post with one pass (no Q370)"
+                        .to_string(),
+                );
+            }
+            let Some(d) = tool_diameter.filter(|d| d.is_finite() && *d > 0.0) else {
+                return Err(
+                    "cycle 208 mills a circle of radius (Q335 − tool diameter)/2, and the \
+                     control takes the diameter from its tool table: give it (--tool-diameter, \
+                     or the machine file's tool.diameter)"
+                        .to_string(),
+                );
+            };
+            let radius = (nominal - d) / 2.0;
+            if radius < -1e-6 {
+                return Err(format!(
+                    "cycle 208: the tool ({d} mm) is wider than the hole Q335 = {nominal} mm"
+                ));
+            }
+            let ccw = q(351).unwrap_or(1.0) >= 0.0;
+            if radius <= 1e-6 {
+                // Q335 = the tool's diameter: straight down, no helix.
+                s.push(Feed(bottom, Some(f)));
+            } else {
+                let pitch = finite(334, need(334)?)?.abs();
+                if pitch <= 0.0 {
+                    return Err("cycle 208: the infeed per helix Q334 is 0".to_string());
+                }
+                let turns = (safe - bottom) / pitch;
+                if turns > MAX_PECKS as f64 {
+                    return Err(format!(
+                        "cycle 208: more than {MAX_PECKS} helix turns in one hole: check Q334"
+                    ));
+                }
+                let sign = if ccw { 1.0 } else { -1.0 };
+                let tau = std::f64::consts::TAU;
+                s.extend([
+                    Across(radius, 0.0, f),
+                    Helix {
+                        radius,
+                        sweep: sign * turns * tau,
+                        z: bottom,
+                        feed: f,
+                    },
+                    Helix {
+                        radius,
+                        sweep: sign * tau,
+                        z: bottom,
+                        feed: f,
+                    },
+                    Across(0.0, 0.0, f),
+                ]);
+                notes.push(
+                    "the move onto the circle is taken straight (the control's rounding arc is a \
+                     little longer), the move back to the centre at Q206",
+                );
+            }
+            s.push(Rapid(safe));
+            if second > clearance {
+                s.push(Rapid(surface + second));
             }
         }
         _ => {

@@ -174,6 +174,8 @@ pub(super) struct Interpreter<'a> {
     aliases_used: Vec<String>,
     /// The block-skip switch ([`super::Settings::block_delete`]).
     pub(super) block_delete: bool,
+    /// The tool's diameter, mm ([`super::Settings::tool_diameter`]).
+    pub(super) tool_diameter: Option<f64>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -226,6 +228,7 @@ impl<'a> Interpreter<'a> {
             cycle_aliases: Vec::new(),
             aliases_used: Vec::new(),
             block_delete: false,
+            tool_diameter: None,
             m92: false,
             m92_warned: [false; 3],
         }
@@ -1189,6 +1192,7 @@ impl<'a> Interpreter<'a> {
     /// Executes cycle steps from the current position.
     fn run_steps(&mut self, line: usize, steps: &[Step]) -> Result<()> {
         self.check_room(line, "the cycle", steps.len())?;
+        let centre = [self.pos[0], self.pos[1]];
         for step in steps {
             let mut q = self.pos;
             let feed = match *step {
@@ -1206,6 +1210,35 @@ impl<'a> Interpreter<'a> {
                 Step::ShiftX(dx) => {
                     q[0] += dx;
                     Feed::Rapid
+                }
+                Step::Across(dx, dy, f) => {
+                    q[0] = centre[0] + dx;
+                    q[1] = centre[1] + dy;
+                    Feed::Programmed(f / 60.0)
+                }
+                Step::Helix {
+                    radius,
+                    sweep,
+                    z,
+                    feed,
+                } => {
+                    let chords = crate::toolpath::arc_chords(sweep, radius)
+                        .map_err(|e| self.error(line, e))?;
+                    self.check_room(line, "the cycle's helix", chords)?;
+                    let (x, y) = (self.pos[0] - centre[0], self.pos[1] - centre[1]);
+                    let start = y.atan2(x);
+                    let z0 = self.pos[2];
+                    for k in 1..=chords {
+                        let t = k as f64 / chords as f64;
+                        let phi = start + t * sweep;
+                        let mut p = self.pos;
+                        p[0] = centre[0] + radius * phi.cos();
+                        p[1] = centre[1] + radius * phi.sin();
+                        p[2] = z0 + t * (z - z0);
+                        self.push(line, &p, Feed::Programmed(feed / 60.0));
+                        self.pos = p;
+                    }
+                    continue;
                 }
                 Step::Dwell(s) => {
                     self.add_dwell(line, s);

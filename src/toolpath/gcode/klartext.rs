@@ -86,8 +86,9 @@
 //!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
 //!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
-//! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle (its Q parameters are
-//!   read when it is called); `CYCL CALL`, `M99` in a block (after its move) and `M89`
+//! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle and `208` bore milling
+//!   (a helix whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]);
+//!   its Q parameters are read when it is called; `CYCL CALL`, `M99` in a block (after its move) and `M89`
 //!   (after every block that positions X or Y, until `M99` or a new `CYCL DEF`) call it at
 //!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
 //!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at

@@ -266,7 +266,7 @@ pub fn parse_assumed(
 }
 
 /// What a control's operator sets rather than the program, and feedopt cannot read from it.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Settings {
     /// Cycles read under another name ([`parse_cycle_alias`]).
     pub cycle_aliases: Vec<(String, String)>,
@@ -275,6 +275,10 @@ pub struct Settings {
     /// default, runs them, as with the switch off (a program run once, as posted: a post's
     /// `/M30` ends it). Each such block is a warning either way, naming what was done.
     pub block_delete: bool,
+    /// The diameter of the tool in the spindle, mm, for a cycle whose path depends on it
+    /// (Klartext `CYCL DEF 208`, bore milling): a control takes it from its tool table, which
+    /// the program does not carry. `None`: such a cycle is an error that says so.
+    pub tool_diameter: Option<f64>,
 }
 
 /// As [`parse_assumed`], under the operator's `settings`.
@@ -291,6 +295,7 @@ pub fn parse_configured(
     interp.procs = program.proc_names();
     interp.cycle_aliases = settings.cycle_aliases.clone();
     interp.block_delete = settings.block_delete;
+    interp.tool_diameter = settings.tool_diameter;
     program.run(spec, &mut interp, source)?;
     let assumed = interp.assumed;
     interp

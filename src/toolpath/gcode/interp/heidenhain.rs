@@ -11,7 +11,7 @@ use super::super::lexer::Num;
 use super::*;
 
 /// Cycles the reader expands when called.
-const CALLABLE: [u32; 3] = [200, 203, 207];
+const CALLABLE: [u32; 4] = [200, 203, 207, 208];
 
 /// The Klartext words of a block the interpreter acts on after the modal settings.
 #[derive(Debug, Default)]
@@ -900,8 +900,8 @@ impl Interpreter<'_> {
                     self.warn(
                         line,
                         format!(
-                            "CYCL DEF {whole}: feedopt cannot expand this cycle (200, 203 and \
-                             207 it can): calling it is an error"
+                            "CYCL DEF {whole}: feedopt cannot expand this cycle (200, 203, 207 \
+                             and 208 it can): calling it is an error"
                         ),
                     );
                 }
@@ -1108,9 +1108,14 @@ impl Interpreter<'_> {
         let Some((number, def_line)) = self.klartext.cycle else {
             return Err(self.error(line, "a cycle call without a CYCL DEF before it"));
         };
-        let (steps, notes) =
-            cycles::heidenhain_steps(number, &|n| self.q(n), self.klartext.spindle_rpm, offset)
-                .map_err(|e| self.error(line, format!("{e} (CYCL DEF at line {def_line})")))?;
+        let (steps, notes) = cycles::heidenhain_steps(
+            number,
+            &|n| self.q(n),
+            self.klartext.spindle_rpm,
+            self.tool_diameter,
+            offset,
+        )
+        .map_err(|e| self.error(line, format!("{e} (CYCL DEF at line {def_line})")))?;
         for n in notes {
             self.warn(line, format!("cycle {number}: {n}"));
         }
