@@ -794,14 +794,20 @@ impl PlanArgs {
     }
 
     /// The same solve as `feedopt solve` with these options (G-code input in `dialect`).
-    fn solve_args(&self, dialect: crate::toolpath::gcode::Dialect, period: f64) -> SolveArgs {
+    /// The solve's arguments, with a G-code input read in `dialect` (`None`: detected as
+    /// `feedopt solve` detects it).
+    fn solve_args(
+        &self,
+        dialect: Option<crate::toolpath::gcode::Dialect>,
+        period: f64,
+    ) -> SolveArgs {
         SolveArgs {
             machine: self.machine.clone(),
             toolpath: self.toolpath.clone(),
             json: false,
             output: None,
             plot: None,
-            dialect: Some(dialect),
+            dialect,
             period,
             opts: self.opts.clone(),
         }
@@ -833,11 +839,12 @@ pub struct GcodeArgs {
     /// The G-code program to write (.ngc, .nc, …).
     #[arg(long, short, value_name = "FILE")]
     pub output: PathBuf,
-    /// Dialect of the written program (and of a G-code input unless --input-dialect):
-    /// linuxcnc, fanuc or sinumerik.
+    /// Dialect of the written program: linuxcnc, fanuc or sinumerik (and of a G-code input
+    /// whose content and extension name none, unless --input-dialect).
     #[arg(long, default_value = "linuxcnc")]
     pub dialect: crate::toolpath::gcode::Dialect,
-    /// Dialect of a G-code input, when it differs from the output's.
+    /// Dialect of a G-code input (default: detected from the program, as `solve` does; where
+    /// nothing in it tells, the output's).
     #[arg(long)]
     pub input_dialect: Option<crate::toolpath::gcode::Dialect>,
     /// Largest turn of a rotary axis within one block (Δθ, degrees, seed 001): longer turns are
@@ -854,8 +861,24 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
         max_rotation_deg: args.max_rotation_deg,
     };
     gcode_options.validate()?;
+    let input_dialect = match args.input_dialect {
+        Some(d) => Some(d),
+        None => {
+            // A Heidenhain `.h` or a Sinumerik program read as such, as `solve` reads it; a
+            // program nothing in which names a dialect, in the output's.
+            let path = &args.plan.toolpath;
+            let bytes = crate::files::read_bounded(
+                path,
+                crate::files::MAX_TOOLPATH_BYTES,
+                "toolpath file",
+            )?;
+            let text = String::from_utf8_lossy(&bytes);
+            let detected = toolpath::detect(path, &text, &toolpath::ReadOptions::default())?;
+            (detected.dialect_by == "default").then_some(args.dialect)
+        }
+    };
     let solve_args = args.plan.solve_args(
-        args.input_dialect.unwrap_or(args.dialect),
+        input_dialect,
         crate::verify::VerifyOptions::default().period,
     );
     let (machine, input, options, solution) = plan(&solve_args)?;
@@ -900,9 +923,10 @@ pub struct InterpolateArgs {
     /// The setpoints to write: FILE.csv or FILE.bin (layout in `feedopt::interpolate`).
     #[arg(long, short, value_name = "FILE")]
     pub output: PathBuf,
-    /// Dialect of a G-code input.
-    #[arg(long, default_value = "linuxcnc")]
-    pub dialect: crate::toolpath::gcode::Dialect,
+    /// G-code dialect of the input: linuxcnc, fanuc, sinumerik or heidenhain (default:
+    /// detected from the program, as `solve` does).
+    #[arg(long)]
+    pub dialect: Option<crate::toolpath::gcode::Dialect>,
 }
 
 /// `feedopt interpolate`: returns what to print on stdout.

@@ -1274,3 +1274,56 @@ fn block_delete_on_the_command_line() {
     let (run, skipped) = (length(&[]), length(&["--block-delete"]));
     assert!((run - skipped - 50.0).abs() < 1e-6, "{run} {skipped}");
 }
+
+#[test]
+fn interpolate_and_gcode_detect_the_input_dialect_as_solve_does() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    // Klartext: read as Heidenhain by its first block, with no dialect option.
+    w.write(
+        "part.h",
+        "0 BEGIN PGM P MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 L X+50 F3000\n3 L Y+20\n4 END PGM P MM\n",
+    );
+    let out = w.run(&[
+        "interpolate",
+        "-m",
+        "machine.json",
+        "part.h",
+        "--stations",
+        STATIONS,
+        "-o",
+        "sp.csv",
+    ]);
+    assert_success(&out);
+    let out = w.run(&[
+        "gcode",
+        "-m",
+        "machine.json",
+        "part.h",
+        "--stations",
+        STATIONS,
+        "-o",
+        "part.ngc",
+    ]);
+    assert_success(&out);
+    // A program nothing in which names a dialect is read in the output's: Fanuc reads `X10`
+    // (no decimal point) as 10 µm, LinuxCNC as 10 mm.
+    w.write("plain.nc", "G21 G90 G0 X0 Y0 Z5\nG1 X10 F3000\nM30\n");
+    for (dialect, x) in [("fanuc", "X0.010"), ("linuxcnc", "X10.000")] {
+        let out = w.run(&[
+            "gcode",
+            "-m",
+            "machine.json",
+            "plain.nc",
+            "--stations",
+            STATIONS,
+            "--dialect",
+            dialect,
+            "-o",
+            "plain-out.nc",
+        ]);
+        assert_success(&out);
+        let text = std::fs::read_to_string(w.path("plain-out.nc")).unwrap();
+        assert!(text.contains(x), "{dialect}: {text}");
+    }
+}
