@@ -284,11 +284,29 @@ fn error_malformed_motion_records() {
     );
     err("CYCLE/DRILL,MMPM,100\nGOTO/1,2,3\n", 1, &["CYCLE", "depth"]);
     err("CYCLE/THREAD,5\nGOTO/1,2,3\n", 1, &["CYCLE/THREAD"]);
-    err(
-        "GOTO/1,2,3\nGODLTA/0,0,5\n",
-        2,
-        &["GODLTA", "not supported"],
+    err("GOTO/1,2,3\nGOHOME\n", 2, &["GOHOME", "not supported"]);
+    err("GODLTA/0,0,5\nGOTO/1,2,3\n", 1, &["GODLTA", "unknown"]);
+    err("GOTO/1,2,3\nGODLTA/0,5\n", 2, &["GODLTA", "found 2"]);
+}
+
+/// `GODLTA/dx,dy,dz` moves by that vector (in the MSYS frame), `GODLTA/d` by d along the tool
+/// axis; `RAPID` before it makes it a rapid; in inches it scales like GOTO.
+#[test]
+fn godlta_moves_by_a_vector_or_along_the_tool_axis() {
+    let tp = ok(
+        "MULTAX/ON\nFEDRAT/MMPM,600\nGOTO/1,2,3,0,0.6,0.8\nGODLTA/0,0,5\nRAPID\nGODLTA/10\n\
+                 MSYS/0,0,0,0,1,0,-1,0,0\nGODLTA/1,0,0\n",
     );
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    let close = |a: Vector3<f64>, b: Vector3<f64>| (a - b).norm() < 1e-12;
+    assert!(close(p[1], Vector3::new(1.0, 2.0, 8.0)), "{:?}", p[1]);
+    assert!(close(p[2], Vector3::new(1.0, 8.0, 16.0)), "{:?}", p[2]);
+    // MSYS x axis is world +Y.
+    assert!(close(p[3], Vector3::new(1.0, 9.0, 16.0)), "{:?}", p[3]);
+    assert_eq!(tp.points[1].feed, Feed::Programmed(10.0));
+    assert_eq!(tp.points[2].feed, Feed::Rapid);
+    let tp = ok("UNITS/INCHES\nGOTO/0,0,0\nGODLTA/0,0,1\n");
+    assert!((tp.points[1].p.z - 25.4).abs() < 1e-12);
 }
 
 #[test]

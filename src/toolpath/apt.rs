@@ -34,6 +34,10 @@
 //!   under `ON`, so 5-axis files that omit it keep their tool vectors.
 //! * `FROM/x,y,z[,i,j,k]` — the start position; read exactly like a `GOTO` (it is a point the
 //!   tool is at).
+//! * `GODLTA/dx,dy,dz` — a straight move from the last point by that vector (in the `MSYS`
+//!   frame, in the current units); `GODLTA/d` — by d along the tool axis. The orientation and
+//!   the feed (or a `RAPID` before it) as for a `GOTO`; before any point, after a `CIRCLE` or
+//!   inside a `CYCLE` it is an error.
 //!
 //! # Units
 //!
@@ -87,7 +91,7 @@
 //!
 //! Motion records this reader cannot represent are errors rather than being skipped, because
 //! skipping them would silently change the geometry: see [`UNSUPPORTED_MOTION_WORDS`]
-//! (`GODLTA`, `GOHOME`, `INDIRV`, `GOFWD`, …).
+//! (`GOHOME`, `INDIRV`, `GOFWD`, …).
 //!
 //! Every error is an [`Error::Parse`] naming the file and the 1-based line where the record
 //! starts.
@@ -155,8 +159,8 @@ pub const NON_MOTION_WORDS: &[&str] = &[
 /// Major words that move the tool in ways a list of straight CL moves cannot represent; they are
 /// rejected (`CYCLE/OFF` is accepted and skipped).
 pub const UNSUPPORTED_MOTION_WORDS: &[&str] = &[
-    "GODLTA", "GOHOME", "GOFWD", "GOLFT", "GORGT", "GOUP", "GODOWN", "GOBACK", "INDIRV", "INDIRP",
-    "PSIS", "AUTOPS",
+    "GOHOME", "GOFWD", "GOLFT", "GORGT", "GOUP", "GODOWN", "GOBACK", "INDIRV", "INDIRP", "PSIS",
+    "AUTOPS",
 ];
 
 /// Most CL points one NURBS curve may become.
@@ -314,6 +318,7 @@ impl<'a> Reader<'a> {
         match (major.as_str(), minor) {
             ("GOTO", Some(minor)) => self.goto(line, "GOTO", minor),
             ("FROM", Some(minor)) => self.goto(line, "FROM", minor),
+            ("GODLTA", Some(minor)) => self.godlta(line, minor),
             ("FEDRAT", Some(minor)) => self.fedrat(line, minor),
             ("UNITS" | "UNIT", Some(minor)) => self.units(line, minor),
             ("MULTAX", minor) => self.multax(line, minor),
@@ -447,6 +452,69 @@ impl<'a> Reader<'a> {
         {
             return self.hole(line, c, p);
         }
+        self.emit(p, feed, line);
+        Ok(())
+    }
+
+    /// `GODLTA/d` (by d along the tool axis) or `GODLTA/dx,dy,dz` (by that vector, in the
+    /// `MSYS` frame where one is set): a straight move from the last point, at the feed (or
+    /// rapid after `RAPID`), keeping the tool axis.
+    fn godlta(&mut self, line: usize, minor: &str) -> Result<()> {
+        let v = self.numbers(line, "GODLTA", minor)?;
+        let d = match v.as_slice() {
+            [d] => self.orientation * *d,
+            [x, y, z] => {
+                let d = Vector3::new(*x, *y, *z);
+                match self.msys {
+                    Some((_, r)) => r * d,
+                    None => d,
+                }
+            }
+            _ => {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "GODLTA: expected 1 number (along the tool axis) or 3 (dx,dy,dz), found \
+                         {}",
+                        v.len()
+                    ),
+                ));
+            }
+        };
+        if self.arc.is_some() || self.cycle.is_some() {
+            return Err(self.error(
+                line,
+                "GODLTA after CIRCLE or inside CYCLE/: post the move as GOTO",
+            ));
+        }
+        let Some(last) = self.points.last().map(|p| p.p) else {
+            return Err(self.error(
+                line,
+                "GODLTA before any GOTO or FROM: the point it moves from is unknown",
+            ));
+        };
+        let p = last + d * self.units.mm_per_unit();
+        if let Some((axis, c)) = ["X", "Y", "Z"]
+            .into_iter()
+            .zip(p.iter())
+            .find(|(_, c)| !(c.is_finite() && c.abs() <= crate::toolpath::MAX_COORDINATE_MM))
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "GODLTA: {axis} = {} mm is beyond ±{:e} mm (1 km): check the number and the \
+                     units",
+                    crate::error::number(*c),
+                    crate::toolpath::MAX_COORDINATE_MM
+                ),
+            ));
+        }
+        let feed = if self.rapid_next {
+            self.rapid_next = false;
+            Feed::Rapid
+        } else {
+            self.feed
+        };
         self.emit(p, feed, line);
         Ok(())
     }

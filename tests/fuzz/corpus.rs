@@ -913,14 +913,22 @@ pub fn gcode_vocabulary(dialect: Dialect) -> Vocabulary {
 
 /// The mutation vocabulary of APT: the records above, every known major word.
 pub fn apt_vocabulary() -> Vocabulary {
-    let mut words: Vec<String> = ["GOTO/", "FEDRAT/", "MMPM", "IPM", "FEDTO", "STEP", "RAPTO"]
-        .iter()
-        .chain(["RTRCTO", "DWELL", "ON", "OFF", "DRILL", "DEEP", "BRKCHP"].iter())
-        .map(|s| s.to_string())
-        .collect();
+    let mut words: Vec<String> = [
+        "GOTO/", "GODLTA/", "FEDRAT/", "MMPM", "IPM", "FEDTO", "STEP",
+    ]
+    .iter()
+    .chain(
+        [
+            "RAPTO", "RTRCTO", "DWELL", "ON", "OFF", "DRILL", "DEEP", "BRKCHP",
+        ]
+        .iter(),
+    )
+    .map(|s| s.to_string())
+    .collect();
     words.extend(NON_MOTION_WORDS.iter().map(|w| format!("{w}/")));
     words.extend(UNSUPPORTED_MOTION_WORDS.iter().map(|w| format!("{w}/")));
     let mut lines: Vec<String> = APT_LINES.iter().map(|s| s.to_string()).collect();
+    lines.extend(["GODLTA/0,0,5".to_string(), "GODLTA/-2.5".to_string()]);
     lines.extend(NON_MOTION_WORDS.iter().map(|w| format!("{w}/1")));
     lines.extend(
         UNSUPPORTED_MOTION_WORDS
