@@ -746,6 +746,11 @@ fn cycle_def_with_the_number_against_def_and_a_localised_dwell() {
     );
     let tp = read(&text);
     assert!((tp.dwell_time() - 6.5).abs() < 1e-12, "{:?}", tp.dwells);
+    // `FN0: Q1 = 25` (hand-typed, the number against FN) is `FN 0: Q1 = 25`.
+    let tp = read(&format!(
+        "{HEADER}4 FN0: Q1 = 25\n5 FN2: Q2 = Q1 - 5\n6 L X+0 Y+0 Z+2 FMAX\n7 L X+Q2 F600\n"
+    ));
+    assert_eq!(tp.points.last().unwrap().p, v(20.0, 0.0, 2.0));
 }
 
 /// Cycle 208 (bore milling) on a 10 mm hole with a 6 mm tool: a helix of radius 2 mm from the

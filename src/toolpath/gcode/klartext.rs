@@ -224,10 +224,22 @@ pub(super) fn lex(
         return Ok(vec![Item::Skipped]);
     }
     let mut words = split_words(text);
+    // `FN0: Q1 = 25` (typed with the number against FN): `FN 0: Q1 = 25`.
+    if words.first().is_some_and(|w| {
+        w.len() > 2
+            && w.is_char_boundary(2)
+            && w[..2].eq_ignore_ascii_case("FN")
+            && w[2..].starts_with(|c: char| c.is_ascii_digit())
+    }) {
+        let number = words[0][2..].to_string();
+        words[0] = "FN".to_string();
+        words.insert(1, number);
+    }
     // `CYCL DEF9.1 …` (a post that writes the cycle number against DEF): `CYCL DEF 9.1 …`.
     if words.len() >= 2 && words[0].eq_ignore_ascii_case("CYCL") {
         let w = &words[1];
         if w.len() > 3
+            && w.is_char_boundary(3)
             && w[..3].eq_ignore_ascii_case("DEF")
             && w[3..].starts_with(|c: char| c.is_ascii_digit())
         {
