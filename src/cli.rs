@@ -196,6 +196,10 @@ pub struct SolveArgs {
     /// program).
     #[arg(long)]
     pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// The dialect of a G-code input whose content and extension name none (`gcode`: the
+    /// output's); `None`: LinuxCNC.
+    #[arg(skip)]
+    pub fallback_dialect: Option<crate::toolpath::gcode::Dialect>,
     /// Servo period of the re-simulation that checks every schedule: `1ms`, `500us`, `0.002`
     /// (seconds); 1 µs to 1 s.
     #[arg(long, default_value = "1ms", value_parser = parse_period)]
@@ -549,11 +553,14 @@ pub fn check(args: &CheckArgs) -> Result<String> {
     let (input, _, _) = read_input_from(
         &args.machine,
         &args.toolpath,
-        args.format,
-        args.dialect,
-        &[],
-        args.block_delete,
-        args.material.tool_diameter,
+        Reading {
+            format: args.format,
+            dialect: args.dialect,
+            fallback_dialect: None,
+            cycle_alias: &[],
+            block_delete: args.block_delete,
+            tool_diameter: args.material.tool_diameter,
+        },
     )?;
     let Some(report) = apply_material(
         &args.machine,
@@ -604,12 +611,25 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
     read_input_from(
         &args.machine,
         &args.toolpath,
-        args.opts.format,
-        args.dialect,
-        &args.opts.cycle_alias,
-        args.opts.block_delete,
-        args.opts.material.tool_diameter,
+        Reading {
+            format: args.opts.format,
+            dialect: args.dialect,
+            fallback_dialect: args.fallback_dialect,
+            cycle_alias: &args.opts.cycle_alias,
+            block_delete: args.opts.block_delete,
+            tool_diameter: args.opts.material.tool_diameter,
+        },
     )
+}
+
+/// How the command line asks for a toolpath to be read (the machine file adds its part).
+struct Reading<'a> {
+    format: Option<FormatChoice>,
+    dialect: Option<crate::toolpath::gcode::Dialect>,
+    fallback_dialect: Option<crate::toolpath::gcode::Dialect>,
+    cycle_alias: &'a [String],
+    block_delete: bool,
+    tool_diameter: Option<f64>,
 }
 
 /// Reads `toolpath_file` for the machine of `machine_file`; its reader's warnings are printed
@@ -617,19 +637,32 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
 fn read_input_from(
     machine_file: &std::path::Path,
     toolpath_file: &std::path::Path,
-    format: Option<FormatChoice>,
-    dialect: Option<crate::toolpath::gcode::Dialect>,
-    cycle_alias: &[String],
-    block_delete: bool,
-    tool_diameter: Option<f64>,
+    reading: Reading,
 ) -> Result<(toolpath::Input, Vec<String>, toolpath::Detected)> {
+    let Reading {
+        format,
+        dialect,
+        fallback_dialect,
+        cycle_alias,
+        block_delete,
+        tool_diameter,
+    } = reading;
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
         FormatChoice::Csv => toolpath::Format::Csv,
     });
-    let (_, references) = Machine::references_from_file(machine_file)?;
-    let machine = Machine::from_file(machine_file)?;
+    // The machine file once: the machine, its reference positions and its tool.
+    let text = crate::files::utf8(
+        machine_file,
+        crate::files::read_bounded(
+            machine_file,
+            crate::files::MAX_MACHINE_FILE_BYTES,
+            "machine file",
+        )?,
+    )?;
+    let machine = Machine::from_json(machine_file, &text)?;
+    let references = crate::machine::references_from_json(machine_file, &text, &machine)?;
     let cycle_aliases = cycle_alias
         .iter()
         .map(|a| toolpath::gcode::parse_cycle_alias(a))
@@ -643,11 +676,12 @@ fn read_input_from(
         // The tool's diameter for the cycles whose path needs it: the option, else the machine
         // file's `tool` (its errors are the material stage's to report).
         tool_diameter: tool_diameter.or_else(|| {
-            crate::material::from_machine_file(machine_file)
+            crate::material::MaterialSpec::from_json(machine_file, &text)
                 .ok()
                 .flatten()
                 .and_then(|s| s.tool.diameter)
         }),
+        fallback_dialect,
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary.
@@ -799,6 +833,7 @@ impl PlanArgs {
     fn solve_args(
         &self,
         dialect: Option<crate::toolpath::gcode::Dialect>,
+        fallback_dialect: Option<crate::toolpath::gcode::Dialect>,
         period: f64,
     ) -> SolveArgs {
         SolveArgs {
@@ -808,6 +843,7 @@ impl PlanArgs {
             output: None,
             plot: None,
             dialect,
+            fallback_dialect,
             period,
             opts: self.opts.clone(),
         }
@@ -861,24 +897,11 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
         max_rotation_deg: args.max_rotation_deg,
     };
     gcode_options.validate()?;
-    let input_dialect = match args.input_dialect {
-        Some(d) => Some(d),
-        None => {
-            // A Heidenhain `.h` or a Sinumerik program read as such, as `solve` reads it; a
-            // program nothing in which names a dialect, in the output's.
-            let path = &args.plan.toolpath;
-            let bytes = crate::files::read_bounded(
-                path,
-                crate::files::MAX_TOOLPATH_BYTES,
-                "toolpath file",
-            )?;
-            let text = String::from_utf8_lossy(&bytes);
-            let detected = toolpath::detect(path, &text, &toolpath::ReadOptions::default())?;
-            (detected.dialect_by == "default").then_some(args.dialect)
-        }
-    };
+    // The input's dialect as `solve` detects it (a Klartext `.h`, a Sinumerik program); a
+    // program nothing in which names one is read in the output's.
     let solve_args = args.plan.solve_args(
-        input_dialect,
+        args.input_dialect,
+        Some(args.dialect),
         crate::verify::VerifyOptions::default().period,
     );
     let (machine, input, options, solution) = plan(&solve_args)?;
@@ -933,7 +956,7 @@ pub struct InterpolateArgs {
 pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
     writers::output_format(&args.output, writers::setpoints::SETPOINTS)?;
     writers::check_output("-o", &args.output, &args.plan.inputs())?;
-    let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, args.period))?;
+    let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, None, args.period))?;
     let sp = crate::interpolate::sample(&machine, &solution, args.period)?;
     writers::setpoints::write_setpoints(&args.output, &sp)?;
     Ok(format!(

@@ -406,21 +406,7 @@ impl<'a> Reader<'a> {
 
         let p =
             self.world(Vector3::new(values[0], values[1], values[2]) * self.units.mm_per_unit());
-        if let Some((axis, c)) = ["X", "Y", "Z"]
-            .into_iter()
-            .zip(p.iter())
-            .find(|(_, c)| !(c.is_finite() && c.abs() <= crate::toolpath::MAX_COORDINATE_MM))
-        {
-            return Err(self.error(
-                line,
-                format!(
-                    "{word}: {axis} = {} mm is beyond ±{:e} mm (1 km): check the number and \
-                     the units",
-                    crate::error::number(*c),
-                    crate::toolpath::MAX_COORDINATE_MM
-                ),
-            ));
-        }
+        self.check_point(line, word, &p)?;
         if fields.len() == 6 && self.multax != Some(false) {
             let v = Vector3::new(values[3], values[4], values[5]);
             let Some(v) = crate::toolpath::unit_tool_vector(v) else {
@@ -438,12 +424,7 @@ impl<'a> Reader<'a> {
             };
         }
 
-        let feed = if self.rapid_next {
-            self.rapid_next = false;
-            Feed::Rapid
-        } else {
-            self.feed
-        };
+        let feed = self.next_feed();
         if let Some((arc_line, arc)) = self.arc.take() {
             return self.arc_to(line, arc_line, arc, p, feed);
         }
@@ -494,29 +475,40 @@ impl<'a> Reader<'a> {
             ));
         };
         let p = last + d * self.units.mm_per_unit();
-        if let Some((axis, c)) = ["X", "Y", "Z"]
+        self.check_point(line, "GODLTA", &p)?;
+        let feed = self.next_feed();
+        self.emit(p, feed, line);
+        Ok(())
+    }
+
+    /// A tool-tip position (world, mm) within ±[`crate::toolpath::MAX_COORDINATE_MM`], or an
+    /// error naming `word` and the axis.
+    fn check_point(&self, line: usize, word: &str, p: &Vector3<f64>) -> Result<()> {
+        match ["X", "Y", "Z"]
             .into_iter()
             .zip(p.iter())
             .find(|(_, c)| !(c.is_finite() && c.abs() <= crate::toolpath::MAX_COORDINATE_MM))
         {
-            return Err(self.error(
+            None => Ok(()),
+            Some((axis, c)) => Err(self.error(
                 line,
                 format!(
-                    "GODLTA: {axis} = {} mm is beyond ±{:e} mm (1 km): check the number and the \
-                     units",
+                    "{word}: {axis} = {} mm is beyond ±{:e} mm (1 km): check the number and \
+                     the units",
                     crate::error::number(*c),
                     crate::toolpath::MAX_COORDINATE_MM
                 ),
-            ));
+            )),
         }
-        let feed = if self.rapid_next {
-            self.rapid_next = false;
+    }
+
+    /// The feed of the next move: rapid once after `RAPID`, else the programmed feed.
+    fn next_feed(&mut self) -> Feed {
+        if std::mem::take(&mut self.rapid_next) {
             Feed::Rapid
         } else {
             self.feed
-        };
-        self.emit(p, feed, line);
-        Ok(())
+        }
     }
 
     /// Checks, before `what` makes `more` CL points (0: the points made so far), that the
@@ -746,12 +738,7 @@ impl<'a> Reader<'a> {
             .sample(MAX_CHORD_ERROR_MM, NURBS_MAX_POINTS)
             .map_err(|e| self.error(line, format!("NURBS: {e}")))?;
         self.check_room(line, "the NURBS curve", samples.len())?;
-        let feed = if self.rapid_next {
-            self.rapid_next = false;
-            Feed::Rapid
-        } else {
-            self.feed
-        };
+        let feed = self.next_feed();
         for p in samples {
             self.emit(p, feed, line);
         }

@@ -263,6 +263,9 @@ pub struct ReadOptions {
     pub block_delete: bool,
     /// The tool's diameter, mm ([`gcode::Settings::tool_diameter`]).
     pub tool_diameter: Option<f64>,
+    /// The dialect of a G-code input whose content and extension name none (`None`: the
+    /// default, LinuxCNC); [`Self::dialect`] overrides detection altogether.
+    pub fallback_dialect: Option<gcode::Dialect>,
 }
 
 /// What a reader was used, and why.
@@ -382,7 +385,10 @@ pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected
     } else if ext == "h" {
         (Some(gcode::Dialect::Heidenhain), "extension")
     } else {
-        (Some(gcode::Dialect::default()), "default")
+        (
+            Some(options.fallback_dialect.unwrap_or_default()),
+            "default",
+        )
     };
     Ok(Detected {
         format,

@@ -886,7 +886,6 @@ impl<'a> Interpreter<'a> {
         }
     }
 
-    /// Machine coordinates → program (frame) coordinates, X Y Z.
     /// The M92 datum of axis `i` (X Y Z), machine coordinates: the machine file's
     /// `axes.<X|Y|Z>.m92`, or machine zero (M91's datum) with a warning where it gives none.
     fn m92_datum(&mut self, line: usize, i: usize) -> f64 {
@@ -911,6 +910,7 @@ impl<'a> Interpreter<'a> {
         0.0
     }
 
+    /// Machine coordinates → program (frame) coordinates, X Y Z.
     fn machine_to_program(&self, m: Vector3<f64>) -> Vector3<f64> {
         let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
         self.frame_now().invert(&(m - Vector3::from(offset)))
