@@ -6,11 +6,159 @@
 //! sides lie on the grid is represented exactly; elsewhere the volume's error is of the order
 //! of the cell size times the boundary's area. Several intervals per dexel keep undercuts of a
 //! tilted tool right (a line may pass through material, a cut, and material again).
+//!
+//! **Storage** (issue 13: memory and set-up no more than the cut needs). The grid is stored in
+//! tiles of [`TILE`] × [`TILE`] dexels, each made from the stock ([`Stock::column`]) the first
+//! time a cut reaches it; a tile never cut costs one null pointer, and reading it gives the
+//! stock's column. A dexel holds its single interval inline ([`Dexel::One`]) and goes to the
+//! heap only when a tilted tool's undercut splits it ([`Dexel::Many`]).
 
 use super::stock::Stock;
 
 /// Removals shorter than this (mm) are rounding, not cutting: they leave the dexel unchanged.
 pub const MIN_CUT_MM: f64 = 1e-9;
+
+/// Dexels along each side of a tile (module doc).
+pub const TILE: usize = 16;
+
+/// One dexel's material: sorted, disjoint intervals `[z0, z1]` (24 bytes; the heap only for
+/// two or more intervals).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum Dexel {
+    /// No material.
+    #[default]
+    Empty,
+    /// One interval (the stock's column, or what stays of it after cuts from above or below).
+    One([f64; 2]),
+    /// Two or more intervals.
+    Many(Vec<[f64; 2]>),
+}
+
+impl Dexel {
+    /// The dexel of a stock column.
+    pub fn from_column(column: Option<[f64; 2]>) -> Dexel {
+        column.map_or(Dexel::Empty, Dexel::One)
+    }
+
+    /// The intervals, sorted and disjoint.
+    pub fn intervals(&self) -> &[[f64; 2]] {
+        match self {
+            Dexel::Empty => &[],
+            Dexel::One(iv) => std::slice::from_ref(iv),
+            Dexel::Many(v) => v,
+        }
+    }
+
+    /// The lowest and the highest material, if any.
+    pub fn extent(&self) -> Option<[f64; 2]> {
+        match self {
+            Dexel::Empty => None,
+            Dexel::One(iv) => Some(*iv),
+            Dexel::Many(v) => Some([v[0][0], v[v.len() - 1][1]]),
+        }
+    }
+
+    /// The material's total length, mm.
+    pub fn length(&self) -> f64 {
+        self.intervals().iter().map(|iv| iv[1] - iv[0]).sum()
+    }
+
+    /// Removes `[lo, hi]`; returns what was removed (length 0: nothing). As [`remove`] on
+    /// the intervals.
+    pub fn remove(&mut self, lo: f64, hi: f64) -> Cut {
+        match self {
+            Dexel::Empty => Cut::NONE,
+            Dexel::One(iv) => {
+                let [a0, b0] = *iv;
+                // `remove`'s steps for one interval: the overlap, then what stays.
+                if hi - lo < MIN_CUT_MM || b0 <= lo || a0 >= hi {
+                    return Cut::NONE;
+                }
+                let (a, b) = (a0.max(lo), b0.min(hi));
+                if b - a < MIN_CUT_MM {
+                    return Cut::NONE;
+                }
+                *self = match (a0 < lo, b0 > hi) {
+                    (false, false) => Dexel::Empty,
+                    (true, false) => Dexel::One([a0, lo]),
+                    (false, true) => Dexel::One([hi, b0]),
+                    (true, true) => Dexel::Many(vec![[a0, lo], [hi, b0]]),
+                };
+                Cut {
+                    length: b - a,
+                    z_lo: a,
+                    z_hi: b,
+                }
+            }
+            Dexel::Many(v) => {
+                let cut = remove(v, lo, hi);
+                match v.len() {
+                    0 => *self = Dexel::Empty,
+                    1 => *self = Dexel::One(v[0]),
+                    _ => {}
+                }
+                cut
+            }
+        }
+    }
+}
+
+/// The tiles of one row of tiles (its [`TILE`] grid rows), for a cut that changes them; the
+/// cut ([`super::cut`]) works on such bands in parallel.
+pub(crate) struct Band<'a> {
+    grid: &'a Grid,
+    /// Tile row index.
+    tj: usize,
+    tiles: &'a mut [Option<Box<[Dexel]>>],
+}
+
+impl Band<'_> {
+    /// The grid rows of this band.
+    pub fn rows(&self) -> std::ops::Range<usize> {
+        self.tj * TILE..((self.tj + 1) * TILE).min(self.grid.ny)
+    }
+
+    /// Dexel (i, j), j in [`Band::rows`]; its tile is made from the stock if never cut.
+    pub fn dexel(&mut self, i: usize, j: usize) -> &mut Dexel {
+        let (ti, tj) = (i / TILE, self.tj);
+        let grid = self.grid;
+        let tile = self.tiles[ti].get_or_insert_with(|| grid.make_tile(ti, tj));
+        &mut tile[(j % TILE) * TILE + i % TILE]
+    }
+}
+
+/// The grid's geometry and the stock untouched tiles stand for.
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    x0: f64,
+    y0: f64,
+    hx: f64,
+    hy: f64,
+    nx: usize,
+    ny: usize,
+    stock: Stock,
+}
+
+impl Grid {
+    fn column(&self, i: usize, j: usize) -> Option<[f64; 2]> {
+        let (x, y) = (
+            self.x0 + (i as f64 + 0.5) * self.hx,
+            self.y0 + (j as f64 + 0.5) * self.hy,
+        );
+        self.stock.column(x, y)
+    }
+
+    /// Tile (ti, tj) as the stock gives it (cells past the grid's edge empty).
+    fn make_tile(&self, ti: usize, tj: usize) -> Box<[Dexel]> {
+        let mut t = vec![Dexel::Empty; TILE * TILE].into_boxed_slice();
+        for j in tj * TILE..((tj + 1) * TILE).min(self.ny) {
+            for i in ti * TILE..((ti + 1) * TILE).min(self.nx) {
+                t[(j % TILE) * TILE + i % TILE] = Dexel::from_column(self.column(i, j));
+            }
+        }
+        t
+    }
+}
 
 /// A grid of Z-dexels.
 #[derive(Debug, Clone)]
@@ -27,9 +175,11 @@ pub struct Dexels {
     pub nx: usize,
     /// Cells along Y.
     pub ny: usize,
-    /// Row-major (index `j * nx + i`): each dexel's material intervals `[z0, z1]`, sorted and
-    /// disjoint.
-    pub cells: Vec<Vec<[f64; 2]>>,
+    grid: Grid,
+    /// Tiles along X.
+    tx: usize,
+    /// Row-major (index `tj * tx + ti`): each tile's dexels, row-major, once cut (module doc).
+    tiles: Vec<Option<Box<[Dexel]>>>,
 }
 
 /// What one removal took from one dexel.
@@ -43,22 +193,25 @@ pub struct Cut {
     pub z_hi: f64,
 }
 
+impl Cut {
+    /// Nothing removed.
+    pub const NONE: Cut = Cut {
+        length: 0.0,
+        z_lo: f64::INFINITY,
+        z_hi: f64::NEG_INFINITY,
+    };
+}
+
 impl Dexels {
     /// The dexels of `stock` on cells of about `cell` mm: the stock's XY bounding rectangle
     /// divided into whole cells (so a box's sides fall on cell edges). The caller has bounded
-    /// the cell count.
+    /// the cell count. No tile is made yet (module doc).
     pub fn new(stock: &Stock, cell: f64) -> Dexels {
         let [x0, y0, x1, y1] = stock.xy_bounds();
         let nx = ((x1 - x0) / cell).round().max(1.0) as usize;
         let ny = ((y1 - y0) / cell).round().max(1.0) as usize;
         let (hx, hy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
-        let mut cells = Vec::with_capacity(nx * ny);
-        for j in 0..ny {
-            for i in 0..nx {
-                let (x, y) = (x0 + (i as f64 + 0.5) * hx, y0 + (j as f64 + 0.5) * hy);
-                cells.push(stock.column(x, y).map_or_else(Vec::new, |c| vec![c]));
-            }
-        }
+        let (tx, ty) = (nx.div_ceil(TILE), ny.div_ceil(TILE));
         Dexels {
             x0,
             y0,
@@ -66,7 +219,17 @@ impl Dexels {
             hy,
             nx,
             ny,
-            cells,
+            grid: Grid {
+                x0,
+                y0,
+                hx,
+                hy,
+                nx,
+                ny,
+                stock: *stock,
+            },
+            tx,
+            tiles: vec![None; tx * ty],
         }
     }
 
@@ -89,32 +252,69 @@ impl Dexels {
         self.y0 + (j as f64 + 0.5) * self.hy
     }
 
-    /// The material volume, mm³.
+    /// Dexel (i, j) (i < nx, j < ny): its tile's, or the stock's column where no cut has
+    /// reached the tile.
+    pub fn dexel(&self, i: usize, j: usize) -> Dexel {
+        match &self.tiles[(j / TILE) * self.tx + i / TILE] {
+            Some(t) => t[(j % TILE) * TILE + i % TILE].clone(),
+            None => Dexel::from_column(self.grid.column(i, j)),
+        }
+    }
+
+    /// Tiles made so far (the rest are the stock's).
+    pub fn tiles_made(&self) -> usize {
+        self.tiles.iter().filter(|t| t.is_some()).count()
+    }
+
+    /// `f(dexel)` for every dexel, row by row (the stock's where no tile is made).
+    fn each_row_major(&self, mut f: impl FnMut(&Dexel)) {
+        for j in 0..self.ny {
+            for ti in 0..self.tx {
+                let is = ti * TILE..((ti + 1) * TILE).min(self.nx);
+                match &self.tiles[(j / TILE) * self.tx + ti] {
+                    Some(t) => {
+                        let row = (j % TILE) * TILE;
+                        is.for_each(|i| f(&t[row + i % TILE]));
+                    }
+                    None => is.for_each(|i| f(&Dexel::from_column(self.grid.column(i, j)))),
+                }
+            }
+        }
+    }
+
+    /// The material volume, mm³ (summed row by row).
     pub fn volume(&self) -> f64 {
-        let len: f64 = self
-            .cells
-            .iter()
-            .map(|c| c.iter().map(|iv| iv[1] - iv[0]).sum::<f64>())
-            .sum();
+        let mut len = 0.0;
+        self.each_row_major(|d| len += d.length());
         len * self.hx * self.hy
     }
 
     /// The highest material on each dexel (`NaN` where there is none), row-major: a height map.
     pub fn heights(&self) -> Vec<f64> {
-        self.cells
-            .iter()
-            .map(|c| c.last().map_or(f64::NAN, |iv| iv[1]))
+        let mut h = Vec::with_capacity(self.nx * self.ny);
+        self.each_row_major(|d| h.push(d.extent().map_or(f64::NAN, |e| e[1])));
+        h
+    }
+
+    /// The bands of tile rows holding grid rows `j0..=j1`, to change in parallel.
+    pub(crate) fn bands(&mut self, j0: usize, j1: usize) -> Vec<Band<'_>> {
+        let (tj0, tj1) = (j0 / TILE, j1 / TILE);
+        let grid = &self.grid;
+        self.tiles[tj0 * self.tx..(tj1 + 1) * self.tx]
+            .chunks_mut(self.tx)
+            .enumerate()
+            .map(|(k, tiles)| Band {
+                grid,
+                tj: tj0 + k,
+                tiles,
+            })
             .collect()
     }
 }
 
 /// Removes `[lo, hi]` from one dexel's intervals; returns what was removed (length 0: nothing).
 pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
-    let mut cut = Cut {
-        length: 0.0,
-        z_lo: f64::INFINITY,
-        z_hi: f64::NEG_INFINITY,
-    };
+    let mut cut = Cut::NONE;
     if hi - lo < MIN_CUT_MM || intervals.is_empty() {
         return cut;
     }
@@ -177,6 +377,99 @@ mod tests {
         assert_eq!(c.length, 0.0);
         let c = remove(&mut d, -1.0, 20.0);
         assert!(d.is_empty() && (c.length - 6.0).abs() < 1e-12);
+    }
+
+    /// A small deterministic generator in [0, 1).
+    fn rng(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn untouched_tiles_read_as_the_stock() {
+        let s = Stock::Cylinder {
+            center: [1.0, -2.0],
+            radius: 3.3,
+            z: [-1.0, 4.0],
+        };
+        let mut d = Dexels::new(&s, 0.1);
+        assert_eq!(d.tiles_made(), 0);
+        let column = |d: &Dexels, i, j| Dexel::from_column(s.column(d.x(i), d.y(j)));
+        // Cut one dexel: its tile is made, and every dexel still reads as the stock but it.
+        let (ci, cj) = (d.nx / 2 + 3, TILE + 5);
+        let cut = d.bands(cj, cj)[0].dexel(ci, cj).remove(0.0, 10.0);
+        assert_eq!((cut.length, cut.z_lo, cut.z_hi), (4.0, 0.0, 4.0));
+        assert_eq!(d.tiles_made(), 1);
+        for j in 0..d.ny {
+            for i in 0..d.nx {
+                let want = if (i, j) == (ci, cj) {
+                    Dexel::One([-1.0, 0.0])
+                } else {
+                    column(&d, i, j)
+                };
+                assert_eq!(d.dexel(i, j), want, "({i}, {j})");
+            }
+        }
+        let h = d.heights();
+        assert_eq!(h.len(), d.nx * d.ny);
+        assert_eq!(h[cj * d.nx + ci], 0.0);
+        assert!(h[0].is_nan() && h[(d.ny / 2) * d.nx + d.nx / 2] == 4.0);
+    }
+
+    /// Random removals on the tiled model and on a plain grid of interval lists (the
+    /// representation before tiles) give the same cuts, dexels and volume.
+    #[test]
+    fn tiles_agree_with_a_dense_grid() {
+        let mut rnd = rng(5);
+        for case in 0..20 {
+            let s = if case % 2 == 0 {
+                Stock::Box {
+                    min: [0.0, 0.0, -5.0],
+                    max: [3.0 + 4.0 * rnd(), 2.0 + 3.0 * rnd(), 0.0],
+                }
+            } else {
+                Stock::Cylinder {
+                    center: [0.0, 0.0],
+                    radius: 1.0 + 3.0 * rnd(),
+                    z: [-5.0, 0.0],
+                }
+            };
+            let cell = 0.05 + 0.1 * rnd();
+            let mut d = Dexels::new(&s, cell);
+            let mut dense: Vec<Vec<[f64; 2]>> = (0..d.ny)
+                .flat_map(|j| (0..d.nx).map(move |i| (i, j)))
+                .map(|(i, j)| s.column(d.x(i), d.y(j)).into_iter().collect())
+                .collect();
+            // Many removals on the dexels of a window across tile edges: splits and merges.
+            let at = |u: f64, n: usize| (TILE - 4 + (24.0 * u) as usize).min(n - 1);
+            for _ in 0..2000 {
+                let (i, j) = (at(rnd(), d.nx), at(rnd(), d.ny));
+                let lo = -6.0 + 7.0 * rnd();
+                let hi = lo + 3.0 * rnd() * rnd();
+                let want = remove(&mut dense[j * d.nx + i], lo, hi);
+                let got = d.bands(j, j)[0].dexel(i, j).remove(lo, hi);
+                assert_eq!(got, want);
+            }
+            for j in 0..d.ny {
+                for i in 0..d.nx {
+                    assert_eq!(d.dexel(i, j).intervals(), &dense[j * d.nx + i][..]);
+                }
+            }
+            let len: f64 = dense
+                .iter()
+                .map(|c| c.iter().map(|iv| iv[1] - iv[0]).sum::<f64>())
+                .sum();
+            assert_eq!(d.volume(), len * d.hx * d.hy);
+        }
+    }
+
+    #[test]
+    fn a_dexel_is_three_words() {
+        assert_eq!(std::mem::size_of::<Dexel>(), 24);
     }
 
     #[test]

@@ -41,8 +41,8 @@ use crate::error::{Error, Result};
 use crate::geometry::{self, ProcessCaps, SpanKind};
 use crate::toolpath::Toolpath;
 
-/// The most dexels a model may have (about 40 bytes each and more per cut): 10 million,
-/// e.g. 316 × 316 mm at 0.1 mm.
+/// The most dexels a model may have (24 bytes each once a cut reaches its tile, and more
+/// where an undercut splits one, [`dexel`]): 10 million, e.g. 316 × 316 mm at 0.1 mm.
 pub const MAX_DEXELS: f64 = 1e7;
 
 /// The most sample steps along a path: 10 million.
