@@ -32,6 +32,11 @@
 //! a wall; a flat end mill's rim is a sharp edge (ρ = 0), so there δ = h/2. A scallop can only
 //! make the engagement look larger, hence the feed lower (safe).
 //!
+//! **Shared poses.** A tilted step's last pose is the next step's first (the step ends are the
+//! exact sample points, [`step_of_move`]): its crossings, computed for the one step, are kept
+//! ([`SharedPose`]) and read by the next instead of being computed again; a step has two or
+//! three poses at the default sample step, so this is a third to a half of the crossings.
+//!
 //! **Which dexels.** Each pose's tool lies inside the cylinder of radius R about its axis
 //! from h = 0 to L_f, so its XY footprint lies inside the capsule of radius R about the
 //! projected axis segment; each grid row visits only the cells of that capsule
@@ -53,7 +58,7 @@
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexel, Dexels};
+use super::dexel::{Dexel, Dexels, TILE};
 use super::tool::Tool;
 use crate::toolpath::{Feed, Toolpath};
 
@@ -133,9 +138,16 @@ impl Step {
         }
     }
 
+    /// The pose at fraction `t`: at t = 1 exactly the step's end, so that the next step's
+    /// first pose is the same (shared poses, module doc).
     fn pose(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let o = (self.o0 * (1.0 - t) + self.o1 * t).normalize();
-        (self.p0 + (self.p1 - self.p0) * t, o)
+        let p = if t == 1.0 {
+            self.p1
+        } else {
+            self.p0 + (self.p1 - self.p0) * t
+        };
+        (p, o)
     }
 
     /// The XY rectangle `[x0, y0, x1, y1]` the step's tool covers (with `poses` poses).
@@ -325,10 +337,50 @@ fn capsule_cells(
     (i0 <= i1).then_some((i0 as usize, i1 as usize))
 }
 
+/// The crossings of a tilted step's last pose with the dexel lines, kept for the next step,
+/// whose first pose it is (shared poses, module doc).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SharedPose {
+    /// The pose (tip, axis) and the number of the step it ended.
+    pose: Option<(Vector3<f64>, Vector3<f64>)>,
+    step: u64,
+    /// Per grid row.
+    rows: Vec<SharedRow>,
+}
+
+/// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, `[NaN, NaN]` where not
+/// computed (material out of the tool's reach) and [`MISS`] where the tool does not cross.
+#[derive(Debug, Clone, Default)]
+struct SharedRow {
+    step: u64,
+    start: usize,
+    hits: Vec<[f64; 2]>,
+}
+
+/// A crossing that is none.
+const MISS: [f64; 2] = [f64::INFINITY, f64::NEG_INFINITY];
+
+impl SharedPose {
+    /// For a grid of `rows` rows.
+    pub fn new(rows: usize) -> SharedPose {
+        SharedPose {
+            pose: None,
+            step: 0,
+            rows: vec![SharedRow::default(); rows],
+        }
+    }
+}
+
 /// Removes one step's swept volume from the dexels (rows in parallel) and returns the sample's
 /// engagement (its `point`, `t`, `line`, `rapid` and feed are the caller's to fill). `delta`:
-/// [`pose_spacing`].
-pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64) -> Sample {
+/// [`pose_spacing`]; `shared`: the previous step's last pose, updated to this step's.
+pub(crate) fn cut_step(
+    dexels: &mut Dexels,
+    tool: &Tool,
+    step: &Step,
+    delta: f64,
+    shared: &mut SharedPose,
+) -> Sample {
     let poses = step.poses(tool, delta);
     let bounds = step.bounds(tool, poses);
     let (pe, oe) = (step.p1, step.o1.normalize());
@@ -352,6 +404,11 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
             })
             .collect()
     };
+    // This step's number; its first pose's crossings where the previous step's last pose is it.
+    let (prev, this) = (shared.step, shared.step + 1);
+    let reuse = !vertical && shared.pose == Some((pose_list[0].0, pose_list[0].1));
+    shared.step = this;
+    shared.pose = pose_list.last().map(|l| (l.0, l.1));
     let acc = match cell_range(dexels, &bounds) {
         None => Acc::ZERO,
         Some((i0, i1, j0, j1)) => {
@@ -361,12 +418,17 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
             // Per task, per row: the run of consecutive poses crossing each cell (`last`: the
             // latest such pose), reused from row to row.
             let scratch = || (Vec::<[f64; 2]>::new(), Vec::<usize>::new());
-            dexels
-                .bands(j0, j1)
+            let bands = dexels.bands(j0, j1);
+            let first_row = bands[0].rows().start;
+            let last_row = bands[bands.len() - 1].rows().end;
+            let shared_rows = &mut shared.rows[first_row..last_row];
+            bands
                 .into_par_iter()
-                .map_init(scratch, |(run, last), mut band| {
+                .zip(shared_rows.par_chunks_mut(TILE))
+                .map_init(scratch, |(run, last), (mut band, shared_rows)| {
                     let mut acc = Acc::ZERO;
-                    for j in band.rows() {
+                    let rows = band.rows();
+                    for (j, row_shared) in rows.zip(shared_rows) {
                         if j < j0 || j > j1 {
                             continue;
                         }
@@ -386,10 +448,9 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                             else {
                                 continue;
                             };
-                            for i in ia..=ib {
-                                let cell = band.dexel(i, j);
+                            band.each(j, ia, ib, |i, cell| {
                                 if matches!(cell, Dexel::Empty) {
-                                    continue;
+                                    return;
                                 }
                                 let x = cx(i);
                                 if let Some([lo, hi]) =
@@ -397,7 +458,7 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                                 {
                                     note(x, cell.remove(lo, hi));
                                 }
-                            }
+                            });
                             continue;
                         }
                         // Pose by pose over the cells of its capsule.
@@ -411,10 +472,17 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                             else {
                                 continue;
                             };
-                            for i in ia..=ib {
-                                let cell = band.dexel(i, j);
+                            let from_shared = k == 0 && reuse && row_shared.step == prev;
+                            let to_shared = k == poses - 1;
+                            if to_shared {
+                                row_shared.step = this;
+                                row_shared.start = ia;
+                                row_shared.hits.clear();
+                                row_shared.hits.resize(ib - ia + 1, [f64::NAN; 2]);
+                            }
+                            band.each(j, ia, ib, |i, cell| {
                                 let Some([bottom, top]) = cell.extent() else {
-                                    continue;
+                                    return;
                                 };
                                 let c = i - i0;
                                 // Material all below or all above the tool's z range: nothing
@@ -425,11 +493,24 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                                     if last[c] != usize::MAX && last[c] + 1 == k {
                                         last[c] = k;
                                     }
-                                    continue;
+                                    return;
                                 }
                                 let x = cx(i);
-                                let Some(h) = tool.line_hit(p, o, x, y) else {
-                                    continue;
+                                let known = if from_shared {
+                                    let k = i.wrapping_sub(row_shared.start);
+                                    row_shared.hits.get(k).filter(|h| !h[0].is_nan())
+                                } else {
+                                    None
+                                };
+                                let h = match known {
+                                    Some(h) => (h[0] <= h[1]).then_some(*h),
+                                    None => tool.line_hit(p, o, x, y),
+                                };
+                                if to_shared {
+                                    row_shared.hits[i - ia] = h.unwrap_or(MISS);
+                                }
+                                let Some(h) = h else {
+                                    return;
                                 };
                                 if last[c] != usize::MAX && last[c] + 1 == k {
                                     run[c] = [run[c][0].min(h[0]), run[c][1].max(h[1])];
@@ -440,7 +521,7 @@ pub(crate) fn cut_step(dexels: &mut Dexels, tool: &Tool, step: &Step, delta: f64
                                     run[c] = h;
                                 }
                                 last[c] = k;
-                            }
+                            });
                         }
                         for c in 0..width {
                             if last[c] != usize::MAX {
@@ -512,13 +593,14 @@ pub(crate) fn steps_of_move(tp: &Toolpath, k: usize, tool: &Tool, step: f64) -> 
     }
 }
 
-/// Step `s` of `n` of CL move k.
+/// Step `s` of `n` of CL move k (its last step ends exactly at CL point k, where the next
+/// move starts).
 pub(crate) fn step_of_move(tp: &Toolpath, k: usize, s: usize, n: usize) -> Step {
     let (a, b) = (&tp.points[k - 1], &tp.points[k]);
     let (t0, t1) = (s as f64 / n as f64, (s + 1) as f64 / n as f64);
     let at = |t: f64| {
         (
-            a.p + (b.p - a.p) * t,
+            if t == 1.0 { b.p } else { a.p + (b.p - a.p) * t },
             (a.o * (1.0 - t) + b.o * t).normalize(),
         )
     };
@@ -637,6 +719,7 @@ mod tests {
                 Vector3::new(tilt * (r() - 0.5), tilt * (r() - 0.5), 1.0).normalize()
             };
             let (mut p, mut o) = (Vector3::new(6.0, 4.5, 1.0), axis(&mut rnd));
+            let mut shared = SharedPose::new(d.ny);
             let mut total = 0.0;
             for _ in 0..15 {
                 let p1 = Vector3::new(
@@ -652,7 +735,8 @@ mod tests {
                     o1,
                 };
                 let want = reference_step(&d, &mut cells, &tool, &step, delta);
-                let got = cut_step(&mut d, &tool, &step, delta).removed / (d.hx * d.hy);
+                let got =
+                    cut_step(&mut d, &tool, &step, delta, &mut shared).removed / (d.hx * d.hy);
                 assert!((got - want).abs() <= 1e-12 * want.max(1.0), "{got} {want}");
                 total += want;
                 (p, o) = (p1, o1);

@@ -125,6 +125,25 @@ impl Band<'_> {
         let tile = self.tiles[ti].get_or_insert_with(|| grid.make_tile(ti, tj));
         &mut tile[(j % TILE) * TILE + i % TILE]
     }
+
+    /// `f(i, dexel)` for dexels `ia..=ib` of row `j` (j in [`Band::rows`]), in order, tile by
+    /// tile.
+    #[inline]
+    pub fn each(&mut self, j: usize, ia: usize, ib: usize, mut f: impl FnMut(usize, &mut Dexel)) {
+        let row = (j % TILE) * TILE;
+        let mut i = ia;
+        while i <= ib {
+            let ti = i / TILE;
+            let end = ((ti + 1) * TILE - 1).min(ib);
+            let (grid, tj) = (self.grid, self.tj);
+            let tile = self.tiles[ti].get_or_insert_with(|| grid.make_tile(ti, tj));
+            let cells = &mut tile[row + i % TILE..=row + end % TILE];
+            for (k, d) in cells.iter_mut().enumerate() {
+                f(i + k, d);
+            }
+            i = end + 1;
+        }
+    }
 }
 
 /// The grid's geometry and the stock untouched tiles stand for.

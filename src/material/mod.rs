@@ -224,12 +224,13 @@ pub fn simulate(tp: &Toolpath, m: &Material) -> Result<Simulation> {
     let initial_volume = dexels.volume();
     let delta = cut::pose_spacing(&m.tool, dexels.hx.min(dexels.hy));
     let mut samples = Vec::new();
+    let mut shared = cut::SharedPose::new(dexels.ny);
     for k in 1..tp.points.len() {
         let n = cut::steps_of_move(tp, k, &m.tool, step);
         let (feed, rapid) = cut::move_feed(tp, k);
         for s in 0..n {
             let st = cut::step_of_move(tp, k, s, n);
-            let mut sample = cut::cut_step(&mut dexels, &m.tool, &st, delta);
+            let mut sample = cut::cut_step(&mut dexels, &m.tool, &st, delta, &mut shared);
             sample.point = k;
             sample.t = [s as f64 / n as f64, (s + 1) as f64 / n as f64];
             sample.line = tp.points[k].line;
