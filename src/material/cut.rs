@@ -33,15 +33,18 @@
 //! make the engagement look larger, hence the feed lower (safe).
 //!
 //! **Shared poses.** A tilted step's last pose is the next step's first (the step ends are the
-//! exact sample points, [`step_of_move`]): its crossings, computed for the one step, are kept
-//! ([`SharedPose`]) and read by the next instead of being computed again; a step has two or
+//! exact sample points, `step_of_move`): its crossings, computed for the one step, are kept
+//! (`SharedPose`) and read by the next instead of being computed again; a step has two or
 //! three poses at the default sample step, so this is a third to a half of the crossings.
 //!
 //! **Which dexels.** Each pose's tool lies inside the cylinder of radius R about its axis
 //! from h = 0 to L_f, so its XY footprint lies inside the capsule of radius R about the
-//! projected axis segment; each grid row visits only the cells of that capsule
-//! ([`capsule_row`]), pose by pose (tilted) or for the segment P₀P₁ (vertical). The work of a
-//! step is thus its footprint's cells times its poses, not its bounding box's.
+//! projected axis segment, and (tilted) inside the rectangle of half-width R along it that
+//! reaches only R·|O_z| past its ends (`axis_row`); each grid row visits only the cells of
+//! that capsule ([`capsule_row`]) and rectangle, pose by pose (tilted), or of the capsule
+//! about the segment P₀P₁ (vertical). A cell outside the footprint is one the tool does not
+//! cross, so skipping it changes nothing. The work of a step is thus its footprint's cells
+//! times its poses, not its bounding box's.
 //!
 //! **Engagement of a sample** (the tool at the step's end pose P, axis O, feed direction f):
 //! - removed volume ΔV (mm³) and engaged cross-section `A = ΔV / Δs` (mm²) normal to the feed,
@@ -320,17 +323,56 @@ pub fn capsule_row(a: [f64; 2], b: [f64; 2], r: f64, y: f64) -> Option<[f64; 2]>
     (lo <= hi).then_some([lo - 1e-9, hi + 1e-9])
 }
 
+/// The x interval where the line at `y` meets the rectangle of half-width `r` about the
+/// segment from `a` to `b` (XY), lengthened by `ends` at both ends, if it does (widened by
+/// 1e-9 mm as [`capsule_row`]). A tilted tool (unit axis O, tip at `a`, flute end at `b`)
+/// lies in it with `ends` = R·|O_z|: a point of the disc of radius R normal to O projects
+/// onto the axis' XY direction û at most R·|O_z| = R·|(û, 0) − ((û, 0)·O) O| from its centre.
+/// `None` also where `a` = `b` (no direction: no bound).
+fn axis_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    if len2 == 0.0 {
+        return None;
+    }
+    let len = len2.sqrt();
+    // With q = (x, y): −ends·|d| ≤ (q − a)·d ≤ |d|² + ends·|d| and |(q − a) × d| ≤ r |d|.
+    let mut band = [f64::NEG_INFINITY, f64::INFINITY];
+    let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
+        if k == 0.0 {
+            if m < c0 || m > c1 {
+                band = [f64::INFINITY, f64::NEG_INFINITY];
+            }
+        } else {
+            let (u, v) = ((c0 - m) / k, (c1 - m) / k);
+            band[0] = band[0].max(u.min(v));
+            band[1] = band[1].min(u.max(v));
+        }
+    };
+    let (e, w) = (ends * len, r * len);
+    clip(dx, (y - a[1]) * dy - a[0] * dx, -e, len2 + e);
+    clip(dy, -(y - a[1]) * dx - a[0] * dy, -w, w);
+    Some([band[0] - 1e-9, band[1] + 1e-9])
+}
+
 /// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule of
-/// [`capsule_row`].
+/// [`capsule_row`] and, for a tilted pose (`ends` finite), the rectangle of [`axis_row`].
+#[allow(clippy::too_many_arguments)]
 fn capsule_cells(
     d: (f64, f64),
     a: [f64; 2],
     b: [f64; 2],
     r: f64,
+    ends: f64,
     y: f64,
     range: (usize, usize),
 ) -> Option<(usize, usize)> {
-    let [x0, x1] = capsule_row(a, b, r, y)?;
+    let [mut x0, mut x1] = capsule_row(a, b, r, y)?;
+    if ends.is_finite() {
+        if let Some([u0, u1]) = axis_row(a, b, r, ends, y) {
+            (x0, x1) = (x0.max(u0), x1.min(u1));
+        }
+    }
     let (ox, hx) = d;
     let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
     let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
@@ -444,7 +486,8 @@ pub(crate) fn cut_step(
                         };
                         if vertical {
                             let (a, b) = ([step.p0.x, step.p0.y], [step.p1.x, step.p1.y]);
-                            let Some((ia, ib)) = capsule_cells((x0, hx), a, b, r, y, (i0, i1))
+                            let Some((ia, ib)) =
+                                capsule_cells((x0, hx), a, b, r, f64::INFINITY, y, (i0, i1))
                             else {
                                 continue;
                             };
@@ -468,7 +511,9 @@ pub(crate) fn cut_step(
                         last.clear();
                         last.resize(width, usize::MAX);
                         for (k, (p, o, a, b, z)) in pose_list.iter().enumerate() {
-                            let Some((ia, ib)) = capsule_cells((x0, hx), *a, *b, r, y, (i0, i1))
+                            let ends = r * o.z.abs();
+                            let Some((ia, ib)) =
+                                capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
                             else {
                                 continue;
                             };
@@ -686,6 +731,47 @@ mod tests {
             }
         }
         length
+    }
+
+    /// Every point of a tilted tool lies in the rectangle of `axis_row`, whose ends are
+    /// tighter than the capsule's.
+    #[test]
+    fn a_tilted_tool_lies_in_its_axis_rectangle() {
+        let mut seed = 9u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let tool = Tool::new(6.0, 3.0, 12.0, 2).unwrap();
+        let r = tool.radius();
+        for _ in 0..200 {
+            let o = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.2 + rnd()).normalize();
+            let p = Vector3::new(rnd(), rnd(), rnd());
+            let top = p + o * tool.flute_length;
+            let (a, b) = ([p.x, p.y], [top.x, top.y]);
+            // Two unit vectors normal to O.
+            let e1 = o.cross(&Vector3::x()).normalize();
+            let e2 = o.cross(&e1);
+            for _ in 0..200 {
+                let h = tool.flute_length * rnd();
+                let (rho, phi) = (
+                    tool.radius_at(h) * rnd().sqrt(),
+                    std::f64::consts::TAU * rnd(),
+                );
+                let x = p + o * h + (e1 * phi.cos() + e2 * phi.sin()) * rho;
+                let [x0, x1] = axis_row(a, b, r, r * o.z.abs(), x.y).unwrap();
+                assert!(x0 <= x.x && x.x <= x1, "{x:?} outside [{x0}, {x1}]");
+            }
+            // Beyond the tip, along the axis' direction, the capsule reaches R; the rectangle
+            // R·|O_z|.
+            let u = Vector3::new(o.x, o.y, 0.0).normalize() * (-r * (1.0 + o.z.abs()) / 2.0);
+            let q = p + u;
+            let inside = |row: Option<[f64; 2]>| row.is_some_and(|[x0, x1]| x0 <= q.x && q.x <= x1);
+            assert!(inside(capsule_row(a, b, r, q.y)));
+            assert!(!inside(axis_row(a, b, r, r * o.z.abs(), q.y)) || o.z.abs() > 0.999);
+        }
     }
 
     /// Random tilted and vertical passes into a block: the cut and the reference remove the
