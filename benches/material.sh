@@ -6,6 +6,8 @@
 #   bash benches/material.sh            # all rows
 #   bash benches/material.sh linuxcnc   # rows whose name contains "linuxcnc"
 #   CELL=0.05 bash benches/material.sh  # another cell size, mm (default 0.1)
+#   FEEDOPT=/tmp/old/feedopt bash benches/material.sh  # another build (no cargo build), for a
+#                                                      # before/after pair in the same hour
 #
 # Rows (the machine files get a `stock` in a temporary folder; nothing is written into the crate):
 # - seed_blade: problems/seed_head_head (the bundled 5-axis problem, a flank pass along one
@@ -29,8 +31,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x /usr/bin/time ] || { echo "needs GNU time at /usr/bin/time (apt-get install time)" >&2; exit 2; }
 cell=${CELL:-0.1}
-cargo build --release --quiet
-bin=target/release/feedopt
+if [ -n "${FEEDOPT:-}" ]; then
+  bin=$FEEDOPT
+else
+  cargo build --release --quiet
+  bin=target/release/feedopt
+fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
