@@ -241,6 +241,7 @@ fn realize(ctx: &Context, profile: &Profile, notes: Vec<String>) -> Candidate {
         problems.push(SpanProblem::at_stations(span, kin, ctx.machine, u));
         solutions.push(SpanSolution {
             a: None,
+            slopes: None,
             b,
             status: Status::Greedy,
             iterations: 0,
@@ -514,7 +515,7 @@ fn dynamics(ctx: &Context, c: &Candidate) -> Result<Dynamics> {
         let mut jj = verify::first_instant(t0, period);
         let mut ta = t0;
         for i in 0..p.intervals() {
-            let iv = Interval::of(&p.u, b, sol.a.as_deref(), i);
+            let iv = Interval::of(&p.u, b, sol.a.as_deref(), sol.slopes.as_deref(), i);
             jj = verify::servo_instants(
                 &iv,
                 (p.u[i], p.u[i + 1]),

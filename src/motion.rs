@@ -12,6 +12,15 @@
 //!   a_0, a_1, so b is quadratic, `b(x) = b_0 + 2 a_0 x + α x²` with `α = (a_1 − a_0)/Δu`, and
 //!   `b_1 − b_0 = Δu (a_0 + a_1)`. ü is continuous; the path jerk is `u⃛ = dü/dt = α u̇`.
 //!   Time is `∫ dx / √b(x)` (Gauss–Legendre; the integrand is analytic on the interval).
+//! - [`Law::Cubic`] (jerk-limited, issue 11): a' = dü/du linear in u between its values s_0,
+//!   s_1 at the interval's ends (a' may jump at a station), so ü is quadratic and b cubic:
+//!   `a(x) = a_0 + s_0 x + (s_1 − s_0) x²/(2Δu)`, `b(x) = b_0 + 2 a_0 x + s_0 x² +
+//!   (s_1 − s_0) x³/(3Δu)`, with `a_1 − a_0 = Δu (s_0 + s_1)/2` and
+//!   `b_1 − b_0 = 2Δu a_0 + Δu² (2 s_0 + s_1)/3`. The path jerk is `u⃛ = a'(x) u̇`. Where the
+//!   jerk limit holds a ramp, a' must follow a bound that varies along the interval: a
+//!   constant a' (the quadratic law) meets it at one end only and loses time of first order
+//!   in Δu there, a linear one of second order. Time is `∫ dx / √b(x)` (adaptive
+//!   Gauss–Legendre), and x(τ) its inverse (safeguarded Newton).
 //! - [`Law::RestStart`] / [`Law::RestEnd`] (jerk-limited, the first and last interval of a
 //!   rest-to-rest span): from rest with ü = 0, constant path jerk j: `u = j t³/6`, so
 //!   `u̇ = j t²/2`, `ü = j t`. Reaching b_1 at the far station takes `τ = 3Δu/√b_1` and
@@ -30,6 +39,8 @@ pub enum Law {
     Linear,
     /// ü linear in u, b quadratic (module doc).
     Quadratic,
+    /// a' = dü/du linear in u, ü quadratic, b cubic (module doc).
+    Cubic,
     /// From rest at constant path jerk (module doc).
     RestStart,
     /// To rest at constant path jerk (module doc).
@@ -49,6 +60,11 @@ pub struct Interval {
     pub a0: f64,
     /// ü at the end.
     pub a1: f64,
+    /// a' = dü/du just after the start (equal to `s1` under the quadratic law, 0 under the
+    /// linear one; unused by the rest laws).
+    pub s0: f64,
+    /// a' just before the end.
+    pub s1: f64,
     /// How u moves in between.
     pub law: Law,
 }
@@ -82,10 +98,15 @@ impl State {
 /// time integration every stage uses (the schedule, the solvers, the re-simulation, the
 /// setpoints); an interval the profile cannot traverse (b zero on the whole of it) is
 /// [`Error::Infeasible`].
-pub fn interval_times(u: &[f64], b: &[f64], a: Option<&[f64]>) -> Result<Vec<f64>> {
+pub fn interval_times(
+    u: &[f64],
+    b: &[f64],
+    a: Option<&[f64]>,
+    slopes: Option<&[[f64; 2]]>,
+) -> Result<Vec<f64>> {
     (0..u.len().saturating_sub(1))
         .map(|k| {
-            Interval::of(u, b, a, k).duration().map_err(|_| {
+            Interval::of(u, b, a, slopes, k).duration().map_err(|_| {
                 Error::Infeasible(format!(
                     "the feed is zero on a whole interval (station {k}): the path cannot be \
                      traversed"
@@ -97,9 +118,16 @@ pub fn interval_times(u: &[f64], b: &[f64], a: Option<&[f64]>) -> Result<Vec<f64
 
 impl Interval {
     /// Interval `k` of a profile: `b` at the stations `u`, and `a` (ü at the stations) for a
-    /// jerk-limited profile (`None`: [`Law::Linear`]). Negative rounding noise in b is
-    /// clamped to 0.
-    pub fn of(u: &[f64], b: &[f64], a: Option<&[f64]>, k: usize) -> Interval {
+    /// jerk-limited profile (`None`: [`Law::Linear`]), with `slopes` (a' at both ends of every
+    /// interval: [`Law::Cubic`]) or without (`None`: [`Law::Quadratic`]). Negative rounding
+    /// noise in b is clamped to 0.
+    pub fn of(
+        u: &[f64],
+        b: &[f64],
+        a: Option<&[f64]>,
+        slopes: Option<&[[f64; 2]]>,
+        k: usize,
+    ) -> Interval {
         let du = u[k + 1] - u[k];
         let (b0, b1) = (b[k].max(0.0), b[k + 1].max(0.0));
         match a {
@@ -111,6 +139,8 @@ impl Interval {
                     b1,
                     a0: udd,
                     a1: udd,
+                    s0: 0.0,
+                    s1: 0.0,
                     law: Law::Linear,
                 }
             }
@@ -119,8 +149,17 @@ impl Interval {
                     Law::RestStart
                 } else if b1 == 0.0 && b0 > 0.0 {
                     Law::RestEnd
+                } else if slopes.is_some() {
+                    Law::Cubic
                 } else {
                     Law::Quadratic
+                };
+                let [s0, s1] = match (law, slopes) {
+                    (Law::Cubic, Some(s)) => s[k],
+                    _ => {
+                        let alpha = (a[k + 1] - a[k]) / du;
+                        [alpha, alpha]
+                    }
                 };
                 Interval {
                     du,
@@ -128,6 +167,8 @@ impl Interval {
                     b1,
                     a0: a[k],
                     a1: a[k + 1],
+                    s0,
+                    s1,
                     law,
                 }
             }
@@ -180,6 +221,131 @@ impl Interval {
         m
     }
 
+    /// b at x (cubic law).
+    fn cubic_b(&self, x: f64) -> f64 {
+        let d = (self.s1 - self.s0) / self.du;
+        self.b0 + x * (2.0 * self.a0 + x * (self.s0 + x * d / 3.0))
+    }
+
+    /// ü at x (cubic law).
+    fn cubic_a(&self, x: f64) -> f64 {
+        let d = (self.s1 - self.s0) / self.du;
+        self.a0 + x * (self.s0 + 0.5 * x * d)
+    }
+
+    /// a' at x (cubic law).
+    fn cubic_slope(&self, x: f64) -> f64 {
+        self.s0 + (self.s1 - self.s0) * x / self.du
+    }
+
+    /// The smallest b on the interval (cubic law): the ends, and where ü = 0 inside.
+    fn cubic_b_min(&self) -> f64 {
+        let mut m = self.b0.min(self.b1);
+        // ü(x) = a0 + s0 x + (d/2) x² = 0.
+        let (qa, qb, qc) = (0.5 * (self.s1 - self.s0) / self.du, self.s0, self.a0);
+        let mut roots = [f64::NAN; 2];
+        if qa.abs() <= 1e-300 {
+            if qb != 0.0 {
+                roots[0] = -qc / qb;
+            }
+        } else {
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+                roots = [q / qa, if q != 0.0 { qc / q } else { f64::NAN }];
+            }
+        }
+        for x in roots {
+            if x > 0.0 && x < self.du {
+                m = m.min(self.cubic_b(x));
+            }
+        }
+        m
+    }
+
+    /// ∫_p^q dξ / √b(ξ) under the cubic law: Gauss–Legendre on 8 points, halved until the
+    /// halves agree with the whole to 1e-13 (relative) (the integrand is analytic where b > 0).
+    fn cubic_time(&self, p: f64, q: f64) -> f64 {
+        fn gl(iv: &Interval, p: f64, q: f64) -> f64 {
+            const X: [f64; 4] = [
+                0.183_434_642_495_649_8,
+                0.525_532_409_916_329,
+                0.796_666_477_413_626_7,
+                0.960_289_856_497_536_3,
+            ];
+            const W: [f64; 4] = [
+                0.362_683_783_378_362,
+                0.313_706_645_877_887_3,
+                0.222_381_034_453_374_5,
+                0.101_228_536_290_376_3,
+            ];
+            let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
+            let f = |x: f64| 1.0 / iv.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
+            h * X
+                .iter()
+                .zip(&W)
+                .map(|(x, w)| w * (f(c - h * x) + f(c + h * x)))
+                .sum::<f64>()
+        }
+        // `tol`: absolute, split between the halves, so the total error stays within the
+        // whole's; `budget`: panels left, so a sharp peak of 1/√b (b nearly 0 inside) cannot
+        // make the recursion exponential.
+        fn adapt(iv: &Interval, p: f64, q: f64, whole: f64, tol: f64, budget: &mut u32) -> f64 {
+            let m = 0.5 * (p + q);
+            let (l, r) = (gl(iv, p, m), gl(iv, m, q));
+            if *budget == 0 || (l + r - whole).abs() <= tol {
+                l + r
+            } else {
+                *budget -= 1;
+                adapt(iv, p, m, l, 0.5 * tol, budget) + adapt(iv, m, q, r, 0.5 * tol, budget)
+            }
+        }
+        if q <= p {
+            return 0.0;
+        }
+        let whole = gl(self, p, q);
+        let mut budget = 4096;
+        adapt(self, p, q, whole, 1e-13 * whole.abs(), &mut budget)
+    }
+
+    /// x reached τ after the start (cubic law): the root of `T(x) = τ`, T increasing with
+    /// T' = 1/√b, by Newton's method kept inside a shrinking bracket (bisection where a step
+    /// would leave it), each T(x) the last one plus the integral over the step.
+    fn cubic_x_at(&self, tau: f64, dur: f64) -> f64 {
+        if tau <= 0.0 {
+            return 0.0;
+        }
+        if tau >= dur {
+            return self.du;
+        }
+        let (mut lo, mut hi) = (0.0, self.du);
+        // A first guess from the start's motion: x ≈ √b₀ τ + a₀ τ²/2.
+        let mut x = (self.b0.sqrt() * tau + 0.5 * self.a0 * tau * tau).clamp(0.0, self.du);
+        let mut t = self.cubic_time(0.0, x);
+        for _ in 0..100 {
+            let err = t - tau;
+            if err > 0.0 {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            if err.abs() <= 1e-14 * dur || hi - lo <= 1e-15 * self.du {
+                break;
+            }
+            let mut next = x - err * self.cubic_b(x).max(0.0).sqrt();
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            t += if next > x {
+                self.cubic_time(x, next)
+            } else {
+                -self.cubic_time(next, x)
+            };
+            x = next;
+        }
+        x
+    }
+
     /// Time to traverse the interval (eq. 43 under the interval's law); an error where the
     /// motion stalls (b reaches 0 inside, or at both ends).
     pub fn duration(&self) -> Result<f64> {
@@ -201,6 +367,12 @@ impl Interval {
                     return stall();
                 }
                 self.time_to(self.du)
+            }
+            Law::Cubic => {
+                if self.cubic_b_min() <= 0.0 {
+                    return stall();
+                }
+                self.cubic_time(0.0, self.du)
             }
             Law::RestStart => 3.0 * self.du / self.b1.sqrt(),
             Law::RestEnd => 3.0 * self.du / self.b0.sqrt(),
@@ -250,6 +422,18 @@ impl Interval {
                     uddd: j,
                 }
             }
+            Law::Cubic => {
+                let x = self.cubic_x_at(tau, dur);
+                let b = self.cubic_b(x).max(0.0);
+                let ud = b.sqrt();
+                State {
+                    x,
+                    ud,
+                    b,
+                    udd: self.cubic_a(x),
+                    uddd: self.cubic_slope(x) * ud,
+                }
+            }
             Law::Quadratic => {
                 let x = self.x_at(tau, dur);
                 let b = self.b_at(x).max(0.0);
@@ -270,6 +454,7 @@ impl Interval {
     pub fn at_x(&self, x: f64) -> (f64, f64) {
         let x = x.clamp(0.0, self.du);
         match self.law {
+            Law::Cubic => (self.cubic_b(x).max(0.0), self.cubic_a(x)),
             Law::Linear => {
                 let f = x / self.du;
                 (self.b0 + f * (self.b1 - self.b0), self.a0)
@@ -290,6 +475,26 @@ impl Interval {
         }
     }
 
+    /// a' = dü/du where u − u_0 = `x`, just inside the interval (0 under the linear law; the
+    /// rest laws' own, `2 b_far/(9Δu²)` at the far end).
+    pub fn slope_at_x(&self, x: f64) -> f64 {
+        let x = x.clamp(0.0, self.du);
+        match self.law {
+            Law::Linear => 0.0,
+            Law::Quadratic => (self.a1 - self.a0) / self.du,
+            Law::Cubic => self.cubic_slope(x),
+            // x = Δu s³: ü = (2/3) s b₁/Δu, so a' = dü/du = (2/9) b₁/(Δu² s²).
+            Law::RestStart => {
+                let s = (x / self.du).cbrt().max(1e-300);
+                2.0 * self.b1 / (9.0 * self.du * self.du * s * s)
+            }
+            Law::RestEnd => {
+                let s = ((self.du - x) / self.du).cbrt().max(1e-300);
+                2.0 * self.b0 / (9.0 * self.du * self.du * s * s)
+            }
+        }
+    }
+
     /// The time from the interval's start to reach u − u_0 = `x` (clamped to the interval): the
     /// inverse of [`Interval::at`].
     pub fn time_to_x(&self, x: f64) -> Result<f64> {
@@ -304,6 +509,7 @@ impl Interval {
                 2.0 * x / (self.b0.sqrt() + b.max(0.0).sqrt())
             }
             Law::Quadratic => self.time_to(x).min(dur),
+            Law::Cubic => self.cubic_time(0.0, x).min(dur),
             Law::RestStart => dur * (x / self.du).cbrt(),
             Law::RestEnd => dur * (1.0 - ((self.du - x) / self.du).cbrt()),
         })
@@ -311,24 +517,27 @@ impl Interval {
 
     /// The motion at the interval's start (τ = 0) and end (τ = duration), exactly.
     pub fn ends(&self) -> (State, State) {
-        let alpha = if self.law == Law::Quadratic {
-            (self.a1 - self.a0) / self.du
-        } else {
-            0.0
+        let (g0, g1) = match self.law {
+            Law::Quadratic => {
+                let alpha = (self.a1 - self.a0) / self.du;
+                (alpha, alpha)
+            }
+            Law::Cubic => (self.s0, self.s1),
+            _ => (0.0, 0.0),
         };
-        let state = |b: f64, a: f64, x: f64| {
+        let state = |b: f64, a: f64, x: f64, g: f64| {
             let ud = b.sqrt();
             State {
                 x,
                 ud,
                 b,
                 udd: a,
-                uddd: alpha * ud,
+                uddd: g * ud,
             }
         };
         let (mut s0, mut s1) = (
-            state(self.b0, self.a0, 0.0),
-            state(self.b1, self.a1, self.du),
+            state(self.b0, self.a0, 0.0, g0),
+            state(self.b1, self.a1, self.du, g1),
         );
         match self.law {
             Law::RestStart => {
@@ -422,6 +631,8 @@ mod tests {
             b1: b0 + du * (a0 + a1),
             a0,
             a1,
+            s0: (a1 - a0) / du,
+            s1: (a1 - a0) / du,
             law: Law::Quadratic,
         }
     }
@@ -572,6 +783,8 @@ mod tests {
             b1,
             a0: 0.0,
             a1: 2.0 * b1 / (3.0 * du),
+            s0: 0.0,
+            s1: 0.0,
             law: Law::RestStart,
         };
         let dur = iv.duration().unwrap();
@@ -594,6 +807,8 @@ mod tests {
             b1: 0.0,
             a0: -iv.a1,
             a1: 0.0,
+            s0: 0.0,
+            s1: 0.0,
             law: Law::RestEnd,
         };
         let s = back.at(0.0, dur);
@@ -608,13 +823,13 @@ mod tests {
         let iv = quad(0.01, -1.0, 1.0, 1.0);
         assert!(iv.b_min() < 0.0);
         assert!(iv.duration().is_err());
-        let flat = Interval::of(&[0.0, 1.0], &[0.0, 0.0], None, 0);
+        let flat = Interval::of(&[0.0, 1.0], &[0.0, 0.0], None, None, 0);
         assert!(flat.duration().is_err());
     }
 
     #[test]
     fn the_law_and_its_inverse_agree() {
-        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, 0);
+        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, None, 0);
         // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
         let dur = iv.duration().unwrap();
         assert!((dur - 0.8).abs() < 1e-15);
@@ -625,9 +840,102 @@ mod tests {
             assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
         }
         // From rest: u = ½ ü τ².
-        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, 0);
+        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, None, 0);
         let st = rest.at(0.5, rest.duration().unwrap());
         assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
         assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);
+    }
+
+    /// A cubic-law interval from b₀, ü₀ and the end slopes: b₁, ü₁ by the law's identities.
+    fn cubic(b0: f64, a0: f64, s0: f64, s1: f64, du: f64) -> Interval {
+        Interval {
+            du,
+            b0,
+            b1: b0 + 2.0 * du * a0 + du * du * (2.0 * s0 + s1) / 3.0,
+            a0,
+            a1: a0 + 0.5 * du * (s0 + s1),
+            s0,
+            s1,
+            law: Law::Cubic,
+        }
+    }
+
+    /// With equal end slopes the cubic law is the quadratic one: the same durations and
+    /// states from two independent computations (closed forms against quadrature and Newton).
+    #[test]
+    fn cubic_with_equal_slopes_is_the_quadratic_law() {
+        for (b0, a0, a1, du) in [
+            (4.0, 1.0, 3.0, 0.5),
+            (9.0, -2.0, 1.0, 0.7),
+            (1.0, 0.5, -1.5, 0.3),
+        ] {
+            let q = quad(b0, a0, a1, du);
+            let alpha = (a1 - a0) / du;
+            let c = cubic(b0, a0, alpha, alpha, du);
+            assert!((c.b1 - q.b1).abs() < 1e-12 && (c.a1 - q.a1).abs() < 1e-12);
+            let (dq, dc) = (q.duration().unwrap(), c.duration().unwrap());
+            assert!((dq - dc).abs() < 1e-12 * dq, "{dq} vs {dc}");
+            for f in [0.1, 0.37, 0.5, 0.9] {
+                let (sq, sc) = (q.at(f * dq, dq), c.at(f * dq, dq));
+                assert!((sq.x - sc.x).abs() < 1e-11 * du, "{sq:?} {sc:?}");
+                assert!((sq.b - sc.b).abs() < 1e-10 && (sq.udd - sc.udd).abs() < 1e-10);
+                assert!((sq.uddd - sc.uddd).abs() < 1e-9);
+            }
+        }
+    }
+
+    /// The cubic law against its definition: the duration against composite Simpson on 20,000
+    /// panels, x(τ) inverting the time, db/dx = 2ü and dü/dx = a' by differences, u⃛ = a' u̇,
+    /// and the ends' states.
+    #[test]
+    fn cubic_law_agrees_with_its_definition() {
+        for (b0, a0, s0, s1, du) in [
+            (4.0, 1.0, 6.0, -2.0, 0.5),
+            (2.0, -1.5, 1.0, 8.0, 0.6),
+            (0.05, 0.0, 3.0, -1.0, 0.4),
+        ] {
+            let iv = cubic(b0, a0, s0, s1, du);
+            let n = 20_000;
+            let h = du / n as f64;
+            let f = |x: f64| 1.0 / iv.cubic_b(x).sqrt();
+            let simpson: f64 = (0..n)
+                .map(|k| {
+                    let x = k as f64 * h;
+                    h / 6.0 * (f(x) + 4.0 * f(x + 0.5 * h) + f(x + h))
+                })
+                .sum();
+            let dur = iv.duration().unwrap();
+            assert!((dur - simpson).abs() < 1e-10 * dur, "{dur} vs {simpson}");
+            for frac in [0.05, 0.3, 0.5, 0.77, 0.99] {
+                let st = iv.at(frac * dur, dur);
+                let back = iv.time_to_x(st.x).unwrap();
+                assert!(
+                    (back - frac * dur).abs() < 1e-11 * dur,
+                    "{back} vs {}",
+                    frac * dur
+                );
+                let e = 1e-6;
+                let (bp, ap) = iv.at_x(st.x + e);
+                let (bm, am) = iv.at_x(st.x - e);
+                assert!(((bp - bm) / (2.0 * e) - 2.0 * st.udd).abs() < 1e-6);
+                let slope = iv.slope_at_x(st.x);
+                assert!(((ap - am) / (2.0 * e) - slope).abs() < 1e-6);
+                assert!((st.uddd - slope * st.ud).abs() < 1e-12 * (1.0 + st.uddd.abs()));
+            }
+            let (e0, e1) = iv.ends();
+            assert!((e0.uddd - s0 * b0.sqrt()).abs() < 1e-12);
+            assert!((e1.uddd - s1 * iv.b1.sqrt()).abs() < 1e-12);
+            let end = iv.at(dur, dur);
+            assert!((end.b - iv.b1).abs() < 1e-12 && (end.udd - iv.a1).abs() < 1e-12);
+        }
+    }
+
+    /// A cubic whose b reaches 0 inside the interval stalls.
+    #[test]
+    fn cubic_stall_is_an_error() {
+        // b(x) = 1 − 2x + x² − …: ü < 0 pulls b to 0 near x = 1.
+        let iv = cubic(1.0, -1.0, 1.0, 1.0, 2.0);
+        assert!(iv.cubic_b_min() <= 1e-12);
+        assert!(iv.duration().is_err());
     }
 }

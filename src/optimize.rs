@@ -802,10 +802,11 @@ impl Plan<'_> {
     /// says it needs to come under the threshold (a first-order prediction, so most intervals
     /// need one round).
     ///
-    /// Why it pays: where the jerk limit holds a ramp, ü is linear between stations, so its
-    /// slope is constant and meets the bound j/√b only at the interval's faster end: the time
-    /// lost is first order in Δu there, and only there. Halving every interval (the uniform
-    /// doubling) spends most stations on plateaus that are already exact.
+    /// Why it pays: the error sits where the jerk limit holds a ramp (a' follows a bound that
+    /// varies along each interval; under the cubic law of [`crate::motion::Law::Cubic`] the
+    /// time lost there is of second order in Δu), at rest ends and at corners. Halving every
+    /// interval (the uniform doubling) spends most stations on plateaus that are already
+    /// exact.
     ///
     /// Only F is solved after the first round: the next G's intervals are intervals of G or
     /// of F, whose times are known, and the next F contains the last F. Its SCP starts from
@@ -838,7 +839,14 @@ impl Plan<'_> {
                 }
                 let raw: f64 = rounds.iter().map(|r| r.eps.iter().sum::<f64>()).sum();
                 // ρ is observed from the third round on; before, the estimate assumes p = 1.
-                (raw * rho / (1.0 - rho), refinement.len() >= 2)
+                // No finer than the SCP resolves: its windows stop when T changes by less
+                // than `jerk.convergence` (the cubic law's discretisation error can fall below
+                // that, e.g. 2.8e-7 on a rest-to-rest line).
+                let tail = raw * rho / (1.0 - rho);
+                (
+                    tail.max(options.jerk.convergence * time),
+                    refinement.len() >= 2,
+                )
             },
             |si, r, threshold| self.next_jerk_round(si, options, r, threshold),
             |estimate, stations| {

@@ -82,7 +82,7 @@ pub fn jerk_ratios(
     let last = knots.len() - 2;
     let mut out = Vec::with_capacity(p.intervals());
     for k in 0..p.intervals() {
-        let iv = Interval::of(&p.u, &sol.b, Some(a), k);
+        let iv = Interval::of(&p.u, &sol.b, Some(a), sol.slopes.as_deref(), k);
         let (s0, s1) = iv.ends();
         let mut best = (0.0, 0);
         for (e, st) in [(k, s0), (k + 1, s1)] {

@@ -153,6 +153,9 @@ pub struct SpanTimeline {
     pub b: Vec<f64>,
     /// ü at the stations of a jerk-limited profile.
     pub a: Option<Vec<f64>>,
+    /// a' at both ends of every interval of a jerk-limited profile with quadratic ü
+    /// ([`crate::motion::Law::Cubic`]).
+    pub slopes: Option<Vec<[f64; 2]>>,
     /// Time at each station, s (the schedule's).
     pub t: Vec<f64>,
     /// Arc length at each station, mm (the schedule's).
@@ -162,7 +165,13 @@ pub struct SpanTimeline {
 impl SpanTimeline {
     /// Interval `i` (stations i, i + 1).
     pub fn interval(&self, i: usize) -> Interval {
-        Interval::of(&self.u, &self.b, self.a.as_deref(), i)
+        Interval::of(
+            &self.u,
+            &self.b,
+            self.a.as_deref(),
+            self.slopes.as_deref(),
+            i,
+        )
     }
 
     /// The interval containing `u` (the last one at the span's end).
@@ -213,6 +222,7 @@ impl Timeline {
                 u: p.u.clone(),
                 b: sol.b.clone(),
                 a: sol.a.clone(),
+                slopes: sol.slopes.clone(),
                 t: st.iter().map(|s| s.t).collect(),
                 s: st.iter().map(|s| s.s).collect(),
             });

@@ -286,6 +286,7 @@ pub fn solve_with_sensitivity(
     Ok((
         SpanSolution {
             a: None,
+            slopes: None,
             b,
             status,
             iterations: sol.iterations,
@@ -365,6 +366,7 @@ pub fn solve_windowed(
     }
     Ok(SpanSolution {
         a: None,
+        slopes: None,
         b,
         status,
         iterations,

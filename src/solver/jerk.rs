@@ -14,11 +14,16 @@
 //!
 //! ## Discretisation (see [`crate::motion`])
 //!
-//! Variables b_i and a_i at every station; a is linear in u between stations, so b is
-//! quadratic there and `b_{k+1} − b_k = Δu_k (a_k + a_{k+1})` (an equality per interval), a'
-//! is constant per interval, q̈ is continuous and q⃛ is bounded. The jerk rows are stated at
-//! both ends e of every interval k, with that interval's a' = (a_{k+1} − a_k)/Δu_k and q''' on
-//! its side of a knot. A rest-to-rest span starts and ends with a constant-jerk interval
+//! Variables b_i and a_i at every station; between stations b is the cubic with b and
+//! b' = 2a given at both ends (Hermite: [`crate::motion::Law::Cubic`]), so a is quadratic and
+//! a' linear there, its end values σ⁰_k, σ¹_k linear in (b_k, b_{k+1}, a_k, a_{k+1}); q̈ is
+//! continuous, q⃛ bounded and free to jump at a station. The jerk rows are stated at both ends
+//! e of every interval k, with that interval's a' at e and q''' on its side of a knot. (With
+//! a' constant per interval — b quadratic, `b_{k+1} − b_k = Δu_k (a_k + a_{k+1})` — a jerk
+//! limit that holds a ramp is met at one end of each interval only, and the time lost is of
+//! first order in Δu; a linear a' follows the bound to second order. The first subproblem
+//! from the reach profile is solved with those equalities, "tied", which tie ü to b from the
+//! span's ends; later ones free the slopes.) A rest-to-rest span starts and ends with a constant-jerk interval
 //! (`u = j t³/6`: b ∝ u^{4/3}, which no quadratic reaches in finite time): there
 //! `a_1 = 2 b_1 / (3 Δu_0)`, its time is `3 Δu_0 / √b_1`, and every axis's jerk is
 //! `c(t) · b_1^{3/2}` with c known along the interval — a plain upper bound on b_1.
@@ -468,16 +473,34 @@ impl Layout {
 pub struct Warm {
     pub b: Vec<f64>,
     pub a: Vec<f64>,
+    /// a' at both ends of every interval.
+    pub slopes: Vec<[f64; 2]>,
     /// Stations that were not stations of the previous profile.
     pub fresh: Vec<bool>,
 }
 
 impl Warm {
-    /// `old`'s profile (b and ü under its motion laws) at the stations of `p`; `None` if `old`
-    /// is not jerk-limited.
+    /// `old`'s profile (b, ü and a' under its motion laws) at the stations of `p`; `None` if
+    /// `old` is not jerk-limited. Where every new interval lies inside an old one (a
+    /// refinement), the cubic law carries the profile over exactly.
     pub fn resample(old_p: &SpanProblem, old: &SpanSolution, p: &SpanProblem) -> Option<Warm> {
         let a_old = old.a.as_deref()?;
+        let s_old = old.slopes.as_deref();
         let n = p.u.len();
+        let last = old_p.intervals() - 1;
+        let mut slopes = Vec::with_capacity(n.saturating_sub(1));
+        let mut k = 0;
+        for j in 0..n.saturating_sub(1) {
+            let mid = 0.5 * (p.u[j] + p.u[j + 1]);
+            while k < last && old_p.u[k + 1] <= mid {
+                k += 1;
+            }
+            let iv = Interval::of(&old_p.u, &old.b, Some(a_old), s_old, k);
+            slopes.push([
+                iv.slope_at_x(p.u[j] - old_p.u[k]),
+                iv.slope_at_x(p.u[j + 1] - old_p.u[k]),
+            ]);
+        }
         let (mut b, mut a, mut fresh) = (
             Vec::with_capacity(n),
             Vec::with_capacity(n),
@@ -489,13 +512,18 @@ impl Warm {
             while k < last && old_p.u[k + 1] <= u {
                 k += 1;
             }
-            let iv = Interval::of(&old_p.u, &old.b, Some(a_old), k);
+            let iv = Interval::of(&old_p.u, &old.b, Some(a_old), s_old, k);
             let (bu, au) = iv.at_x(u - old_p.u[k]);
             b.push(bu);
             a.push(au);
             fresh.push(u != old_p.u[k] && u != old_p.u[k + 1]);
         }
-        Some(Warm { b, a, fresh })
+        Some(Warm {
+            b,
+            a,
+            slopes,
+            fresh,
+        })
     }
 }
 
@@ -527,11 +555,13 @@ pub fn solve(
         Some(w) => Start {
             b: &w.b,
             a: Some(&w.a),
+            slopes: Some(&w.slopes),
             fresh: Some(&w.fresh),
         },
         None => Start {
             b: &greedy.b,
             a: None,
+            slopes: None,
             fresh: None,
         },
     };
@@ -554,6 +584,7 @@ pub fn solve(
                 return Ok(SpanSolution {
                     b: w.b[a..=b].to_vec(),
                     a: Some(w.a[a..=b].to_vec()),
+                    slopes: Some(w.slopes[a..b].to_vec()),
                     status: Status::Optimal,
                     iterations: 0,
                     solve_time: 0.0,
@@ -567,6 +598,7 @@ pub fn solve(
             let ws = Start {
                 b: &start.b[a..=b],
                 a: start.a.map(|x| &x[a..=b]),
+                slopes: start.slopes.map(|x| &x[a..b]),
                 fresh: start.fresh.map(|x| &x[a..=b]),
             };
             solve_piece(&wp, &wjd, &ws, (aa, ab), settings, options)
@@ -592,6 +624,8 @@ pub fn solve(
 struct Start<'a> {
     b: &'a [f64],
     a: Option<&'a [f64]>,
+    /// a' at both ends of every interval (with `a`).
+    slopes: Option<&'a [[f64; 2]]>,
     /// Stations where a warm start's profile is interpolated, not solved: no window ends
     /// there (its b and ü need not be feasible on the new stations).
     fresh: Option<&'a [bool]>,
@@ -673,6 +707,7 @@ fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<us
 fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Result<SpanSolution> {
     let mut b = Vec::new();
     let mut a = Vec::new();
+    let mut slopes = Vec::new();
     let (mut status, mut iterations, mut scp) = (Status::Optimal, 0, 0);
     for (w, r) in results.into_iter().enumerate() {
         let s = r?;
@@ -681,12 +716,14 @@ fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Res
         debug_assert_eq!(s.b.len(), windows[w].1 - windows[w].0 + 1);
         b.extend_from_slice(&s.b[from..]);
         a.extend_from_slice(&s.a.as_deref().unwrap_or_default()[from..]);
+        slopes.extend_from_slice(s.slopes.as_deref().unwrap_or_default());
         status = status.worst(s.status);
         iterations += s.iterations;
     }
     Ok(SpanSolution {
         b,
         a: Some(a),
+        slopes: Some(slopes),
         status,
         iterations,
         solve_time: 0.0,
@@ -706,6 +743,7 @@ fn solve_piece(
 ) -> Result<SpanSolution> {
     let mut bbar = start.b.to_vec();
     let mut abar: Option<Vec<f64>> = start.a.map(<[f64]>::to_vec);
+    let mut sbar: Option<Vec<[f64; 2]>> = start.slopes.map(<[[f64; 2]]>::to_vec);
     // The time of the previous profile, for the stopping test.
     let mut last_time: Option<f64> = match &abar {
         Some(a) => Some(
@@ -714,6 +752,7 @@ fn solve_piece(
                 &SpanSolution {
                     b: bbar.clone(),
                     a: Some(a.clone()),
+                    slopes: sbar.clone(),
                     status: Status::Optimal,
                     iterations: 0,
                     solve_time: 0.0,
@@ -733,7 +772,34 @@ fn solve_piece(
     let mut from_iterate = false;
     let mut subproblems = 0;
     for it in 0..options.max_iterations.max(1) {
-        let mut sol = match program.solve(&bbar, abar.as_deref(), settings, &mut carried) {
+        // From the reach profile (no slopes yet) the first subproblem keeps a' constant per
+        // interval (the quadratic law), which ties ü to b from the span's ends on; later ones
+        // free both ends of every interval. Where Clarabel fails on the free form (it did on
+        // short rest-to-rest spans whose rows are nearly all active), the tied form is tried.
+        let solved = program
+            .solve(
+                &bbar,
+                abar.as_deref(),
+                sbar.as_deref(),
+                sbar.is_none(),
+                settings,
+                &mut carried,
+            )
+            .or_else(|e| {
+                if sbar.is_none() {
+                    return Err(e);
+                }
+                tracing::debug!("SCP {it}: {e}; again with a' constant per interval");
+                program.solve(
+                    &bbar,
+                    abar.as_deref(),
+                    sbar.as_deref(),
+                    true,
+                    settings,
+                    &mut carried,
+                )
+            });
+        let mut sol = match solved {
             Ok(sol) => sol,
             // Every iterate is jerk-feasible: when a later subproblem fails (a time limit,
             // a numerical stall), the best iterate so far is a valid answer, not yet
@@ -768,6 +834,17 @@ fn solve_piece(
                 let trial = SpanSolution {
                     b: mix(&bbar, &sol.b),
                     a: sol.a.as_deref().map(|a| mix(a0, a)),
+                    slopes: match (sbar.as_deref(), sol.slopes.as_deref()) {
+                        (Some(old), Some(new)) => Some(
+                            old.iter()
+                                .zip(new)
+                                .map(|(o, n)| {
+                                    [o[0] + step * (n[0] - o[0]), o[1] + step * (n[1] - o[1])]
+                                })
+                                .collect(),
+                        ),
+                        _ => sol.slopes.clone(),
+                    },
                     ..sol.clone()
                 };
                 let t = interval_times(p, &trial)?.iter().sum();
@@ -787,6 +864,7 @@ fn solve_piece(
         last_time = Some(time);
         bbar.clone_from(&sol.b);
         abar.clone_from(&sol.a);
+        sbar.clone_from(&sol.slopes);
         if best.as_ref().is_none_or(|(_, t)| time <= *t) {
             best = Some((sol, time));
         }
@@ -802,10 +880,11 @@ fn solve_piece(
     Ok(sol)
 }
 
-/// A linear expression in the scaled variables with at most four terms, and a constant.
+/// A linear expression in the scaled variables with at most five terms (a dip row inside an
+/// interval: x_k, x_{k+1}, y_k and both slopes), and a constant.
 #[derive(Debug, Clone, Copy, Default)]
 struct Lin {
-    terms: [(usize, f64); 4],
+    terms: [(usize, f64); 5],
     len: usize,
     constant: f64,
 }
@@ -849,20 +928,21 @@ impl Lin {
 #[derive(Debug, Clone, Copy)]
 enum BbarAt {
     Station(usize),
-    /// Inside interval k: `b_k + wa·a_k + wb·a_{k+1}` under the previous profile's quadratic
-    /// law, or `(1 − θ) b_k + θ b_{k+1}` for the reach profile (no ü).
+    /// Inside interval k at x = θΔu: `b_k + 2 a_k x + w0 σ⁰_k + w1 σ¹_k` under the previous
+    /// profile's cubic law, or `(1 − θ) b_k + θ b_{k+1}` for the reach profile (no ü).
     Inside {
         k: usize,
         theta: f64,
-        wa: f64,
-        wb: f64,
+        x: f64,
+        w0: f64,
+        w1: f64,
     },
 }
 
 /// A point of the path where rows are stated: a station (acceleration), an end of an interval
 /// (jerk, with that interval's a'), or a collocation point (velocity, acceleration, jerk).
 struct Site<'a> {
-    /// b/B, ü/B and (for jerk) a'/B = (ü_{k+1} − ü_k)/(B Δu) there.
+    /// b/B, ü/B and (for jerk) a'/B there (the cubic law's, linear in the stations' x, y).
     xb: Lin,
     ya: Lin,
     slope: Lin,
@@ -922,6 +1002,8 @@ struct Program<'a> {
     /// Candidate rows: site index and kind, in site order.
     cands: Vec<(u32, Kind)>,
     eq: Rows,
+    /// The equalities of a tied subproblem (a' constant per interval).
+    tied: Rows,
     /// The velocity bounds at the stations (always stated: they keep the LP bounded).
     lin: Rows,
     /// ü at the first and last station.
@@ -972,8 +1054,23 @@ impl<'a> Program<'a> {
             }
         };
 
-        // Equalities (zero cone): b_{k+1} − b_k = Δu (a_k + a_{k+1}) on quadratic intervals;
-        // the constant-jerk ends: a_1 = 2 b_1/(3Δu_0), a_{N−1} = −2 b_{N−1}/(3Δu_{N−1}).
+        // The slopes σ⁰_k, σ¹_k (a'/B at the start and end of interval k) of the cubic law
+        // ([`crate::motion::Law::Cubic`]): b is the cubic with b and b' = 2ü given at both
+        // stations (Hermite), so with D = (x_{k+1} − x_k)/Δu²,
+        // σ⁰ = 3D − (4y_k + 2y_{k+1})/Δu and σ¹ = −3D + (2y_k + 4y_{k+1})/Δu.
+        let sv = |k: usize, end: usize| {
+            let du = p.du(k);
+            let d = x(k + 1).add(&x(k), -1.0);
+            let (wk, wk1) = if end == 0 { (-4.0, -2.0) } else { (2.0, 4.0) };
+            let sign = if end == 0 { 3.0 } else { -3.0 };
+            Lin::default()
+                .add(&d, sign / (du * du))
+                .add(&y(k), wk / du)
+                .add(&y(k + 1), wk1 / du)
+        };
+        // Equalities (zero cone): the constant-jerk ends, a_1 = 2 b_1/(3Δu_0) and
+        // a_{N−1} = −2 b_{N−1}/(3Δu_{N−1}). (A tied subproblem adds
+        // b_{k+1} − b_k = Δu (a_k + a_{k+1}) on every other interval: σ⁰ = σ¹.)
         let mut eq = Rows::default();
         for k in 0..n {
             let du = p.du(k);
@@ -982,12 +1079,18 @@ impl<'a> Program<'a> {
             } else if k + 1 == n && rest_end {
                 y(n - 1).add(&x(n - 1), 2.0 / (3.0 * du))
             } else {
-                x(k + 1)
-                    .add(&x(k), -1.0)
-                    .add(&y(k), -du)
-                    .add(&y(k + 1), -du)
+                continue;
             };
             eq.push(&e.terms[..e.len], -e.constant);
+        }
+        let mut tied = Rows::default();
+        for k in (0..n).filter(|&k| !is_rest(k)) {
+            let du = p.du(k);
+            let e = x(k + 1)
+                .add(&x(k), -1.0)
+                .add(&y(k), -du)
+                .add(&y(k + 1), -du);
+            tied.push(&e.terms[..e.len], -e.constant);
         }
 
         // The sites: stations (velocity in `lin`, acceleration), both ends of every quadratic
@@ -1020,14 +1123,11 @@ impl<'a> Program<'a> {
         }
         for k in (0..n).filter(|&k| !is_rest(k)) {
             let du = p.du(k);
-            let slope = Lin::default()
-                .add(&y(k + 1), 1.0 / du)
-                .add(&y(k), -1.0 / du);
-            for (e, d3) in [(k, &jd.right[k]), (k + 1, &jd.left[k + 1])] {
+            for (end, e, d3) in [(0, k, &jd.right[k]), (1, k + 1, &jd.left[k + 1])] {
                 sites.push(Site {
                     xb: x(e),
                     ya: y(e),
-                    slope,
+                    slope: sv(k, end),
                     chord: Lin::default(),
                     jets: &p.jets[e],
                     d3: Some(d3),
@@ -1036,15 +1136,19 @@ impl<'a> Program<'a> {
                     at: BbarAt::Station(e),
                 });
             }
-            // At θ: b(x) = b_k + (2x − x²/Δu) a_k + (x²/Δu) a_{k+1} (x = θΔu),
-            // a(x) = (1 − θ) a_k + θ a_{k+1}.
+            // At x = θΔu: b(x) = b_k + 2x a_k + (x² − x³/(3Δu)) σ⁰ + (x³/(3Δu)) σ¹,
+            // a(x) = a_k + (x − x²/(2Δu)) σ⁰ + (x²/(2Δu)) σ¹, a'(x) = (1 − θ) σ⁰ + θ σ¹.
             for m in &jd.mid[jd.mid_start[k]..jd.mid_start[k + 1]] {
                 let (th, xx) = (m.theta, m.theta * du);
-                let (wa, wb) = (2.0 * xx - xx * xx / du, xx * xx / du);
+                let (w0, w1) = (xx * xx - xx.powi(3) / (3.0 * du), xx.powi(3) / (3.0 * du));
+                let (v0, v1) = (xx - xx * xx / (2.0 * du), xx * xx / (2.0 * du));
                 sites.push(Site {
-                    xb: x(k).add(&y(k), wa).add(&y(k + 1), wb),
-                    ya: Lin::default().add(&y(k), 1.0 - th).add(&y(k + 1), th),
-                    slope,
+                    xb: x(k)
+                        .add(&y(k), 2.0 * xx)
+                        .add(&sv(k, 0), w0)
+                        .add(&sv(k, 1), w1),
+                    ya: y(k).add(&sv(k, 0), v0).add(&sv(k, 1), v1),
+                    slope: Lin::default().add(&sv(k, 0), 1.0 - th).add(&sv(k, 1), th),
                     chord: Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th),
                     jets: &m.jets,
                     d3: Some(&m.d3),
@@ -1053,8 +1157,9 @@ impl<'a> Program<'a> {
                     at: BbarAt::Inside {
                         k,
                         theta: th,
-                        wa,
-                        wb,
+                        x: xx,
+                        w0,
+                        w1,
                     },
                 });
             }
@@ -1126,6 +1231,7 @@ impl<'a> Program<'a> {
             sites,
             cands,
             eq,
+            tied,
             lin,
             a_ends,
             soc,
@@ -1138,13 +1244,33 @@ impl<'a> Program<'a> {
     }
 
     /// b̄ at every site under the linearisation point.
-    fn bbar_at_sites(&self, bbar: &[f64], abar: Option<&[f64]>) -> Vec<f64> {
+    fn bbar_at_sites(
+        &self,
+        bbar: &[f64],
+        abar: Option<&[f64]>,
+        sbar: Option<&[[f64; 2]]>,
+    ) -> Vec<f64> {
         self.sites
             .iter()
             .map(|s| match s.at {
                 BbarAt::Station(i) => bbar[i],
-                BbarAt::Inside { k, theta, wa, wb } => match abar {
-                    Some(a) => bbar[k] + wa * a[k] + wb * a[k + 1],
+                BbarAt::Inside {
+                    k,
+                    theta,
+                    x,
+                    w0,
+                    w1,
+                } => match abar {
+                    Some(a) => {
+                        let [s0, s1] = match sbar {
+                            Some(sl) => sl[k],
+                            None => {
+                                let g = (a[k + 1] - a[k]) / self.p.du(k);
+                                [g, g]
+                            }
+                        };
+                        bbar[k] + 2.0 * a[k] * x + w0 * s0 + w1 * s1
+                    }
                     None => (1.0 - theta) * bbar[k] + theta * bbar[k + 1],
                 },
             })
@@ -1252,6 +1378,8 @@ impl<'a> Program<'a> {
         &self,
         bbar: &[f64],
         abar: Option<&[f64]>,
+        sbar: Option<&[[f64; 2]]>,
+        tie: bool,
         settings: &SolverSettings,
         carried: &mut Vec<bool>,
     ) -> Result<SpanSolution> {
@@ -1282,7 +1410,7 @@ impl<'a> Program<'a> {
                 q[lay.d(k)] = if self.is_rest(k) { 3.0 } else { 2.0 } * p.du(k) / scale.sqrt();
             }
         }
-        let bbar_sites = self.bbar_at_sites(bbar, abar);
+        let bbar_sites = self.bbar_at_sites(bbar, abar, sbar);
 
         // Active set over every row but the equalities and the velocity bounds at the stations:
         // most are far from binding. Start with those within ACTIVE_AT of their bound at the
@@ -1301,8 +1429,19 @@ impl<'a> Program<'a> {
         let mut vals = Vec::with_capacity(self.cands.len());
         self.values(&zbar, &bbar_sites, &mut vals);
         let keep = carried.len() == self.cands.len();
-        let mut active: Vec<bool> = (0..self.cands.len())
-            .map(|r| (keep && carried[r]) || vals[r] >= ACTIVE_AT)
+        // With free slopes, b and ü at a station are independent: the stations' acceleration
+        // rows (the first N − 1 sites) are always stated, as what bounds ü where no other row
+        // binds it.
+        let n_station_sites = (n - 1) as u32;
+        let mut active: Vec<bool> = self
+            .cands
+            .iter()
+            .enumerate()
+            .map(|(r, c)| {
+                (keep && carried[r])
+                    || vals[r] >= ACTIVE_AT
+                    || (!tie && c.0 < n_station_sites && matches!(c.1, Kind::Acceleration(..)))
+            })
             .collect();
         // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
         // cycle time is a tenth of what the iteration's own stopping test resolves.
@@ -1311,6 +1450,12 @@ impl<'a> Program<'a> {
         let (x, status) = loop {
             let mut all = Rows::default();
             all.append(&self.eq);
+            // `tie`: a' constant per interval (σ⁰ = σ¹, the quadratic law).
+            let mut n_eq = self.eq.len();
+            if tie {
+                all.append(&self.tied);
+                n_eq += self.tied.len();
+            }
             all.append(&self.lin);
             let mut n_rows = 0;
             for (r, _) in active.iter().enumerate().filter(|(_, a)| **a) {
@@ -1323,7 +1468,7 @@ impl<'a> Program<'a> {
             let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
             let pmat = CscMatrix::zeros((nv, nv));
             let mut cones = Vec::with_capacity(2 + self.n_soc);
-            cones.push(SupportedConeT::ZeroConeT(self.eq.len()));
+            cones.push(SupportedConeT::ZeroConeT(n_eq));
             if self.lin.len() + n_rows > 0 {
                 cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
             }
@@ -1383,8 +1528,20 @@ impl<'a> Program<'a> {
         }
         b.push(p.b_end);
         acc.push(self.a_ends.1);
+        // The slopes of the cubic law (the same Hermite identities as the rows').
+        let slopes = (0..n)
+            .map(|k| {
+                let du = p.du(k);
+                let d = 3.0 * (b[k + 1] - b[k]) / (du * du);
+                [
+                    d - (4.0 * acc[k] + 2.0 * acc[k + 1]) / du,
+                    -d + (2.0 * acc[k] + 4.0 * acc[k + 1]) / du,
+                ]
+            })
+            .collect();
         Ok(SpanSolution {
             a: Some(acc),
+            slopes: Some(slopes),
             b,
             status,
             iterations,

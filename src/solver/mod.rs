@@ -155,10 +155,14 @@ pub(crate) fn median_scale(values: &[f64]) -> f64 {
 pub struct SpanSolution {
     /// b = u̇² at every station.
     pub b: Vec<f64>,
-    /// ü at every station for a jerk-limited profile (ü continuous, b quadratic in u between
-    /// stations; see [`crate::motion`]); `None`: b linear in u between stations, ü constant
-    /// per interval.
+    /// ü at every station for a jerk-limited profile (ü continuous; b quadratic in u between
+    /// stations, or cubic with `slopes`; see [`crate::motion`]); `None`: b linear in u between
+    /// stations, ü constant per interval.
     pub a: Option<Vec<f64>>,
+    /// a' = dü/du at the start and end of every interval, for a jerk-limited profile whose ü
+    /// is quadratic between stations ([`crate::motion::Law::Cubic`]); `None` with `a`: ü
+    /// linear between stations.
+    pub slopes: Option<Vec<[f64; 2]>>,
     /// How the solve ended.
     pub status: Status,
     /// Interior-point iterations (0 for the reach pass).
@@ -176,7 +180,7 @@ pub fn interval_times(
     problem: &crate::constraints::SpanProblem,
     sol: &SpanSolution,
 ) -> crate::error::Result<Vec<f64>> {
-    crate::motion::interval_times(&problem.u, &sol.b, sol.a.as_deref())
+    crate::motion::interval_times(&problem.u, &sol.b, sol.a.as_deref(), sol.slopes.as_deref())
 }
 
 /// A sparse row block under construction (triplets in row order), with its right-hand side.
@@ -316,6 +320,7 @@ pub fn optimal(
     Ok(SpanSolution {
         b,
         a: None,
+        slopes: None,
         status,
         iterations,
         solve_time: t0.elapsed().as_secs_f64(),

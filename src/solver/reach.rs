@@ -333,6 +333,7 @@ fn passes(p: &SpanProblem, lattice_only: bool) -> Result<SpanSolution, Infeasibl
     }
     Ok(SpanSolution {
         a: None,
+        slopes: None,
         b,
         status: Status::Greedy,
         iterations: 0,
