@@ -295,48 +295,26 @@ pub fn capsule_row(a: [f64; 2], b: [f64; 2], r: f64, y: f64) -> Option<[f64; 2]>
             hi = hi.max(c[0] + s);
         }
     }
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    if len2 > 0.0 {
-        // With q = (x, y): 0 ≤ (q − a)·d ≤ |d|² and |(q − a) × d| ≤ r |d|, each k x + m in a
-        // range.
-        let mut band = [f64::NEG_INFINITY, f64::INFINITY];
-        let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
-            if k == 0.0 {
-                if m < c0 || m > c1 {
-                    band = [f64::INFINITY, f64::NEG_INFINITY];
-                }
-            } else {
-                let (u, v) = ((c0 - m) / k, (c1 - m) / k);
-                band[0] = band[0].max(u.min(v));
-                band[1] = band[1].min(u.max(v));
-            }
-        };
-        let w = r * len2.sqrt();
-        clip(dx, (y - a[1]) * dy - a[0] * dx, 0.0, len2);
-        clip(dy, -(y - a[1]) * dx - a[0] * dy, -w, w);
-        if band[0] <= band[1] {
-            lo = lo.min(band[0]);
-            hi = hi.max(band[1]);
-        }
+    // The band between the end discs: the rectangle of half-width r along the segment.
+    if let Some(band) = rectangle_row(a, b, r, 0.0, y).filter(|band| band[0] <= band[1]) {
+        lo = lo.min(band[0]);
+        hi = hi.max(band[1]);
     }
     (lo <= hi).then_some([lo - 1e-9, hi + 1e-9])
 }
 
-/// The x interval where the line at `y` meets the rectangle of half-width `r` about the
-/// segment from `a` to `b` (XY), lengthened by `ends` at both ends, if it does (widened by
-/// 1e-9 mm as [`capsule_row`]). A tilted tool (unit axis O, tip at `a`, flute end at `b`)
-/// lies in it with `ends` = R·|O_z|: a point of the disc of radius R normal to O projects
-/// onto the axis' XY direction û at most R·|O_z| = R·|(û, 0) − ((û, 0)·O) O| from its centre.
-/// `None` also where `a` = `b` (no direction: no bound).
-fn axis_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
+/// The x interval (empty where `[0] > [1]`) where the line at `y` meets the rectangle of
+/// half-width `r` about the segment from `a` to `b` (XY), lengthened by `ends` at both ends;
+/// `None` where `a` = `b` (no direction).
+fn rectangle_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let len2 = dx * dx + dy * dy;
     if len2 == 0.0 {
         return None;
     }
     let len = len2.sqrt();
-    // With q = (x, y): −ends·|d| ≤ (q − a)·d ≤ |d|² + ends·|d| and |(q − a) × d| ≤ r |d|.
+    // With q = (x, y): −ends·|d| ≤ (q − a)·d ≤ |d|² + ends·|d| and |(q − a) × d| ≤ r |d|,
+    // each k x + m in a range.
     let mut band = [f64::NEG_INFINITY, f64::INFINITY];
     let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
         if k == 0.0 {
@@ -352,7 +330,17 @@ fn axis_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64;
     let (e, w) = (ends * len, r * len);
     clip(dx, (y - a[1]) * dy - a[0] * dx, -e, len2 + e);
     clip(dy, -(y - a[1]) * dx - a[0] * dy, -w, w);
-    Some([band[0] - 1e-9, band[1] + 1e-9])
+    Some(band)
+}
+
+/// The x interval where the line at `y` meets the rectangle of half-width `r` about the
+/// segment from `a` to `b` (XY), lengthened by `ends` at both ends, if it does (widened by
+/// 1e-9 mm as [`capsule_row`]). A tilted tool (unit axis O, tip at `a`, flute end at `b`)
+/// lies in it with `ends` = R·|O_z|: a point of the disc of radius R normal to O projects
+/// onto the axis' XY direction û at most R·|O_z| = R·|(û, 0) − ((û, 0)·O) O| from its centre.
+/// `None` also where `a` = `b` (no direction: no bound).
+fn axis_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
+    rectangle_row(a, b, r, ends, y).map(|band| [band[0] - 1e-9, band[1] + 1e-9])
 }
 
 /// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule of
@@ -795,10 +783,7 @@ mod tests {
             let tool = Tool::new(dia, rc, 6.0, 2).unwrap();
             let cell = 0.1 + 0.1 * rnd();
             let mut d = Dexels::new(&stock, cell);
-            let mut cells: Vec<Vec<[f64; 2]>> = (0..d.ny)
-                .flat_map(|j| (0..d.nx).map(move |i| (i, j)))
-                .map(|(i, j)| stock.column(d.x(i), d.y(j)).into_iter().collect())
-                .collect();
+            let mut cells = d.dense_reference(&stock);
             let delta = pose_spacing(&tool, cell);
             let tilt = if case < 9 { 0.7 } else { 0.0 };
             let axis = |r: &mut dyn FnMut() -> f64| {

@@ -380,6 +380,18 @@ pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
 }
 
 #[cfg(test)]
+impl Dexels {
+    /// The stock's column at every dexel as a plain row-major grid of interval lists: the
+    /// reference the tiled storage and the cut are tested against.
+    pub(crate) fn dense_reference(&self, stock: &Stock) -> Vec<Vec<[f64; 2]>> {
+        (0..self.ny)
+            .flat_map(|j| (0..self.nx).map(move |i| (i, j)))
+            .map(|(i, j)| stock.column(self.x(i), self.y(j)).into_iter().collect())
+            .collect()
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -459,10 +471,7 @@ mod tests {
             };
             let cell = 0.05 + 0.1 * rnd();
             let mut d = Dexels::new(&s, cell);
-            let mut dense: Vec<Vec<[f64; 2]>> = (0..d.ny)
-                .flat_map(|j| (0..d.nx).map(move |i| (i, j)))
-                .map(|(i, j)| s.column(d.x(i), d.y(j)).into_iter().collect())
-                .collect();
+            let mut dense = d.dense_reference(&s);
             // Many removals on the dexels of a window across tile edges: splits and merges.
             let at = |u: f64, n: usize| (TILE - 4 + (24.0 * u) as usize).min(n - 1);
             for _ in 0..2000 {
