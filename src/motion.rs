@@ -116,6 +116,16 @@ pub fn interval_times(
         .collect()
 }
 
+/// The end slopes σ⁰, σ¹ of the cubic law ([`Law::Cubic`]) on an interval of length `du` when
+/// b is the Hermite cubic through b and b' = 2ü at both ends: their weights on
+/// (b_0, b_1, a_0, a_1), `σ⁰ = 3(b_1 − b_0)/Δu² − (4a_0 + 2a_1)/Δu` and
+/// `σ¹ = −3(b_1 − b_0)/Δu² + (2a_0 + 4a_1)/Δu`. (With `b_1 − b_0 = Δu (a_0 + a_1)` both are
+/// the quadratic law's `(a_1 − a_0)/Δu`.)
+pub fn hermite_slope_weights(du: f64) -> [[f64; 4]; 2] {
+    let (d, e) = (3.0 / (du * du), 1.0 / du);
+    [[-d, d, -4.0 * e, -2.0 * e], [d, -d, 2.0 * e, 4.0 * e]]
+}
+
 impl Interval {
     /// Interval `k` of a profile: `b` at the stations `u`, and `a` (ü at the stations) for a
     /// jerk-limited profile (`None`: [`Law::Linear`]), with `slopes` (a' at both ends of every

@@ -1056,17 +1056,15 @@ impl<'a> Program<'a> {
 
         // The slopes σ⁰_k, σ¹_k (a'/B at the start and end of interval k) of the cubic law
         // ([`crate::motion::Law::Cubic`]): b is the cubic with b and b' = 2ü given at both
-        // stations (Hermite), so with D = (x_{k+1} − x_k)/Δu²,
-        // σ⁰ = 3D − (4y_k + 2y_{k+1})/Δu and σ¹ = −3D + (2y_k + 4y_{k+1})/Δu.
+        // stations (Hermite): linear in x_k, x_{k+1}, y_k, y_{k+1}
+        // ([`crate::motion::hermite_slope_weights`]).
         let sv = |k: usize, end: usize| {
-            let du = p.du(k);
-            let d = x(k + 1).add(&x(k), -1.0);
-            let (wk, wk1) = if end == 0 { (-4.0, -2.0) } else { (2.0, 4.0) };
-            let sign = if end == 0 { 3.0 } else { -3.0 };
+            let w = crate::motion::hermite_slope_weights(p.du(k))[end];
             Lin::default()
-                .add(&d, sign / (du * du))
-                .add(&y(k), wk / du)
-                .add(&y(k + 1), wk1 / du)
+                .add(&x(k), w[0])
+                .add(&x(k + 1), w[1])
+                .add(&y(k), w[2])
+                .add(&y(k + 1), w[3])
         };
         // Equalities (zero cone): the constant-jerk ends, a_1 = 2 b_1/(3Δu_0) and
         // a_{N−1} = −2 b_{N−1}/(3Δu_{N−1}). (A tied subproblem adds
@@ -1528,15 +1526,12 @@ impl<'a> Program<'a> {
         }
         b.push(p.b_end);
         acc.push(self.a_ends.1);
-        // The slopes of the cubic law (the same Hermite identities as the rows').
+        // The slopes of the cubic law (the same weights as the rows').
         let slopes = (0..n)
             .map(|k| {
-                let du = p.du(k);
-                let d = 3.0 * (b[k + 1] - b[k]) / (du * du);
-                [
-                    d - (4.0 * acc[k] + 2.0 * acc[k + 1]) / du,
-                    -d + (2.0 * acc[k] + 4.0 * acc[k + 1]) / du,
-                ]
+                let v = [b[k], b[k + 1], acc[k], acc[k + 1]];
+                crate::motion::hermite_slope_weights(p.du(k))
+                    .map(|w| w.iter().zip(&v).map(|(w, v)| w * v).sum())
             })
             .collect();
         Ok(SpanSolution {
