@@ -298,6 +298,21 @@ impl JerkData {
 }
 
 impl JerkData {
+    /// The longest time an axis takes to ramp its acceleration from 0 to its limit at its jerk
+    /// limit, max_j a_j / j_j (s; 0 without jerk limits): about how early a jerk-limited
+    /// profile leaves a velocity plateau of the acceleration-limited one.
+    pub fn ramp_time(&self, p: &SpanProblem) -> f64 {
+        self.limits
+            .iter()
+            .zip(&p.acceleration)
+            .filter_map(|(j, a)| {
+                let j = (*j)?;
+                let jm = j.max.abs().min(j.min.abs());
+                (jm > 0.0).then(|| a.max.abs().max(a.min.abs()) / jm)
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The data of stations `a..=b` (intervals a..b), as [`SpanProblem::window`].
     pub fn window(&self, a: usize, b: usize) -> JerkData {
         let n = self.right.len() - 1;
@@ -566,16 +581,25 @@ pub fn solve(
         },
     };
     let threads = settings.worker_threads();
-    let cuts = cuts(p, &start, threads, options.window);
-    if cuts.len() > 2 {
-        let t0 = std::time::Instant::now();
+    let mut cuts = cuts(p, jd, &start, threads, options.window);
+    if cuts.len() <= 2 {
+        return solve_piece(p, jd, &start, (0.0, 0.0), settings, options);
+    }
+    let t0 = std::time::Instant::now();
+    // Solved windows, by their ends. A window that fails (its fixed ends can be out of reach:
+    // a plateau the jerk-limited profile leaves earlier than PLATEAU stations before the cut,
+    // or a kink of the bound at the cut) is merged with its neighbours and solved again; the
+    // others keep their profiles (their ends do not move). At worst the span is one piece.
+    let mut solved: Vec<((usize, usize), SpanSolution)> = Vec::new();
+    loop {
         let windows: Vec<(usize, usize)> = cuts.windows(2).map(|c| (c[0], c[1])).collect();
         // The windows at the span's ends first: their dense collocation and their start from
         // rest make them the slowest, and a slow window taken last leaves the other threads
         // idle.
         let last = windows.len() - 1;
-        let mut queue: Vec<usize> = vec![0, last];
+        let mut queue: Vec<usize> = if last == 0 { vec![0] } else { vec![0, last] };
         queue.extend(1..last);
+        queue.retain(|&w| !solved.iter().any(|(ab, _)| *ab == windows[w]));
         let results = super::par_map(&queue, threads, |&w| {
             let (a, b) = windows[w];
             if let Some(w) = warm.as_ref().filter(|w| !w.fresh[a..=b].contains(&true)) {
@@ -603,20 +627,34 @@ pub fn solve(
             };
             solve_piece(&wp, &wjd, &ws, (aa, ab), settings, options)
         });
-        let mut results: Vec<(usize, Result<SpanSolution>)> =
-            queue.into_iter().zip(results).collect();
-        results.sort_by_key(|(w, _)| *w);
-        let results = results.into_iter().map(|(_, r)| r).collect();
-        match stitch(&windows, results) {
-            Ok(mut sol) => {
-                sol.solve_time = t0.elapsed().as_secs_f64();
-                tracing::debug!("SCP in {} windows: {:?}", windows.len(), windows);
-                return Ok(sol);
+        let mut failed: Vec<(usize, usize)> = Vec::new();
+        let mut error = None;
+        for (w, r) in queue.into_iter().zip(results) {
+            match r {
+                Ok(sol) => solved.push((windows[w], sol)),
+                Err(e) => {
+                    failed.push(windows[w]);
+                    error = Some(e);
+                }
             }
-            Err(e) => tracing::debug!("SCP windows failed ({e}); one piece"),
         }
+        if let Some(e) = error {
+            if windows.len() == 1 {
+                return Err(e);
+            }
+            tracing::debug!("SCP windows {failed:?} failed ({e}); merged with their neighbours");
+            cuts.retain(|&c| c == 0 || c == n || !failed.iter().any(|&(a, b)| c == a || c == b));
+            solved.retain(|((a, b), _)| cuts.contains(a) && cuts.contains(b));
+            continue;
+        }
+        solved.sort_by_key(|(ab, _)| ab.0);
+        let (windows, results): (Vec<_>, Vec<_>) =
+            solved.into_iter().map(|(ab, sol)| (ab, Ok(sol))).unzip();
+        let mut sol = stitch(&windows, results)?;
+        sol.solve_time = t0.elapsed().as_secs_f64();
+        tracing::debug!("SCP in {} windows: {:?}", windows.len(), windows);
+        return Ok(sol);
     }
-    solve_piece(p, jd, &start, (0.0, 0.0), settings, options)
 }
 
 /// The first linearisation point: b at every station, and ü (a jerk-limited profile) or none
@@ -641,11 +679,29 @@ impl Start<'_> {
         }
         let a = match self.a {
             Some(a) => a[i],
-            None => 0.5 * (p.b_max[i + 1] - p.b_max[i - 1]) / (p.u[i + 1] - p.u[i - 1]),
+            None => {
+                // A flat plateau (the bound varies by less than FLAT around the cut, e.g. a feed
+                // cap): b at the lowest bound there and ü = 0, which stay feasible on both
+                // sides. The bound's central slope is noise there, and where its one-sided
+                // slopes differ (a kink) no ü keeps b under it on both sides: the windows of
+                // the bundled pocket with jerk limits were infeasible so, and the span fell
+                // back to one piece.
+                let near = &p.b_max[i.saturating_sub(PLATEAU)..=(i + PLATEAU).min(p.intervals())];
+                let lo = near.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = near.iter().copied().fold(0.0, f64::max);
+                if hi <= lo * (1.0 + FLAT) {
+                    return (self.b[i].min(lo), 0.0);
+                }
+                0.5 * (p.b_max[i + 1] - p.b_max[i - 1]) / (p.u[i + 1] - p.u[i - 1])
+            }
         };
         (self.b[i], a)
     }
 }
+
+/// A plateau of the reach profile whose bound varies by less than this (relative) around a
+/// cut is taken as flat there ([`Start::at`]).
+const FLAT: f64 = 1e-4;
 
 /// Stations fewer than this apart are not cut.
 const MIN_WINDOW: usize = 100;
@@ -660,7 +716,13 @@ pub const PLATEAU: usize = 5;
 /// Window boundaries `0 = c_0 < c_1 < … = N`: about `max(threads, N/window)` windows of similar
 /// length (none shorter than [`MIN_WINDOW`]), each cut at the plateau station nearest its
 /// target (within ±40 % of a window); targets without one are skipped.
-fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<usize> {
+fn cuts(
+    p: &SpanProblem,
+    jd: &JerkData,
+    start: &Start,
+    threads: usize,
+    window: usize,
+) -> Vec<usize> {
     let n = p.intervals();
     if window == usize::MAX {
         return vec![0, n];
@@ -673,16 +735,35 @@ fn cuts(p: &SpanProblem, start: &Start, threads: usize, window: usize) -> Vec<us
     if windows > 1 {
         // A jerk-limited start is on the bound wherever the optimum is (up to the refinement
         // that follows): its neighbours on the bound suffice.
+        // From the reach profile, the plateau must also reach a jerk ramp's length past the
+        // cut on both sides: the jerk-limited profile leaves it about that early (on the
+        // bundled pocket, 15 mm of a 150 mm/s feed cap with a/j = 0.1 s: ten stations, where
+        // PLATEAU = 5 made the windows infeasible).
         let half = if start.a.is_some() { 1 } else { PLATEAU };
+        let ramp = if start.a.is_some() {
+            0.0
+        } else {
+            jd.ramp_time(p)
+        };
         let on_plateau = |m: usize| {
-            m > half
-                && m + half < n
-                && (m - half..=m + half).all(|i| {
-                    p.b_max[i].is_finite()
-                        && p.b_max_by[i] == p.b_max_by[m]
-                        && start.b[i] >= (1.0 - 1e-4) * p.b_max[i]
-                        && !start.fresh.is_some_and(|f| f[i])
-                })
+            if m <= half || m + half >= n || !p.b_max[m].is_finite() {
+                return false;
+            }
+            let reach = 2.0 * ramp * p.b_max[m].sqrt();
+            let mut lo = m - half;
+            while lo > 1 && p.u[m] - p.u[lo] < reach {
+                lo -= 1;
+            }
+            let mut hi = m + half;
+            while hi + 1 < n && p.u[hi] - p.u[m] < reach {
+                hi += 1;
+            }
+            (lo..=hi).all(|i| {
+                p.b_max[i].is_finite()
+                    && p.b_max_by[i] == p.b_max_by[m]
+                    && start.b[i] >= (1.0 - 1e-4) * p.b_max[i]
+                    && !start.fresh.is_some_and(|f| f[i])
+            })
         };
         let len = n / windows;
         for w in 1..windows {
@@ -774,27 +855,29 @@ fn solve_piece(
     for it in 0..options.max_iterations.max(1) {
         // From the reach profile (no slopes yet) the first subproblem keeps a' constant per
         // interval (the quadratic law), which ties ü to b from the span's ends on; later ones
-        // free both ends of every interval. Where Clarabel fails on the free form (it did on
-        // short rest-to-rest spans whose rows are nearly all active), the tied form is tried.
+        // free both ends of every interval. Where Clarabel fails on one form, the other is
+        // tried: the free form failed on short rest-to-rest spans whose rows are nearly all
+        // active; the tied form is infeasible on a window whose ends fix both b and ü (the
+        // equalities then determine ü at both ends from b, which need not agree: the bundled
+        // pocket with jerk limits fell back to one piece, at 100–300 ms a subproblem).
+        let tie = sbar.is_none();
         let solved = program
             .solve(
                 &bbar,
                 abar.as_deref(),
                 sbar.as_deref(),
-                sbar.is_none(),
+                tie,
                 settings,
                 &mut carried,
             )
             .or_else(|e| {
-                if sbar.is_none() {
-                    return Err(e);
-                }
-                tracing::debug!("SCP {it}: {e}; again with a' constant per interval");
+                let form = if tie { "free" } else { "constant" };
+                tracing::debug!("SCP {it}: {e}; again with a' {form} per interval");
                 program.solve(
                     &bbar,
                     abar.as_deref(),
                     sbar.as_deref(),
-                    true,
+                    !tie,
                     settings,
                     &mut carried,
                 )
