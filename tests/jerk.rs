@@ -420,3 +420,46 @@ fn adaptive_jerk_refinement_approaches_the_closed_form_within_its_estimate() {
     );
     assert!(estimate <= 1e-3, "{estimate}");
 }
+
+/// The bundled 3-axis pocket with jerk = 10 × acceleration (a Clarabel-only problem: no
+/// closed form): the adaptive jerk-limited solve's estimate is honest against a grid twice as
+/// fine as the one it ends on (that solve is itself above the continuous optimum, so the true
+/// error is larger only by that solve's own error). Several of the pocket's SCP windows have
+/// ends the jerk-limited profile cannot meet from the reach profile (a feed-cap plateau it
+/// leaves earlier than the cut assumes); they are merged with their neighbours.
+#[test]
+fn bundled_pocket_with_jerk_limits_is_within_its_estimate() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/xyz_pocket");
+    let mut m = Machine::from_file(&dir.join("machine.json")).expect("machine");
+    for a in &mut m.axes {
+        a.jerk = Some(feedopt::machine::Limit {
+            min: 10.0 * a.acceleration.min,
+            max: 10.0 * a.acceleration.max,
+        });
+    }
+    let tp = feedopt::toolpath::read(&dir.join("pocket_contour.cls")).expect("toolpath");
+    let adaptive = optimize(&m, &tp, &Options::default()).expect("adaptive");
+    let t = adaptive.schedule.cycle_time;
+    let estimate = adaptive.error_estimate.expect("an estimate");
+    assert_verified_with_jerk(&adaptive, "pocket, adaptive");
+    let stations = adaptive.schedule.stations.len();
+    let o = Options {
+        stations: Some(2 * stations),
+        refine_until_verified: false,
+        ..Options::default()
+    };
+    let finer = optimize(&m, &tp, &o)
+        .expect("fixed grid")
+        .schedule
+        .cycle_time;
+    eprintln!(
+        "pocket with jerk: adaptive {t:.6} s on {stations} stations (estimate {estimate:.2e}); \
+         ×2 stations {finer:.6} s ({:.2e})",
+        t / finer - 1.0
+    );
+    assert!(
+        t / finer - 1.0 <= estimate,
+        "{t} vs {finer}: more than the estimate {estimate}"
+    );
+    assert!(estimate <= 1e-3, "{estimate}");
+}
