@@ -69,6 +69,34 @@ pub struct Interval {
     pub law: Law,
 }
 
+/// An [`Interval`] evaluated at non-decreasing times ([`Interval::marcher`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Marcher<'a> {
+    iv: &'a Interval,
+    dur: f64,
+    /// The last instant's x and τ.
+    x: f64,
+    t: f64,
+}
+
+impl Marcher<'_> {
+    /// The motion `tau` after the interval's start, as [`Interval::at`]; `tau` should not
+    /// decrease from one call to the next (if it does, the cubic law starts over from the
+    /// interval's start).
+    pub fn at(&mut self, tau: f64) -> State {
+        if self.iv.law != Law::Cubic {
+            return self.iv.at(tau, self.dur);
+        }
+        let tau = tau.clamp(0.0, self.dur);
+        if tau < self.t {
+            (self.x, self.t) = (0.0, 0.0);
+        }
+        let x = self.iv.cubic_x_from(self.x, self.t, tau, self.dur);
+        (self.x, self.t) = (x, tau);
+        self.iv.cubic_state(x)
+    }
+}
+
 /// The motion at one instant of an interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct State {
@@ -318,20 +346,36 @@ impl Interval {
         adapt(self, p, q, whole, 1e-13 * whole.abs(), &mut budget)
     }
 
-    /// x reached τ after the start (cubic law): the root of `T(x) = τ`, T increasing with
-    /// T' = 1/√b, by Newton's method kept inside a shrinking bracket (bisection where a step
-    /// would leave it), each T(x) the last one plus the integral over the step.
-    fn cubic_x_at(&self, tau: f64, dur: f64) -> f64 {
-        if tau <= 0.0 {
-            return 0.0;
+    /// The motion at x under the cubic law.
+    fn cubic_state(&self, x: f64) -> State {
+        let b = self.cubic_b(x).max(0.0);
+        let ud = b.sqrt();
+        State {
+            x,
+            ud,
+            b,
+            udd: self.cubic_a(x),
+            uddd: self.cubic_slope(x) * ud,
+        }
+    }
+
+    /// x reached τ after the start (cubic law), given that x0 is reached at t0 ≤ τ: the root of
+    /// `T(x) = τ`, T increasing with T' = 1/√b, by Newton's method kept inside a shrinking
+    /// bracket [x0, Δu] (bisection where a step would leave it), each T(x) the last one plus
+    /// the integral over the step.
+    fn cubic_x_from(&self, x0: f64, t0: f64, tau: f64, dur: f64) -> f64 {
+        if tau <= t0 {
+            return x0;
         }
         if tau >= dur {
             return self.du;
         }
-        let (mut lo, mut hi) = (0.0, self.du);
-        // A first guess from the start's motion: x ≈ √b₀ τ + a₀ τ²/2.
-        let mut x = (self.b0.sqrt() * tau + 0.5 * self.a0 * tau * tau).clamp(0.0, self.du);
-        let mut t = self.cubic_time(0.0, x);
+        let (mut lo, mut hi) = (x0, self.du);
+        // A first guess from the motion at x0: x ≈ x0 + √b dτ + ü dτ²/2.
+        let dt = tau - t0;
+        let (b0, a0) = (self.cubic_b(x0).max(0.0), self.cubic_a(x0));
+        let mut x = (x0 + b0.sqrt() * dt + 0.5 * a0 * dt * dt).clamp(x0, self.du);
+        let mut t = t0 + self.cubic_time(x0, x);
         for _ in 0..100 {
             let err = t - tau;
             if err > 0.0 {
@@ -432,18 +476,7 @@ impl Interval {
                     uddd: j,
                 }
             }
-            Law::Cubic => {
-                let x = self.cubic_x_at(tau, dur);
-                let b = self.cubic_b(x).max(0.0);
-                let ud = b.sqrt();
-                State {
-                    x,
-                    ud,
-                    b,
-                    udd: self.cubic_a(x),
-                    uddd: self.cubic_slope(x) * ud,
-                }
-            }
+            Law::Cubic => self.cubic_state(self.cubic_x_from(0.0, 0.0, tau, dur)),
             Law::Quadratic => {
                 let x = self.x_at(tau, dur);
                 let b = self.b_at(x).max(0.0);
@@ -457,6 +490,18 @@ impl Interval {
                     uddd: alpha * ud,
                 }
             }
+        }
+    }
+
+    /// An evaluator of this interval at non-decreasing times (a re-simulation's servo
+    /// instants): under the cubic law each instant's x(τ) continues from the last one, so it
+    /// costs the integral over one period, not over the interval so far.
+    pub fn marcher(&self, dur: f64) -> Marcher<'_> {
+        Marcher {
+            iv: self,
+            dur,
+            x: 0.0,
+            t: 0.0,
         }
     }
 
@@ -937,6 +982,30 @@ mod tests {
             assert!((e1.uddd - s1 * iv.b1.sqrt()).abs() < 1e-12);
             let end = iv.at(dur, dur);
             assert!((end.b - iv.b1).abs() < 1e-12 && (end.udd - iv.a1).abs() < 1e-12);
+        }
+    }
+
+    /// The marcher (x continued from the last instant) and `at` (x from the interval's start)
+    /// agree at every servo instant, and a step back in time starts over.
+    #[test]
+    fn marching_agrees_with_evaluating_from_the_start() {
+        for (b0, a0, s0, s1, du) in [
+            (4.0, 1.0, 6.0, -2.0, 0.5),
+            (2.0, -1.5, 1.0, 8.0, 0.6),
+            (0.05, 0.0, 3.0, -1.0, 0.4),
+        ] {
+            let iv = cubic(b0, a0, s0, s1, du);
+            let dur = iv.duration().unwrap();
+            let mut m = iv.marcher(dur);
+            let n = 997;
+            for k in 0..=n {
+                let tau = dur * k as f64 / n as f64;
+                let (a, b) = (m.at(tau), iv.at(tau, dur));
+                assert!((a.x - b.x).abs() <= 1e-12 * du, "{k}: {} vs {}", a.x, b.x);
+                assert!((a.b - b.b).abs() <= 1e-11 * (1.0 + b.b), "{k}");
+            }
+            let back = m.at(0.3 * dur);
+            assert!((back.x - iv.at(0.3 * dur, dur).x).abs() <= 1e-12 * du);
         }
     }
 

@@ -77,12 +77,13 @@ pub(crate) fn servo_instants(
     let tb = ta + dt;
     let inside = ((tb / period).ceil() - j as f64).max(0.0);
     let stride = max.map_or(1, |m| (inside / m as f64).ceil().max(1.0) as u64);
+    let mut march = iv.marcher(dt);
     loop {
         let t = j as f64 * period;
         if t >= tb {
             break;
         }
-        let st = iv.at(t - ta, dt);
+        let st = march.at(t - ta);
         f(t, &st, (ua + st.x).min(ub));
         j += stride;
     }
