@@ -58,6 +58,7 @@ fn toolpath() -> Toolpath {
         points,
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     }
 }
 

@@ -118,6 +118,7 @@ fn main() -> Result<(), feedopt::error::Error> {
             .collect(),
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

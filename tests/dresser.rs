@@ -37,6 +37,7 @@ fn groove() -> Toolpath {
             .collect(),
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     }
 }
 

@@ -229,6 +229,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         points: pts,
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     };
     (m, t)
 }

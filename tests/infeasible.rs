@@ -52,6 +52,7 @@ fn line() -> Toolpath {
             .collect(),
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     }
 }
 
@@ -262,6 +263,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         points,
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -25,6 +25,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
             .collect(),
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     }
 }
 

@@ -218,6 +218,7 @@ fn random_cl(seed: u64) -> Case {
             points,
             warnings: Vec::new(),
             dwells: Vec::new(),
+            tool_changes: Vec::new(),
         },
     }
 }

@@ -106,7 +106,9 @@ use crate::toolpath::gcode::cycles::PECK_CLEARANCE_MM;
 use crate::toolpath::gcode::{
     ARC_RADIUS_MISMATCH_MM, ARC_RADIUS_MISMATCH_RELATIVE, MAX_CHORD_ERROR_MM,
 };
-use crate::toolpath::{ClPoint, Dwell, Feed, MachineContext, Toolpath, Units};
+use crate::toolpath::{
+    ClPoint, Dwell, Feed, MachineContext, ToolChange, ToolSelect, Toolpath, Units,
+};
 
 /// Known major words that do not affect the motion and are skipped.
 ///
@@ -235,6 +237,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         points: reader.points,
         warnings: reader.warnings,
         dwells: reader.dwells,
+        tool_changes: reader.tool_changes,
     })
 }
 
@@ -259,6 +262,8 @@ struct Reader<'a> {
     /// A `NURBS/` being read: (line, knots, control points with weights).
     nurbs: Option<(usize, Vec<f64>, Vec<[f64; 4]>)>,
     cycle: Option<AptCycle>,
+    /// `CUTTER/` and `TLDATA/MILL` records, in program order.
+    tool_changes: Vec<ToolChange>,
 }
 
 /// An APT arc's centre, unit axis and radius (if given), in world mm.
@@ -297,11 +302,38 @@ impl<'a> Reader<'a> {
             arc: None,
             nurbs: None,
             cycle: None,
+            tool_changes: Vec::new(),
         }
     }
 
     fn error(&self, line: usize, message: impl Into<String>) -> Error {
         Error::parse(self.source, line, message)
+    }
+
+    /// `CUTTER/d, r, …` or NX's `TLDATA/MILL, d, r, length, taper, tip`: the tool from the
+    /// next move on (diameter and corner radius in the program's units; r 0 when not given).
+    fn cutter(&mut self, line: usize, word: &str, args: &str) -> Result<()> {
+        let mut nums = args.split(',').map(|a| a.trim().parse::<f64>().ok());
+        let (Some(Some(d)), r) = (nums.next(), nums.next()) else {
+            return Err(self.error(line, format!("{word} without a diameter")));
+        };
+        let scale = self.units.mm_per_unit();
+        let r = r.flatten().unwrap_or(0.0);
+        if !(d.is_finite() && r.is_finite()) {
+            return Err(self.error(
+                line,
+                format!("{word}: diameter {d} and radius {r} must be finite"),
+            ));
+        }
+        self.tool_changes.push(ToolChange {
+            point: self.points.len(),
+            line,
+            tool: ToolSelect::Cutter {
+                diameter: d * scale,
+                corner_radius: r * scale,
+            },
+        });
+        Ok(())
     }
 
     /// Handles one complete (continuation-joined, comment-stripped) record.
@@ -332,6 +364,13 @@ impl<'a> Reader<'a> {
             ("KNOT", Some(minor)) => self.knot(line, minor),
             ("CNTRL", Some(minor)) => self.cntrl(line, minor),
             ("CYCLE", Some(minor)) => self.cycle(line, minor),
+            ("CUTTER", Some(minor)) => self.cutter(line, "CUTTER", minor),
+            ("TLDATA", Some(minor))
+                if minor.trim_start().to_ascii_uppercase().starts_with("MILL") =>
+            {
+                let args = minor.trim_start()[4..].trim_start().trim_start_matches(',');
+                self.cutter(line, "TLDATA/MILL", args)
+            }
             (word, _) if UNSUPPORTED_MOTION_WORDS.contains(&word) => Err(self.error(
                 line,
                 format!(

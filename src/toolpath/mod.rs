@@ -132,6 +132,10 @@ pub struct Toolpath {
     /// Dwells (G4, a cycle's dwell at the bottom of a hole): the tool stands still at a CL
     /// point for a programmed time, which is part of the cycle time.
     pub dwells: Vec<Dwell>,
+    /// The tools the program selects, in the order it runs (APT `CUTTER/`, `TLDATA/MILL`;
+    /// G-code `T… M6`, `M61 Q…`, Sinumerik `T="name"`; Klartext `TOOL CALL`). Read by the
+    /// material model ([`crate::material`]); the motion does not depend on them.
+    pub tool_changes: Vec<ToolChange>,
 }
 
 impl Toolpath {
@@ -142,6 +146,7 @@ impl Toolpath {
             points,
             warnings: Vec::new(),
             dwells: Vec::new(),
+            tool_changes: Vec::new(),
         }
     }
 
@@ -165,6 +170,48 @@ pub struct Dwell {
     pub point: usize,
     pub seconds: f64,
     pub line: usize,
+}
+
+/// A tool the program selects: by number (G-code `T5`, Klartext `TOOL CALL 5`, looked up in
+/// a tool table), by name (Sinumerik `T="MILL_D10"`, Klartext `TOOL CALL "MILL_D10"`), or by
+/// its geometry (APT `CUTTER/d, r`, NX `TLDATA/MILL, d, r, …`, in mm).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ToolSelect {
+    /// A tool number.
+    Number(u32),
+    /// A tool name (as written, upper case in Sinumerik programs).
+    Name(String),
+    /// Diameter and corner radius, mm.
+    Cutter {
+        /// D, mm.
+        diameter: f64,
+        /// Corner radius, mm.
+        corner_radius: f64,
+    },
+}
+
+impl std::fmt::Display for ToolSelect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ToolSelect::Number(n) => write!(f, "T{n}"),
+            ToolSelect::Name(s) => write!(f, "T=\"{s}\""),
+            ToolSelect::Cutter {
+                diameter,
+                corner_radius,
+            } => write!(f, "CUTTER/{diameter},{corner_radius}"),
+        }
+    }
+}
+
+/// The program puts `tool` in the spindle at `line`: the move ending at CL point `point` (an
+/// index into [`Toolpath::points`], the number of points made before the change) and every
+/// later one, up to the next change, cut with it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolChange {
+    pub point: usize,
+    pub line: usize,
+    pub tool: ToolSelect,
 }
 
 /// A reader's warning: a line and what about it.

@@ -29,6 +29,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
             .collect(),
         warnings: Vec::new(),
         dwells: Vec::new(),
+        tool_changes: Vec::new(),
     }
 }
 

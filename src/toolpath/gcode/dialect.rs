@@ -247,6 +247,10 @@ pub enum Action {
     /// Fanuc/Haas `M98`: call program `O<P>` of this file `L` times (see
     /// [`super::subprograms`]).
     Call,
+    /// `M6`: the tool the last `T` word selected goes into the spindle.
+    ToolChange,
+    /// LinuxCNC `M61 Q<n>`: tool n is taken as in the spindle, without a change.
+    SetTool,
     /// A Fanuc/LinuxCNC canned cycle (73, 74, 76, 81–89): modal until `G80` or a motion code.
     Cycle(u32),
     /// `G80` (Fanuc): cancels the canned cycle; the motion mode stays.
@@ -562,11 +566,15 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..9", Action::Ignored),
+        ("3..5", Action::Ignored),
+        ("6", Action::ToolChange),
+        ("7..9", Action::Ignored),
         ("19", Action::Ignored),
         ("30", ProgramEnd),
         ("48..53", Action::Ignored),
-        ("60..68", Action::Ignored),
+        ("60", Action::Ignored),
+        ("61", Action::SetTool),
+        ("62..68", Action::Ignored),
         ("70..73", Action::Ignored),
         ("100..199", Action::Ignored),
         ("428", Action::Tcp(Tcp::On)),
@@ -711,7 +719,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..9", Action::Ignored),
+        ("3..5", Action::Ignored),
+        ("6", Action::ToolChange),
+        ("7..9", Action::Ignored),
         ("19", Action::Ignored),
         ("29", Action::Ignored),
         ("30", ProgramEnd),
@@ -862,7 +872,9 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..9", Action::Ignored),
+        ("3..5", Action::Ignored),
+        ("6", Action::ToolChange),
+        ("7..9", Action::Ignored),
         ("17", Return),
         ("19", Action::Ignored),
         ("30", ProgramEnd),

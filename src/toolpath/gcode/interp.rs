@@ -14,7 +14,8 @@ use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, Toolpath, Warning,
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, ToolChange, ToolSelect, Toolpath,
+    Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -48,6 +49,8 @@ struct Block {
     arc_plane: Option<Plane>,
     arc_centre: Option<ArcCentre>,
     arc_sweep: Option<f64>,
+    /// Sinumerik `T="name"`.
+    tool_name: Option<String>,
 }
 
 /// Where a Klartext arc's centre comes from.
@@ -176,6 +179,10 @@ pub(super) struct Interpreter<'a> {
     pub(super) block_delete: bool,
     /// The tool's diameter, mm ([`super::Settings::tool_diameter`]).
     pub(super) tool_diameter: Option<f64>,
+    /// The tool the last `T` word selected (`M6` puts it in the spindle).
+    prepared_tool: Option<ToolSelect>,
+    /// The tool changes so far.
+    pub(super) tool_changes: Vec<ToolChange>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -229,6 +236,8 @@ impl<'a> Interpreter<'a> {
             aliases_used: Vec::new(),
             block_delete: false,
             tool_diameter: None,
+            prepared_tool: None,
+            tool_changes: Vec::new(),
             m92: false,
             m92_warned: [false; 3],
         }
@@ -259,6 +268,7 @@ impl<'a> Interpreter<'a> {
             points: self.points,
             warnings: self.warnings,
             dwells: self.dwells,
+            tool_changes: self.tool_changes,
         })
     }
 
@@ -275,6 +285,14 @@ impl<'a> Interpreter<'a> {
                     continue;
                 }
                 Item::Skipped => continue,
+                Item::ToolName(name) => {
+                    if block.tool_name.replace(name).is_some() {
+                        return Err(
+                            self.error(line, "`T=`: the same word appears twice in the block")
+                        );
+                    }
+                    continue;
+                }
                 Item::Unknown { text } if self.procs.contains(&text) => {
                     if let Some(first) = call_word.replace(text.clone()) {
                         return Err(self.error(
@@ -573,6 +591,15 @@ impl<'a> Interpreter<'a> {
         let mut modal_call = false;
         let mut tilted_plane = false;
         let mut klartext = KlartextWords::default();
+        let mut tool_change: Option<&str> = None;
+        let mut set_tool = false;
+        if let Some(name) = &block.tool_name {
+            self.prepared_tool = Some(ToolSelect::Name(name.clone()));
+        } else if self.spec.spaces != Spaces::Klartext
+            && let Some(t) = block.letter('T')
+        {
+            self.prepared_tool = Some(ToolSelect::Number(self.tool_number(line, "T", t.value)?));
+        }
         for (text, action, args) in &block.actions {
             match *action {
                 Action::FeedMode(mode) => {
@@ -677,6 +704,8 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::Return => end = true,
                 Action::Call => fanuc_call = true,
+                Action::ToolChange => tool_change = Some(text.as_str()),
+                Action::SetTool => set_tool = true,
                 Action::Path(kind) => klartext.path = Some((text.clone(), kind)),
                 Action::Statement(st) => {
                     klartext.statement = Some((text.clone(), st, args.clone().unwrap_or_default()));
@@ -692,6 +721,23 @@ impl<'a> Interpreter<'a> {
                 Action::Unsupported(message) => {
                     return Err(self.error(line, format!("{text}: {message}")));
                 }
+            }
+        }
+        if set_tool {
+            // LinuxCNC `M61 Q<n>`: tool n is in the spindle from here on.
+            let Some(q) = block.letter('Q') else {
+                return Err(self.error(line, "M61 without Q: give the tool number, M61 Q<n>"));
+            };
+            let n = self.tool_number(line, "M61 Q", q.value)?;
+            self.change_tool(line, ToolSelect::Number(n));
+        }
+        if let Some(text) = tool_change {
+            match self.prepared_tool.clone() {
+                Some(tool) => self.change_tool(line, tool),
+                None => self.warn(
+                    line,
+                    format!("{text} without a T word before it: no tool change recorded"),
+                ),
             }
         }
         if fanuc_call {
@@ -791,6 +837,27 @@ impl<'a> Interpreter<'a> {
         }
         self.end_if(end);
         Ok(())
+    }
+
+    /// A tool number as written after `what` (T, M61 Q): a whole number from 0 to 4294967295.
+    fn tool_number(&self, line: usize, what: &str, value: f64) -> Result<u32> {
+        if value >= 0.0 && value.fract() == 0.0 && value <= u32::MAX as f64 {
+            Ok(value as u32)
+        } else {
+            Err(self.error(
+                line,
+                format!("{what}{value}: a tool number is a whole number from 0"),
+            ))
+        }
+    }
+
+    /// `tool` goes into the spindle here: the next move is its first.
+    pub(super) fn change_tool(&mut self, line: usize, tool: ToolSelect) {
+        self.tool_changes.push(ToolChange {
+            point: self.points.len(),
+            line,
+            tool,
+        });
     }
 
     fn end_if(&mut self, end: bool) {

@@ -90,8 +90,11 @@ pub(super) enum Item {
         action: Action,
         args: Option<String>,
     },
-    /// A known word whose value is not a number and does not matter (Sinumerik `T="MILL"`).
+    /// A known word whose value is not a number and does not matter.
     Skipped,
+    /// Sinumerik `T="MILL"`: a tool selected by name (as written between the quotes, upper
+    /// case).
+    ToolName(String),
     /// A word the dialect does not know.
     Unknown { text: String },
 }
@@ -395,6 +398,14 @@ fn lex_separate_word(
         };
         match address {
             Address::Unsupported(message) => return Err(format!("`{name}=`: {message}")),
+            Address::Ignored
+                if name == "T"
+                    && text.len() >= 2
+                    && text.starts_with('"')
+                    && text.ends_with('"') =>
+            {
+                items.push(Item::ToolName(text[1..text.len() - 1].to_string()))
+            }
             Address::Ignored if value(text, vars).is_err() => items.push(Item::Skipped),
             _ => {
                 if text.is_empty() {

@@ -217,8 +217,31 @@ impl Interpreter<'_> {
     }
 
     fn tool_call(&mut self, line: usize, args: &str) -> Result<()> {
-        for word in klartext::words(args) {
+        for (k, word) in klartext::words(args).into_iter().enumerate() {
             let upper = word.to_ascii_uppercase();
+            // The tool: `TOOL CALL 5 Z …` by number, `TOOL CALL "MILL_D10" Z …` by name (a
+            // TOOL CALL without either changes the spindle speed or feed only).
+            if k == 0 {
+                if word.len() >= 2 && word.starts_with('"') && word.ends_with('"') {
+                    let name = word[1..word.len() - 1].to_string();
+                    self.change_tool(line, ToolSelect::Name(name));
+                    continue;
+                }
+                if word.starts_with(|c: char| c.is_ascii_digit()) {
+                    let n = word
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.fract() == 0.0 && *v <= u32::MAX as f64)
+                        .ok_or_else(|| {
+                            self.error(
+                                line,
+                                format!("TOOL CALL {word}: a tool number is a whole number"),
+                            )
+                        })?;
+                    self.change_tool(line, ToolSelect::Number(n as u32));
+                    continue;
+                }
+            }
             match upper.as_str() {
                 "Z" => self.plane = Plane::Xy,
                 "X" | "Y" => {

@@ -1,0 +1,136 @@
+//! Tool changes as the readers record them (issue 13 item 1): APT `CUTTER/` and NX
+//! `TLDATA/MILL`, G-code `T… M6` (LinuxCNC, Fanuc, Sinumerik, also inside subprograms),
+//! LinuxCNC `M61 Q`, Sinumerik `T="name"`, Klartext `TOOL CALL`; each with the CL point the
+//! new tool cuts from and the line that selects it.
+
+use feedopt::toolpath::gcode::{Dialect, parse};
+use feedopt::toolpath::{ToolChange, ToolSelect, Toolpath, apt};
+use std::path::Path;
+
+fn changes(tp: &Toolpath) -> Vec<(usize, usize, ToolSelect)> {
+    tp.tool_changes
+        .iter()
+        .map(|ToolChange { point, line, tool }| (*point, *line, tool.clone()))
+        .collect()
+}
+
+fn gcode(dialect: Dialect, text: &str) -> Toolpath {
+    parse(Path::new("t.nc"), text, dialect).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+fn cutter(diameter: f64, corner_radius: f64) -> ToolSelect {
+    ToolSelect::Cutter {
+        diameter,
+        corner_radius,
+    }
+}
+
+#[test]
+fn apt_cutters_in_order_with_their_first_point() {
+    let t = "CUTTER/10,2\nGOTO/0,0,5\nGOTO/0,0,0\nCUTTER/6.0,3.0\nGOTO/1,0,0\n\
+             TLDATA/MILL,4.0000,0.5000,50.0000,2.0000,0.0000\nGOTO/2,0,0\n\
+             TLDATA/TURN,0.4\n";
+    let tp = apt::parse(Path::new("a.cls"), t).unwrap();
+    assert_eq!(
+        changes(&tp),
+        vec![
+            (0, 1, cutter(10.0, 2.0)),
+            (2, 4, cutter(6.0, 3.0)),
+            (3, 6, cutter(4.0, 0.5)),
+        ]
+    );
+    // Inch programs: the cutter in mm.
+    let inch = "UNITS/INCH\nCUTTER/0.5\nGOTO/0,0,0\n";
+    let tp = apt::parse(Path::new("a.cls"), inch).unwrap();
+    assert_eq!(changes(&tp), vec![(0, 2, cutter(12.7, 0.0))]);
+    let e = apt::parse(Path::new("a.cls"), "GOTO/0,0,0\nCUTTER/\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("a.cls:2:") && e.contains("without a diameter"),
+        "{e}"
+    );
+}
+
+#[test]
+fn linuxcnc_t_m6_and_m61() {
+    // T prepares, M6 changes (also `M6 T3` in one block), M61 Q sets without a change.
+    let t = "G21 G90\nT1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nT2\nG1 X10\nM6\nG1 X20\nM6 T3\nG1 X30\n\
+             M61 Q4\nG1 X40\nM2\n";
+    let tp = gcode(Dialect::LinuxCnc, t);
+    assert_eq!(
+        changes(&tp),
+        vec![
+            (0, 2, ToolSelect::Number(1)),
+            (3, 7, ToolSelect::Number(2)),
+            (4, 9, ToolSelect::Number(3)),
+            (5, 11, ToolSelect::Number(4)),
+        ]
+    );
+    // M6 without any T before it: a warning, never a silent change.
+    let tp = gcode(Dialect::LinuxCnc, "G21\nM6\nG0 X1 Y0 Z0\n");
+    assert!(tp.tool_changes.is_empty());
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 2 && w.message.contains("without a T"))
+    );
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21\nT1.5 M6\nG0 X1\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("t.ngc:2:") && e.contains("whole number"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_tool_change_inside_a_subroutine_counts_where_it_runs() {
+    // The subroutine is written before the calls: the changes follow the execution, not the
+    // text.
+    let t = "o100 sub\nG1 X10 F100\nG0 X0\no100 endsub\nG21 G90 G0 X0 Y0 Z0\nT1 M6\n\
+             o100 call\nT2 M6\no100 call\nM2\n";
+    let tp = gcode(Dialect::LinuxCnc, t);
+    assert_eq!(
+        changes(&tp),
+        vec![(1, 6, ToolSelect::Number(1)), (3, 8, ToolSelect::Number(2))]
+    );
+}
+
+#[test]
+fn fanuc_and_sinumerik() {
+    let t = "O1\nG21 G90 G0 X0 Y0 Z5\nT05 M06\nG1 Z0 F100\nT6 M6\nG1 X5\nM30\n";
+    let tp = gcode(Dialect::Fanuc, t);
+    assert_eq!(
+        changes(&tp),
+        vec![(1, 3, ToolSelect::Number(5)), (2, 5, ToolSelect::Number(6))]
+    );
+    let t = "G71 G90\nT=\"Mill_D10\"\nM6\nG0 X0 Y0 Z5\nT7 M6\nG1 Z0 F100\nM30\n";
+    let tp = gcode(Dialect::Sinumerik, t);
+    assert_eq!(
+        changes(&tp),
+        vec![
+            (0, 3, ToolSelect::Name("MILL_D10".into())),
+            (1, 5, ToolSelect::Number(7)),
+        ]
+    );
+}
+
+#[test]
+fn klartext_tool_call() {
+    let t = "0 BEGIN PGM T MM\n1 TOOL CALL 5 Z S3000\n2 L X+0 Y+0 Z+5 FMAX\n\
+             3 TOOL CALL \"MILL_D6\" Z S5000\n4 L Z+0 F100\n5 TOOL CALL Z S4000\n\
+             6 L X+5\n7 END PGM T MM\n";
+    let tp = parse(Path::new("t.h"), t, Dialect::Heidenhain).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        changes(&tp),
+        vec![
+            (0, 2, ToolSelect::Number(5)),
+            (1, 4, ToolSelect::Name("MILL_D6".into())),
+        ]
+    );
+}
