@@ -94,6 +94,11 @@ pub struct MaterialArgs {
     /// Number of flutes (teeth).
     #[arg(long, value_name = "N")]
     pub tool_flutes: Option<u32>,
+    /// Tool table: what the program's tool numbers and names (`T5 M6`, `T="MILL"`, `TOOL CALL
+    /// 5`) stand for; LinuxCNC `.tbl` (`T5 P5 D6.35`) or JSON (`{"5": {"diameter": 6.35,
+    /// "flutes": 3}}`), instead of the machine file's `tools`.
+    #[arg(long, value_name = "FILE")]
+    pub tool_table: Option<PathBuf>,
     /// Ignore the machine file's stock, tool and process sections: axis limits and programmed
     /// feeds only.
     #[arg(long)]
@@ -489,18 +494,19 @@ fn apply_material(
         || args.spindle_speed.is_some()
         || args.tool_corner_radius.is_some()
         || args.tool_flute_length.is_some()
-        || args.tool_flutes.is_some();
+        || args.tool_flutes.is_some()
+        || args.tool_table.is_some();
     if args.no_material {
         return Ok(None);
     }
     let spec = material::from_machine_file(machine_file)?;
-    if !given && spec.is_none_or(|s| s.stock.is_none()) {
+    if !given && spec.as_ref().is_none_or(|s| s.stock.is_none()) {
         // No stock, no material stage: the program is not scanned for tools (a program with
         // several cutters solves as before).
         return Ok(None);
     }
     let toolpath::Input::Cl(tp) = input else {
-        if spec.is_some_and(|s| s.stock.is_some()) || given {
+        if spec.as_ref().is_some_and(|s| s.stock.is_some()) || given {
             return Err(Error::Usage(format!(
                 "{}: a joint-space path has no tool tip to cut a stock with: remove the \
                  machine file's `stock` or give --no-material",
@@ -509,8 +515,13 @@ fn apply_material(
         }
         return Ok(None);
     };
-    let program = material::program::scan_file(toolpath_file)?;
+    let program = material::program::scan_file(toolpath_file)?.with_toolpath(tp);
     let overrides = material::Overrides {
+        tool_table: args
+            .tool_table
+            .as_deref()
+            .map(material::tooltable::read)
+            .transpose()?,
         tool: material::ToolSpec {
             diameter: args.tool_diameter,
             corner_radius: args.tool_corner_radius,

@@ -12,7 +12,7 @@
 //! in mm/s and mm/s², rotary axes in °/s and °/s². An optional `"jerk"` (number or `[min, max]`,
 //! mm/s³ or °/s³) makes the schedule jerk-limited. An axis may also give its travel, `"min"` and
 //! `"max"` (mm or degrees, both or neither, `min < max`). `feed.max` (mm/s) caps the tool-tip
-//! feed V; the `feed` section is optional. The optional `stock`, `tool` and `process` sections
+//! feed V; the `feed` section is optional. The optional `stock`, `tool`, `tools` and `process` sections
 //! belong to the material model and are read by [`crate::material::from_machine_file`].
 //! Unknown fields, missing axes or limits,
 //! non-positive limits and keys given twice in one object are errors that name the field; so
@@ -588,6 +588,7 @@ impl Parser {
                 "feed",
                 "stock",
                 "tool",
+                "tools",
                 "process",
             ],
         )?;

@@ -35,15 +35,15 @@ fn flat10() -> Tool {
 }
 
 fn material(tool: Tool, cell: f64, process: ProcessLimits) -> Material {
-    Material {
-        stock: block(),
+    Material::single(
+        block(),
         tool,
         process,
-        options: CutOptions {
+        CutOptions {
             cell: Some(cell),
             step: None,
         },
-    }
+    )
 }
 
 /// Tip positions, tool up, at 20 mm/s (the first move a rapid from above).

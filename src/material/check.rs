@@ -71,8 +71,9 @@ impl std::fmt::Display for Finding {
     }
 }
 
-/// The findings of a simulation under `m`'s limits, in path order; `feed_override` scales
-/// every programmed feed (1: as programmed).
+/// The findings of a simulation under `m`'s limits, each move with its own tool
+/// ([`Material::tool_at`]), in path order; `feed_override` scales every programmed feed (1: as
+/// programmed).
 pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Finding> {
     let mut out: Vec<Finding> = Vec::new();
     let mut by_move: Vec<&Sample> = Vec::new();
@@ -102,8 +103,9 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
         };
         // The worst sample per limit.
         let mut worst: Vec<(ProcessLimit, f64, f64)> = Vec::new(); // (limit, allowed, area)
+        let tool = m.tool_at(first.point);
         for s in group.iter().filter(|s| s.area > 0.0) {
-            for (allowed, lim) in m.process.bounds(s, m.tool.diameter, m.tool.flutes) {
+            for (allowed, lim) in m.process.bounds(s, tool.diameter, tool.flutes) {
                 match worst.iter_mut().find(|w| w.0 == lim) {
                     Some(w) if allowed < w.1 => *w = (lim, allowed, s.area),
                     Some(_) => {}

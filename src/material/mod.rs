@@ -28,6 +28,7 @@ pub mod process;
 pub mod program;
 pub mod stock;
 pub mod tool;
+pub mod tooltable;
 
 use std::path::Path;
 
@@ -39,7 +40,7 @@ pub use tool::Tool;
 
 use crate::error::{Error, Result};
 use crate::geometry::{self, ProcessCaps, SpanKind};
-use crate::toolpath::Toolpath;
+use crate::toolpath::{ToolSelect, Toolpath};
 
 /// The most dexels a model may have (24 bytes each once a cut reaches its tile, and more
 /// where an undercut splits one, [`dexel`]): 10 million, e.g. 316 × 316 mm at 0.1 mm.
@@ -82,17 +83,93 @@ impl CutOptions {
     }
 }
 
-/// Everything the material stage needs: stock, tool, process limits and resolution.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+/// A tool of the program and the moves it cuts.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ToolUse {
+    /// The first CL move it cuts (the move ending at this CL point); it cuts every move up to
+    /// the next tool's first. The first tool's is 0: it also cuts the moves before the
+    /// program's first tool selection.
+    pub first_move: usize,
+    /// The program line that selects it (0: the program selects none; the machine file's or
+    /// the options' tool).
+    pub line: usize,
+    /// What the program writes (`T2`, `CUTTER/10,2`, …), if anything.
+    pub select: Option<ToolSelect>,
+    /// The tool.
+    pub tool: Tool,
+}
+
+/// Everything the material stage needs: stock, tools, process limits and resolution.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Material {
     /// The blank, in workpiece coordinates.
     pub stock: Stock,
-    /// The cutter.
-    pub tool: Tool,
+    /// The cutters in the order the program uses them (at least one; `first_move` increasing
+    /// from 0).
+    pub tools: Vec<ToolUse>,
     /// The process limits (each optional).
     pub process: ProcessLimits,
     /// Grid resolution and sample step.
     pub options: CutOptions,
+}
+
+impl Material {
+    /// The material model of one tool for the whole program.
+    pub fn single(
+        stock: Stock,
+        tool: Tool,
+        process: ProcessLimits,
+        options: CutOptions,
+    ) -> Material {
+        Material {
+            stock,
+            tools: vec![ToolUse {
+                first_move: 0,
+                line: 0,
+                select: None,
+                tool,
+            }],
+            process,
+            options,
+        }
+    }
+
+    /// The first tool.
+    pub fn tool(&self) -> &Tool {
+        &self.tools[0].tool
+    }
+
+    /// The index into [`Material::tools`] of the tool that cuts the move ending at CL point `k`.
+    pub fn tool_index(&self, k: usize) -> usize {
+        self.tools
+            .partition_point(|t| t.first_move <= k)
+            .saturating_sub(1)
+    }
+
+    /// The tool that cuts the move ending at CL point `k`.
+    pub fn tool_at(&self, k: usize) -> &Tool {
+        &self.tools[self.tool_index(k)].tool
+    }
+
+    /// The dexel cell, mm: the option, else D/[`CELLS_PER_DIAMETER`] of the smallest tool (one
+    /// grid for every tool).
+    pub fn cell(&self) -> f64 {
+        let smallest = self
+            .tools
+            .iter()
+            .map(|t| &t.tool)
+            .min_by(|a, b| a.diameter.total_cmp(&b.diameter))
+            .unwrap_or(&self.tools[0].tool);
+        self.options.cell_for(smallest)
+    }
+
+    /// The sample step of the moves `tool` cuts, mm: the option, else the larger of 5 cells
+    /// and D/8.
+    pub fn step_for(&self, tool: &Tool) -> f64 {
+        self.options
+            .step
+            .unwrap_or_else(|| (5.0 * self.cell()).max(tool.diameter / 8.0))
+    }
 }
 
 /// The result of a cut: every sample's engagement and the final stock.
@@ -145,20 +222,21 @@ pub fn tool_axes<'a>(
 /// Checks the resolution and estimates the work of cutting `tp` with `m` (module doc),
 /// refusing what exceeds the bounds before anything is allocated.
 pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
-    let cell = m.options.cell_for(&m.tool);
-    let step = m.options.step_for(&m.tool);
+    let cell = m.cell();
     let usage = |what: String| Error::Usage(what);
-    if !(cell.is_finite() && cell >= 1e-4 && cell <= m.tool.diameter) {
-        return Err(usage(format!(
-            "dexel cell {cell} mm: give a cell from 0.0001 mm to the tool diameter ({} mm)",
-            m.tool.diameter
-        )));
-    }
-    if !(step.is_finite() && step >= cell && step <= 100.0 * m.tool.diameter) {
-        return Err(usage(format!(
-            "sample step {step} mm: give a step from the cell size ({cell} mm) to 100 tool \
-             diameters"
-        )));
+    for t in &m.tools {
+        let (d, step) = (t.tool.diameter, m.step_for(&t.tool));
+        if !(cell.is_finite() && cell >= 1e-4 && cell <= d) {
+            return Err(usage(format!(
+                "dexel cell {cell} mm: give a cell from 0.0001 mm to the tool diameter ({d} mm)"
+            )));
+        }
+        if !(step.is_finite() && step >= cell && step <= 100.0 * d) {
+            return Err(usage(format!(
+                "sample step {step} mm: give a step from the cell size ({cell} mm) to 100 tool \
+                 diameters ({d} mm)"
+            )));
+        }
     }
     let (nx, ny) = Dexels::shape(&m.stock, cell);
     if nx * ny > MAX_DEXELS {
@@ -179,24 +257,27 @@ pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
                  tell which way it turns; split the move",
             ));
         }
+        let tool = m.tool_at(k);
         let e =
-            (b.p - a.p).norm() + m.tool.flute_length * a.o.cross(&b.o).norm().atan2(a.o.dot(&b.o));
-        samples += (e / step).ceil();
+            (b.p - a.p).norm() + tool.flute_length * a.o.cross(&b.o).norm().atan2(a.o.dot(&b.o));
+        samples += (e / m.step_for(tool)).ceil();
     }
     if samples > MAX_SAMPLES {
         return Err(usage(format!(
-            "the path needs {samples:.3e} samples at a step of {step} mm (at most \
-             {MAX_SAMPLES:e}): give a longer sample step"
+            "the path needs {samples:.3e} samples at a step of {} mm (at most \
+             {MAX_SAMPLES:e}): give a longer sample step",
+            m.step_for(m.tool())
         )));
     }
-    let delta = cut::pose_spacing(&m.tool, cell);
     let mut work = 0.0;
     for k in 1..tp.points.len() {
-        let n = cut::steps_of_move(tp, k, &m.tool, step);
+        let tool = m.tool_at(k);
+        let delta = cut::pose_spacing(tool, cell);
+        let n = cut::steps_of_move(tp, k, tool, m.step_for(tool));
         for s in 0..n {
             let st = cut::step_of_move(tp, k, s, n);
-            let poses = st.poses(&m.tool, delta);
-            let b = st.bounds(&m.tool, poses);
+            let poses = st.poses(tool, delta);
+            let b = st.bounds(tool, poses);
             let cells = ((b[2] - b[0]) / cell + 1.0) * ((b[3] - b[1]) / cell + 1.0);
             work += cells * poses as f64;
         }
@@ -212,25 +293,32 @@ pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
 }
 
 /// Cuts the stock along the toolpath (module doc): every CL move in order, sample step by
-/// sample step.
+/// sample step, each with the tool that cuts it ([`Material::tool_at`]).
 pub fn simulate(tp: &Toolpath, m: &Material) -> Result<Simulation> {
     m.stock
         .validate()
         .map_err(|e| Error::Usage(format!("stock: {e}")))?;
     let work = estimate_work(tp, m)?;
-    let cell = m.options.cell_for(&m.tool);
-    let step = m.options.step_for(&m.tool);
+    let cell = m.cell();
     let mut dexels = Dexels::new(&m.stock, cell);
     let initial_volume = dexels.volume();
-    let delta = cut::pose_spacing(&m.tool, dexels.hx.min(dexels.hy));
     let mut samples = Vec::new();
     let mut shared = cut::SharedPose::new(dexels.ny);
+    let mut current = m.tool_index(1.min(tp.points.len()));
     for k in 1..tp.points.len() {
-        let n = cut::steps_of_move(tp, k, &m.tool, step);
+        let which = m.tool_index(k);
+        if which != current {
+            // Another tool: the last pose's crossings were the old tool's.
+            shared = cut::SharedPose::new(dexels.ny);
+            current = which;
+        }
+        let tool = &m.tools[which].tool;
+        let delta = cut::pose_spacing(tool, dexels.hx.min(dexels.hy));
+        let n = cut::steps_of_move(tp, k, tool, m.step_for(tool));
         let (feed, rapid) = cut::move_feed(tp, k);
         for s in 0..n {
             let st = cut::step_of_move(tp, k, s, n);
-            let mut sample = cut::cut_step(&mut dexels, &m.tool, &st, delta, &mut shared);
+            let mut sample = cut::cut_step(&mut dexels, tool, &st, delta, &mut shared);
             sample.point = k;
             sample.t = [s as f64 / n as f64, (s + 1) as f64 / n as f64];
             sample.line = tp.points[k].line;
@@ -248,7 +336,7 @@ pub fn simulate(tp: &Toolpath, m: &Material) -> Result<Simulation> {
         initial_volume,
         final_volume,
         removed_volume,
-        step,
+        step: m.step_for(m.tool()),
         work,
     })
 }
@@ -286,7 +374,8 @@ impl FeedLimits {
                     ProcessLimit::Air,
                 ))
             } else {
-                m.process.bound(s, m.tool.diameter, m.tool.flutes)
+                let tool = m.tool_at(s.point);
+                m.process.bound(s, tool.diameter, tool.flutes)
             };
             let pieces = &mut moves[s.point];
             if let Some(last) = pieces.last_mut() {
@@ -383,6 +472,57 @@ impl FeedLimits {
     }
 }
 
+/// A tool object (`{"diameter", "corner_radius", "flute_length", "flutes"}`, each optional)
+/// at `field` of `source`: the machine file's `tool`, or an entry of a JSON tool table.
+pub fn tool_spec_from_json(source: &Path, field: &str, v: &serde_json::Value) -> Result<ToolSpec> {
+    let err = |f: &str, m: String| Error::field(source, format!("{field}{f}"), m);
+    let obj = v
+        .as_object()
+        .ok_or_else(|| err("", "expected a JSON object".into()))?;
+    const KEYS: [&str; 4] = ["diameter", "corner_radius", "flute_length", "flutes"];
+    if let Some(k) = obj.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        return Err(err(
+            &format!(".{k}"),
+            format!("unknown field (expected one of: {})", KEYS.join(", ")),
+        ));
+    }
+    // `any`: the corner radius, any finite number (Tool::new says what is wrong with it).
+    let num = |key: &str, max: f64, any: bool| -> Result<Option<f64>> {
+        obj.get(key)
+            .map(|v| {
+                let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                    err(
+                        &format!(".{key}"),
+                        format!("expected a finite number, found {v}"),
+                    )
+                })?;
+                if any || (x > 0.0 && x <= max) {
+                    Ok(x)
+                } else {
+                    Err(err(
+                        &format!(".{key}"),
+                        format!("must be positive and at most {max:e}, found {x}"),
+                    ))
+                }
+            })
+            .transpose()
+    };
+    Ok(ToolSpec {
+        diameter: num("diameter", tool::MAX_TOOL_DIAMETER_MM, false)?,
+        corner_radius: num("corner_radius", f64::INFINITY, true)?,
+        flute_length: num("flute_length", 1e5, false)?,
+        flutes: obj
+            .get("flutes")
+            .map(|v| {
+                v.as_u64()
+                    .filter(|&n| (1..=64).contains(&n))
+                    .map(|n| n as u32)
+                    .ok_or_else(|| err(".flutes", format!("expected 1 to 64, found {v}")))
+            })
+            .transpose()?,
+    })
+}
+
 /// Reads the `stock`, `tool` and `process` sections of a machine file (each optional;
 /// `None` when the file has no `stock`). Errors name the field.
 pub fn from_machine_file(path: &Path) -> Result<Option<MaterialSpec>> {
@@ -394,12 +534,15 @@ pub fn from_machine_file(path: &Path) -> Result<Option<MaterialSpec>> {
 
 /// The material sections of a machine file, before options and the program fill the gaps
 /// (spindle speed, tool).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct MaterialSpec {
     /// The `stock` section, if any.
     pub stock: Option<Stock>,
     /// Diameter, corner radius, flute length, flutes, as far as given.
     pub tool: ToolSpec,
+    /// The `tools` section: a tool table inline, or the name of a tool table file (relative
+    /// to the machine file; [`tooltable`]).
+    pub tools: Option<tooltable::ToolTable>,
     /// The `process` section (every limit optional).
     pub process: ProcessLimits,
 }
@@ -431,12 +574,15 @@ impl ToolSpec {
     /// The tool: the diameter is required; corner radius 0, flute length 2 D and 2 flutes when
     /// not given (the flutes matter only to the chip load, which then requires them).
     pub fn build(&self, needs_flutes: bool) -> std::result::Result<Tool, String> {
-        let d = self
-            .diameter
-            .ok_or("no tool diameter: give the machine file's `tool.diameter`, --tool-diameter or a CUTTER/ record")?;
+        let d = self.diameter.ok_or(
+            "no tool diameter: give the machine file's `tool.diameter`, --tool-diameter, a \
+                 CUTTER/ record or the tool table's D",
+        )?;
         if needs_flutes && self.flutes.is_none() {
             return Err(
-                "the chip load needs the tool's flutes: give `tool.flutes` or --tool-flutes".into(),
+                "the chip load needs the tool's flutes: give `tool.flutes`, --tool-flutes or \
+                 the JSON tool table's `flutes`"
+                    .into(),
             );
         }
         Tool::new(
@@ -549,29 +695,17 @@ impl MaterialSpec {
             spec.stock = Some(stock);
         }
         if let Some(t) = root.get("tool") {
-            let obj = t
-                .as_object()
-                .ok_or_else(|| err("tool", "expected a JSON object".into()))?;
-            known(
-                obj,
-                "tool",
-                &["diameter", "corner_radius", "flute_length", "flutes"],
-            )?;
-            spec.tool.diameter = positive(obj, "diameter", "tool", tool::MAX_TOOL_DIAMETER_MM)?;
-            spec.tool.corner_radius = obj
-                .get("corner_radius")
-                .map(|v| num(v, "tool.corner_radius"))
-                .transpose()?;
-            spec.tool.flute_length = positive(obj, "flute_length", "tool", 1e5)?;
-            spec.tool.flutes = obj
-                .get("flutes")
-                .map(|v| {
-                    v.as_u64()
-                        .filter(|&n| (1..=64).contains(&n))
-                        .map(|n| n as u32)
-                        .ok_or_else(|| err("tool.flutes", format!("expected 1 to 64, found {v}")))
-                })
-                .transpose()?;
+            spec.tool = tool_spec_from_json(source, "tool", t)?;
+        }
+        if let Some(t) = root.get("tools") {
+            spec.tools = Some(match t {
+                // A file of its own, relative to the machine file.
+                Value::String(name) => {
+                    let path = source.parent().unwrap_or(Path::new("")).join(name);
+                    tooltable::read(&path)?
+                }
+                _ => tooltable::from_json(source, "tools", t)?,
+            });
         }
         if let Some(p) = root.get("process") {
             let obj = p
@@ -603,18 +737,22 @@ impl MaterialSpec {
                 ));
             }
         }
-        Ok(
-            (spec.stock.is_some() || spec.process.any() || spec.tool.diameter.is_some())
-                .then_some(spec),
-        )
+        Ok((spec.stock.is_some()
+            || spec.process.any()
+            || spec.tool.diameter.is_some()
+            || spec.tools.is_some())
+        .then_some(spec))
     }
 }
 
 /// Where the material model's inputs come from besides the machine file.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Overrides {
-    /// The tool as the options give it (first choice).
+    /// The tool as the options give it (first choice, for every tool of the program).
     pub tool: ToolSpec,
+    /// The tool table the options give (`--tool-table`; instead of the machine file's
+    /// `tools`).
+    pub tool_table: Option<tooltable::ToolTable>,
     /// The spindle speed option, rpm (first choice).
     pub spindle_speed: Option<f64>,
     /// Resolution.
@@ -623,10 +761,14 @@ pub struct Overrides {
 
 impl Material {
     /// The material model of a run: the machine file's sections (`spec`, `None` without any),
-    /// the program's `CUTTER/` and spindle speed (`program`), and the options (`o`), which win
-    /// over the program, which wins over the machine file. `None` when there is no stock; an
+    /// the program's tools and spindle speed (`program`), and the options (`o`). Field by
+    /// field, the options win over the program's tool (its `CUTTER/`, or the tool table's
+    /// entry for its `T` number or name), which wins over the machine file's `tool`. Every
+    /// tool the program selects becomes a [`ToolUse`] from its first move on; the moves before
+    /// the first selection are cut with the first tool. `None` when there is no stock; an
     /// error naming what is missing when process limits are given without a stock, a tool or
-    /// the spindle speed the chip load needs.
+    /// the spindle speed the chip load needs, and naming the program line where a selected
+    /// tool is not in the tool table.
     pub fn resolve(
         file: &Path,
         spec: Option<MaterialSpec>,
@@ -646,18 +788,80 @@ impl Material {
             }
             return Ok(None);
         };
-        let from_program = ToolSpec {
-            diameter: program.cutter.map(|c| c.0),
-            corner_radius: program.cutter.map(|c| c.1),
-            ..ToolSpec::default()
-        };
         let mut process = spec.process;
-        let tool = o
-            .tool
-            .or(from_program)
-            .or(spec.tool)
-            .build(process.chip_load.is_some())
-            .map_err(|e| field("tool", e))?;
+        let needs_flutes = process.chip_load.is_some();
+        let build =
+            |from_program: ToolSpec| o.tool.or(from_program).or(spec.tool).build(needs_flutes);
+        let table = o.tool_table.as_ref().or(spec.tools.as_ref());
+        let mut tools: Vec<ToolUse> = Vec::new();
+        for change in &program.tool_changes {
+            if change.point >= program.points.max(1) && !tools.is_empty() {
+                // After the last move (an unload, `T0 M6`): it cuts nothing.
+                continue;
+            }
+            let sel = &change.tool;
+            let at = |m: String| Error::parse(&program.source, change.line, m);
+            let given = match sel {
+                ToolSelect::Cutter {
+                    diameter,
+                    corner_radius,
+                } => ToolSpec {
+                    diameter: Some(*diameter),
+                    corner_radius: Some(*corner_radius),
+                    ..ToolSpec::default()
+                },
+                ToolSelect::Number(_) | ToolSelect::Name(_) => {
+                    let Some(table) = table else {
+                        return Err(at(format!(
+                            "{sel} selects a tool the material model needs to know: give a \
+                             tool table (--tool-table FILE, or the machine file's `tools`)"
+                        )));
+                    };
+                    let Some(entry) = table.lookup(sel) else {
+                        return Err(at(format!(
+                            "{sel}: the tool table {} has no tool {}: add it to the table or \
+                             correct the program",
+                            table.source.display(),
+                            match sel {
+                                ToolSelect::Name(s) => format!("\"{s}\""),
+                                _ => sel.to_string().trim_start_matches('T').to_string(),
+                            }
+                        )));
+                    };
+                    entry.tool
+                }
+            };
+            let tool = build(given).map_err(|e| at(format!("{sel}: {e}")))?;
+            let first_move = if tools.is_empty() { 0 } else { change.point };
+            match tools.last_mut() {
+                // The same tool again: no change.
+                Some(last) if last.tool == tool && last.select.as_ref() == Some(sel) => {}
+                // Two selections before a move: the later one cuts.
+                Some(last) if last.first_move >= first_move => {
+                    *last = ToolUse {
+                        first_move: last.first_move,
+                        line: change.line,
+                        select: Some(sel.clone()),
+                        tool,
+                    };
+                }
+                _ => tools.push(ToolUse {
+                    first_move,
+                    line: change.line,
+                    select: Some(sel.clone()),
+                    tool,
+                }),
+            }
+        }
+        if tools.is_empty() {
+            let tool = build(ToolSpec::default()).map_err(|e| field("tool", e))?;
+            tools.push(ToolUse {
+                first_move: 0,
+                line: 0,
+                select: None,
+                tool,
+            });
+        }
         process.spindle_speed = o
             .spindle_speed
             .or(program.spindle_speed.map(|s| s.0))
@@ -679,7 +883,7 @@ impl Material {
         }
         Ok(Some(Material {
             stock,
-            tool,
+            tools,
             process,
             options: o.options,
         }))
@@ -692,10 +896,12 @@ impl Material {
 pub struct MaterialReport {
     /// The blank.
     pub stock: Stock,
-    /// The cutter used.
+    /// The cutter used (the first, where the program changes tools).
     pub tool: Tool,
     /// Flat, ball or bull-nose, from the corner radius.
     pub tool_kind: tool::ToolKind,
+    /// Every tool in the order the program uses it, with where it starts and what it cut.
+    pub tools: Vec<ToolReport>,
     /// The process limits applied.
     pub process: ProcessLimits,
     /// Dexel cells along X and Y.
@@ -728,6 +934,30 @@ pub struct MaterialReport {
     pub findings: Vec<check::Finding>,
 }
 
+/// What one tool of the program did.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ToolReport {
+    /// What the program writes (`T2`, `CUTTER/10,2`; `null`: no selection, the machine file's
+    /// or the options' tool).
+    pub select: Option<String>,
+    /// The program line that selects it (0: none).
+    pub line: usize,
+    /// The source line of its first move (0: it moves nowhere).
+    pub first_move_line: usize,
+    /// The tool.
+    pub tool: Tool,
+    /// Flat, ball or bull-nose.
+    pub kind: tool::ToolKind,
+    /// The sample step of its moves, mm.
+    pub sample_step_mm: f64,
+    /// Path samples it cut.
+    pub samples: usize,
+    /// Volume it removed, mm³.
+    pub removed_volume_mm3: f64,
+    /// Largest engaged cross-section A of its samples, mm².
+    pub peak_area_mm2: f64,
+}
+
 impl MaterialReport {
     /// The report of `sim` under `m`.
     pub fn new(
@@ -744,10 +974,34 @@ impl MaterialReport {
             .filter(|s| s.removed <= 0.0)
             .map(|s| s.length)
             .sum();
+        let tools = m
+            .tools
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let mine: Vec<&Sample> = sim
+                    .samples
+                    .iter()
+                    .filter(|s| m.tool_index(s.point) == i)
+                    .collect();
+                ToolReport {
+                    select: t.select.as_ref().map(ToString::to_string),
+                    line: t.line,
+                    first_move_line: mine.first().map_or(0, |s| s.line),
+                    tool: t.tool,
+                    kind: t.tool.kind(),
+                    sample_step_mm: m.step_for(&t.tool),
+                    samples: mine.len(),
+                    removed_volume_mm3: mine.iter().map(|s| s.removed).sum(),
+                    peak_area_mm2: mine.iter().map(|s| s.area).fold(0.0, f64::max),
+                }
+            })
+            .collect();
         MaterialReport {
             stock: m.stock,
-            tool: m.tool,
-            tool_kind: m.tool.kind(),
+            tool: *m.tool(),
+            tool_kind: m.tool().kind(),
+            tools,
             process: m.process,
             dexels: [sim.dexels.nx, sim.dexels.ny],
             cell_mm: [sim.cell.0, sim.cell.1],
@@ -769,12 +1023,34 @@ impl MaterialReport {
 
 impl std::fmt::Display for MaterialReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let t = &self.tool;
-        writeln!(
-            f,
-            "tool          {:?} end mill D {} mm, r {} mm, {} flutes, flute length {} mm",
-            self.tool_kind, t.diameter, t.corner_radius, t.flutes, t.flute_length
-        )?;
+        if self.tools.len() > 1 {
+            for (i, u) in self.tools.iter().enumerate() {
+                let t = &u.tool;
+                writeln!(
+                    f,
+                    "tool {:<8} {} at line {}: {:?} end mill D {} mm, r {} mm, {} flutes, flute \
+                     length {} mm; first move line {}, removed {:.1} mm³, peak A {:.3} mm²",
+                    format!("{}/{}", i + 1, self.tools.len()),
+                    u.select.as_deref().unwrap_or("(no selection)"),
+                    u.line,
+                    u.kind,
+                    t.diameter,
+                    t.corner_radius,
+                    t.flutes,
+                    t.flute_length,
+                    u.first_move_line,
+                    u.removed_volume_mm3,
+                    u.peak_area_mm2
+                )?;
+            }
+        } else {
+            let t = &self.tool;
+            writeln!(
+                f,
+                "tool          {:?} end mill D {} mm, r {} mm, {} flutes, flute length {} mm",
+                self.tool_kind, t.diameter, t.corner_radius, t.flutes, t.flute_length
+            )?;
+        }
         writeln!(
             f,
             "stock         {:.1} mm³ → removed {:.1} mm³ → {:.1} mm³ ({}×{} dexels of {:.3} mm, \
