@@ -80,7 +80,8 @@ pub struct MaterialArgs {
     /// `process.spindle_speed`).
     #[arg(long, value_name = "RPM")]
     pub spindle_speed: Option<f64>,
-    /// Tool diameter, mm (instead of the program's CUTTER/ or the machine file's `tool`). Also
+    /// Tool diameter, mm (for every tool, instead of the program's CUTTER/, the tool table or
+    /// the machine file's `tool`). Also
     /// what a Klartext bore-milling cycle (CYCL DEF 208) mills with, which the control takes
     /// from its tool table; alone (without a stock) it asks for no material stage.
     #[arg(long, value_name = "MM")]

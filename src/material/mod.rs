@@ -4,13 +4,16 @@
 //! Plain data in, plain data out, between the toolpath and the constraints:
 //!
 //! 1. [`simulate`]: a [`Stock`] (box or cylinder, workpiece coordinates) as Z-dexels
-//!    ([`dexel`]), a [`Tool`] (flat, ball or bull-nose end mill), and the toolpath's CL moves
+//!    ([`dexel`]), the program's [`Tool`]s (flat, ball or bull-nose end mills; each move is
+//!    cut with the tool in the spindle there, [`Material::tool_at`], from the program's tool
+//!    changes and the [`tooltable`]), and the toolpath's CL moves
 //!    cut into sample steps fixed by the grid; each step's swept volume removes material
 //!    ([`cut`]: exact for a vertical tool axis, conservative for a tilted one) and yields a
 //!    [`cut::Sample`]: removed volume ΔV, engaged cross-section A = ΔV/Δs normal to the feed
 //!    (MRR = A·V), axial depth a_p, radial engagement a_e and engagement angle φ.
 //! 2. [`FeedLimits::new`]: the [`ProcessLimits`] (chip load, MRR, power, air feed; each
-//!    optional) as a piecewise-constant cap on the tool-tip feed V along every CL move.
+//!    optional) as a piecewise-constant cap on the tool-tip feed V along every CL move, with
+//!    that move's tool's D and flutes.
 //! 3. [`FeedLimits::attach`]: those caps on the spans of a built path, as
 //!    [`crate::geometry::ProcessCaps`] in each span's u. Their breaks become stations
 //!    ([`crate::constraints::stations`]) and each cap one more upper bound on b = u̇² at the
