@@ -171,13 +171,27 @@ fn a_tool_missing_from_the_table_names_the_program_line_and_the_tool() {
         e.starts_with("prog.ngc:6:") && e.contains("tools.json has no tool 7"),
         "{e}"
     );
-    // No table at all: say where to give one.
+    // No table and two tool numbers: say where to give one.
     let e = resolve(&program(&tp, 2), &overrides(None))
         .unwrap_err()
         .to_string();
     assert!(
-        e.starts_with("prog.ngc:1:") && e.contains("--tool-table"),
+        e.starts_with("prog.ngc:6:") && e.contains("T1 at line 1") && e.contains("--tool-table"),
         "{e}"
+    );
+    // No table and one tool number all through (`T1 M6` … `T1 M6`): the machine file's or the
+    // options' tool, as before tool tables.
+    let mut o = overrides(None);
+    o.tool = ToolSpec {
+        diameter: Some(8.0),
+        flutes: Some(2),
+        ..ToolSpec::default()
+    };
+    let m = resolve(&program(&tp, 1), &o).unwrap().unwrap();
+    assert_eq!(m.tools.len(), 1);
+    assert_eq!(
+        (m.tools[0].tool.diameter, m.tools[0].select.clone()),
+        (8.0, None)
     );
 }
 

@@ -768,7 +768,9 @@ impl Material {
     /// field, the options win over the program's tool (its `CUTTER/`, or the tool table's
     /// entry for its `T` number or name), which wins over the machine file's `tool`. Every
     /// tool the program selects becomes a [`ToolUse`] from its first move on; the moves before
-    /// the first selection are cut with the first tool. `None` when there is no stock; an
+    /// the first selection are cut with the first tool. Without a tool table, one tool number
+    /// or name all through stands for the machine file's or the options' tool, and two are
+    /// an error asking for a table. `None` when there is no stock; an
     /// error naming what is missing when process limits are given without a stock, a tool or
     /// the spindle speed the chip load needs, and naming the program line where a selected
     /// tool is not in the tool table.
@@ -804,6 +806,23 @@ impl Material {
             }
             let sel = &change.tool;
             let at = |m: String| Error::parse(&program.source, change.line, m);
+            if table.is_none() && !matches!(sel, ToolSelect::Cutter { .. }) {
+                // No table: one tool number all through is the machine file's or the options'
+                // tool (as a program with `T1 M6` was read before tool tables); two are an error.
+                let first = program
+                    .tool_changes
+                    .iter()
+                    .find(|c| !matches!(c.tool, ToolSelect::Cutter { .. }));
+                if let Some(first) = first.filter(|f| f.tool != *sel) {
+                    return Err(at(format!(
+                        "{sel}: the program changes tools ({} at line {}): give a tool table \
+                         (--tool-table FILE, or the machine file's `tools`) so that the material \
+                         model knows each",
+                        first.tool, first.line
+                    )));
+                }
+                continue;
+            }
             let given = match sel {
                 ToolSelect::Cutter {
                     diameter,
