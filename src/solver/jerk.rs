@@ -703,6 +703,10 @@ impl Start<'_> {
 /// cut is taken as flat there ([`Start::at`]).
 const FLAT: f64 = 1e-4;
 
+/// How many times a piece whose first subproblem fails is linearised again at b̄/4
+/// ([`solve_piece`]).
+const MAX_RESCALES: usize = 3;
+
 /// Stations fewer than this apart are not cut.
 const MIN_WINDOW: usize = 100;
 
@@ -852,6 +856,7 @@ fn solve_piece(
     // Whether (bbar, abar) is an iterate of this SCP (feasible), not the start.
     let mut from_iterate = false;
     let mut subproblems = 0;
+    let mut rescaled = 0;
     for it in 0..options.max_iterations.max(1) {
         // From the reach profile (no slopes yet) the first subproblem keeps a' constant per
         // interval (the quadratic law), which ties ü to b from the span's ends on; later ones
@@ -881,6 +886,28 @@ fn solve_piece(
                     settings,
                     &mut carried,
                 )
+            })
+            .or_else(|e| {
+                // Both forms stalled (InsufficientProgress or NumericalError: seen on the
+                // CAMotics bear with jerk limits, where the whole solve then failed): once more
+                // with iterative refinement of every KKT solve, which Clarabel's default
+                // leaves on and ours turns off for speed.
+                if settings.iterative_refinement {
+                    return Err(e);
+                }
+                tracing::debug!("SCP {it}: {e}; again with iterative refinement");
+                let refined = SolverSettings {
+                    iterative_refinement: true,
+                    ..*settings
+                };
+                program.solve(
+                    &bbar,
+                    abar.as_deref(),
+                    sbar.as_deref(),
+                    tie,
+                    &refined,
+                    &mut carried,
+                )
             });
         let mut sol = match solved {
             Ok(sol) => sol,
@@ -892,6 +919,21 @@ fn solve_piece(
                 tracing::debug!("SCP {it}: {e}; keeping the best iterate");
                 status = status.worst(Status::AlmostOptimal);
                 break;
+            }
+            // No iterate yet: linearise at a quarter of b̄ (the tangent rows of a point far
+            // above the jerk-feasible profiles leave a sliver that Clarabel could not
+            // solve: a 2.5 mm rest-to-rest span of the CAMotics bear with jerk limits, b̄ up
+            // to 50 times the jerk-limited b). The tangent at any b̄ is an inner
+            // approximation, so every iterate stays jerk-feasible.
+            Err(e) if rescaled < MAX_RESCALES => {
+                rescaled += 1;
+                tracing::debug!("SCP {it}: {e}; again linearised at b̄/4");
+                for b in &mut bbar[1..p.intervals()] {
+                    *b *= 0.25;
+                }
+                (abar, sbar, last_time) = (None, None, None);
+                carried.clear();
+                continue;
             }
             Err(e) => return Err(e),
         };
