@@ -464,15 +464,24 @@ fn bundled_pocket_with_jerk_limits_is_within_its_estimate() {
     assert!(estimate <= 1e-3, "{estimate}");
 }
 
-/// A real CAM program at size with jerk limits: the CAMotics bear (15k lines, 3,209 spans) on
-/// its 3-axis mill with jerk = 10 × acceleration on every axis, default options, verified at
-/// 1 ms including jerk, and no faster than acceleration-limited. It failed with
-/// "Clarabel stopped with status NumericalError" on a 2.5 mm rest-to-rest span until a piece
-/// whose first subproblem fails is linearised again lower. Minutes in release: by hand
-/// (`cargo test --release --test jerk -- --ignored real_cam`).
+/// Real CAM programs at size with jerk limits, on their 3-axis mill with jerk = 10 ×
+/// acceleration on every axis: default options, verified at 1 ms including jerk, within the
+/// jerk-limited target (1e-3) by their estimate, and no faster than acceleration-limited.
+/// - the CAMotics bear (15k lines, 3,209 spans) failed with "Clarabel stopped with status
+///   NumericalError" on a 2.5 mm rest-to-rest span until a piece whose first subproblem fails
+///   is linearised again lower;
+/// - aamorim_basemach (3.4k lines, 1,403 spans) failed after twelve rounds of local
+///   refinement: the jerk bulged 0.1–0.2 % over its limit between the collocation points of
+///   the intervals after a rest end, caught by the 1 ms re-simulation only at some clock
+///   phases, until those intervals took denser points;
+/// - the CAMotics flower mould (17k lines, 9,664 spans) ran its 60 adaptive rounds unchanged
+///   at an estimate of 2.5e-3: the threshold took the whole tolerance for the errors' sum
+///   while the estimate was nine times that sum.
+///
+/// Minutes in release: by hand (`cargo test --release --test jerk -- --ignored real_cam`).
 #[test]
 #[ignore = "minutes; needs ../shared"]
-fn real_cam_program_with_jerk_limits_solves_and_verifies() {
+fn real_cam_programs_with_jerk_limits_solve_and_verify() {
     let cam = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/cam");
     let text = std::fs::read_to_string(cam.join("machines/xyz_mill.json")).expect("machine");
     let mut v: Value = serde_json::from_str(&text).expect("json");
@@ -487,17 +496,23 @@ fn real_cam_program_with_jerk_limits_solves_and_verifies() {
         };
     }
     let m = Machine::from_json(Path::new("xyz_mill_jerk.json"), &v.to_string()).expect("machine");
-    let name = "camotics_bear.nc";
-    let t = feedopt::toolpath::read(&cam.join(name)).expect("program");
-    let jerk = optimize(&m, &t, &Options::default()).expect("solves");
-    let accel = optimize(&m.without_jerk(), &t, &Options::default()).expect("solves");
-    let (tj, ta) = (jerk.schedule.cycle_time, accel.schedule.cycle_time);
-    eprintln!(
-        "{name}: jerk-limited {tj:.4} s on {} stations (estimate {:?}), acceleration-limited \
-         {ta:.4} s",
-        jerk.schedule.stations.len(),
-        jerk.error_estimate
-    );
-    assert_verified_with_jerk(&jerk, name);
-    assert!(tj >= ta * (1.0 - 1e-3), "{name}: {tj} vs {ta}");
+    for name in [
+        "aamorim_basemach.apt",
+        "camotics_bear.nc",
+        "camotics_flower_mold.nc",
+    ] {
+        let t = feedopt::toolpath::read(&cam.join(name)).expect("program");
+        let jerk = optimize(&m, &t, &Options::default()).expect("solves");
+        let accel = optimize(&m.without_jerk(), &t, &Options::default()).expect("solves");
+        let (tj, ta) = (jerk.schedule.cycle_time, accel.schedule.cycle_time);
+        let estimate = jerk.error_estimate.expect("adaptive");
+        eprintln!(
+            "{name}: jerk-limited {tj:.4} s on {} stations (estimate {estimate:.1e}), \
+             acceleration-limited {ta:.4} s",
+            jerk.schedule.stations.len(),
+        );
+        assert_verified_with_jerk(&jerk, name);
+        assert!(estimate <= 1e-3, "{name}: {estimate}");
+        assert!(tj >= ta * (1.0 - 1e-3), "{name}: {tj} vs {ta}");
+    }
 }
