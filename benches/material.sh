@@ -8,6 +8,7 @@
 #   CELL=0.05 bash benches/material.sh  # another cell size, mm (default 0.1)
 #   FEEDOPT=/tmp/old/feedopt bash benches/material.sh  # another build (no cargo build), for a
 #                                                      # before/after pair in the same hour
+#   COMPARE=/tmp/old/feedopt bash benches/material.sh  # also: does this build cut as that one?
 #
 # Rows (the machine files get a `stock` in a temporary folder; nothing is written into the crate):
 # - seed_blade: problems/seed_head_head (the bundled 5-axis problem, a flank pass along one
@@ -27,6 +28,11 @@
 # -v). The machine is assumed
 # shared: compare the two runs of a row, measured minutes apart, not rows of other days.
 # Needs GNU time (/usr/bin/time) and python3; skips a row whose inputs in ../shared are absent.
+#
+# COMPARE=path: per row, both builds check the program once more with an MRR cap of 1e-9 mm³/s,
+# so that every move that cuts is a finding carrying the move's removed volume and its worst
+# sample's A; prints the largest differences of those per move, of the totals and of the peaks
+# (`check --json` reports no single samples). Untimed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x /usr/bin/time ] || { echo "needs GNU time at /usr/bin/time (apt-get install time)" >&2; exit 2; }
@@ -96,6 +102,31 @@ print("%d samples, %dx%d dexels, removed %.0f mm3" % (r["samples"], r["dexels"][
     result="error: $(grep -v '^\s' "$tmp/time.txt" | head -1 | cut -c1-60)"
   fi
   printf '%-18s %-6s %-50s %8s %8s %8s\n' "$name" check "$result" "$wall" "$cpu" "$rss"
+  if [ -n "${COMPARE:-}" ]; then
+    python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["process"] = {"mrr_max": 1e-9}
+json.dump(m, open(sys.argv[2], "w"), indent=1)
+' "$stocked" "$tmp/capped.json"
+    # shellcheck disable=SC2086
+    "$bin" check --json --cell "$cell" $tool --machine "$tmp/capped.json" "$program" > "$tmp/new.json"
+    # shellcheck disable=SC2086
+    "$COMPARE" check --json --cell "$cell" $tool --machine "$tmp/capped.json" "$program" > "$tmp/old.json"
+    python3 -c '
+import json, sys
+new = json.load(open(sys.argv[1] + "/new.json"))
+old = json.load(open(sys.argv[1] + "/old.json"))
+keys = ["removed_volume_mm3", "peak_area_mm2", "peak_axial_depth_mm", "peak_radial_engagement_mm", "air_share"]
+print("  vs COMPARE: " + ", ".join("%s %.2e" % (k, abs(new[k] - old[k])) for k in keys))
+f = lambda r: {(x["point"], x["severity"], str(x["limit"])): x for x in r["findings"]}
+a, b = f(old), f(new)
+both = set(a) & set(b)
+dv = max((abs(a[k]["removed"] - b[k]["removed"]) for k in both), default=0.0)
+da = max((abs(a[k]["area"] - b[k]["area"]) for k in both), default=0.0)
+print("  vs COMPARE: %d moves cut (%d in one build only); largest per-move diff: removed %.2e mm3, A %.2e mm2" % (len(both), len(set(a) ^ set(b)), dv, da))
+' "$tmp"
+  fi
   run solve --json --machine "$machine" "$program"
   if [ "$ok" = 1 ]; then
     result=$(python3 -c '
