@@ -355,6 +355,16 @@ fn optimize_path(
 /// run to be kept whole ([`Plan::rest_split`]).
 const REST_HOLDS: f64 = 0.9;
 
+/// The SCP convergence of the first coarse grid G of a jerk-limited refinement (relative
+/// change of its cycle time; every other grid takes [`JerkOptions::convergence`]). G's profile
+/// is only F's first linearisation point (F's SCP converges as every other), and its times
+/// enter only round 0's ε: an unconverged G is slower, so those ε are, summed, too large
+/// rather than too small (an estimate that ends the refinement at round 0 stays an upper
+/// one). G's cold SCP (from the reach profile, 4–7 subproblems a window) is the costliest
+/// part of the rounds: 3 % less time on the jerk-limited impeller, its cycle time within
+/// 1e-5 of before.
+const COARSE_SCP: f64 = 3e-3;
+
 /// Geometric grading of the stations into a rest end of a jerk-limited span (levels).
 const GRADING: usize = 4;
 
@@ -820,7 +830,7 @@ impl Plan<'_> {
             .enumerate()
             .map(|(si, r)| {
                 // (Acceleration-limited only: jerk-limited solves take `solve_adaptive_jerk`.)
-                let s = self.solve_span(si, &r.fine, options, None, Some(r.greedy))?;
+                let s = self.solve_span(si, &r.fine, options, None, Some(r.greedy), false)?;
                 Ok((r.fine, s))
             })
             .collect::<Vec<Result<_>>>()
@@ -883,7 +893,11 @@ impl Plan<'_> {
                     self.uniform_problem(si, options.initial_stations, options)?,
                     options,
                 );
-                let s = self.solve_span(si, &p, options, None, None)?;
+                // G's SCP stops at COARSE_SCP: its profile only starts F's SCP (which
+                // converges as every other), and its times enter only round 0's ε.
+                let mut coarse_options = options.clone();
+                coarse_options.jerk.convergence = options.jerk.convergence.max(COARSE_SCP);
+                let s = self.solve_span(si, &p, &coarse_options, None, None, false)?;
                 let coarse = self.times(si, &p, &s)?;
                 let split = self.rest_split(si, &p, &s);
                 self.refine_jerk(si, options, &p, split, coarse, (&p, &s))
@@ -1129,7 +1143,7 @@ impl Plan<'_> {
             });
         }
         self.check_travel(si, &pf)?;
-        let sf = self.solve_span(si, &pf, options, Some(warm), None)?;
+        let sf = self.solve_span(si, &pf, options, Some(warm), None, false)?;
         let tf = self.times(si, &pf, &sf)?;
         let mut at = 0;
         let eps: Vec<f64> = split
@@ -1298,7 +1312,7 @@ impl Plan<'_> {
             }
             self.check_travel(si, &p)?;
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
-            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None)?;
+            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true)?;
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
@@ -1334,7 +1348,9 @@ impl Plan<'_> {
     }
 
     /// Solves one span's problem with the chosen solver, after the reach pass has checked that a
-    /// schedule exists (and said where not).
+    /// schedule exists (and said where not). `previous`: a profile on stations that `p`
+    /// contains, the jerk-limited SCP's start; `local`: solve again only about the stations
+    /// `p` adds to it ([`Warm::local`]).
     fn solve_span(
         &self,
         si: usize,
@@ -1342,6 +1358,7 @@ impl Plan<'_> {
         options: &Options,
         previous: Option<(&SpanProblem, &SpanSolution)>,
         greedy: Option<SpanSolution>,
+        local: bool,
     ) -> Result<SpanSolution> {
         // The O(N) pass runs first whatever the solver (unless the caller has its profile on
         // these stations already): it finds an impossible request and says where, which a
@@ -1366,7 +1383,9 @@ impl Plan<'_> {
                 options.verify.chord.as_ref(),
                 options.solver.worker_threads(),
             );
-            let warm = previous.and_then(|(op, os)| Warm::resample(op, os, p));
+            let warm = previous
+                .and_then(|(op, os)| Warm::resample(op, os, p))
+                .map(|w| Warm { local, ..w });
             return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk);
         }
         Ok(match options.solver_kind {
@@ -1412,7 +1431,7 @@ impl Plan<'_> {
         let mut solutions = Vec::with_capacity(self.path.spans.len());
         for si in 0..self.path.spans.len() {
             let p = self.final_grid(si, self.uniform_problem(si, total, options)?, options);
-            solutions.push(self.solve_span(si, &p, options, None, None)?);
+            solutions.push(self.solve_span(si, &p, options, None, None, false)?);
             problems.push(p);
         }
         self.level(problems, solutions)
