@@ -301,49 +301,79 @@ impl Interval {
         m
     }
 
-    /// ∫_p^q dξ / √b(ξ) under the cubic law: Gauss–Legendre on 8 points, halved until the
-    /// halves agree with the whole to 1e-13 (relative) (the integrand is analytic where b > 0).
+    /// ∫_p^q dξ / √b(ξ) under the cubic law: the 15-point Gauss–Kronrod rule, whose embedded
+    /// 7-point Gauss rule estimates its error; halved until that estimate is within 1e-13
+    /// (relative) of the whole (the integrand is analytic where b > 0). 15 evaluations a
+    /// panel, where 8-point Gauss–Legendre checked against its two halves took 24; the time
+    /// integrals are 5–9 % of a jerk-limited solve (SCP steps and the re-simulation's servo
+    /// instants).
     fn cubic_time(&self, p: f64, q: f64) -> f64 {
-        fn gl(iv: &Interval, p: f64, q: f64) -> f64 {
-            const X: [f64; 4] = [
-                0.183_434_642_495_649_8,
-                0.525_532_409_916_329,
-                0.796_666_477_413_626_7,
-                0.960_289_856_497_536_3,
-            ];
-            const W: [f64; 4] = [
-                0.362_683_783_378_362,
-                0.313_706_645_877_887_3,
-                0.222_381_034_453_374_5,
-                0.101_228_536_290_376_3,
-            ];
+        // Nodes and weights of QUADPACK's qk15: the Kronrod nodes (the odd ones, 1, 3, 5 and
+        // the centre, are the 7-point Gauss nodes) and weights, and the Gauss weights.
+        const XK: [f64; 8] = [
+            0.991_455_371_120_812_6,
+            0.949_107_912_342_758_5,
+            0.864_864_423_359_769_1,
+            0.741_531_185_599_394_4,
+            0.586_087_235_467_691_1,
+            0.405_845_151_377_397_2,
+            0.207_784_955_007_898_5,
+            0.0,
+        ];
+        const WK: [f64; 8] = [
+            0.022_935_322_010_529_22,
+            0.063_092_092_629_978_55,
+            0.104_790_010_322_250_2,
+            0.140_653_259_715_525_9,
+            0.169_004_726_639_267_9,
+            0.190_350_578_064_785_4,
+            0.204_432_940_075_298_9,
+            0.209_482_141_084_727_8,
+        ];
+        const WG: [f64; 4] = [
+            0.129_484_966_168_869_7,
+            0.279_705_391_489_276_7,
+            0.381_830_050_505_118_9,
+            0.417_959_183_673_469_4,
+        ];
+        /// (Kronrod's value, |Kronrod − Gauss|) on [p, q].
+        fn gk(iv: &Interval, p: f64, q: f64) -> (f64, f64) {
             let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
             let f = |x: f64| 1.0 / iv.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
-            h * X
-                .iter()
-                .zip(&W)
-                .map(|(x, w)| w * (f(c - h * x) + f(c + h * x)))
-                .sum::<f64>()
+            let centre = f(c);
+            let (mut k, mut g) = (WK[7] * centre, WG[3] * centre);
+            for j in 0..7 {
+                let pair = f(c - h * XK[j]) + f(c + h * XK[j]);
+                k += WK[j] * pair;
+                if j % 2 == 1 {
+                    g += WG[j / 2] * pair;
+                }
+            }
+            (h * k, (h * (k - g)).abs())
         }
         // `tol`: absolute, split between the halves, so the total error stays within the
         // whole's; `budget`: panels left, so a sharp peak of 1/√b (b nearly 0 inside) cannot
         // make the recursion exponential.
-        fn adapt(iv: &Interval, p: f64, q: f64, whole: f64, tol: f64, budget: &mut u32) -> f64 {
-            let m = 0.5 * (p + q);
-            let (l, r) = (gl(iv, p, m), gl(iv, m, q));
-            if *budget == 0 || (l + r - whole).abs() <= tol {
-                l + r
+        fn adapt(iv: &Interval, p: f64, q: f64, tol: f64, budget: &mut u32) -> f64 {
+            let (k, err) = gk(iv, p, q);
+            if *budget == 0 || err <= tol {
+                k
             } else {
                 *budget -= 1;
-                adapt(iv, p, m, l, 0.5 * tol, budget) + adapt(iv, m, q, r, 0.5 * tol, budget)
+                let m = 0.5 * (p + q);
+                adapt(iv, p, m, 0.5 * tol, budget) + adapt(iv, m, q, 0.5 * tol, budget)
             }
         }
         if q <= p {
             return 0.0;
         }
-        let whole = gl(self, p, q);
-        let mut budget = 4096;
-        adapt(self, p, q, whole, 1e-13 * whole.abs(), &mut budget)
+        let (whole, err) = gk(self, p, q);
+        let tol = 1e-13 * whole.abs();
+        if err <= tol {
+            return whole;
+        }
+        let (m, mut budget) = (0.5 * (p + q), 4096);
+        adapt(self, p, m, 0.5 * tol, &mut budget) + adapt(self, m, q, 0.5 * tol, &mut budget)
     }
 
     /// The motion at x under the cubic law.

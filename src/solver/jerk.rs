@@ -143,15 +143,17 @@ pub struct JerkData {
 
 /// Where inside each interval velocity, acceleration and jerk are also bounded (as fractions
 /// of the interval): b is cubic between stations and may bulge above both ends, and the
-/// geometry's curvature varies in between.
-///
-/// Two points lie near the stations: on a feed plateau b sits on its bound at both stations
-/// while ü there is free (nothing else binds it), and the cubic through them then bulged over
-/// the cap just inside a station, where ¼, ½, ¾ did not look (θ ≈ 0.1 or 0.9 in every feed
-/// excess the re-simulation found on the jerk-limited impeller, up to 0.6 %; each solved
-/// again found the next). With these four the impeller's local refinement takes 5 rounds
-/// instead of 10–12, for the same wall time in the adaptive rounds.
-pub const COLLOCATION: [f64; 4] = [0.1, 0.37, 0.63, 0.9];
+/// geometry's curvature varies in between. At [`VELOCITY_ONLY`] only the velocity bound.
+pub const COLLOCATION: [f64; 5] = [0.1, 0.25, 0.5, 0.75, 0.9];
+
+/// The points of [`COLLOCATION`] where only the velocity bound (axes and feed cap) is stated:
+/// on a feed plateau b sits on its cap at both stations while ü there is free (nothing else
+/// binds it), and the cubic through them then bulged over the cap just inside a station,
+/// where ¼, ½, ¾ did not look (θ ≈ 0.1 or 0.9 in every feed excess the re-simulation found on
+/// the jerk-limited impeller, up to 0.6 %; each interval solved again found the next, for
+/// 10–12 rounds of local refinement; with these, 5–6). Acceleration and jerk rows there too
+/// cost the 20 COPP jerk paths 20 % more time for nothing the re-simulation needed.
+pub const VELOCITY_ONLY: [f64; 2] = [0.1, 0.9];
 
 /// The collocation points of the intervals next to a rest end ([`NEAR_REST`]): there b grows
 /// as u^(4/3) from 0, which the quadratic pieces follow with a jerk that curves strongly
@@ -211,6 +213,8 @@ pub struct Midpoint {
     /// The acceleration rows that are edges of the polygon there
     /// ([`crate::constraints::essential_rows`]).
     pub essential: u16,
+    /// Only the velocity bound is stated here ([`VELOCITY_ONLY`]).
+    pub velocity_only: bool,
 }
 
 /// Inside an interval b may not dip below this share of the chord between its stations: the
@@ -278,7 +282,7 @@ impl JerkData {
         for k in 0..n {
             mid_start.push(mid_start[k] + collocation(k, n, rs, re).len());
         }
-        let midpoint = |(k, th): (usize, f64)| {
+        let midpoint = |(k, th, velocity_only): (usize, f64, bool)| {
             let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
             let seg = span.spline.segment(um);
             let w = span.spline.eval_in(seg, um);
@@ -299,6 +303,7 @@ impl JerkData {
                 jets,
                 b_max: pb.b_max,
                 essential: pb.essential,
+                velocity_only,
             }
         };
         // Chunks of intervals (their first stations and collocation points) in parallel.
@@ -310,7 +315,12 @@ impl JerkData {
         let parts = super::par_map(&chunks, threads, |&(k0, k1)| {
             let stations: Vec<_> = (k0..k1).map(|i| sides(p.u[i])).collect();
             let mids: Vec<Midpoint> = (k0..k1.min(n))
-                .flat_map(|k| collocation(k, n, rs, re).iter().map(move |&th| (k, th)))
+                .flat_map(|k| {
+                    let set = collocation(k, n, rs, re);
+                    let regular = set.len() == COLLOCATION.len();
+                    set.iter()
+                        .map(move |&th| (k, th, regular && VELOCITY_ONLY.contains(&th)))
+                })
                 .map(midpoint)
                 .collect();
             (stations, mids)
@@ -624,10 +634,14 @@ pub fn solve(
         },
     };
     let threads = settings.worker_threads();
-    let mut cuts = match &warm {
-        Some(w) if w.local => local_cuts(&w.fresh),
-        _ => cuts(p, jd, &start, threads, options.window),
-    };
+    let mut cuts = cuts(p, jd, &start, threads, options.window);
+    if let Some(w) = warm.as_ref().filter(|w| w.local) {
+        // The plateau cuts as well: where the fresh stations lie close together, their
+        // windows merge into one as long as the span (a COPP path: 470 and 660 stations).
+        cuts.extend(local_cuts(&w.fresh));
+        cuts.sort_unstable();
+        cuts.dedup();
+    }
     if cuts.len() <= 2 {
         return solve_piece(p, jd, &start, (0.0, 0.0), settings, options);
     }
@@ -838,10 +852,10 @@ fn cuts(
 /// ([`local_cuts`]).
 const LOCAL_REACH: usize = 12;
 
-/// Window boundaries `0 = c_0 < c_1 < … = N` of a local refinement: every run of fresh
-/// stations gets a window reaching [`LOCAL_REACH`] stations past its first and last (windows
-/// that would overlap are one); the stretches between them hold no fresh station, so their
-/// profile is kept ([`solve`]). A window cut anywhere else than on a plateau fixes b and ü at
+/// Window boundaries `0 = c_0 < c_1 < … = N` of a local refinement (added to the plateau cuts
+/// of [`cuts`]): every run of fresh stations gets a window reaching [`LOCAL_REACH`] stations
+/// past its first and last (windows that would overlap are one); the stretches between them
+/// hold no fresh station, so their profile is kept ([`solve`]). A window cut anywhere else than on a plateau fixes b and ü at
 /// the previous profile's values there; where that leaves no feasible profile inside (the
 /// fresh stations too close to a cut for the profile to slow down in time), the window fails
 /// and is merged with its neighbours, as any window.
@@ -1379,10 +1393,14 @@ impl<'a> Program<'a> {
                         .add(&sv(k, 1), w1),
                     ya: y(k).add(&sv(k, 0), v0).add(&sv(k, 1), v1),
                     slope: Lin::default().add(&sv(k, 0), 1.0 - th).add(&sv(k, 1), th),
-                    chord: Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th),
+                    chord: if m.velocity_only {
+                        Lin::default()
+                    } else {
+                        Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th)
+                    },
                     jets: &m.jets,
-                    d3: Some(&m.d3),
-                    essential: m.essential,
+                    d3: (!m.velocity_only).then_some(&m.d3),
+                    essential: if m.velocity_only { 0 } else { m.essential },
                     b_max: m.b_max,
                     at: BbarAt::Inside {
                         k,
