@@ -1807,3 +1807,45 @@ impl<'a> Program<'a> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{LOCAL_REACH, local_cuts};
+
+    /// `n + 1` stations with the listed ones fresh.
+    fn fresh(n: usize, at: &[usize]) -> Vec<bool> {
+        (0..=n).map(|i| at.contains(&i)).collect()
+    }
+
+    #[test]
+    fn local_windows_reach_past_each_run_of_fresh_stations_and_merge_when_they_meet() {
+        let r = LOCAL_REACH;
+        // One run in the middle: a window from r + 1 before it to r + 1 after it, the rest kept.
+        assert_eq!(
+            local_cuts(&fresh(200, &[100, 101])),
+            vec![0, 100 - r - 1, 101 + r + 1, 200]
+        );
+        // Two runs closer than two reaches: one window.
+        assert_eq!(
+            local_cuts(&fresh(200, &[50, 60])),
+            vec![0, 50 - r - 1, 60 + r + 1, 200]
+        );
+        // Two runs far apart: two windows, the stretch between them kept.
+        assert_eq!(
+            local_cuts(&fresh(300, &[50, 250])),
+            vec![0, 50 - r - 1, 50 + r + 1, 250 - r - 1, 250 + r + 1, 300]
+        );
+        // Near the span's ends: the windows stop there.
+        assert_eq!(
+            local_cuts(&fresh(100, &[2, 98])),
+            vec![0, 2 + r + 1, 98 - r - 1, 100]
+        );
+        // Nothing fresh: one window, which the solve keeps as it is.
+        assert_eq!(local_cuts(&fresh(50, &[])), vec![0, 50]);
+        // Every window end is a station that is not fresh (the previous profile is kept there).
+        let f = fresh(400, &[10, 11, 12, 40, 90, 91, 200, 231, 399]);
+        let cuts = local_cuts(&f);
+        assert!(cuts.windows(2).all(|w| w[0] < w[1]));
+        assert!(cuts.iter().all(|&c| c == 0 || c == 400 || !f[c]));
+    }
+}
