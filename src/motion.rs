@@ -354,26 +354,29 @@ impl Interval {
         // `tol`: absolute, split between the halves, so the total error stays within the
         // whole's; `budget`: panels left, so a sharp peak of 1/√b (b nearly 0 inside) cannot
         // make the recursion exponential.
-        fn adapt(iv: &Interval, p: f64, q: f64, tol: f64, budget: &mut u32) -> f64 {
-            let (k, err) = gk(iv, p, q);
+        // `(k, err)`: gk on [p, q].
+        fn adapt(
+            iv: &Interval,
+            p: f64,
+            q: f64,
+            (k, err): (f64, f64),
+            tol: f64,
+            budget: &mut u32,
+        ) -> f64 {
             if *budget == 0 || err <= tol {
-                k
-            } else {
-                *budget -= 1;
-                let m = 0.5 * (p + q);
-                adapt(iv, p, m, 0.5 * tol, budget) + adapt(iv, m, q, 0.5 * tol, budget)
+                return k;
             }
+            *budget -= 1;
+            let m = 0.5 * (p + q);
+            adapt(iv, p, m, gk(iv, p, m), 0.5 * tol, budget)
+                + adapt(iv, m, q, gk(iv, m, q), 0.5 * tol, budget)
         }
         if q <= p {
             return 0.0;
         }
-        let (whole, err) = gk(self, p, q);
-        let tol = 1e-13 * whole.abs();
-        if err <= tol {
-            return whole;
-        }
-        let (m, mut budget) = (0.5 * (p + q), 4096);
-        adapt(self, p, m, 0.5 * tol, &mut budget) + adapt(self, m, q, 0.5 * tol, &mut budget)
+        let whole = gk(self, p, q);
+        let mut budget = 4096;
+        adapt(self, p, q, whole, 1e-13 * whole.0.abs(), &mut budget)
     }
 
     /// The motion at x under the cubic law.

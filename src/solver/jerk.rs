@@ -540,9 +540,8 @@ pub struct Warm {
     pub slopes: Vec<[f64; 2]>,
     /// Stations that were not stations of the previous profile.
     pub fresh: Vec<bool>,
-    /// Solve only windows about the fresh stations, cut [`LOCAL_REACH`] stations from them
-    /// where the previous profile is kept (a local refinement: [`local_cuts`]); otherwise the
-    /// windows of [`cuts`].
+    /// Solve only windows about the fresh stations, cut a few stations from them where the
+    /// previous profile is kept (a local refinement), besides the plateau cuts ([`solve`]).
     pub local: bool,
 }
 
@@ -897,7 +896,6 @@ fn local_cuts(fresh: &[bool]) -> Vec<usize> {
     if cuts[cuts.len() - 1] != n {
         cuts.push(n);
     }
-    cuts.dedup();
     cuts
 }
 
@@ -965,12 +963,7 @@ fn solve_piece(
     let mut best: Option<(SpanSolution, f64)> = None;
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
     let mut carried: Vec<bool> = Vec::new();
-    let mut program = Program::new(p, jd, &bbar, a_ends, options.objective);
-    program.hot = start.fresh.map(|f| {
-        (0..f.len())
-            .map(|i| f[i.saturating_sub(1)..(i + 2).min(f.len())].contains(&true))
-            .collect()
-    });
+    let program = Program::new(p, jd, &bbar, a_ends, options.objective, start.fresh);
     // Whether (bbar, abar) is an iterate of this SCP (feasible), not the start.
     let mut from_iterate = false;
     let mut subproblems = 0;
@@ -1253,7 +1246,7 @@ struct Program<'a> {
     a_ends: (f64, f64),
     soc: Rows,
     n_soc: usize,
-    /// Per station: fresh, or next to a fresh station, of a warm start (see
+    /// Per site: at or inside an interval next to a fresh station of a warm start (see
     /// [`ACTIVE_NEAR_FRESH`]); `None` from the reach profile.
     hot: Option<Vec<bool>>,
 }
@@ -1265,6 +1258,7 @@ impl<'a> Program<'a> {
         bbar: &[f64],
         a_ends: (f64, f64),
         objective: Objective,
+        fresh: Option<&[bool]>,
     ) -> Self {
         let n = p.intervals();
         let lay = Layout {
@@ -1412,6 +1406,19 @@ impl<'a> Program<'a> {
                 });
             }
         }
+        // A site at station i or inside interval i is near a fresh station within i − 1 … i + 2.
+        let hot = fresh.map(|f| {
+            sites
+                .iter()
+                .map(|site| {
+                    let i = match site.at {
+                        BbarAt::Station(i) => i,
+                        BbarAt::Inside { k, .. } => k,
+                    };
+                    f[i.saturating_sub(1)..(i + 3).min(f.len())].contains(&true)
+                })
+                .collect()
+        });
         let mut cands = Vec::new();
         for (s, site) in sites.iter().enumerate() {
             let s = s as u32;
@@ -1484,7 +1491,7 @@ impl<'a> Program<'a> {
             a_ends,
             soc,
             n_soc,
-            hot: None,
+            hot,
         }
     }
 
@@ -1632,7 +1639,6 @@ impl<'a> Program<'a> {
         settings: &SolverSettings,
         carried: &mut Vec<bool>,
     ) -> Result<SpanSolution> {
-        let hot = self.hot.as_deref();
         let (p, lay, scale) = (self.p, &self.lay, self.scale);
         let n = p.intervals();
         let interior = |i: usize| i > 0 && i < n;
@@ -1690,15 +1696,8 @@ impl<'a> Program<'a> {
             .map(|(r, c)| {
                 (keep && carried[r])
                     || vals[r] >= ACTIVE_AT
-                    // A site at station i or inside interval i, next to a fresh station.
                     || (!keep
-                        && hot.is_some_and(|h| {
-                            let i = match self.sites[c.0 as usize].at {
-                                BbarAt::Station(i) => i,
-                                BbarAt::Inside { k, .. } => k,
-                            };
-                            h[i] || h[(i + 1).min(h.len() - 1)]
-                        })
+                        && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
                         && vals[r] >= ACTIVE_NEAR_FRESH)
                     || (!tie && c.0 < n_station_sites && matches!(c.1, Kind::Acceleration(..)))
             })
