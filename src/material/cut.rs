@@ -62,7 +62,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::dexel::{Dexel, Dexels, TILE};
-use super::tool::Tool;
+use super::tool::{Pose, Tool};
 use crate::toolpath::{Feed, Toolpath};
 
 /// What the tool engaged over one sample step.
@@ -378,8 +378,8 @@ pub(crate) struct SharedPose {
     rows: Vec<SharedRow>,
 }
 
-/// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, `[NaN, NaN]` where not
-/// computed (material out of the tool's reach) and [`MISS`] where the tool does not cross.
+/// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, [`MISS`] where the
+/// tool does not cross.
 #[derive(Debug, Clone, Default)]
 struct SharedRow {
     step: u64,
@@ -418,27 +418,23 @@ pub(crate) fn cut_step(
     let plunge = oe.cross(&f).norm() <= 1e-9 * f.norm();
     let r = tool.radius();
     let vertical = poses == 1;
-    // Every pose once (tilted): tip, axis and the projected axis segment.
-    type Pose = (Vector3<f64>, Vector3<f64>, [f64; 2], [f64; 2], [f64; 2]);
-    let pose_list: Vec<Pose> = if vertical {
+    // Every pose once (tilted): the tool there and its projected axis segment.
+    let pose_list: Vec<(Pose, [f64; 2], [f64; 2])> = if vertical {
         Vec::new()
     } else {
         (0..poses)
             .map(|j| {
                 let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
                 let top = p + o * tool.flute_length;
-                // The tool lies in the cylinder of radius R about [p, top]: its z range.
-                let drop = r * (1.0 - o.z * o.z).max(0.0).sqrt();
-                let z = [p.z.min(top.z) - drop, p.z.max(top.z) + drop];
-                (p, o, [p.x, p.y], [top.x, top.y], z)
+                (Pose::new(tool, &p, &o), [p.x, p.y], [top.x, top.y])
             })
             .collect()
     };
     // This step's number; its first pose's crossings where the previous step's last pose is it.
     let (prev, this) = (shared.step, shared.step + 1);
-    let reuse = !vertical && shared.pose == Some((pose_list[0].0, pose_list[0].1));
+    let reuse = !vertical && shared.pose == Some((pose_list[0].0.tip(), pose_list[0].0.axis()));
     shared.step = this;
-    shared.pose = pose_list.last().map(|l| (l.0, l.1));
+    shared.pose = pose_list.last().map(|l| (l.0.tip(), l.0.axis()));
     let acc = match cell_range(dexels, &bounds) {
         None => Acc::ZERO,
         Some((i0, i1, j0, j1)) => {
@@ -446,8 +442,15 @@ pub(crate) fn cut_step(
             let pose_list = &pose_list;
             let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
             // Per task, per row: the run of consecutive poses crossing each cell (`last`: the
-            // latest such pose), reused from row to row.
-            let scratch = || (Vec::<[f64; 2]>::new(), Vec::<usize>::new());
+            // latest such pose) and the runs a miss ended (cell, interval), reused from row to
+            // row.
+            let scratch = || {
+                (
+                    Vec::<[f64; 2]>::new(),
+                    Vec::<usize>::new(),
+                    Vec::<(usize, [f64; 2])>::new(),
+                )
+            };
             let bands = dexels.bands(j0, j1);
             let first_row = bands[0].rows().start;
             let last_row = bands[bands.len() - 1].rows().end;
@@ -455,7 +458,7 @@ pub(crate) fn cut_step(
             bands
                 .into_par_iter()
                 .zip(shared_rows.par_chunks_mut(TILE))
-                .map_init(scratch, |(run, last), (mut band, shared_rows)| {
+                .map_init(scratch, |(run, last, ended), (mut band, shared_rows)| {
                     let mut acc = Acc::ZERO;
                     let rows = band.rows();
                     for (j, row_shared) in rows.zip(shared_rows) {
@@ -492,76 +495,80 @@ pub(crate) fn cut_step(
                             });
                             continue;
                         }
-                        // Pose by pose over the cells of its capsule.
-                        let width = i1 - i0 + 1;
+                        // Pose by pose over the cells of its capsule: each pose's crossings
+                        // (no dexel is read), joined into runs; then the runs are removed.
+                        let row_of = |k: usize| {
+                            let (_, a, b) = &pose_list[k];
+                            let ends = r * pose_list[k].0.axis().z.abs();
+                            capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
+                        };
+                        let (mut ua, mut ub) = (usize::MAX, 0);
+                        for k in 0..poses {
+                            if let Some((ia, ib)) = row_of(k) {
+                                (ua, ub) = (ua.min(ia), ub.max(ib));
+                            }
+                        }
+                        if ua > ub {
+                            continue;
+                        }
+                        let width = ub - ua + 1;
                         run.clear();
-                        run.resize(width, [0.0; 2]);
+                        run.resize(width, MISS);
                         last.clear();
                         last.resize(width, usize::MAX);
-                        for (k, (p, o, a, b, z)) in pose_list.iter().enumerate() {
-                            let ends = r * o.z.abs();
-                            let Some((ia, ib)) =
-                                capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
-                            else {
+                        ended.clear();
+                        for k in 0..poses {
+                            let Some((ia, ib)) = row_of(k) else {
                                 continue;
                             };
+                            let pose = &pose_list[k].0;
                             let from_shared = k == 0 && reuse && row_shared.step == prev;
+                            let known = if from_shared {
+                                let s0 = row_shared.start;
+                                s0..s0 + row_shared.hits.len()
+                            } else {
+                                0..0
+                            };
                             let to_shared = k == poses - 1;
                             if to_shared {
                                 row_shared.step = this;
                                 row_shared.start = ia;
                                 row_shared.hits.clear();
-                                row_shared.hits.resize(ib - ia + 1, [f64::NAN; 2]);
                             }
-                            band.each(j, ia, ib, |i, cell| {
-                                let Some([bottom, top]) = cell.extent() else {
-                                    return;
-                                };
-                                let c = i - i0;
-                                // Material all below or all above the tool's z range: nothing
-                                // to cut at this pose, and a run through it goes on (a convex
-                                // tool crosses the line at every pose between two that cross
-                                // it).
-                                if top <= z[0] || bottom >= z[1] {
-                                    if last[c] != usize::MAX && last[c] + 1 == k {
-                                        last[c] = k;
-                                    }
-                                    return;
-                                }
-                                let x = cx(i);
-                                let known = if from_shared {
-                                    let k = i.wrapping_sub(row_shared.start);
-                                    row_shared.hits.get(k).filter(|h| !h[0].is_nan())
+                            for i in ia..=ib {
+                                // (k = 0 reads the shared row, k = poses − 1 ≥ 1 writes it.)
+                                let h = if known.contains(&i) {
+                                    row_shared.hits[i - known.start]
                                 } else {
-                                    None
-                                };
-                                let h = match known {
-                                    Some(h) => (h[0] <= h[1]).then_some(*h),
-                                    None => tool.line_hit(p, o, x, y),
+                                    pose.hit(cx(i), y).unwrap_or(MISS)
                                 };
                                 if to_shared {
-                                    row_shared.hits[i - ia] = h.unwrap_or(MISS);
+                                    row_shared.hits.push(h);
                                 }
-                                let Some(h) = h else {
-                                    return;
-                                };
+                                if h[0] > h[1] {
+                                    continue;
+                                }
+                                let c = i - ua;
                                 if last[c] != usize::MAX && last[c] + 1 == k {
                                     run[c] = [run[c][0].min(h[0]), run[c][1].max(h[1])];
                                 } else {
                                     if last[c] != usize::MAX {
-                                        note(x, cell.remove(run[c][0], run[c][1]));
+                                        ended.push((i, run[c]));
                                     }
                                     run[c] = h;
                                 }
                                 last[c] = k;
-                            });
-                        }
-                        for c in 0..width {
-                            if last[c] != usize::MAX {
-                                let i = i0 + c;
-                                note(cx(i), band.dexel(i, j).remove(run[c][0], run[c][1]));
                             }
                         }
+                        for &(i, [lo, hi]) in ended.iter() {
+                            note(cx(i), band.dexel(i, j).remove(lo, hi));
+                        }
+                        band.each(j, ua, ub, |i, cell| {
+                            let c = i - ua;
+                            if last[c] != usize::MAX {
+                                note(cx(i), cell.remove(run[c][0], run[c][1]));
+                            }
+                        });
                     }
                     acc
                 })
@@ -691,16 +698,7 @@ mod tests {
                         continue;
                     }
                     let (p, o) = step.pose(k as f64 / (poses - 1) as f64);
-                    let top = p + o * tool.flute_length;
-                    let drop = tool.radius() * (1.0 - o.z * o.z).max(0.0).sqrt();
-                    let z = [p.z.min(top.z) - drop, p.z.max(top.z) + drop];
                     let goes_on = run.is_some_and(|(last, _)| last + 1 == k);
-                    if cell[cell.len() - 1][1] <= z[0] || cell[0][0] >= z[1] {
-                        if goes_on {
-                            run = run.map(|(_, h)| (k, h));
-                        }
-                        continue;
-                    }
                     let Some(h) = tool.line_hit(&p, &o, x, y) else {
                         continue;
                     };

@@ -126,34 +126,88 @@ impl Tool {
     /// `p` and unit axis `o` (a static pose), if it does. Exact for flat and ball-nose tools
     /// (quadratics); for a bull-nose tool the torus part is solved as a convex problem in z
     /// (ρ(z) − r(h(z)) is convex: a norm of an affine function minus a concave one) to 1e-9 mm.
+    /// The same as [`Pose::hit`], which keeps what depends on the pose alone for many lines.
     pub fn line_hit(&self, p: &Vector3<f64>, o: &Vector3<f64>, x: f64, y: f64) -> Option<[f64; 2]> {
-        let (dx, dy) = (x - p.x, y - p.y);
-        let (r, rc, lf) = (self.radius(), self.corner_radius, self.flute_length);
-        // With s = z − P_z: h(s) = c + s O_z, ρ²(s) = a s² − 2 c O_z s + (dx² + dy² − c²).
-        let c = dx * o.x + dy * o.y;
+        Pose::new(self, p, o).hit(x, y)
+    }
+}
+
+/// A tool at a static pose (tip `p`, unit axis `o`), with what its crossings with the dexel
+/// lines share: [`Tool::line_hit`] for line after line.
+///
+/// With s = z − P_z along the line through (x, y), d = (x − P_x, y − P_y) and c = d·(O_x, O_y):
+/// the height above the tip is h(s) = c + s O_z and the squared distance from the axis
+/// ρ²(s) = a s² − 2 c O_z s + (|d|² − c²), a = 1 − O_z².
+#[derive(Debug, Clone, Copy)]
+pub struct Pose<'a> {
+    tool: &'a Tool,
+    p: Vector3<f64>,
+    o: Vector3<f64>,
+    /// 1 − O_z² and its inverse (∞ for a vertical axis: then ρ does not depend on s).
+    a: f64,
+    inv_a: f64,
+    /// 1/O_z (∞ for a horizontal axis: then h does not depend on s).
+    inv_oz: f64,
+}
+
+impl<'a> Pose<'a> {
+    /// `tool` with its tip at `p` and unit axis `o`.
+    pub fn new(tool: &'a Tool, p: &Vector3<f64>, o: &Vector3<f64>) -> Pose<'a> {
         let a = 1.0 - o.z * o.z;
+        Pose {
+            tool,
+            p: *p,
+            o: *o,
+            a,
+            inv_a: if a < 1e-15 { f64::INFINITY } else { 1.0 / a },
+            inv_oz: if o.z.abs() < 1e-15 {
+                f64::INFINITY
+            } else {
+                1.0 / o.z
+            },
+        }
+    }
+
+    /// The tip.
+    pub fn tip(&self) -> Vector3<f64> {
+        self.p
+    }
+
+    /// The unit axis.
+    pub fn axis(&self) -> Vector3<f64> {
+        self.o
+    }
+
+    /// The interval of z (mm) where the vertical line through (x, y) crosses the tool, if it
+    /// does ([`Tool::line_hit`]).
+    #[inline]
+    pub fn hit(&self, x: f64, y: f64) -> Option<[f64; 2]> {
+        let (p, o, tool) = (&self.p, &self.o, self.tool);
+        let (dx, dy) = (x - p.x, y - p.y);
+        let (r, rc, lf) = (tool.radius(), tool.corner_radius, tool.flute_length);
+        let c = dx * o.x + dy * o.y;
         let q0 = dx * dx + dy * dy - c * c;
         // The s where h(s) lies within [h0, h1].
         let slab = |h0: f64, h1: f64| -> Option<(f64, f64)> {
-            if o.z.abs() < 1e-15 {
+            if self.inv_oz.is_infinite() {
                 return (c >= h0 && c <= h1).then_some((f64::NEG_INFINITY, f64::INFINITY));
             }
-            let (s0, s1) = ((h0 - c) / o.z, (h1 - c) / o.z);
+            let (s0, s1) = ((h0 - c) * self.inv_oz, (h1 - c) * self.inv_oz);
             Some((s0.min(s1), s0.max(s1)))
         };
         // The s where ρ²(s) ≤ rad².
         let within = |rad: f64| -> Option<(f64, f64)> {
             let cc = q0 - rad * rad;
-            if a < 1e-15 {
+            if self.inv_a.is_infinite() {
                 return (cc <= 0.0).then_some((f64::NEG_INFINITY, f64::INFINITY));
             }
             let bh = -c * o.z; // half of the linear coefficient
-            let disc = bh * bh - a * cc;
+            let disc = bh * bh - self.a * cc;
             if disc < 0.0 {
                 return None;
             }
             let sq = disc.sqrt();
-            Some(((-bh - sq) / a, (-bh + sq) / a))
+            Some(((-bh - sq) * self.inv_a, (-bh + sq) * self.inv_a))
         };
         let meet = |x: Option<(f64, f64)>, y: Option<(f64, f64)>| -> Option<(f64, f64)> {
             let (x, y) = (x?, y?);
@@ -177,12 +231,13 @@ impl Tool {
                 (-ez - sq, -ez + sq)
             })
         } else {
-            let (s0, s1) = slab(0.0, rc)?;
-            // No part of the torus section reaches the line: outside the cylinder of radius R.
-            meet(Some((s0, s1)), within(r)).and_then(|(s0, s1)| {
+            // No part of the torus section reaches the line outside the slab h ∈ [0, r_c] or
+            // the cylinder of radius R.
+            let a = self.a;
+            meet(slab(0.0, rc), within(r)).and_then(|(s0, s1)| {
                 let f = |s: f64| {
                     let rho2 = (a * s * s - 2.0 * c * o.z * s + q0).max(0.0);
-                    rho2.sqrt() - self.radius_at(c + s * o.z)
+                    rho2.sqrt() - tool.radius_at(c + s * o.z)
                 };
                 convex_sublevel(f, s0, s1, 1e-9)
             })
@@ -267,8 +322,10 @@ mod tests {
             Tool::new(10.0, 5.0, 20.0, 2).unwrap(),
             Tool::new(10.0, 2.0, 20.0, 4).unwrap(),
         ] {
-            for _ in 0..300 {
-                let o = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 + rnd()).normalize();
+            for case in 0..400 {
+                // A quarter of the poses with a horizontal axis (O_z = 0).
+                let oz = if case % 4 == 0 { 0.0 } else { 0.3 + rnd() };
+                let o = Vector3::new(rnd() - 0.5, rnd() - 0.5, oz).normalize();
                 let p = Vector3::new(rnd(), rnd(), rnd());
                 let (x, y) = (p.x + 16.0 * (rnd() - 0.5), p.y + 16.0 * (rnd() - 0.5));
                 let hit = tool.line_hit(&p, &o, x, y);
