@@ -89,7 +89,8 @@ fn time_of(sol: &Solution) -> f64 {
 }
 
 /// The default answer (lattice relaxation where it is exact, Clarabel on the windows where it
-/// is not) equals Clarabel run on every span in one piece on the same final stations.
+/// is not) equals Clarabel run on every span in one piece, with every row from the start (no
+/// constraint generation), on the same final stations.
 #[test]
 fn default_answer_equals_all_clarabel_on_the_same_grid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
@@ -111,7 +112,8 @@ fn default_answer_equals_all_clarabel_on_the_same_grid() {
         };
         let mut all_clarabel = 0.0;
         for (p, s) in sol.problems.iter().zip(&sol.solutions) {
-            let c = clarabel::solve(p, &settings).expect("Clarabel solves the span");
+            let (c, _) = clarabel::solve_rows(p, &settings, clarabel::Rows0::Every)
+                .expect("Clarabel solves the span");
             all_clarabel += interval_times(p, &c).expect("finite").iter().sum::<f64>();
             used_clarabel |= s.iterations > 0;
             exact_somewhere |= s.iterations == 0 && p.intervals() > 10;
@@ -125,6 +127,40 @@ fn default_answer_equals_all_clarabel_on_the_same_grid() {
     }
     // Both ways of the final solve were exercised.
     assert!(used_clarabel && exact_somewhere);
+}
+
+/// Clarabel's constraint generation (`solver::clarabel`), from the rows near the reachability
+/// profile or from the velocity rows alone (more rounds), gives the time and the sensitivities
+/// of the program with every row, on every span of the bundled blade (to a gap of 1e-9, so
+/// that two solves of the same optimum agree well inside the 1e-6 checked).
+#[test]
+fn generated_rows_give_the_whole_program() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    let machine = Machine::from_file(&root.join("seed_head_head/machine.json")).expect("machine");
+    let input = toolpath::read_input(&root.join("seed_head_head/impeller_blade.cls")).expect("tp");
+    let sol = optimize_input(&machine, &input, &Options::default()).expect("solves");
+    let settings = SolverSettings {
+        tol_gap: 1e-9,
+        ..SolverSettings::default()
+    };
+    assert!(!sol.problems.is_empty());
+    for p in &sol.problems {
+        let time = |s: &feedopt::solver::SpanSolution| -> f64 {
+            interval_times(p, s).expect("finite").iter().sum()
+        };
+        let (every, se) =
+            clarabel::solve_rows(p, &settings, clarabel::Rows0::Every).expect("solves");
+        for first in [clarabel::Rows0::NearReach, clarabel::Rows0::Velocity] {
+            let (got, sg) = clarabel::solve_rows(p, &settings, first).expect("solves");
+            let rel = (time(&got) - time(&every)).abs() / time(&every);
+            assert!(rel <= 1e-6, "{first:?}: time differs by {rel:e}");
+            for (a, b) in sg.acceleration.iter().zip(&se.acceleration) {
+                let d = (a.max - b.max).abs() + (a.min - b.min).abs();
+                let s = b.max.abs() + b.min.abs();
+                assert!(d <= 1e-3 * s + 1e-9, "{first:?}: dT/da {a:?} vs {b:?}");
+            }
+        }
+    }
 }
 
 /// A fixed grid (`stations`) is solved as given, without an estimate; the reach solver on the
