@@ -267,9 +267,13 @@ fn check_impeller_sweep(s: &Sweep) {
     );
 }
 
-/// The full-resolution study: automatic refinement at the nominal limits (about 1.4 M
-/// stations), then Clarabel at every step on those stations. Minutes in release:
-/// `cargo test --release --test sweep -- --ignored --nocapture`.
+/// The full-resolution study: automatic refinement at the nominal limits (30,867 stations
+/// since the adaptive refinement; 1.4 M when this test was written), then Clarabel at every
+/// step on those stations: `cargo test --release --test sweep -- --ignored --nocapture`.
+/// The steps stop at 240 °/s² (C's acceleration holds the feed down on 0.7 % of the time
+/// there): at the nominal 300 °/s² (0.5 %) the limits that bind change within ±1 %, so that
+/// step is not smooth and has no finite difference to compare (it made this test fail with
+/// three steps from 60 to 300, before and after the constraint generation alike).
 #[test]
 #[ignore]
 fn impeller_c_acceleration_sweep_at_full_resolution() {
@@ -281,7 +285,7 @@ fn impeller_c_acceleration_sweep_at_full_resolution() {
         &m,
         &input,
         "impeller-7bl-xyzac.ngc",
-        &SweepOptions::new("C", SweptLimit::Acceleration, 60.0, 300.0, 3),
+        &SweepOptions::new("C", SweptLimit::Acceleration, 60.0, 240.0, 4),
     )
     .unwrap();
     eprintln!("wall time {:.1} s", t0.elapsed().as_secs_f64());
