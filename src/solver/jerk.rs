@@ -189,15 +189,30 @@ pub const AT_REST: usize = 3;
 /// tenth.
 pub const NEAR_REST: usize = 12;
 
-/// The collocation points of interval `k` of `n` (as fractions of it).
-pub fn collocation(k: usize, n: usize, rest_start: bool, rest_end: bool) -> &'static [f64] {
+/// An interval's collocation points (fractions of it) and those of them where only the
+/// velocity bound is stated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collocation {
+    /// Every point.
+    pub points: &'static [f64],
+    /// The points (of `points`) with only the velocity bound ([`VELOCITY_ONLY`]; none next to
+    /// a rest end, where the jerk is what bulges between points).
+    pub velocity_only: &'static [f64],
+}
+
+/// The collocation points of interval `k` of `n`.
+pub fn collocation(k: usize, n: usize, rest_start: bool, rest_end: bool) -> Collocation {
     let from_rest = |m: usize| (rest_start && k < m) || (rest_end && k + m >= n);
-    if from_rest(AT_REST) {
-        &COLLOCATION_AT_REST
+    let (points, velocity_only): (&'static [f64], &'static [f64]) = if from_rest(AT_REST) {
+        (&COLLOCATION_AT_REST, &[])
     } else if from_rest(NEAR_REST) {
-        &COLLOCATION_NEAR_REST
+        (&COLLOCATION_NEAR_REST, &[])
     } else {
-        &COLLOCATION
+        (&COLLOCATION, &VELOCITY_ONLY)
+    };
+    Collocation {
+        points,
+        velocity_only,
     }
 }
 
@@ -280,7 +295,7 @@ impl JerkData {
         let mut mid_start = Vec::with_capacity(n + 1);
         mid_start.push(0);
         for k in 0..n {
-            mid_start.push(mid_start[k] + collocation(k, n, rs, re).len());
+            mid_start.push(mid_start[k] + collocation(k, n, rs, re).points.len());
         }
         let midpoint = |(k, th, velocity_only): (usize, f64, bool)| {
             let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
@@ -317,9 +332,9 @@ impl JerkData {
             let mids: Vec<Midpoint> = (k0..k1.min(n))
                 .flat_map(|k| {
                     let set = collocation(k, n, rs, re);
-                    let regular = set.len() == COLLOCATION.len();
-                    set.iter()
-                        .map(move |&th| (k, th, regular && VELOCITY_ONLY.contains(&th)))
+                    set.points
+                        .iter()
+                        .map(move |&th| (k, th, set.velocity_only.contains(&th)))
                 })
                 .map(midpoint)
                 .collect();
@@ -1809,7 +1824,27 @@ impl<'a> Program<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::{LOCAL_REACH, local_cuts};
+    use super::{COLLOCATION, LOCAL_REACH, NEAR_REST, VELOCITY_ONLY, collocation, local_cuts};
+
+    /// Away from rest ends the velocity-only points are [`VELOCITY_ONLY`], each one of the
+    /// interval's points; next to a rest end there are none (whatever the sets' sizes).
+    #[test]
+    fn velocity_only_points_are_the_regular_sets_own() {
+        let n = 40;
+        for k in 0..n {
+            for (rs, re) in [(false, false), (true, false), (false, true), (true, true)] {
+                let c = collocation(k, n, rs, re);
+                assert!(c.velocity_only.iter().all(|t| c.points.contains(t)));
+                let near = (rs && k < NEAR_REST) || (re && k + NEAR_REST >= n);
+                if near {
+                    assert!(c.velocity_only.is_empty(), "k {k} ({rs}, {re})");
+                } else {
+                    assert_eq!(c.points, &COLLOCATION[..]);
+                    assert_eq!(c.velocity_only, &VELOCITY_ONLY[..]);
+                }
+            }
+        }
+    }
 
     /// `n + 1` stations with the listed ones fresh.
     fn fresh(n: usize, at: &[usize]) -> Vec<bool> {
