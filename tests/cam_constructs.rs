@@ -461,3 +461,75 @@ fn cycle76_with_a_boring_list_reads_as_cycle86_and_a_spigot_call_is_an_error() {
         );
     }
 }
+
+/// A Sinumerik call feedopt does not know (a cycle or subprogram with an argument list, here
+/// NX's thread-milling CYCLE90 from a Huron KX20 post) may move the tool: an error naming the
+/// line and the call, not a warning that drops it. CYCLE832 (tolerances) and MSG are read and
+/// ignored; a bare unknown word stays a warning.
+#[test]
+fn an_unknown_sinumerik_call_is_an_error() {
+    let text =
+        "G90 G54\nG0 X0 Y0 Z10\nCYCLE90(-17,-17,,-36,,28,25,2,1000,2,0,72.415,-34)\nG1 X10 F100\n";
+    let e = message(parse(Path::new("t.mpf"), text, Dialect::Sinumerik).unwrap_err());
+    assert!(e.contains("t.mpf:3") && e.contains("CYCLE90(…)"), "{e}");
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nFOO\nG0 X0 Y0 Z10\nG1 X10 F100\n",
+    );
+    assert_eq!(tp.points.len(), 2);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.message.contains("unknown word `FOO`")),
+        "{:?}",
+        tp.warnings
+    );
+}
+
+/// Fanuc G60 (single-direction positioning, one-shot; a Kuraki KBT post writes
+/// `G60G00X-.9843Y-1.0891`): the move to its end point, with a warning that the overshoot the
+/// control's parameters set is not modelled.
+#[test]
+fn fanuc_g60_moves_to_its_end_point_with_a_warning() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X0. Y0. Z10.\nG60 G0 X5. Y2.\nG1 X10. F100.\n",
+    );
+    assert_eq!(tp.points.len(), 3);
+    assert_close(tp.points[1].p, v(5.0, 2.0, 10.0), 1e-12);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 3 && w.message.contains("single-direction positioning")),
+        "{:?}",
+        tp.warnings
+    );
+}
+
+/// Sinumerik `I=AC(…)` gives an arc centre in program coordinates and `I=IC(…)` from the
+/// start, whatever the modal mode (an NX post for a Huron KX20 writes
+/// `G2 X39 Y0 Z-10 I=AC(0.) J=AC(0.) TURN=1`): the same helix as the plain incremental I J.
+#[test]
+fn sinumerik_ac_and_ic_arc_centres() {
+    let head = "G90 G17\nG0 X39 Y0 Z0\nF100\n";
+    let points = |arc: &str| gcode(Dialect::Sinumerik, &format!("{head}{arc}\n")).points;
+    let plain = points("G2 X39 Y0 Z-2 I-39 J0 TURN=1");
+    assert!(plain.len() > 20, "a helix of two turns in chords");
+    for arc in [
+        "G2 X39 Y0 Z-2 I=AC(0.) J=AC(0.) TURN=1",
+        "G2 X39 Y0 Z-2 I=IC(-39) J=AC(0) TURN=1",
+        "G2 X39 Y0 Z-2 I=AC(0) TURN=1",
+    ] {
+        let got = points(arc);
+        assert_eq!(got.len(), plain.len(), "{arc}");
+        for (g, p) in got.iter().zip(&plain) {
+            assert_close(g.p, p.p, 1e-12);
+        }
+    }
+    // An off-origin centre: (10, 0) absolute is I-29 from (39, 0).
+    let a = points("G3 X-19 Y0 I=AC(10) J=AC(0)");
+    let b = points("G3 X-19 Y0 I-29 J0");
+    assert_eq!(a.len(), b.len());
+    assert_close(a[a.len() / 2].p, b[b.len() / 2].p, 1e-12);
+    assert_close(a[a.len() / 2].p, v(10.0, 29.0, 0.0), 1e-6);
+}

@@ -111,6 +111,10 @@ pub enum Address {
     Axis(usize),
     /// Arc centre 0–2 (I J K); under [`Tcp::OnIjkVector`] on G0/G1 blocks, the tool vector.
     ArcCentre(usize),
+    /// Arc centre 0–2 written `I=AC(…)` (`true`: absolute, in program coordinates) or
+    /// `I=IC(…)` (`false`: from the arc's start), whatever the modal arc-centre mode
+    /// (Sinumerik). Made by the lexer, in no dialect's table.
+    ArcCentreAs(usize, bool),
     /// Tool-vector component 0–2 (Sinumerik `A3= B3= C3=`).
     ToolVector(usize),
     /// Arc radius (`R`, Sinumerik `CR=`).
@@ -420,6 +424,9 @@ const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution (G95) is not supported";
 const COMP: &str = "cutter radius compensation is not applied: the programmed path is used";
+const G60: &str = "single-direction positioning approaches the end point from one side, past \
+                   it by an amount the control's parameters set; that approach is not modelled: \
+                   the move goes straight to its end point";
 const G10: &str = "G10 sets a tool or work offset and moves nothing; the program's coordinates \
                    are used as written";
 const UVW: &str = "U V W axes are not modelled: word ignored";
@@ -679,6 +686,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("53.1", Action::Ignored),
         ("54..59", Action::Ignored),
         ("54.1", Action::Ignored),
+        ("60", Note(G60)),
         ("61..64", Action::Ignored),
         ("65", Unsup("macro calls (G65/G66) are not supported")),
         ("66", Unsup("macro calls (G65/G66) are not supported")),

@@ -23,6 +23,9 @@ use crate::toolpath::{
 struct Block {
     axes: [Option<Num>; 6],
     centre: [Option<Num>; 3],
+    /// Per centre word, `I=AC(…)` (Some(true)) or `I=IC(…)` (Some(false)): absolute or from
+    /// the start whatever the modal arc-centre mode.
+    centre_as: [Option<bool>; 3],
     vector: [Option<f64>; 3],
     radius: Option<Num>,
     turns: Option<f64>,
@@ -293,7 +296,7 @@ impl<'a> Interpreter<'a> {
                     }
                     continue;
                 }
-                Item::Unknown { text } if self.procs.contains(&text) => {
+                Item::Unknown { text, .. } if self.procs.contains(&text) => {
                     if let Some(first) = call_word.replace(text.clone()) {
                         return Err(self.error(
                             line,
@@ -302,7 +305,19 @@ impl<'a> Interpreter<'a> {
                     }
                     continue;
                 }
-                Item::Unknown { text } => {
+                Item::Unknown { text, call: true } => {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{text}(…)`: a call of a cycle or subprogram feedopt does not know; \
+                             it may move the tool, so it is not skipped. Post the operation as \
+                             G0/G1/G2/G3 moves, or define the subprogram in this file (PROC \
+                             {text} … RET); the {name} cycles feedopt reads are CYCLE81–CYCLE89 \
+                             and CYCLE800"
+                        ),
+                    ));
+                }
+                Item::Unknown { text, call: false } => {
                     self.warn(
                         line,
                         format!("unknown word `{text}` (not a {name} word): ignored"),
@@ -367,6 +382,11 @@ impl<'a> Interpreter<'a> {
                 Address::ArcCentre(i) => {
                     duplicate(block.centre[i].is_some())?;
                     block.centre[i] = Some(num);
+                }
+                Address::ArcCentreAs(i, absolute) => {
+                    duplicate(block.centre[i].is_some())?;
+                    block.centre[i] = Some(num);
+                    block.centre_as[i] = Some(absolute);
                 }
                 Address::ToolVector(i) => {
                     duplicate(block.vector[i].is_some())?;
@@ -1735,10 +1755,15 @@ impl<'a> Interpreter<'a> {
                 ));
             }
             let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
-            match self.arc_distance {
-                Distance::Incremental => (s0 + word(a), s1 + word(b)),
-                Distance::Absolute => (word(a), word(b)),
-            }
+            let modal = self.arc_distance == Distance::Absolute;
+            let coordinate = |i: usize, start: f64| {
+                if block.centre_as[i].unwrap_or(modal) {
+                    word(i)
+                } else {
+                    start + word(i)
+                }
+            };
+            (coordinate(a, s0), coordinate(b, s1))
         };
 
         let r_start = (s0 - c0).hypot(s1 - c1);

@@ -95,8 +95,9 @@ pub(super) enum Item {
     /// Sinumerik `T="MILL"`: a tool selected by name (as written between the quotes, upper
     /// case).
     ToolName(String),
-    /// A word the dialect does not know.
-    Unknown { text: String },
+    /// A word the dialect does not know; `call`: written with an argument list, `NAME(…)`
+    /// (Sinumerik: a call of a cycle or subprogram, which may move the tool).
+    Unknown { text: String, call: bool },
 }
 
 /// Parses the number after a letter or `=`: optional sign, digits with at most one decimal
@@ -236,7 +237,7 @@ fn lex_letters(
         let text = format!("{letter}{text_value}");
         items.push(match address {
             Some(address) => Item::Word { text, address, num },
-            None => Item::Unknown { text },
+            None => Item::Unknown { text, call: false },
         });
         i = end;
     }
@@ -392,6 +393,7 @@ fn lex_separate_word(
             } else {
                 items.push(Item::Unknown {
                     text: format!("{name}="),
+                    call: false,
                 });
             }
             return Ok(());
@@ -410,6 +412,20 @@ fn lex_separate_word(
             _ => {
                 if text.is_empty() {
                     return Err(format!("`{name}=` has no number"));
+                }
+                if let (Address::ArcCentre(i), Some(inner)) = (
+                    address,
+                    text.strip_prefix("AC(")
+                        .or_else(|| text.strip_prefix("IC("))
+                        .and_then(|t| t.strip_suffix(')')),
+                ) {
+                    let num = value(inner, vars).map_err(|e| format!("`{name}={text}`: {e}"))?;
+                    items.push(Item::Word {
+                        text: format!("{name}={text}"),
+                        address: Address::ArcCentreAs(i, text.starts_with("AC(")),
+                        num,
+                    });
+                    return Ok(());
                 }
                 if text.starts_with("IC(") || text.starts_with("AC(") {
                     return Err(format!(
@@ -455,6 +471,7 @@ fn lex_separate_word(
             }),
             None => items.push(Item::Unknown {
                 text: name.to_string(),
+                call: args.is_some(),
             }),
         }
         return Ok(());
