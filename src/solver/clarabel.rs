@@ -160,18 +160,22 @@ pub fn solve_rows(
     // The median finite bound.
     let scale = super::median_scale(&p.b_max);
     let rows = linear_rows(p, &lay, scale);
-    let mut keep: Vec<bool> = match (first, super::reach::solve(p)) {
-        (Rows0::NearReach, Ok(seed)) => {
-            let x = |col: usize| seed.b[col / 3 + 1] / scale;
-            rows.iter().map(|r| r.slack(x) <= NEAR * r.unit()).collect()
-        }
-        (Rows0::Velocity, _) => rows
+    let every = vec![true; rows.len()];
+    let mut keep: Vec<bool> = match first {
+        Rows0::NearReach => match super::reach::solve(p) {
+            Ok(seed) => {
+                // Row columns are x_i's, 3(i − 1) (Layout::x).
+                let x = |col: usize| seed.b[col / 3 + 1] / scale;
+                rows.iter().map(|r| r.slack(x) <= NEAR * r.unit()).collect()
+            }
+            // No feasible profile: let Clarabel say why on the whole program.
+            Err(_) => every,
+        },
+        Rows0::Velocity => rows
             .iter()
             .map(|r| matches!(r.tag, RowTag::BMax(_)))
             .collect(),
-        // Every row; also where the reachability pass finds none feasible: let Clarabel say
-        // why on the whole program.
-        _ => vec![true; rows.len()],
+        Rows0::Every => every,
     };
     let (mut iterations, mut solve_time) = (0, 0.0);
     for round in 1.. {
