@@ -300,6 +300,19 @@ pub struct References {
     /// The axes that give Heidenhain's M92 datum (`"m92"`, machine coordinates, mm): name and
     /// datum.
     pub m92: Vec<(String, f64)>,
+    /// `"program_units"`: the unit the control reads a program in that selects none (Fanuc
+    /// and Sinumerik set it by a parameter or machine datum, not in the program); `None`: the
+    /// file does not say.
+    pub program_units: Option<LengthUnit>,
+}
+
+/// A program's length unit (F in that unit per minute).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LengthUnit {
+    /// Millimetres.
+    Mm,
+    /// Inches.
+    Inch,
 }
 
 impl Machine {
@@ -369,10 +382,25 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         };
         axes.push((axis.name.clone(), list));
     }
+    let program_units = match value.get("program_units") {
+        None => None,
+        Some(Value::String(u)) if u == "mm" => Some(LengthUnit::Mm),
+        Some(Value::String(u)) if u == "inch" => Some(LengthUnit::Inch),
+        Some(v) => {
+            return Err(parser.err(
+                "program_units",
+                format!(
+                    "expected \"mm\" or \"inch\" (the unit the control reads a program that \
+                     selects none in), found {v}"
+                ),
+            ));
+        }
+    };
     Ok(References {
         file: source.to_path_buf(),
         axes,
         m92,
+        program_units,
     })
 }
 
@@ -590,6 +618,7 @@ impl Parser {
                 "tool",
                 "tools",
                 "process",
+                "program_units",
             ],
         )?;
         let name = match obj.get("name") {

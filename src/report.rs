@@ -215,6 +215,9 @@ pub struct Summary {
     /// What the reader assumed for `G28`/`G30` where the machine file gives no reference
     /// point (machine zero, the controls' default; the fields to set), else `null`.
     pub reference: Option<String>,
+    /// What the reader assumed of the unit of a Fanuc or Sinumerik program that selects none
+    /// where the machine file gives no `program_units` (mm), else `null`.
+    pub units: Option<String>,
 }
 
 /// Worst use of one axis's limits in the re-simulation.
@@ -344,6 +347,7 @@ impl Summary {
             dialect_by: None,
             dwell_time_s: 0.0,
             reference: None,
+            units: None,
         }
     }
 
@@ -356,6 +360,7 @@ impl Summary {
         self.cycle_time_s += dwell_time_s - self.dwell_time_s;
         self.dwell_time_s = dwell_time_s;
         self.reference = detected.assumed.reference_note();
+        self.units = detected.assumed.units_note();
     }
 }
 
@@ -385,6 +390,9 @@ impl fmt::Display for Summary {
                 )?,
                 None => writeln!(f, "read as       {} ({})", self.format, self.format_by)?,
             }
+        }
+        if let Some(units) = &self.units {
+            writeln!(f, "units         {units}")?;
         }
         if let Some(reference) = &self.reference {
             writeln!(f, "reference     {reference}")?;

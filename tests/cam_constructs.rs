@@ -2,6 +2,7 @@
 //! and axes, each against hand-computed moves and times.
 
 use feedopt::error::Error;
+use feedopt::machine::LengthUnit;
 use feedopt::toolpath::gcode::{Dialect, parse, parse_assumed, parse_cycle_alias, parse_for};
 use feedopt::toolpath::{Feed, MachineContext, Toolpath, Warning, apt};
 use nalgebra::Vector3;
@@ -123,6 +124,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         work_offset,
         travel: Default::default(),
         m92: [None; 3],
+        program_units: None,
     }
 }
 
@@ -532,4 +534,74 @@ fn sinumerik_ac_and_ic_arc_centres() {
     assert_eq!(a.len(), b.len());
     assert_close(a[a.len() / 2].p, b[b.len() / 2].p, 1e-12);
     assert_close(a[a.len() / 2].p, v(10.0, 29.0, 0.0), 1e-6);
+}
+
+/// A Fanuc or Sinumerik program that selects no unit is read in the unit the control is set
+/// to, which only the machine file can give (`program_units`). Without it: mm, a warning at the
+/// first move and the `units` note (an NX post for a Makino, "_in", with no G20 was read in
+/// mm with no word said). With `inch`: coordinates and F in inch.
+/// LinuxCNC (units from its INI file) and a program that selects its unit say nothing.
+#[test]
+fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm() {
+    let text = "G90 G0 X1. Y0. Z0.\nG1 X2. F10.\n";
+    let read = |spec, units| {
+        let mut m = context("XYZ", Default::default(), [0.0; 3]);
+        m.program_units = units;
+        parse_assumed(Path::new("t.nc"), text, spec, Some(&m), &[]).unwrap()
+    };
+    for d in [Dialect::Fanuc, Dialect::Sinumerik] {
+        let (tp, assumed) = read(d.spec(), None);
+        assert!(assumed.units_mm && assumed.units_note().unwrap().contains("program_units"));
+        let w: Vec<&Warning> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("selects no unit"))
+            .collect();
+        assert!(w.len() == 1 && w[0].line == 1, "{d:?}: {w:?}");
+        assert_close(tp.points[1].p, v(2.0, 0.0, 0.0), 1e-12);
+        let (tp, assumed) = read(d.spec(), Some(LengthUnit::Mm));
+        assert!(
+            !assumed.units_mm && tp.warnings.is_empty(),
+            "{:?}",
+            tp.warnings
+        );
+        let (tp, _) = read(d.spec(), Some(LengthUnit::Inch));
+        assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+        assert_close(tp.points[1].p, v(50.8, 0.0, 0.0), 1e-12);
+        match tp.points[1].feed {
+            Feed::Programmed(f) => assert!((f - 10.0 * 25.4 / 60.0).abs() < 1e-12, "{f}"),
+            other => panic!("{other:?}"),
+        }
+        // The program's own G21 / G71 wins over the machine file.
+        let own = if d == Dialect::Fanuc { "G21 " } else { "G71 " };
+        let mut m = context("XYZ", Default::default(), [0.0; 3]);
+        m.program_units = Some(LengthUnit::Inch);
+        let (tp, assumed) = parse_assumed(
+            Path::new("t.nc"),
+            &format!("{own}{text}"),
+            d.spec(),
+            Some(&m),
+            &[],
+        )
+        .unwrap();
+        assert!(!assumed.units_mm);
+        assert_close(tp.points[1].p, v(2.0, 0.0, 0.0), 1e-12);
+        // F: Fanuc's G21 sets it in mm/min; Sinumerik's G71 changes lengths only, F stays in
+        // the basic system the machine file gives (inch/min).
+        let f = if d == Dialect::Fanuc {
+            10.0
+        } else {
+            10.0 * 25.4
+        };
+        match tp.points[1].feed {
+            Feed::Programmed(got) => assert!((got - f / 60.0).abs() < 1e-12, "{d:?}: {got}"),
+            other => panic!("{other:?}"),
+        }
+    }
+    let (tp, assumed) = read(Dialect::LinuxCnc.spec(), None);
+    assert!(
+        !assumed.units_mm && tp.warnings.is_empty(),
+        "{:?}",
+        tp.warnings
+    );
 }

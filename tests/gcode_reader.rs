@@ -473,7 +473,7 @@ fn unknown_word_warns_with_its_line() {
     // Sinumerik: an unknown keyword and an unknown named word.
     let tp = ok_in(
         Dialect::Sinumerik,
-        "G0 X0 Y0 Z0\nFOO G1 X1 F100\nBAR=3 Y1\n",
+        "G71 G0 X0 Y0 Z0\nFOO G1 X1 F100\nBAR=3 Y1\n",
     );
     assert_eq!(tp.points.len(), 3);
     assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
@@ -618,12 +618,15 @@ fn tcp_modes_per_dialect() {
         .collect();
     assert_eq!(tcp, vec![4]);
     // Fanuc G43.4: rotary words in TCP mode, no warnings.
-    let tp = ok_in(Dialect::Fanuc, "G43.4 H1\nG0 X0. Y0. Z0. A10. C20.\nG49\n");
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "G21 G43.4 H1\nG0 X0. Y0. Z0. A10. C20.\nG49\n",
+    );
     assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
     // Fanuc G43.5: I J K on G1 are the tool vector (normalised); rotary stays None.
     let tp = ok_in(
         Dialect::Fanuc,
-        "G43.5 H1\nG0 X0. Y0. Z0. I0. J0. K1.\nG1 X1. I1. K1. F600.\nG1 X2.\n",
+        "G21 G43.5 H1\nG0 X0. Y0. Z0. I0. J0. K1.\nG1 X1. I1. K1. F600.\nG1 X2.\n",
     );
     assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
     assert!(tp.points.iter().all(|p| p.rotary.is_none()));
@@ -634,7 +637,7 @@ fn tcp_modes_per_dialect() {
     // Sinumerik TRAORI with A3 B3 C3.
     let tp = ok_in(
         Dialect::Sinumerik,
-        "TRAORI\nG0 X0 Y0 Z0 A3=0 B3=0 C3=1\nG1 X1 A3=0 B3=1 C3=1 F600\nTRAFOOF\nM30\n",
+        "G71 TRAORI\nG0 X0 Y0 Z0 A3=0 B3=0 C3=1\nG1 X1 A3=0 B3=1 C3=1 F600\nTRAFOOF\nM30\n",
     );
     assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
     assert_close(tp.points[1].o, v(0.0, h, h), 1e-15);

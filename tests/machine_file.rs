@@ -1063,3 +1063,35 @@ fn a_file_that_never_ends_is_refused() {
         );
     }
 }
+
+/// `program_units`: "mm" or "inch", the unit the control reads a program that selects none in
+/// (for the toolpath readers); anything else is an error naming the field.
+#[test]
+fn program_units_is_mm_or_inch() {
+    use feedopt::machine::{LengthUnit, references_from_json};
+    let with = |u: &str| {
+        format!(
+            r#"{{"name": "xyz", "kinematics": {{"type": "xyz"}}, "program_units": {u},
+                "axes": {{"X": {{"velocity": 400, "acceleration": 2000}},
+                         "Y": {{"velocity": 400, "acceleration": 2000}},
+                         "Z": {{"velocity": 400, "acceleration": 2000}}}}}}"#
+        )
+    };
+    for (u, want) in [("\"mm\"", LengthUnit::Mm), ("\"inch\"", LengthUnit::Inch)] {
+        let text = with(u);
+        let m = ok(&text);
+        let r = references_from_json(Path::new("m.json"), &text, &m).unwrap();
+        assert_eq!(r.program_units, Some(want));
+    }
+    for bad in ["\"in\"", "25.4", "null"] {
+        let text = with(bad);
+        let m = ok(&text);
+        let e = references_from_json(Path::new("m.json"), &text, &m)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("program_units") && e.contains("inch"),
+            "{bad}: {e}"
+        );
+    }
+}

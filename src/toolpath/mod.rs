@@ -242,6 +242,9 @@ pub struct MachineContext {
     /// Heidenhain's M92 datum per axis X Y Z, machine coordinates (mm), where the machine file
     /// gives it (`axes.Z.m92`).
     pub m92: [Option<f64>; 3],
+    /// The unit the control reads a program that selects none in (`program_units`), where the
+    /// machine file gives it.
+    pub program_units: Option<crate::machine::LengthUnit>,
 }
 
 impl MachineContext {
@@ -287,6 +290,7 @@ impl MachineContext {
                     .find(|(n, _)| n == NAMES[i])
                     .map(|(_, d)| *d)
             }),
+            program_units: references.program_units,
         }
     }
 
@@ -337,9 +341,21 @@ pub struct Assumed {
     /// not give (`axes.Z.reference`): machine zero, machine coordinate 0, was used — the
     /// controls' default.
     pub reference_at_machine_zero: [bool; 6],
+    /// A Fanuc or Sinumerik program selected no unit (G20/G21, G70/G71, G700/G710) and the
+    /// machine file gives no `program_units`: it was read in mm, as a metric control does.
+    pub units_mm: bool,
 }
 
 impl Assumed {
+    /// One line saying what was assumed of the program's unit, or `None` when nothing was.
+    pub fn units_note(&self) -> Option<String> {
+        self.units_mm.then(|| {
+            "the program selects no unit: read in mm, as a metric control does; set \
+             program_units (\"mm\" or \"inch\") in the machine file"
+                .to_string()
+        })
+    }
+
     /// One line saying what was assumed, or `None` when nothing was.
     pub fn reference_note(&self) -> Option<String> {
         const NAMES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];

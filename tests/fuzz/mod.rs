@@ -541,12 +541,14 @@ fn machine_case(path: PathBuf, bytes: Vec<u8>) -> Outcome {
 }
 
 /// Fields of the summary that are `null` by design: no estimate on a fixed grid, no dialect
-/// for an APT or CSV input, no reference note when the reader assumed no G28/G30 reference.
-const OPTIONAL: [&str; 4] = [
+/// for an APT or CSV input, no reference or units note when the reader assumed no G28/G30
+/// reference and no program unit.
+const OPTIONAL: [&str; 5] = [
     "summary.error_estimate",
     "summary.dialect",
     "summary.dialect_by",
     "summary.reference",
+    "summary.units",
 ];
 
 /// Checks a JSON summary for NaN (serde_json writes NaN and infinities as null).

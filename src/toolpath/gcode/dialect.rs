@@ -409,6 +409,10 @@ pub struct DialectSpec {
     pub integer_increments: Option<IntegerIncrements>,
     /// How subprograms are written.
     pub subprograms: Subprograms,
+    /// A program that selects no unit is read in the unit a control parameter sets (Fanuc,
+    /// Sinumerik), which the machine file may give (`program_units`); otherwise the unit is
+    /// the configuration's (LinuxCNC's INI file) or the program's own (Klartext `BEGIN PGM`).
+    pub units_by_setting: bool,
 }
 
 use Action::{
@@ -593,6 +597,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     g94_clears_feed: true,
     integer_increments: None,
     subprograms: Subprograms::OWordSub,
+    units_by_setting: false,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -752,6 +757,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         deg: 0.001,
     }),
     subprograms: Subprograms::OPrograms,
+    units_by_setting: true,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -968,6 +974,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     g94_clears_feed: false,
     integer_increments: None,
     subprograms: Subprograms::Procs,
+    units_by_setting: true,
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1206,6 +1213,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     g94_clears_feed: false,
     integer_increments: None,
     subprograms: Subprograms::Labels,
+    units_by_setting: false,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

@@ -130,8 +130,11 @@ pub(super) struct Interpreter<'a> {
     pub(super) vars: Variables,
     units: Units,
     feed_units: Units,
-    /// A Sinumerik program's first G70/G71 has set the basic system F is read in.
+    /// The basic system F is read in is known (Sinumerik: G70/G71 change lengths only): the
+    /// machine file's `program_units`, else the program's first unit word.
     basic_system_set: bool,
+    /// The program has selected its unit (G20/G21, G70/G71, G700/G710).
+    units_selected: bool,
     distance: Distance,
     arc_distance: Distance,
     plane: Plane,
@@ -198,14 +201,20 @@ impl<'a> Interpreter<'a> {
         source: &'a Path,
         machine: Option<&'a MachineContext>,
     ) -> Self {
+        // A program that selects no unit is read in the machine file's `program_units`.
+        let units = match machine.and_then(|m| m.program_units) {
+            Some(crate::machine::LengthUnit::Inch) => Units::Inch,
+            _ => Units::Mm,
+        };
         Interpreter {
             spec,
             source,
             machine,
             vars: Variables::default(),
-            units: Units::Mm,
-            feed_units: Units::Mm,
-            basic_system_set: false,
+            units,
+            feed_units: units,
+            basic_system_set: machine.is_some_and(|m| m.program_units.is_some()),
+            units_selected: false,
             distance: Distance::Absolute,
             arc_distance: Distance::Incremental,
             plane: Plane::Xy,
@@ -255,6 +264,26 @@ impl<'a> Interpreter<'a> {
             line,
             message: message.into(),
         });
+    }
+
+    /// After the program: a Fanuc or Sinumerik program that selected no unit, on a machine
+    /// whose file does not say which unit its control reads such a program in, was read in mm;
+    /// a warning at its first move and [`Assumed::units_mm`] say so.
+    pub(super) fn note_units(&mut self) {
+        let given = self.machine.is_some_and(|m| m.program_units.is_some());
+        if self.spec.units_by_setting
+            && !self.units_selected
+            && !given
+            && let Some(first) = self.points.first().map(|p| p.line)
+        {
+            self.assumed.units_mm = true;
+            self.warn(
+                first,
+                "the program selects no unit (G20/G21, G70/G71 or G700/G710): read in mm and \
+                 mm/min, as a control set for metric reads it; a control set for inch reads it \
+                 in inch (set program_units in the machine file)",
+            );
+        }
     }
 
     pub(super) fn finish(mut self, last_line: usize) -> Result<Toolpath> {
@@ -650,6 +679,7 @@ impl<'a> Interpreter<'a> {
                 Action::Plane(p) => self.plane = p,
                 Action::Units { units, feed } => {
                     self.units = units;
+                    self.units_selected = true;
                     if feed {
                         self.feed_units = units;
                         self.basic_system_set = true;

@@ -297,6 +297,7 @@ pub fn parse_configured(
     interp.block_delete = settings.block_delete;
     interp.tool_diameter = settings.tool_diameter;
     program.run(spec, &mut interp, source)?;
+    interp.note_units();
     let assumed = interp.assumed;
     interp
         .finish(program.last_line())
