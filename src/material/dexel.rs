@@ -10,8 +10,9 @@
 //! **Storage** (issue 13: memory and set-up no more than the cut needs). The grid is stored in
 //! tiles of [`TILE`] × [`TILE`] dexels, each made from the stock ([`Stock::column`]) the first
 //! time a cut reaches it; a tile never cut costs one null pointer, and reading it gives the
-//! stock's column. A dexel holds its single interval inline ([`Dexel::One`]) and goes to the
-//! heap only when a tilted tool's undercut splits it ([`Dexel::Many`]).
+//! stock's column. A dexel holds one or two intervals inline ([`Dexel::One`], [`Dexel::Two`]:
+//! a tilted tool's undercut leaves material below it and above its flutes) and goes to the
+//! heap only for three or more ([`Dexel::Many`]).
 
 use super::stock::Stock;
 
@@ -21,8 +22,8 @@ pub const MIN_CUT_MM: f64 = 1e-9;
 /// Dexels along each side of a tile (module doc).
 pub const TILE: usize = 16;
 
-/// One dexel's material: sorted, disjoint intervals `[z0, z1]` (24 bytes; the heap only for
-/// two or more intervals).
+/// One dexel's material: sorted, disjoint intervals `[z0, z1]` (40 bytes; the heap only for
+/// three or more intervals).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum Dexel {
     /// No material.
@@ -30,7 +31,9 @@ pub enum Dexel {
     Empty,
     /// One interval (the stock's column, or what stays of it after cuts from above or below).
     One([f64; 2]),
-    /// Two or more intervals.
+    /// Two intervals (a tilted tool's undercut: material below it and above its flutes).
+    Two([[f64; 2]; 2]),
+    /// Three or more intervals.
     Many(Vec<[f64; 2]>),
 }
 
@@ -40,11 +43,22 @@ impl Dexel {
         column.map_or(Dexel::Empty, Dexel::One)
     }
 
+    /// The dexel of sorted, disjoint intervals, in its inline form where it has one.
+    fn from_intervals(v: Vec<[f64; 2]>) -> Dexel {
+        match v.len() {
+            0 => Dexel::Empty,
+            1 => Dexel::One(v[0]),
+            2 => Dexel::Two([v[0], v[1]]),
+            _ => Dexel::Many(v),
+        }
+    }
+
     /// The intervals, sorted and disjoint.
     pub fn intervals(&self) -> &[[f64; 2]] {
         match self {
             Dexel::Empty => &[],
             Dexel::One(iv) => std::slice::from_ref(iv),
+            Dexel::Two(v) => v,
             Dexel::Many(v) => v,
         }
     }
@@ -54,6 +68,7 @@ impl Dexel {
         match self {
             Dexel::Empty => None,
             Dexel::One(iv) => Some(*iv),
+            Dexel::Two(v) => Some([v[0][0], v[1][1]]),
             Dexel::Many(v) => Some([v[0][0], v[v.len() - 1][1]]),
         }
     }
@@ -82,7 +97,7 @@ impl Dexel {
                     (false, false) => Dexel::Empty,
                     (true, false) => Dexel::One([a0, lo]),
                     (false, true) => Dexel::One([hi, b0]),
-                    (true, true) => Dexel::Many(vec![[a0, lo], [hi, b0]]),
+                    (true, true) => Dexel::Two([[a0, lo], [hi, b0]]),
                 };
                 Cut {
                     length: b - a,
@@ -90,12 +105,55 @@ impl Dexel {
                     z_hi: b,
                 }
             }
+            Dexel::Two(v) => {
+                // `remove`'s steps on two intervals, without the heap unless a split makes three.
+                let [f, l] = *v;
+                if hi - lo < MIN_CUT_MM || l[1] <= lo || f[0] >= hi || (f[1] <= lo && l[0] >= hi) {
+                    return Cut::NONE;
+                }
+                let mut cut = Cut::NONE;
+                for iv in [f, l] {
+                    let (a, b) = (iv[0].max(lo), iv[1].min(hi));
+                    if b - a >= MIN_CUT_MM {
+                        cut.length += b - a;
+                        cut.z_lo = cut.z_lo.min(a);
+                        cut.z_hi = cut.z_hi.max(b);
+                    }
+                }
+                if cut.length == 0.0 {
+                    return cut;
+                }
+                // What stays of each interval [lo, hi] overlaps (sorted; three at most: a split
+                // leaves the other interval whole).
+                let mut out = [[0.0; 2]; 3];
+                let mut n = 0;
+                for iv in [f, l] {
+                    if iv[1] <= lo || iv[0] >= hi {
+                        out[n] = iv;
+                        n += 1;
+                        continue;
+                    }
+                    if iv[0] < lo {
+                        out[n] = [iv[0], lo];
+                        n += 1;
+                    }
+                    if iv[1] > hi {
+                        out[n] = [hi, iv[1]];
+                        n += 1;
+                    }
+                }
+                *self = match n {
+                    0 => Dexel::Empty,
+                    1 => Dexel::One(out[0]),
+                    2 => Dexel::Two([out[0], out[1]]),
+                    _ => Dexel::Many(out.to_vec()),
+                };
+                cut
+            }
             Dexel::Many(v) => {
                 let cut = remove(v, lo, hi);
-                match v.len() {
-                    0 => *self = Dexel::Empty,
-                    1 => *self = Dexel::One(v[0]),
-                    _ => {}
+                if v.len() <= 2 {
+                    *self = Dexel::from_intervals(std::mem::take(v));
                 }
                 cut
             }
@@ -496,8 +554,54 @@ mod tests {
     }
 
     #[test]
-    fn a_dexel_is_three_words() {
-        assert_eq!(std::mem::size_of::<Dexel>(), 24);
+    fn a_dexel_is_five_words() {
+        assert_eq!(std::mem::size_of::<Dexel>(), 40);
+    }
+
+    /// Dexel::remove, through its inline forms (One, Two) and the heap (Many), removes what
+    /// the plain interval-list `remove` does, and says the same cut, on random removals
+    /// (splits, trims, removals in a gap, shorter than MIN_CUT_MM, touching an end).
+    #[test]
+    fn the_inline_forms_remove_as_the_interval_list() {
+        let mut r = rng(5);
+        let mut forms = [0usize; 4];
+        for _ in 0..200 {
+            let mut d = Dexel::One([0.0, 10.0]);
+            let mut list = vec![[0.0, 10.0]];
+            for _ in 0..12 {
+                let a = 12.0 * r() - 1.0;
+                let len = match (r() * 12.0) as usize {
+                    0..=2 => 0.5e-9,
+                    3..=5 => 0.5 * r(),
+                    6..=10 => 4.0 * r(),
+                    _ => 15.0, // most or all of what is left
+                };
+                // Now and then exactly at an interval's end.
+                let lo = if r() < 0.2 && !list.is_empty() {
+                    list[(r() * list.len() as f64) as usize][1]
+                } else {
+                    a
+                };
+                let (got, want) = (d.remove(lo, lo + len), remove(&mut list, lo, lo + len));
+                assert_eq!(d.intervals(), &list[..], "remove [{lo}, {}]", lo + len);
+                assert_eq!(
+                    (got.length, got.z_lo, got.z_hi),
+                    (want.length, want.z_lo, want.z_hi)
+                );
+                let form = match (&d, list.len()) {
+                    (Dexel::Empty, 0) => 0,
+                    (Dexel::One(_), 1) => 1,
+                    (Dexel::Two(_), 2) => 2,
+                    (Dexel::Many(_), 3..) => 3,
+                    (d, n) => panic!("{n} intervals held as {d:?}"),
+                };
+                forms[form] += 1;
+            }
+        }
+        assert!(
+            forms.iter().all(|&n| n > 20),
+            "every form exercised: {forms:?}"
+        );
     }
 
     #[test]

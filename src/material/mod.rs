@@ -45,7 +45,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{self, ProcessCaps, SpanKind};
 use crate::toolpath::{ToolSelect, Toolpath};
 
-/// The most dexels a model may have (24 bytes each once a cut reaches its tile, and more
+/// The most dexels a model may have (40 bytes each once a cut reaches its tile, and more
 /// where an undercut splits one, [`dexel`]): 10 million, e.g. 316 × 316 mm at 0.1 mm.
 pub const MAX_DEXELS: f64 = 1e7;
 
