@@ -161,6 +161,27 @@ fn generated_rows_give_the_whole_program() {
             }
         }
     }
+    // Without velocity bounds, a first program of the velocity rows alone has no row at all
+    // and leaves b unbounded above: its solution breaks the acceleration rows, which join
+    // (had Clarabel failed on it, every row would have: the same answer either way).
+    let mut p = sol
+        .problems
+        .iter()
+        .max_by_key(|p| p.intervals())
+        .unwrap()
+        .clone();
+    let n = p.intervals();
+    p.b_max[1..n].fill(f64::INFINITY);
+    let time = |s: &feedopt::solver::SpanSolution| -> f64 {
+        interval_times(&p, s).expect("finite").iter().sum()
+    };
+    let (every, _) = clarabel::solve_rows(&p, &settings, clarabel::Rows0::Every).expect("solves");
+    let (got, _) = clarabel::solve_rows(&p, &settings, clarabel::Rows0::Velocity).expect("solves");
+    let rel = (time(&got) - time(&every)).abs() / time(&every);
+    assert!(
+        rel <= 1e-6,
+        "unbounded first program: time differs by {rel:e}"
+    );
 }
 
 /// A fixed grid (`stations`) is solved as given, without an estimate; the reach solver on the

@@ -182,7 +182,16 @@ pub fn solve_rows(
         if round == MAX_ROUNDS {
             keep.fill(true);
         }
-        let (mut solution, sens, x) = program(p, &lay, scale, &rows, &keep, settings)?;
+        let (mut solution, sens, x) = match program(p, &lay, scale, &rows, &keep, settings) {
+            Ok(s) => s,
+            // A program with rows left out that Clarabel cannot solve (one left unbounded,
+            // say): every row in the next, which then speaks for the whole problem.
+            Err(Error::Solver(_)) if keep.iter().any(|k| !k) => {
+                keep.fill(true);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         iterations += solution.iterations;
         solve_time += solution.solve_time;
         let at = |col: usize| x[col];
