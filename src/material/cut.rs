@@ -449,6 +449,7 @@ pub(crate) fn cut_step(
                     Vec::<[f64; 2]>::new(),
                     Vec::<usize>::new(),
                     Vec::<(usize, [f64; 2])>::new(),
+                    Vec::<Option<(usize, usize)>>::new(),
                 )
             };
             let bands = dexels.bands(j0, j1);
@@ -458,120 +459,122 @@ pub(crate) fn cut_step(
             bands
                 .into_par_iter()
                 .zip(shared_rows.par_chunks_mut(TILE))
-                .map_init(scratch, |(run, last, ended), (mut band, shared_rows)| {
-                    let mut acc = Acc::ZERO;
-                    let rows = band.rows();
-                    for (j, row_shared) in rows.zip(shared_rows) {
-                        if j < j0 || j > j1 {
-                            continue;
-                        }
-                        let y = y0 + (j as f64 + 0.5) * hy;
-                        let mut note = |x: f64, c: super::dexel::Cut| {
-                            if c.length <= 0.0 {
-                                return;
-                            }
-                            let top = Vector3::new(x, y, c.z_hi) - pe;
-                            let bottom = Vector3::new(x, y, c.z_lo) - pe;
-                            acc.length += c.length;
-                            acc.axial_max = acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
-                        };
-                        if vertical {
-                            let (a, b) = ([step.p0.x, step.p0.y], [step.p1.x, step.p1.y]);
-                            let Some((ia, ib)) =
-                                capsule_cells((x0, hx), a, b, r, f64::INFINITY, y, (i0, i1))
-                            else {
+                .map_init(
+                    scratch,
+                    |(run, last, ended, ranges), (mut band, shared_rows)| {
+                        let mut acc = Acc::ZERO;
+                        let rows = band.rows();
+                        for (j, row_shared) in rows.zip(shared_rows) {
+                            if j < j0 || j > j1 {
                                 continue;
-                            };
-                            band.each(j, ia, ib, |i, cell| {
-                                if matches!(cell, Dexel::Empty) {
+                            }
+                            let y = y0 + (j as f64 + 0.5) * hy;
+                            let mut note = |x: f64, c: super::dexel::Cut| {
+                                if c.length <= 0.0 {
                                     return;
                                 }
-                                let x = cx(i);
-                                if let Some([lo, hi]) =
-                                    vertical_sweep(tool, &step.p0, &step.p1, x, y)
-                                {
-                                    note(x, cell.remove(lo, hi));
-                                }
-                            });
-                            continue;
-                        }
-                        // Pose by pose over the cells of its capsule: each pose's crossings
-                        // (no dexel is read), joined into runs; then the runs are removed.
-                        let row_of = |k: usize| {
-                            let (_, a, b) = &pose_list[k];
-                            let ends = r * pose_list[k].0.axis().z.abs();
-                            capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
-                        };
-                        let (mut ua, mut ub) = (usize::MAX, 0);
-                        for k in 0..poses {
-                            if let Some((ia, ib)) = row_of(k) {
+                                let top = Vector3::new(x, y, c.z_hi) - pe;
+                                let bottom = Vector3::new(x, y, c.z_lo) - pe;
+                                acc.length += c.length;
+                                acc.axial_max =
+                                    acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
+                            };
+                            if vertical {
+                                let (a, b) = ([step.p0.x, step.p0.y], [step.p1.x, step.p1.y]);
+                                let Some((ia, ib)) =
+                                    capsule_cells((x0, hx), a, b, r, f64::INFINITY, y, (i0, i1))
+                                else {
+                                    continue;
+                                };
+                                band.each(j, ia, ib, |i, cell| {
+                                    if matches!(cell, Dexel::Empty) {
+                                        return;
+                                    }
+                                    let x = cx(i);
+                                    if let Some([lo, hi]) =
+                                        vertical_sweep(tool, &step.p0, &step.p1, x, y)
+                                    {
+                                        note(x, cell.remove(lo, hi));
+                                    }
+                                });
+                                continue;
+                            }
+                            // Pose by pose over the cells of its capsule: each pose's crossings
+                            // (no dexel is read), joined into runs; then the runs are removed.
+                            ranges.clear();
+                            ranges.extend(pose_list.iter().map(|(pose, a, b)| {
+                                let ends = r * pose.axis().z.abs();
+                                capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
+                            }));
+                            let (mut ua, mut ub) = (usize::MAX, 0);
+                            for &(ia, ib) in ranges.iter().flatten() {
                                 (ua, ub) = (ua.min(ia), ub.max(ib));
                             }
-                        }
-                        if ua > ub {
-                            continue;
-                        }
-                        let width = ub - ua + 1;
-                        run.clear();
-                        run.resize(width, MISS);
-                        last.clear();
-                        last.resize(width, usize::MAX);
-                        ended.clear();
-                        for k in 0..poses {
-                            let Some((ia, ib)) = row_of(k) else {
+                            if ua > ub {
                                 continue;
-                            };
-                            let pose = &pose_list[k].0;
-                            let from_shared = k == 0 && reuse && row_shared.step == prev;
-                            let known = if from_shared {
-                                let s0 = row_shared.start;
-                                s0..s0 + row_shared.hits.len()
-                            } else {
-                                0..0
-                            };
-                            let to_shared = k == poses - 1;
-                            if to_shared {
-                                row_shared.step = this;
-                                row_shared.start = ia;
-                                row_shared.hits.clear();
                             }
-                            for i in ia..=ib {
-                                // (k = 0 reads the shared row, k = poses − 1 ≥ 1 writes it.)
-                                let h = if known.contains(&i) {
-                                    row_shared.hits[i - known.start]
-                                } else {
-                                    pose.hit(cx(i), y).unwrap_or(MISS)
-                                };
-                                if to_shared {
-                                    row_shared.hits.push(h);
-                                }
-                                if h[0] > h[1] {
+                            let width = ub - ua + 1;
+                            run.clear();
+                            run.resize(width, MISS);
+                            last.clear();
+                            last.resize(width, usize::MAX);
+                            ended.clear();
+                            for k in 0..poses {
+                                let Some((ia, ib)) = ranges[k] else {
                                     continue;
-                                }
-                                let c = i - ua;
-                                if last[c] != usize::MAX && last[c] + 1 == k {
-                                    run[c] = [run[c][0].min(h[0]), run[c][1].max(h[1])];
+                                };
+                                let pose = &pose_list[k].0;
+                                let from_shared = k == 0 && reuse && row_shared.step == prev;
+                                let known = if from_shared {
+                                    let s0 = row_shared.start;
+                                    s0..s0 + row_shared.hits.len()
                                 } else {
-                                    if last[c] != usize::MAX {
-                                        ended.push((i, run[c]));
-                                    }
-                                    run[c] = h;
+                                    0..0
+                                };
+                                let to_shared = k == poses - 1;
+                                if to_shared {
+                                    row_shared.step = this;
+                                    row_shared.start = ia;
+                                    row_shared.hits.clear();
                                 }
-                                last[c] = k;
+                                for i in ia..=ib {
+                                    // (k = 0 reads the shared row, k = poses − 1 ≥ 1 writes it.)
+                                    let h = if known.contains(&i) {
+                                        row_shared.hits[i - known.start]
+                                    } else {
+                                        pose.hit(cx(i), y).unwrap_or(MISS)
+                                    };
+                                    if to_shared {
+                                        row_shared.hits.push(h);
+                                    }
+                                    if h[0] > h[1] {
+                                        continue;
+                                    }
+                                    let c = i - ua;
+                                    if last[c] != usize::MAX && last[c] + 1 == k {
+                                        run[c] = [run[c][0].min(h[0]), run[c][1].max(h[1])];
+                                    } else {
+                                        if last[c] != usize::MAX {
+                                            ended.push((i, run[c]));
+                                        }
+                                        run[c] = h;
+                                    }
+                                    last[c] = k;
+                                }
                             }
-                        }
-                        for &(i, [lo, hi]) in ended.iter() {
-                            note(cx(i), band.dexel(i, j).remove(lo, hi));
-                        }
-                        band.each(j, ua, ub, |i, cell| {
-                            let c = i - ua;
-                            if last[c] != usize::MAX {
-                                note(cx(i), cell.remove(run[c][0], run[c][1]));
+                            for &(i, [lo, hi]) in ended.iter() {
+                                note(cx(i), band.dexel(i, j).remove(lo, hi));
                             }
-                        });
-                    }
-                    acc
-                })
+                            band.each(j, ua, ub, |i, cell| {
+                                let c = i - ua;
+                                if last[c] != usize::MAX {
+                                    note(cx(i), cell.remove(run[c][0], run[c][1]));
+                                }
+                            });
+                        }
+                        acc
+                    },
+                )
                 .reduce(|| Acc::ZERO, Acc::join)
         }
     };

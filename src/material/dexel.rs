@@ -108,18 +108,10 @@ impl Dexel {
             Dexel::Two(v) => {
                 // `remove`'s steps on two intervals, without the heap unless a split makes three.
                 let [f, l] = *v;
-                if hi - lo < MIN_CUT_MM || l[1] <= lo || f[0] >= hi || (f[1] <= lo && l[0] >= hi) {
+                if hi - lo < MIN_CUT_MM {
                     return Cut::NONE;
                 }
-                let mut cut = Cut::NONE;
-                for iv in [f, l] {
-                    let (a, b) = (iv[0].max(lo), iv[1].min(hi));
-                    if b - a >= MIN_CUT_MM {
-                        cut.length += b - a;
-                        cut.z_lo = cut.z_lo.min(a);
-                        cut.z_hi = cut.z_hi.max(b);
-                    }
-                }
+                let cut = overlap(v, lo, hi);
                 if cut.length == 0.0 {
                     return cut;
                 }
@@ -389,19 +381,11 @@ impl Dexels {
     }
 }
 
-/// Removes `[lo, hi]` from one dexel's intervals; returns what was removed (length 0: nothing).
-pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
+/// What removing `[lo, hi]` would take from `intervals`: the overlaps of at least
+/// [`MIN_CUT_MM`], their total length and z range (length 0: nothing).
+fn overlap(intervals: &[[f64; 2]], lo: f64, hi: f64) -> Cut {
     let mut cut = Cut::NONE;
-    if hi - lo < MIN_CUT_MM || intervals.is_empty() {
-        return cut;
-    }
-    // Only the intervals overlapping [lo, hi] change.
-    let first = intervals.partition_point(|iv| iv[1] <= lo);
-    let last = intervals.partition_point(|iv| iv[0] < hi);
-    if first >= last {
-        return cut;
-    }
-    for iv in &intervals[first..last] {
+    for iv in intervals {
         let (a, b) = (iv[0].max(lo), iv[1].min(hi));
         if b - a >= MIN_CUT_MM {
             cut.length += b - a;
@@ -409,6 +393,21 @@ pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
             cut.z_hi = cut.z_hi.max(b);
         }
     }
+    cut
+}
+
+/// Removes `[lo, hi]` from one dexel's intervals; returns what was removed (length 0: nothing).
+pub fn remove(intervals: &mut Vec<[f64; 2]>, lo: f64, hi: f64) -> Cut {
+    if hi - lo < MIN_CUT_MM || intervals.is_empty() {
+        return Cut::NONE;
+    }
+    // Only the intervals overlapping [lo, hi] change.
+    let first = intervals.partition_point(|iv| iv[1] <= lo);
+    let last = intervals.partition_point(|iv| iv[0] < hi);
+    if first >= last {
+        return Cut::NONE;
+    }
+    let cut = overlap(&intervals[first..last], lo, hi);
     if cut.length == 0.0 {
         return cut;
     }
