@@ -159,6 +159,19 @@ fn generated_rows_give_the_whole_program() {
                 let s = b.max.abs() + b.min.abs();
                 assert!(d <= 1e-3 * s + 1e-9, "{first:?}: dT/da {a:?} vs {b:?}");
             }
+            // dT/dμ for every velocity bound scaled by μ: Σ dT/db_max_i · b_max_i (the
+            // stations fixed on their bound take theirs through the cones).
+            let dmu = |s: &clarabel::Sensitivity| -> f64 {
+                (1..p.intervals())
+                    .filter(|&i| p.b_max[i].is_finite())
+                    .map(|i| s.b_max[i] * p.b_max[i])
+                    .sum()
+            };
+            let (g, e) = (dmu(&sg), dmu(&se));
+            assert!(
+                (g - e).abs() <= 1e-3 * e.abs() + 1e-9,
+                "{first:?}: dT/dμ of the velocity bounds {g} vs {e}"
+            );
         }
     }
     // Without velocity bounds, a first program of the velocity rows alone has no row at all
