@@ -59,6 +59,7 @@ fn toolpath() -> Toolpath {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     }
 }
 

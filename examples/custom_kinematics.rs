@@ -119,6 +119,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

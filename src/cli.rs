@@ -516,7 +516,7 @@ fn apply_material(
         }
         return Ok(None);
     };
-    let program = material::program::scan_file(toolpath_file)?.with_toolpath(tp);
+    let program = material::program::ProgramProcess::from_toolpath(tp);
     let overrides = material::Overrides {
         tool_table: args
             .tool_table

@@ -38,6 +38,7 @@ fn groove() -> Toolpath {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     }
 }
 

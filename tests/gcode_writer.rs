@@ -230,6 +230,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     };
     (m, t)
 }

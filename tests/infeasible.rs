@@ -53,6 +53,7 @@ fn line() -> Toolpath {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     }
 }
 
@@ -264,6 +265,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -26,6 +26,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     }
 }
 

@@ -219,6 +219,7 @@ fn random_cl(seed: u64) -> Case {
             warnings: Vec::new(),
             dwells: Vec::new(),
             tool_changes: Vec::new(),
+            spindle_changes: Vec::new(),
         },
     }
 }

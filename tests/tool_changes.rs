@@ -134,3 +134,48 @@ fn klartext_tool_call() {
         ]
     );
 }
+
+/// The spindle speeds each reader records, in the order the program runs, with the CL point
+/// from which each runs: G-code `S` (not `G4 S`, a dwell in revolutions on Sinumerik; the same
+/// speed again is no change; a subprogram's where it is called), Klartext `TOOL CALL … S`,
+/// APT `SPINDL/`.
+#[test]
+fn spindle_speeds_in_program_order() {
+    let speeds = |tp: &Toolpath| -> Vec<(usize, usize, f64)> {
+        tp.spindle_changes
+            .iter()
+            .map(|c| (c.point, c.line, c.rpm))
+            .collect()
+    };
+    // LinuxCNC: a speed in a subroutine counts where it is called, after the move before it.
+    let t = "G21 G90\nM3 S8000\nG0 X0 Y0 Z5\nG1 Z0 F100\no100 sub\nS12000\no100 endsub\n\
+             G1 X10\no100 call\nG1 X20 S12000\nG1 X30 S9000\nM2\n";
+    let tp = gcode(Dialect::LinuxCnc, t);
+    assert_eq!(
+        speeds(&tp),
+        vec![(0, 2, 8000.0), (3, 6, 12000.0), (4, 11, 9000.0)]
+    );
+    // Fanuc: `M03 S…` and a speed on a move's own block (it runs that move).
+    let t = "%\nO1000\nG21 G90\nT1 M6\nS6000 M3\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X10 S7000\nM30\n%\n";
+    let tp = gcode(Dialect::Fanuc, t);
+    assert_eq!(speeds(&tp), vec![(0, 5, 6000.0), (2, 8, 7000.0)]);
+    // Klartext: the TOOL CALL's S, also without a tool (a speed change only).
+    let t = "0 BEGIN PGM T MM\n1 TOOL CALL 5 Z S3000\n2 L X+0 Y+0 Z+5 FMAX\n\
+             3 TOOL CALL Z S4500\n4 L Z+0 F100\n5 END PGM T MM\n";
+    let tp = parse(Path::new("t.h"), t, Dialect::Heidenhain).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(speeds(&tp), vec![(0, 2, 3000.0), (1, 4, 4500.0)]);
+    // APT: `SPINDL/RPM,n,CLW`; `SPINDL/OFF` changes nothing.
+    let t =
+        "SPINDL/RPM,8000,CLW\nGOTO/0,0,5\nGOTO/0,0,0\nSPINDL/OFF\nSPINDL/RPM,6000\nGOTO/1,0,0\n";
+    let tp = apt::parse(Path::new("a.cls"), t).unwrap();
+    assert_eq!(speeds(&tp), vec![(0, 1, 8000.0), (2, 5, 6000.0)]);
+    // Sinumerik `G4 S2` dwells two revolutions: not a speed (feedopt refuses it, as before).
+    let e = parse(
+        Path::new("t.mpf"),
+        "G71 G90\nS5000 M3\nG1 X1 F100\nG4 S2\nM30\n",
+        Dialect::Sinumerik,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("t.mpf:4:") && e.contains("G4 S"), "{e}");
+}

@@ -65,11 +65,7 @@ fn program(tp: &Toolpath, second: u32) -> ProgramProcess {
             tool: ToolSelect::Number(second),
         },
     ];
-    ProgramProcess {
-        source: tp.source.clone(),
-        ..ProgramProcess::default()
-    }
-    .with_toolpath(&tp)
+    ProgramProcess::from_toolpath(&tp)
 }
 
 fn overrides(table: Option<ToolTable>) -> Overrides {
@@ -336,4 +332,64 @@ fn feedopt_check_reads_the_tool_table_of_the_machine_file_or_the_option() {
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Each move's chip load uses the spindle speed the program has set there (its `S` words as
+/// the reader recorded them): the first slot at 6,000 rpm, the second at 12,000 — caps
+/// f_z·z·n/60 of each; before the program's first speed the machine file's 10,000 applies; an
+/// option `--spindle-speed` applies to every move.
+#[test]
+fn each_move_has_the_spindle_speed_the_program_set_there() {
+    use feedopt::toolpath::SpindleChange;
+    let tp = two_slots();
+    let mut p = program(&tp, 2);
+    p.spindle_changes = vec![
+        SpindleChange {
+            point: 1,
+            line: 2,
+            rpm: 6000.0,
+        },
+        SpindleChange {
+            point: 5,
+            line: 6,
+            rpm: 12000.0,
+        },
+    ];
+    let m = resolve(&p, &overrides(Some(table()))).unwrap().unwrap();
+    let at: Vec<Option<f64>> = (0..10).map(|k| m.spindle_at(k)).collect();
+    assert_eq!(
+        at[0],
+        Some(10000.0),
+        "the machine file's before the first S"
+    );
+    assert!(at[1..5].iter().all(|n| *n == Some(6000.0)), "{at:?}");
+    assert!(at[5..].iter().all(|n| *n == Some(12000.0)), "{at:?}");
+    let sim = material::simulate(&tp, &m).unwrap();
+    let limits = FeedLimits::new(&sim, &m, tp.points.len());
+    let chip_cap = |point: usize| -> f64 {
+        limits.moves[point]
+            .iter()
+            .filter_map(|p| p.cap)
+            .filter(|c| c.1 == ProcessLimit::ChipLoad)
+            .map(|c| c.0)
+            .fold(f64::INFINITY, f64::min)
+    };
+    for (point, z, n) in [(3, 3.0, 6000.0), (8, 2.0, 12000.0)] {
+        let want = 0.05 * z * n / 60.0;
+        let got = chip_cap(point);
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "move {point}: {got} vs {want}"
+        );
+    }
+    let report = material::MaterialReport::new(&m, &sim, &p, Vec::new());
+    assert_eq!(report.program_spindle_speeds, 2);
+    assert!(report.to_string().contains("6000–12000 rpm"), "{report}");
+    // The option wins everywhere.
+    let o = Overrides {
+        spindle_speed: Some(9000.0),
+        ..overrides(Some(table()))
+    };
+    let m = resolve(&p, &o).unwrap().unwrap();
+    assert!((0..10).all(|k| m.spindle_at(k) == Some(9000.0)));
 }

@@ -105,7 +105,7 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
         let mut worst: Vec<(ProcessLimit, f64, f64)> = Vec::new(); // (limit, allowed, area)
         let tool = m.tool_at(first.point);
         for s in group.iter().filter(|s| s.area > 0.0) {
-            for (allowed, lim) in m.process.bounds(s, tool.diameter, tool.flutes) {
+            for (allowed, lim) in m.process_at(s.point).bounds(s, tool.diameter, tool.flutes) {
                 match worst.iter_mut().find(|w| w.0 == lim) {
                     Some(w) if allowed < w.1 => *w = (lim, allowed, s.area),
                     Some(_) => {}

@@ -110,10 +110,26 @@ pub struct Material {
     /// The cutters in the order the program uses them (at least one; `first_move` increasing
     /// from 0).
     pub tools: Vec<ToolUse>,
-    /// The process limits (each optional).
+    /// The process limits (each optional). Its `spindle_speed` is the speed of the moves
+    /// the program sets none for (all of them when [`Material::spindle`] is empty).
     pub process: ProcessLimits,
+    /// The program's spindle speeds, each from its first move on (`first_move` increasing):
+    /// empty when an option gives the speed or the program sets none.
+    pub spindle: Vec<SpindleUse>,
     /// Grid resolution and sample step.
     pub options: CutOptions,
+}
+
+/// A spindle speed of the program and the moves it runs: from the move ending at CL point
+/// `first_move` to the next change.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SpindleUse {
+    /// The CL point that ends its first move.
+    pub first_move: usize,
+    /// The program line that sets it.
+    pub line: usize,
+    /// The speed, rpm.
+    pub rpm: f64,
 }
 
 impl Material {
@@ -133,7 +149,27 @@ impl Material {
                 tool,
             }],
             process,
+            spindle: Vec::new(),
             options,
+        }
+    }
+
+    /// The spindle speed on the move ending at CL point `k`, rpm: the program's speed in force
+    /// there, else (before the program sets one, or without any) `process.spindle_speed`.
+    pub fn spindle_at(&self, k: usize) -> Option<f64> {
+        let i = self.spindle.partition_point(|s| s.first_move <= k);
+        match i {
+            0 => self.process.spindle_speed,
+            _ => Some(self.spindle[i - 1].rpm),
+        }
+    }
+
+    /// The process limits on the move ending at CL point `k`: [`Material::process`] with that
+    /// move's spindle speed ([`Material::spindle_at`]).
+    pub fn process_at(&self, k: usize) -> ProcessLimits {
+        ProcessLimits {
+            spindle_speed: self.spindle_at(k),
+            ..self.process
         }
     }
 
@@ -378,7 +414,7 @@ impl FeedLimits {
                 ))
             } else {
                 let tool = m.tool_at(s.point);
-                m.process.bound(s, tool.diameter, tool.flutes)
+                m.process_at(s.point).bound(s, tool.diameter, tool.flutes)
             };
             let pieces = &mut moves[s.point];
             if let Some(last) = pieces.last_mut() {
@@ -884,10 +920,42 @@ impl Material {
                 tool,
             });
         }
-        process.spindle_speed = o
-            .spindle_speed
-            .or(program.spindle_speed.map(|s| s.0))
-            .or(process.spindle_speed);
+        // The spindle speed: the option for every move; else the program's, move by move
+        // (the machine file's before the program's first, or the program's first without it);
+        // else the machine file's.
+        let mut spindle: Vec<SpindleUse> = Vec::new();
+        if let Some(n) = o.spindle_speed {
+            process.spindle_speed = Some(n);
+        } else {
+            for c in &program.spindle_changes {
+                let at = |m: String| Error::parse(&program.source, c.line, m);
+                if !(c.rpm.is_finite() && c.rpm > 0.0 && c.rpm <= 1e6) {
+                    return Err(at(format!(
+                        "S {}: a spindle speed is from 0 to 1e6 rpm",
+                        c.rpm
+                    )));
+                }
+                let first_move = c.point;
+                match spindle.last_mut() {
+                    // Two speeds before a move: the later one runs it.
+                    Some(last) if last.first_move >= first_move => {
+                        *last = SpindleUse {
+                            first_move,
+                            line: c.line,
+                            rpm: c.rpm,
+                        }
+                    }
+                    _ => spindle.push(SpindleUse {
+                        first_move,
+                        line: c.line,
+                        rpm: c.rpm,
+                    }),
+                }
+            }
+            if process.spindle_speed.is_none() {
+                process.spindle_speed = spindle.first().map(|s| s.rpm);
+            }
+        }
         if let Some(n) = process.spindle_speed {
             if !(n.is_finite() && n > 0.0 && n <= 1e6) {
                 return Err(Error::Usage(format!(
@@ -907,6 +975,7 @@ impl Material {
             stock,
             tools,
             process,
+            spindle,
             options: o.options,
         }))
     }
@@ -950,8 +1019,12 @@ pub struct MaterialReport {
     pub air_share: f64,
     /// Dexel updates done.
     pub work: f64,
-    /// How many different spindle speeds the program gives (the lowest is used).
+    /// How many different spindle speeds the program sets (each move's chip load uses the
+    /// one in force there).
     pub program_spindle_speeds: usize,
+    /// The program's spindle speeds from their first moves on (empty: `process.spindle_speed`
+    /// for every move).
+    pub spindle: Vec<SpindleUse>,
     /// The overload check's findings.
     pub findings: Vec<check::Finding>,
 }
@@ -1037,7 +1110,8 @@ impl MaterialReport {
             peak_radial_engagement_mm: peak(|s| s.radial_engagement),
             air_share: if total > 0.0 { air / total } else { 0.0 },
             work: sim.work,
-            program_spindle_speeds: program.spindle_speeds,
+            program_spindle_speeds: program.spindle_speeds(),
+            spindle: m.spindle.clone(),
             findings,
         }
     }
@@ -1092,19 +1166,25 @@ impl std::fmt::Display for MaterialReport {
             "engagement    peak A {:.3} mm², a_p {:.3} mm, a_e {:.3} mm",
             self.peak_area_mm2, self.peak_axial_depth_mm, self.peak_radial_engagement_mm
         )?;
-        if let Some(n) = self.process.spindle_speed {
+        let (lo, hi) = self
+            .spindle
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+                (lo.min(s.rpm), hi.max(s.rpm))
+            });
+        if self.spindle.len() > 1 && lo < hi {
             writeln!(
                 f,
-                "spindle       {n} rpm{}",
-                if self.program_spindle_speeds > 1 {
-                    format!(
-                        " (the lowest of the program's {} speeds)",
-                        self.program_spindle_speeds
-                    )
-                } else {
-                    String::new()
-                }
+                "spindle       {lo}–{hi} rpm: the program's {} speeds, each on its moves",
+                self.program_spindle_speeds
             )?;
+        } else if let Some(n) = self
+            .spindle
+            .first()
+            .map(|s| s.rpm)
+            .or(self.process.spindle_speed)
+        {
+            writeln!(f, "spindle       {n} rpm")?;
         }
         Ok(())
     }

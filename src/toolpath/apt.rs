@@ -107,7 +107,7 @@ use crate::toolpath::gcode::{
     ARC_RADIUS_MISMATCH_MM, ARC_RADIUS_MISMATCH_RELATIVE, MAX_CHORD_ERROR_MM,
 };
 use crate::toolpath::{
-    ClPoint, Dwell, Feed, MachineContext, ToolChange, ToolSelect, Toolpath, Units,
+    ClPoint, Dwell, Feed, MachineContext, SpindleChange, ToolChange, ToolSelect, Toolpath, Units,
 };
 
 /// Known major words that do not affect the motion and are skipped.
@@ -238,6 +238,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         warnings: reader.warnings,
         dwells: reader.dwells,
         tool_changes: reader.tool_changes,
+        spindle_changes: reader.spindle_changes,
     })
 }
 
@@ -264,6 +265,8 @@ struct Reader<'a> {
     cycle: Option<AptCycle>,
     /// `CUTTER/` and `TLDATA/MILL` records, in program order.
     tool_changes: Vec<ToolChange>,
+    /// `SPINDL/` speeds, in program order.
+    spindle_changes: Vec<SpindleChange>,
 }
 
 /// An APT arc's centre, unit axis and radius (if given), in world mm.
@@ -303,11 +306,33 @@ impl<'a> Reader<'a> {
             nurbs: None,
             cycle: None,
             tool_changes: Vec::new(),
+            spindle_changes: Vec::new(),
         }
     }
 
     fn error(&self, line: usize, message: impl Into<String>) -> Error {
         Error::parse(self.source, line, message)
+    }
+
+    /// `SPINDL/RPM, n, CLW` (or `SPINDL/n, …`): the speed n from the next move on; `SPINDL/OFF`
+    /// and a record without a number change nothing (the motion does not depend on it).
+    fn spindle(&mut self, line: usize, args: &str) {
+        let Some(rpm) = args
+            .split(',')
+            .find_map(|a| a.trim().parse::<f64>().ok())
+            .map(f64::abs)
+            .filter(|n| n.is_finite() && *n > 0.0)
+        else {
+            return;
+        };
+        if self.spindle_changes.last().is_some_and(|c| c.rpm == rpm) {
+            return;
+        }
+        self.spindle_changes.push(SpindleChange {
+            point: self.points.len(),
+            line,
+            rpm,
+        });
     }
 
     /// `CUTTER/d, r, …` or NX's `TLDATA/MILL, d, r, length, taper, tip`: the tool from the
@@ -365,6 +390,10 @@ impl<'a> Reader<'a> {
             ("CNTRL", Some(minor)) => self.cntrl(line, minor),
             ("CYCLE", Some(minor)) => self.cycle(line, minor),
             ("CUTTER", Some(minor)) => self.cutter(line, "CUTTER", minor),
+            ("SPINDL", Some(minor)) => {
+                self.spindle(line, minor);
+                Ok(())
+            }
             ("TLDATA", Some(minor))
                 if minor.trim_start().to_ascii_uppercase().starts_with("MILL") =>
             {

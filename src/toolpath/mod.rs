@@ -136,6 +136,9 @@ pub struct Toolpath {
     /// G-code `T… M6`, `M61 Q…`, Sinumerik `T="name"`; Klartext `TOOL CALL`). Read by the
     /// material model ([`crate::material`]); the motion does not depend on them.
     pub tool_changes: Vec<ToolChange>,
+    /// The spindle speeds the program sets, in the order it runs (G-code `S`, Klartext
+    /// `TOOL CALL … S`, APT `SPINDL/`). Read by the material model's chip load.
+    pub spindle_changes: Vec<SpindleChange>,
 }
 
 impl Toolpath {
@@ -147,6 +150,7 @@ impl Toolpath {
             warnings: Vec::new(),
             dwells: Vec::new(),
             tool_changes: Vec::new(),
+            spindle_changes: Vec::new(),
         }
     }
 
@@ -212,6 +216,16 @@ pub struct ToolChange {
     pub point: usize,
     pub line: usize,
     pub tool: ToolSelect,
+}
+
+/// The program sets the spindle speed to `rpm` at `line`: the move ending at CL point `point`
+/// (the number of points made before the change) and every later one, up to the next change,
+/// run at it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpindleChange {
+    pub point: usize,
+    pub line: usize,
+    pub rpm: f64,
 }
 
 /// A reader's warning: a line and what about it.

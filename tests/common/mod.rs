@@ -30,6 +30,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
         warnings: Vec::new(),
         dwells: Vec::new(),
         tool_changes: Vec::new(),
+        spindle_changes: Vec::new(),
     }
 }
 

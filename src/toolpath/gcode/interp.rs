@@ -14,8 +14,8 @@ use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, ToolChange, ToolSelect, Toolpath,
-    Warning,
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, SpindleChange, ToolChange,
+    ToolSelect, Toolpath, Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -189,6 +189,8 @@ pub(super) struct Interpreter<'a> {
     prepared_tool: Option<ToolSelect>,
     /// The tool changes so far.
     pub(super) tool_changes: Vec<ToolChange>,
+    /// The spindle speed changes so far.
+    pub(super) spindle_changes: Vec<SpindleChange>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -250,6 +252,7 @@ impl<'a> Interpreter<'a> {
             tool_diameter: None,
             prepared_tool: None,
             tool_changes: Vec::new(),
+            spindle_changes: Vec::new(),
             m92: false,
             m92_warned: [false; 3],
         }
@@ -301,6 +304,7 @@ impl<'a> Interpreter<'a> {
             warnings: self.warnings,
             dwells: self.dwells,
             tool_changes: self.tool_changes,
+            spindle_changes: self.spindle_changes,
         })
     }
 
@@ -773,6 +777,14 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
+        // `S`: the spindle speed, rpm (not in a dwell, where Sinumerik's `G4 S` counts
+        // revolutions; Klartext's comes with `TOOL CALL`).
+        if self.spec.spaces != Spaces::Klartext
+            && !dwell
+            && let Some(s) = block.letter('S')
+        {
+            self.set_spindle(line, s.value);
+        }
         if set_tool {
             // LinuxCNC `M61 Q<n>`: tool n is in the spindle from here on.
             let Some(q) = block.letter('Q') else {
@@ -899,6 +911,22 @@ impl<'a> Interpreter<'a> {
                 format!("{what}{value}: a tool number is a whole number from 0"),
             ))
         }
+    }
+
+    /// The spindle turns at `rpm` from the next move on (a speed that is not positive and
+    /// finite, or the same as before, changes nothing).
+    pub(super) fn set_spindle(&mut self, line: usize, rpm: f64) {
+        let rpm = rpm.abs();
+        if !(rpm.is_finite() && rpm > 0.0)
+            || self.spindle_changes.last().is_some_and(|c| c.rpm == rpm)
+        {
+            return;
+        }
+        self.spindle_changes.push(SpindleChange {
+            point: self.points.len(),
+            line,
+            rpm,
+        });
     }
 
     /// `tool` goes into the spindle here: the next move is its first.

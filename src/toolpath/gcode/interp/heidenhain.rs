@@ -259,7 +259,9 @@ impl Interpreter<'_> {
                     if let Some(rest) = upper.strip_prefix('S')
                         && value_start(rest)
                     {
-                        self.klartext.spindle_rpm = Some(self.klartext_value(line, &word, rest)?);
+                        let rpm = self.klartext_value(line, &word, rest)?;
+                        self.klartext.spindle_rpm = Some(rpm);
+                        self.set_spindle(line, rpm);
                     } else if let Some(rest) = upper.strip_prefix('F')
                         && value_start(rest)
                     {
