@@ -278,7 +278,8 @@ pub struct Row {
     pub key: String,
     /// What the schedule is.
     pub label: String,
-    /// Cycle time, s.
+    /// Cycle time, s, the program's dwells included (the same in every row), as `solve`
+    /// reports it.
     pub cycle_time_s: f64,
     /// Every ratio ≤ 1 + tolerance (1.001).
     pub verified: bool,
@@ -323,6 +324,8 @@ pub struct Comparison {
     pub junction_deviation_mm: f64,
     /// Whether lengths and feeds are in the joint-space path's parameter s.
     pub joint_space: bool,
+    /// The program's dwells (G4, cycle dwells), s: part of every row's cycle time.
+    pub dwell_time_s: f64,
     /// The schedules compared, in table order.
     pub schedules: Vec<Row>,
     /// The schedules that do not apply to this input.
@@ -375,9 +378,18 @@ pub fn compare(
         period_s: options.solve.verify.period,
         junction_deviation_mm: options.junction_deviation,
         joint_space: machine.kinematics == crate::machine::KinematicsSpec::Joint,
+        dwell_time_s: dwell_time(input),
         schedules,
         omitted,
     })
+}
+
+/// The program's dwell time, s (none on a joint-space path).
+fn dwell_time(input: &Input) -> f64 {
+    match input {
+        Input::Cl(t) => t.dwell_time(),
+        Input::Joint(_) => 0.0,
+    }
 }
 
 /// The common evaluation of one schedule.
@@ -425,7 +437,7 @@ fn evaluate(ctx: &Context, entry: &Entry, c: Candidate) -> Result<Row> {
     Ok(Row {
         key: entry.key.to_string(),
         label: entry.label.to_string(),
-        cycle_time_s: schedule.cycle_time,
+        cycle_time_s: schedule.cycle_time + dwell_time(ctx.input),
         verified: worst.0 <= 1.0 + vopt.tolerance,
         worst_ratio: worst.0,
         worst_limit: worst.1,

@@ -170,8 +170,9 @@ pub struct Summary {
     pub path_length_mm: f64,
     /// Whether the input was a joint-space path (so lengths and feeds are in s, not mm).
     pub joint_space: bool,
-    /// Largest distance of the fitted path from a programmed point (smoothing within
-    /// `--tolerance`): tool tip, mm; rotary angles, degrees.
+    /// Largest distance of the fitted path from the programmed path, at its points (smoothing
+    /// within `--tolerance`) and between them (the programmed chords): tool tip, mm; rotary
+    /// angles, degrees.
     pub max_deviation_mm: f64,
     /// The same for the rotary angles, degrees.
     pub max_deviation_deg: f64,
@@ -411,7 +412,7 @@ impl fmt::Display for Summary {
         if self.max_deviation_mm > 0.0 || self.max_deviation_deg > 0.0 {
             writeln!(
                 f,
-                "fitted path   within {:.4} mm and {:.4}° of the programmed points",
+                "fitted path   within {:.4} mm and {:.4}° of the programmed path (at and between its points)",
                 self.max_deviation_mm, self.max_deviation_deg
             )?;
         }

@@ -419,3 +419,40 @@ fn cli_compare_prints_the_table_and_json() {
     let out = run(&["compare", "-m", "m.json", "p.cls", "--plot", "x.png"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("PNG"));
 }
+
+/// A program's dwells are part of every schedule's cycle time, as `solve` reports it: each
+/// row's time is its schedule's plus the 2.5 s dwell, and feedopt's row equals `solve`'s time.
+#[test]
+fn dwells_count_in_every_row_as_in_solve() {
+    let m = common::machine(XYZ);
+    let text = "G21 G90\nG0 X0 Y0 Z0\nG1 X50 F6000\nG4 P2.5\nG1 X100\nM2\n";
+    let tp = feedopt::toolpath::gcode::parse(
+        Path::new("dwell.ngc"),
+        text,
+        feedopt::toolpath::gcode::Dialect::LinuxCnc,
+    )
+    .expect("reads");
+    assert_eq!(tp.dwell_time(), 2.5);
+    let o = options(400);
+    let input = Input::Cl(tp);
+    let cmp = compare(&m, &input, "dwell", &o).expect("compare");
+    assert_eq!(cmp.dwell_time_s, 2.5);
+    assert!(cmp.schedules.len() >= 3);
+    for row in &cmp.schedules {
+        assert!(
+            (row.cycle_time_s - row.schedule.cycle_time - 2.5).abs() < 1e-9,
+            "{}: {} vs its schedule's {}",
+            row.key,
+            row.cycle_time_s,
+            row.schedule.cycle_time
+        );
+    }
+    let solved = optimize::optimize_input(&m, &input, &o.solve).expect("solves");
+    let feedopt = cmp.row("feedopt").expect("feedopt row");
+    assert!(
+        (feedopt.cycle_time_s - (solved.schedule.cycle_time + 2.5)).abs() < 1e-9,
+        "compare {} vs solve {} + 2.5",
+        feedopt.cycle_time_s,
+        solved.schedule.cycle_time
+    );
+}

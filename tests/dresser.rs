@@ -95,7 +95,9 @@ fn a_groove_is_fitted_by_biarcs_and_b_follows_the_profile_normal() {
     let s45 = 45f64.to_radians();
     assert!((b_at(5.0 * s45.sin(), -5.0 + 5.0 * s45.cos()) - 45.0).abs() < 1.0);
     assert!((b_at(5.0, -10.0) - 90.0).abs() < 0.1);
-    // Through every rounded point exactly instead (tolerance 0): fitting must not cost time.
+    // Through every rounded point exactly instead (tolerance 0). Fitting costs little time:
+    // within 2.5 %. (It cost none while the exact cubic swung off the programmed chords between
+    // points; since it follows them, within 1 µm, it runs 1.9 % faster than the fit here.)
     let mut exact = options.clone();
     exact.geometry.tolerance_mm = 0.0;
     exact.geometry.tolerance_deg = 0.0;
@@ -106,7 +108,7 @@ fn a_groove_is_fitted_by_biarcs_and_b_follows_the_profile_normal() {
         fitted.schedule.cycle_time, raw.schedule.cycle_time
     );
     assert!(
-        fitted.schedule.cycle_time <= raw.schedule.cycle_time * (1.0 + 1e-3),
+        fitted.schedule.cycle_time <= raw.schedule.cycle_time * (1.0 + 2.5e-2),
         "fitted {} vs exact {}",
         fitted.schedule.cycle_time,
         raw.schedule.cycle_time

@@ -479,13 +479,21 @@ fn unknown_word_warns_with_its_line() {
     assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
     assert!(tp.warnings[0].line == 2 && tp.warnings[0].message.contains("FOO"));
     assert!(tp.warnings[1].line == 3 && tp.warnings[1].message.contains("BAR"));
-    // U V W are known to LinuxCNC but not modelled: a warning too.
-    let tp = ok("G0 X0 Y0 Z0 U5\n");
-    assert!(
-        tp.warnings
-            .iter()
-            .any(|w| w.line == 1 && w.message.contains("U5"))
+    // U V W move axes feedopt does not model: an error naming the word, in LinuxCNC and
+    // Fanuc (a warning before, and the move was lost).
+    err(
+        "G0 X0 Y0 Z0\nG1 X1 U5 F100\n",
+        2,
+        &["U5", "post the program without it"],
     );
+    let e = parse(
+        Path::new("t.nc"),
+        "G21 G90\nG0 X0 Y0 Z0\nG00 W3.\n",
+        Dialect::Fanuc,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("t.nc:3:") && e.contains("W3."), "{e}");
 }
 
 #[test]

@@ -259,7 +259,7 @@ fn a_curvature_peak_between_stations_is_found() {
     // bend) or stays: b·y''(u) + y'(u)·ü peaks between stations, where the solver has no row.
     // The turns between chords reach 22°, so the exact-stop angle is raised to keep one span.
     //
-    // Found: Y exceeds its acceleration limit by about 6.6 % between stations, while every
+    // Found: Y exceeds its acceleration limit by about 3 % between stations, while every
     // station is within the limit. (With the default 10° exact-stop angle the CL points must
     // be closer, c h ≤ 0.087, and the excess is only about 0.2–0.5 %.)
     let (c, h) = (0.1, 2.0);
@@ -291,7 +291,9 @@ fn a_curvature_peak_between_stations_is_found() {
         v.violating_intervals,
         v.violations.first()
     );
-    assert!(worst > 1.03, "worst acceleration ratio {worst}");
+    // (About 3 %: the geometry now inserts knots where the curve would leave the chords by
+    // more than their allowance, and so stations; 6.6 % before.)
+    assert!(worst > 1.01, "worst acceleration ratio {worst}");
     assert!(!v.verified);
     let first = &v.violations[0];
     assert_eq!((first.kind, first.axis), (Quantity::Acceleration, Some(1)));

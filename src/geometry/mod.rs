@@ -37,7 +37,8 @@ pub struct GeometryOptions {
     /// Turning angle (degrees) above which a corner is an exact stop.
     pub corner_angle_deg: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm
-    /// (0: interpolate them exactly). See [`smooth_within`].
+    /// (0: interpolate them exactly). See [`smooth_within`]. Between the points, the curve
+    /// stays within this plus [`CHORD_SLACK_MM`] of the programmed chords ([`Path::build`]).
     pub tolerance_mm: f64,
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     pub tolerance_deg: f64,
@@ -73,19 +74,22 @@ pub enum SpanKind {
 /// A rest-to-rest piece of the path.
 #[derive(Debug, Clone)]
 pub struct Span {
-    /// Largest distance of a fitted point from its programmed position: mm (tool tip) and
-    /// radians (rotary angles).
+    /// How far the fitted curve strays from the programmed path: the largest distance of the
+    /// tool tip from a programmed point (at a knot) or chord (between knots, [`chord_deviation`]),
+    /// mm, and of the rotary angles from theirs, radians.
     pub deviation: (f64, f64),
     /// What moves in the span.
     pub kind: SpanKind,
-    /// w(u) = (Px, Py, Pz, θ1, θ2); its knots are the CL points of the span.
+    /// w(u) = (Px, Py, Pz, θ1, θ2); its knots are the CL points of the span and the points
+    /// [`Path::build`] inserts on the programmed chords between them ([`INSERTED`]).
     pub spline: CubicSpline<PATH_DIM>,
     /// Feed cap (mm/s) of the move between knot k and k+1 (`f64::INFINITY`: none).
     pub feed_caps: Vec<f64>,
     /// Source line of the CL point at each knot.
     pub lines: Vec<usize>,
-    /// Index into [`Toolpath::points`] of the CL point at each knot (empty where the knots are
-    /// not CL points: a dresser profile refitted by biarcs, a joint-space path).
+    /// Index into [`Toolpath::points`] of the CL point at each knot, [`INSERTED`] at a knot
+    /// inserted on a programmed chord (empty where the knots are not CL points: a dresser
+    /// profile refitted by biarcs, a joint-space path).
     pub points: Vec<usize>,
     /// Feed caps of a process model ([`crate::material`]), which replace `feed_caps` on this
     /// span where present: a piecewise-constant cap in u whose breaks are stations.
@@ -221,8 +225,9 @@ impl Path {
             orientation_moves_axes,
             options.corner_angle_deg,
         );
-        let mut spans = Vec::with_capacity(plan.len());
-        for idx in &plan {
+        // Each span on its own (its smoothing and chord refinement are most of the work).
+        let threads = crate::parallel::resolve_threads(0);
+        let spans: Vec<Span> = crate::parallel::par_map(&plan, threads, |idx| {
             let idx = idx.as_slice();
             let moving = (pts[idx[1]].p - pts[idx[0]].p).norm() > SAME_POSITION_MM;
             let p0: Vector3<f64> = pts[idx[0]].p;
@@ -238,44 +243,199 @@ impl Path {
             let mut feed_caps: Vec<f64> = idx.windows(2).map(|w| cap(w[0], w[1])).collect();
             let mut lines: Vec<usize> = idx.iter().map(|&i| pts[i].line).collect();
             let refitted = moving && profile_normal && options.tolerance_mm > 0.0;
-            let deviation = if refitted {
+            if refitted {
                 let fitted = dresser_profile(&values, &feed_caps, &lines, options.tolerance_mm);
-                (values, feed_caps, lines) = (fitted.values, fitted.caps, fitted.lines);
-                fitted.deviation
-            } else {
-                smooth_within(
-                    &mut values,
-                    if moving { options.tolerance_mm } else { 0.0 },
-                    options.tolerance_deg.to_radians(),
-                )
-            };
-            // u: the tip's chord length, or on a reorientation the rotary angles' travel.
-            let mut u = Vec::with_capacity(idx.len());
-            let mut acc = 0.0;
-            u.push(0.0);
-            for w in values.windows(2) {
-                let d = |r: std::ops::Range<usize>| {
-                    r.map(|j| (w[1][j] - w[0][j]).powi(2)).sum::<f64>().sqrt()
+                let u = chord_parameter(&fitted.values, moving);
+                return Span {
+                    deviation: fitted.deviation,
+                    kind: SpanKind::Moving,
+                    spline: CubicSpline::new(&u, &fitted.values),
+                    feed_caps: fitted.caps,
+                    lines: fitted.lines,
+                    points: Vec::new(),
+                    process: None,
                 };
-                acc += if moving { d(0..3) } else { d(3..5) };
-                u.push(acc);
             }
-            spans.push(Span {
+            let mut points = idx.to_vec();
+            let tol_mm = if moving { options.tolerance_mm } else { 0.0 };
+            let tol_rad = options.tolerance_deg.to_radians();
+            // The curve through the points smoothed within the tolerance, its knots refined
+            // where the tip strays from the programmed chords between them: a long chord next
+            // to short ones lets a cubic spline swing far out (an arc's 0.3 mm chords, then a
+            // 185 mm line: 440 mm). Each such interval is cut into up to [`MAX_PIECES`] on its
+            // programmed chord, the new points smoothed with the rest, until the tip is within
+            // the tolerance plus [`CHORD_SLACK_MM`] plus the chord's allowance
+            // ([`chord_allowance`]) everywhere, or the span has [`max_knots`]; `deviation`
+            // says how far it is (the rotary angles' too).
+            // Only the tip is held to its chords: inserting knots where the rotary angles leave
+            // their linear interpolation made jerk-limited subproblems fail (Clarabel:
+            // DualInfeasible on the LinuxCNC boats); their deviation is measured and reported.
+            let bound = (tol_mm + CHORD_SLACK_MM, f64::INFINITY);
+            // The curvature of each chord's allowance, from the programmed points (a chord's
+            // pieces keep their chord's).
+            let mut kchord = if moving {
+                chord_curvature(&values)
+            } else {
+                vec![0.0; values.len() - 1]
+            };
+            let (spline, deviation) = loop {
+                let mut smooth = values.clone();
+                let at_knots = smooth_within(&mut smooth, tol_mm, tol_rad);
+                let u = chord_parameter(&smooth, moving);
+                let spline = CubicSpline::new(&u, &smooth);
+                let between = chord_deviation(&spline, &values);
+                let sag: Vec<f64> = (0..kchord.len())
+                    .map(|k| (u[k + 1] - u[k]).powi(2) * kchord[k] / 8.0)
+                    .collect();
+                // (An interval shorter than twice the bound is not cut: a cubic that swings
+                // that far off so short a chord turns back on itself, which the points do not
+                // ask for, and much shorter intervals leave the solvers badly scaled.)
+                let far: Vec<usize> = (0..between.len())
+                    .filter(|&k| {
+                        let short = u[k + 1] - u[k] < 2.0 * if moving { bound.0 } else { bound.1 };
+                        !short && between[k].0 > bound.0 + sag[k]
+                    })
+                    .collect();
+                if far.is_empty()
+                    || values.len() + (MAX_PIECES - 1) * far.len() > max_knots(idx.len())
+                {
+                    let worst = between
+                        .iter()
+                        .fold(at_knots, |w, d| (w.0.max(d.0), w.1.max(d.1)));
+                    break (spline, worst);
+                }
+                let mut at = far.into_iter().peekable();
+                let n = values.len();
+                let mut k2: Vec<f64> = Vec::with_capacity(n + 16);
+                let (mut v2, mut c2, mut l2, mut p2) = (
+                    Vec::with_capacity(n + 16),
+                    Vec::with_capacity(n + 16),
+                    Vec::with_capacity(n + 16),
+                    Vec::with_capacity(n + 16),
+                );
+                for k in 0..n {
+                    v2.push(values[k]);
+                    l2.push(lines[k]);
+                    p2.push(points[k]);
+                    if k + 1 == n {
+                        break;
+                    }
+                    c2.push(feed_caps[k]);
+                    k2.push(kchord[k]);
+                    if at.next_if_eq(&k).is_some() {
+                        // m pieces: a cubic's distance from a chord falls as the square of
+                        // the interval (a kink's, as the interval).
+                        let r = between[k].0 / (bound.0 + sag[k]);
+                        let m = (r.sqrt().ceil() as usize).clamp(2, MAX_PIECES);
+                        for i in 1..m {
+                            let t = i as f64 / m as f64;
+                            let (a, b) = (&values[k], &values[k + 1]);
+                            v2.push(std::array::from_fn(|j| a[j] + t * (b[j] - a[j])));
+                            c2.push(feed_caps[k]);
+                            l2.push(lines[k + 1]);
+                            p2.push(INSERTED);
+                            k2.push(kchord[k]);
+                        }
+                    }
+                }
+                (values, feed_caps, lines, points, kchord) = (v2, c2, l2, p2, k2);
+            };
+            Span {
                 deviation,
                 kind: if moving {
                     SpanKind::Moving
                 } else {
                     SpanKind::Reorientation
                 },
-                spline: CubicSpline::new(&u, &values),
+                spline,
                 feed_caps,
                 lines,
-                points: if refitted { Vec::new() } else { idx.to_vec() },
+                points,
                 process: None,
-            });
-        }
+            }
+        });
         Ok(Path { spans })
     }
+}
+
+/// [`Span::points`] of a knot that is not a CL point: inserted on the programmed chord between
+/// two, where the curve strayed from it ([`Path::build`]).
+pub const INSERTED: usize = usize::MAX;
+
+/// How far beyond the fitting tolerance the tool tip may stray from the programmed chords
+/// between knots, mm (the sagitta an arc's chords may have,
+/// [`crate::toolpath::gcode::MAX_CHORD_ERROR_MM`]).
+pub const CHORD_SLACK_MM: f64 = 1e-3;
+
+/// The most pieces [`Path::build`]'s chord refinement cuts an interval into at once.
+const MAX_PIECES: usize = 8;
+
+/// The most knots a span of `cl` CL points may get by [`Path::build`]'s chord refinement.
+fn max_knots(cl: usize) -> usize {
+    8 * cl + 1024
+}
+
+/// The curvature (1/mm) that bounds how far a smooth curve through the programmed points may
+/// leave each chord beyond the tolerance: the chord of length h may bulge by the sagitta h²κ/8
+/// of an arc through its ends. κ is the smaller of the curvatures the points show at the
+/// chord's two ends: turning angle over the mean of the two chords there, trusted only where
+/// those two chords differ by at most [`EVEN_SPACING`] (points sampled from a curve — a
+/// surface's polyline, an arc's chords — are spaced so; a long line after short chords is
+/// not, and there κ is 0: the curve must keep to the line). At a span's end, the curvature of
+/// the next point where that is trusted and the end chord is as long as the next, else 0.
+fn chord_curvature(values: &[[f64; PATH_DIM]]) -> Vec<f64> {
+    let n = values.len();
+    let h: Vec<f64> = values
+        .windows(2)
+        .map(|w| {
+            (0..3)
+                .map(|j| (w[1][j] - w[0][j]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect();
+    let even = |a: f64, b: f64| a > 0.0 && b > 0.0 && a.max(b) <= EVEN_SPACING * a.min(b);
+    let mut kappa = vec![0.0f64; n];
+    for i in 1..n.saturating_sub(1) {
+        let (a, b) = (h[i - 1], h[i]);
+        if !even(a, b) {
+            continue;
+        }
+        let d0: [f64; 3] = std::array::from_fn(|j| values[i][j] - values[i - 1][j]);
+        let d1: [f64; 3] = std::array::from_fn(|j| values[i + 1][j] - values[i][j]);
+        let cos = (0..3).map(|j| d0[j] * d1[j]).sum::<f64>() / (a * b);
+        kappa[i] = cos.clamp(-1.0, 1.0).acos() / (0.5 * (a + b));
+    }
+    if n >= 4 {
+        if even(h[0], h[1]) {
+            kappa[0] = kappa[1];
+        }
+        if even(h[n - 2], h[n - 3]) {
+            kappa[n - 1] = kappa[n - 2];
+        }
+    }
+    (0..n.saturating_sub(1))
+        .map(|k| kappa[k].min(kappa[k + 1]))
+        .collect()
+}
+
+/// Neighbouring chords whose lengths differ by at most this factor are evenly spaced
+/// ([`chord_curvature`]).
+const EVEN_SPACING: f64 = 2.0;
+
+/// The parameter u at every point: the tip's cumulative chord length (mm), or on a
+/// reorientation (`moving` false) the rotary angles' cumulative travel (rad).
+fn chord_parameter(values: &[[f64; PATH_DIM]], moving: bool) -> Vec<f64> {
+    let mut u = Vec::with_capacity(values.len());
+    let mut acc = 0.0;
+    u.push(0.0);
+    for w in values.windows(2) {
+        let d =
+            |r: std::ops::Range<usize>| r.map(|j| (w[1][j] - w[0][j]).powi(2)).sum::<f64>().sqrt();
+        acc += if moving { d(0..3) } else { d(3..5) };
+        u.push(acc);
+    }
+    u
 }
 
 /// The CL points (indices into `toolpath.points`) at the knots of each span [`Path::build`]
@@ -592,6 +752,52 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
         .map(|(i, j)| (values[i][j] - orig[i][j]).abs())
         .fold(0.0, f64::max);
     (dev_mm, dev_rad)
+}
+
+/// Interior samples per interval at which [`chord_deviation`] compares the curve with the
+/// programmed chord (the deviation of a cubic from a line is a cubic in the interval's
+/// parameter; nine samples find its largest value to within 2 % of it).
+pub const CHORD_SAMPLES: usize = 9;
+
+/// How far the fitted curve strays from the programmed path *between* knots: for interval k,
+/// the largest distance of the curve's tool tip from the programmed chord between knots k and
+/// k+1 (mm; the segment between the programmed positions `prog[k]`, `prog[k + 1]`) and of its
+/// rotary angles from their linear interpolation in u (rad), at [`CHORD_SAMPLES`] interior
+/// points.
+pub fn chord_deviation(
+    spline: &CubicSpline<PATH_DIM>,
+    prog: &[[f64; PATH_DIM]],
+) -> Vec<(f64, f64)> {
+    let u = spline.knots();
+    (0..u.len() - 1)
+        .map(|k| {
+            let (a, b) = (&prog[k], &prog[k + 1]);
+            let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let len2 = ab.iter().map(|c| c * c).sum::<f64>();
+            let (mut mm, mut rad) = (0.0f64, 0.0f64);
+            for m in 1..=CHORD_SAMPLES {
+                let th = m as f64 / (CHORD_SAMPLES + 1) as f64;
+                let w = spline.eval_in(k, u[k] + th * (u[k + 1] - u[k])).value;
+                let ap = [w[0] - a[0], w[1] - a[1], w[2] - a[2]];
+                // The nearest point of the segment, and the fraction along it (the parameter's
+                // fraction where the tip does not move).
+                let t = if len2 > 0.0 {
+                    ((0..3).map(|j| ap[j] * ab[j]).sum::<f64>() / len2).clamp(0.0, 1.0)
+                } else {
+                    th
+                };
+                let d = (0..3)
+                    .map(|j| (ap[j] - t * ab[j]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                mm = mm.max(d);
+                for j in 3..5 {
+                    rad = rad.max((w[j] - (a[j] + th * (b[j] - a[j]))).abs());
+                }
+            }
+            (mm, rad)
+        })
+        .collect()
 }
 
 /// Angle between two unit vectors, accurate for small angles.

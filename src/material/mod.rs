@@ -463,9 +463,15 @@ impl FeedLimits {
             }
             let knots = span.spline.knots().to_vec();
             let mut pc = ProcessCaps::default();
-            for k in 0..knots.len() - 1 {
-                let (a, b) = (span.points[k], span.points[k + 1]);
-                let own = span.feed_caps[k];
+            // The knots at CL points (the geometry inserts others on the programmed chords,
+            // geometry::INSERTED): the moves between two of them map onto their u range.
+            let cl: Vec<usize> = (0..knots.len())
+                .filter(|&k| span.points[k] != geometry::INSERTED)
+                .collect();
+            for w in cl.windows(2) {
+                let (ka, kb) = (w[0], w[1]);
+                let (a, b) = (span.points[ka], span.points[kb]);
+                let own = span.feed_caps[ka];
                 let lens: Vec<f64> = (a + 1..=b)
                     .map(|j| (tp.points[j].p - tp.points[j - 1].p).norm())
                     .collect();
@@ -483,7 +489,7 @@ impl FeedLimits {
                     };
                     for piece in list {
                         let frac = (before + piece.t * len) / total;
-                        let u = knots[k] + frac * (knots[k + 1] - knots[k]);
+                        let u = knots[ka] + frac * (knots[kb] - knots[ka]);
                         let (cap, by) = match piece.cap {
                             Some((c, lim)) if c < fmax => (c, Some(lim)),
                             Some(_) => (fmax, None),

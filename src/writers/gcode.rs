@@ -323,18 +323,28 @@ fn halvings(at: &dyn Fn(f64) -> [f64; 5], ua: f64, ub: f64, step: f64) -> usize 
 fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<Vec<f64>> {
     let knots = span.spline.knots();
     let pts = &toolpath.points;
-    if knots.len() == idx.len() {
-        if let Some(k) = (0..idx.len()).find(|&k| span.lines[k] != pts[idx[k]].line) {
+    if span.points.len() == knots.len() {
+        // The knots at CL points (the geometry inserts others on the programmed chords).
+        let at: Vec<usize> = (0..knots.len())
+            .filter(|&k| span.points[k] != crate::geometry::INSERTED)
+            .collect();
+        let stray = (at.len() != idx.len()).then_some(0).or_else(|| {
+            (0..idx.len())
+                .find(|&k| span.points[at[k]] != idx[k] || span.lines[at[k]] != pts[idx[k]].line)
+        });
+        if let Some(k) = stray {
+            let k = k.min(idx.len() - 1);
             return Err(Error::parse(
                 &toolpath.source,
                 pts[idx[k]].line,
                 format!(
-                    "internal: the span's knot {k} comes from line {}, not from this CL point",
-                    span.lines[k]
+                    "internal: the span's knots are not this span's CL points (at the CL point \
+                     of line {})",
+                    pts[idx[k]].line
                 ),
             ));
         }
-        return Ok(knots.to_vec());
+        return Ok(at.iter().map(|&k| knots[k]).collect());
     }
     // Dresser refit: project on the fitted X–Z profile (a cursor moving forward along it).
     let d2 = |u: f64, k: usize| {

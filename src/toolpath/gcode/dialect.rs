@@ -131,8 +131,6 @@ pub enum Address {
     M,
     /// Accepted, no effect on motion (N, S, T, H, D, parameters of other codes).
     Ignored,
-    /// Accepted but not modelled: skipped with this warning (U V W axes).
-    Unmodelled(&'static str),
     /// Rejected with this error (LinuxCNC O-words other than subroutines).
     Unsupported(&'static str),
     /// A subprogram call by number, the word as written naming it (Sinumerik `L123`; `P`
@@ -419,7 +417,7 @@ use Action::{
     ArcDistance, BuilderDatum, Distance as Dist, FeedMode as Fm, MachineCoordinates, Motion as Mo,
     MotionCancel, NoMotion, Note, ProgramEnd, Return, Unsupported as Unsup,
 };
-use Address::{ArcCentre, Axis, Unmodelled};
+use Address::{ArcCentre, Axis};
 
 const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
 const OFFSETS: &str = "coordinate offsets that shift program coordinates (G92, G52) are not \
@@ -433,7 +431,8 @@ const G60: &str = "single-direction positioning approaches the end point from on
                    the move goes straight to its end point";
 const G10: &str = "G10 sets a tool or work offset and moves nothing; the program's coordinates \
                    are used as written";
-const UVW: &str = "U V W axes are not modelled: word ignored";
+const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
+                   quill); the move would be lost: post the program without it";
 const TRANSFORM: &str = "coordinate transformations (polar, rotation, scaling, mirroring, tilted \
                          planes) are not supported";
 
@@ -467,9 +466,9 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ('E', Address::Ignored),
         ('L', Address::Ignored),
         ('Q', Address::Ignored),
-        ('U', Unmodelled(UVW)),
-        ('V', Unmodelled(UVW)),
-        ('W', Unmodelled(UVW)),
+        ('U', Address::Unsupported(UVW)),
+        ('V', Address::Unsupported(UVW)),
+        ('W', Address::Unsupported(UVW)),
         (
             'O',
             Address::Unsupported(
@@ -631,9 +630,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ('L', Address::Ignored),
         ('P', Address::Ignored),
         ('Q', Address::Ignored),
-        ('U', Unmodelled(UVW)),
-        ('V', Unmodelled(UVW)),
-        ('W', Unmodelled(UVW)),
+        ('U', Address::Unsupported(UVW)),
+        ('V', Address::Unsupported(UVW)),
+        ('W', Address::Unsupported(UVW)),
     ],
     named: &[],
     g_codes: &[

@@ -477,7 +477,6 @@ impl<'a> Interpreter<'a> {
                         ));
                     }
                 }
-                Address::Unmodelled(message) => self.warn(line, format!("`{text}`: {message}")),
                 Address::Unsupported(message) => {
                     return Err(self.error(line, format!("{text}: {message}")));
                 }

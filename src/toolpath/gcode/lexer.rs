@@ -202,11 +202,11 @@ fn lex_letters(
         }
         let letter = c.to_ascii_uppercase();
         let address = letter_address(spec, letter);
-        if let Some(Address::Unsupported(message)) = address {
-            return Err(format!("`{letter}` word: {message}"));
-        }
         let end = scan_value(&chars, i + 1);
         let text_value: String = chars[i + 1..end].iter().collect();
+        if let Some(Address::Unsupported(message)) = address {
+            return Err(format!("`{letter}{text_value}`: {message}"));
+        }
         if end < chars.len()
             && matches!(chars[end], 'E' | 'e')
             && chars

@@ -119,8 +119,9 @@
 //! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
 //! moves nothing: its axis words are not a move). A block starting with `/` (block delete, or `/1` … `/9`)
 //! runs, as on a control whose block-skip switch is off, or is skipped under
-//! [`Settings::block_delete`]; either way with a warning. U V W axis words, and I J K or R on a straight move (outside G43.5) or without a
-//! move, are skipped with a warning.
+//! [`Settings::block_delete`]; either way with a warning. I J K or R on a straight move (outside G43.5) or without a
+//! move are skipped with a warning. U V W axis words are errors: they move an axis feedopt
+//! does not model.
 //!
 //! # What is rejected
 //!
