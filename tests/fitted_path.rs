@@ -96,3 +96,60 @@ fn a_long_line_after_short_arc_chords_stays_on_the_line() {
         sol.schedule.cycle_time
     );
 }
+
+/// A reorientation (the tip stands while the tool turns) through three orientations whose steps
+/// differ 25-fold: a 5° tilt, then the tilt turned 130° about Z. The curve in the angles
+/// through its three points, a parabola, took the tilt axis about 30° past both programmed
+/// tilts between them (found on LinuxCNC's boat-xyzbc, 32°); it keeps to the linear
+/// interpolation of the programmed angles now.
+#[test]
+fn a_reorientation_keeps_its_rotary_axes_between_the_programmed_angles() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
+    let machine = Machine::from_file(&root.join("machine.json")).expect("machine");
+    let dir = |tilt: f64, turn: f64| {
+        let (t, c) = (tilt.to_radians(), turn.to_radians());
+        (t.sin() * c.cos(), t.sin() * c.sin(), t.cos())
+    };
+    let mut text = String::from("UNITS/MM\nMULTAX/ON\nFEDRAT/600\n");
+    let mut goto = |p: (f64, f64, f64), o: (f64, f64, f64)| {
+        text.push_str(&format!(
+            "GOTO/{:.4},{:.4},{:.4},{:.6},{:.6},{:.6}\n",
+            p.0, p.1, p.2, o.0, o.1, o.2
+        ));
+    };
+    goto((-20.0, 0.0, 0.0), dir(10.0, 0.0));
+    goto((0.0, 0.0, 0.0), dir(10.0, 0.0));
+    goto((0.0, 0.0, 0.0), dir(15.0, 0.0));
+    goto((0.0, 0.0, 0.0), dir(15.0, 130.0));
+    goto((20.0, 0.0, 0.0), dir(15.0, 130.0));
+    let tp = feedopt::toolpath::apt::parse(Path::new("turn.cls"), &text).expect("reads");
+    let sol = optimize_input(&machine, &Input::Cl(tp), &Options::default()).expect("solves");
+    assert!(sol.verification.verified);
+    let turn = sol
+        .path
+        .spans
+        .iter()
+        .find(|s| s.kind == feedopt::geometry::SpanKind::Reorientation)
+        .expect("a reorientation span");
+    let u = turn.spline.knots();
+    let cl: Vec<usize> = (0..u.len())
+        .filter(|&k| turn.points[k] != feedopt::geometry::INSERTED)
+        .collect();
+    assert_eq!(cl.len(), 3, "three orientations");
+    let mut worst = 0.0f64;
+    for w in cl.windows(2) {
+        let (a, b) = (turn.eval(u[w[0]]).value, turn.eval(u[w[1]]).value);
+        for m in 0..=200 {
+            let th = m as f64 / 200.0;
+            let v = turn.eval(u[w[0]] + th * (u[w[1]] - u[w[0]])).value;
+            for j in 3..5 {
+                worst = worst.max((v[j] - (a[j] + th * (b[j] - a[j]))).abs().to_degrees());
+            }
+        }
+    }
+    let tol = GeometryOptions::default().tolerance_deg;
+    assert!(
+        worst <= 2.0 * tol + 0.002,
+        "the rotary axes leave their programmed interpolation by {worst}°"
+    );
+}

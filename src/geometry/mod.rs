@@ -267,10 +267,17 @@ impl Path {
             // the tolerance plus [`CHORD_SLACK_MM`] plus the chord's allowance
             // ([`chord_allowance`]) everywhere, or the span has [`max_knots`]; `deviation`
             // says how far it is (the rotary angles' too).
-            // Only the tip is held to its chords: inserting knots where the rotary angles leave
-            // their linear interpolation made jerk-limited subproblems fail (Clarabel:
-            // DualInfeasible on the LinuxCNC boats); their deviation is measured and reported.
-            let bound = (tol_mm + CHORD_SLACK_MM, f64::INFINITY);
+            // On a moving span only the tip is held to its chords: inserting knots where the
+            // rotary angles leave their linear interpolation in u made jerk-limited
+            // subproblems fail (Clarabel: DualInfeasible on the LinuxCNC boats); their
+            // deviation is measured and reported. On a reorientation (the tip stands, u is the
+            // angles' travel) the angles are what is held: three points 0.1 and 2.2 rad apart
+            // swung B 32° past the programmed positions on boat-xyzbc.
+            let bound = if moving {
+                (tol_mm + CHORD_SLACK_MM, f64::INFINITY)
+            } else {
+                (f64::INFINITY, tol_rad + CHORD_SLACK_RAD)
+            };
             // The curvature of each chord's allowance, from the programmed points (a chord's
             // pieces keep their chord's).
             let mut kchord = if moving {
@@ -293,7 +300,7 @@ impl Path {
                 let far: Vec<usize> = (0..between.len())
                     .filter(|&k| {
                         let short = u[k + 1] - u[k] < 2.0 * if moving { bound.0 } else { bound.1 };
-                        !short && between[k].0 > bound.0 + sag[k]
+                        !short && (between[k].0 > bound.0 + sag[k] || between[k].1 > bound.1)
                     })
                     .collect();
                 if far.is_empty()
@@ -325,7 +332,7 @@ impl Path {
                     if at.next_if_eq(&k).is_some() {
                         // m pieces: a cubic's distance from a chord falls as the square of
                         // the interval (a kink's, as the interval).
-                        let r = between[k].0 / (bound.0 + sag[k]);
+                        let r = (between[k].0 / (bound.0 + sag[k])).max(between[k].1 / bound.1);
                         let m = (r.sqrt().ceil() as usize).clamp(2, MAX_PIECES);
                         for i in 1..m {
                             let t = i as f64 / m as f64;
@@ -366,6 +373,9 @@ pub const INSERTED: usize = usize::MAX;
 /// between knots, mm (the sagitta an arc's chords may have,
 /// [`crate::toolpath::gcode::MAX_CHORD_ERROR_MM`]).
 pub const CHORD_SLACK_MM: f64 = 1e-3;
+/// How far beyond the angular tolerance a reorientation's rotary angles may stray from their
+/// linear interpolation between knots, rad (a thousandth of a degree).
+pub const CHORD_SLACK_RAD: f64 = 1e-3 * std::f64::consts::PI / 180.0;
 
 /// The most pieces [`Path::build`]'s chord refinement cuts an interval into at once.
 const MAX_PIECES: usize = 8;
