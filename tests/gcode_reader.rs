@@ -528,6 +528,31 @@ fn other_errors_name_the_line() {
     err("G0 X0 Y0 Z0\nG1 X#1 F100\n", 2, &["#1", "before it is set"]);
     err("G0 X0 Y0 Z0\no100 sub\n", 2, &["O-word"]);
     err("G0 X0 Y0 Z0\nG81 X1 Y1 Z-1\n", 2, &["G81", "R"]);
+    // LinuxCNC repeats a cycle with L; K there is not a repeat count (it drilled the hole K
+    // times before), and G87 is back boring with I J K offsets (they were dropped).
+    err("G0 X0 Y0 Z5\nG81 X5 Y5 Z-2 R1 K3\n", 2, &["G81", "K", "L"]);
+    err(
+        "G0 X0 Y0 Z5\nG87 X5 Y5 Z-2 R1 I2 J0 K3\n",
+        2,
+        &["G87", "back boring"],
+    );
+    let tp = ok("G0 X0 Y0 Z5\nG91 G81 X5 Y0 Z-3 R-4 L3\n");
+    let bottoms = tp
+        .points
+        .iter()
+        .filter(|p| (p.p.z - -2.0).abs() < 1e-9)
+        .count();
+    assert_eq!(bottoms, 3, "L3: three holes");
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X0. Y0. Z5.\nG91 G81 X5. Y0. Z-3. R-4. K3\nM30\n",
+    );
+    let bottoms = tp
+        .points
+        .iter()
+        .filter(|p| (p.p.z - -2.0).abs() < 1e-9)
+        .count();
+    assert_eq!(bottoms, 3, "Fanuc K3: three holes");
     err("G0 X0 Y0 Z0\nG1 X1 X2 F100\n", 2, &["twice"]);
     err("G0 X0 Y0 Z0\nG0 G1 X1\n", 2, &["two motion codes"]);
     err("X1 Y2\n", 1, &["motion mode"]);

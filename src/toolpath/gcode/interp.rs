@@ -1246,7 +1246,29 @@ impl<'a> Interpreter<'a> {
             }
         }
         self.cycle = Some(c);
-        let repeats = match block.letter('L').or(block.letter('K')) {
+        // Repeats: `L` on LinuxCNC, `K` (or `L`) on Fanuc. LinuxCNC has no K repeat: its K is
+        // G87's back-boring offset (with I and J), which is not modelled.
+        let linuxcnc = self.spec.name == "LinuxCNC";
+        if linuxcnc && (c.code == 87 || block.letter('K').is_some()) {
+            return Err(self.error(
+                line,
+                if c.code == 87 {
+                    "G87: LinuxCNC back boring (with its I J K offsets) is not supported"
+                        .to_string()
+                } else {
+                    format!(
+                        "G{}: K is not a LinuxCNC canned-cycle word (LinuxCNC repeats with L)",
+                        c.code
+                    )
+                },
+            ));
+        }
+        let count = if linuxcnc {
+            block.letter('L')
+        } else {
+            block.letter('K').or(block.letter('L'))
+        };
+        let repeats = match count {
             None => 1,
             Some(n)
                 if n.value.fract() == 0.0
