@@ -603,7 +603,7 @@ fn comments_of_both_kinds_and_skipped_lines() {
 #[test]
 fn tolerated_codes_do_not_move() {
     let tp = ok(
-        "G17 G21 G40 G49 G54 G64 G61 G90 G94\nG0 G43 H1 X0 Y0 Z5 M8\nG59.1 G1 X1 F60\n\
+        "G17 G21 G40 G49 G59.1 G64 G61 G90 G94\nG0 G43 H1 X0 Y0 Z5 M8\nG59.1 G1 X1 F60\n\
          M5 M9\nM30\nG1 X99\n",
     );
     assert_eq!(tp.points.len(), 2, "M30 ends the program");
@@ -876,4 +876,54 @@ fn linuxcnc_boat_xyzbc() {
     // And the first move (line 11) comes before any Z.
     assert_eq!(tp.warnings.len(), 3, "{:?}", tp.warnings);
     assert_eq!(tp.warnings[0].line, 11);
+}
+
+/// A program that selects one work offset reads its coordinates in that frame, without a
+/// word; one that changes to another (a second setup) gets a warning at the change, naming
+/// both: feedopt does not know their values, so the move between the setups is sized as if
+/// they were equal (it was silent before).
+#[test]
+fn a_change_of_work_offset_is_a_warning_naming_both() {
+    let warned = |tp: &Toolpath| -> Vec<(usize, String)> {
+        tp.warnings
+            .iter()
+            .filter(|w| w.message.contains("work offset"))
+            .map(|w| (w.line, w.message.clone()))
+            .collect()
+    };
+    let one = ok_in(
+        Dialect::Fanuc,
+        "G21 G90 G54\nG0 X0. Y0. Z5.\nG1 X10. F100.\nG54 G0 Z10.\nM30\n",
+    );
+    assert!(warned(&one).is_empty(), "{:?}", one.warnings);
+    let two = ok_in(
+        Dialect::Fanuc,
+        "G21 G90 G54\nG0 X0. Y0. Z5.\nG1 X10. F100.\nG55 G0 X0. Y0.\nG1 X5.\nM30\n",
+    );
+    let w = warned(&two);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].0 == 4 && w[0].1.contains("G55") && w[0].1.contains("G54"),
+        "{w:?}"
+    );
+    // Fanuc's extended offsets are told apart by P.
+    let ext = ok_in(
+        Dialect::Fanuc,
+        "G21 G90 G54.1 P1\nG0 X0. Y0. Z5.\nG54.1 P3 G0 X1.\nM30\n",
+    );
+    let w = warned(&ext);
+    assert!(
+        w.len() == 1 && w[0].0 == 3 && w[0].1.contains("P3"),
+        "{w:?}"
+    );
+    // Sinumerik's G505–G599 too.
+    let sin = ok_in(
+        Dialect::Sinumerik,
+        "G71 G90 G54\nG0 X0 Y0 Z5\nG505\nG0 X1\nM30\n",
+    );
+    let w = warned(&sin);
+    assert!(
+        w.len() == 1 && w[0].0 == 3 && w[0].1.contains("G505"),
+        "{w:?}"
+    );
 }

@@ -297,6 +297,11 @@ pub enum Action {
     RetractToolAxis,
     /// Klartext `MB MAX`: retract to the travel limit.
     RetractMax,
+    /// A work offset (`G54`–`G59`, Fanuc `G54.1 P…`, Sinumerik `G505`–`G599`): the program's
+    /// coordinates are read in the frame it selects, whose values feedopt does not know. A
+    /// change from one to another is a warning: the move between them is sized as if the two
+    /// offsets were equal.
+    WorkOffset,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
@@ -532,8 +537,8 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("49", Action::Ignored),
         ("52", Unsup(OFFSETS)),
         ("53", MachineCoordinates),
-        ("54..59", Action::Ignored),
-        ("59.1", Action::Ignored),
+        ("54..59", Action::WorkOffset),
+        ("59.1", Action::WorkOffset),
         ("59.2", Action::Ignored),
         ("59.3", Action::Ignored),
         ("61", Action::Ignored),
@@ -688,8 +693,8 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("52", Unsup(OFFSETS)),
         ("53", MachineCoordinates),
         ("53.1", Action::Ignored),
-        ("54..59", Action::Ignored),
-        ("54.1", Action::Ignored),
+        ("54..59", Action::WorkOffset),
+        ("54.1", Action::WorkOffset),
         ("60", Note(G60)),
         ("61..64", Action::Ignored),
         ("65", Unsup("macro calls (G65/G66) are not supported")),
@@ -848,7 +853,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
                 feed: false,
             },
         ),
-        ("54..57", Action::Ignored),
+        ("54..57", Action::WorkOffset),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
         ("93", Fm(FeedMode::InverseTime)),
@@ -863,7 +868,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("450", Action::Ignored),
         ("451", Action::Ignored),
         ("500", Action::Ignored),
-        ("505..599", Action::Ignored),
+        ("505..599", Action::WorkOffset),
         ("601..603", Action::Ignored),
         ("641..645", Action::Ignored),
         (

@@ -187,6 +187,8 @@ pub(super) struct Interpreter<'a> {
     pub(super) tool_diameter: Option<f64>,
     /// The tool the last `T` word selected (`M6` puts it in the spindle).
     prepared_tool: Option<ToolSelect>,
+    /// The work offset the program selected last (`G54`, `G54.1 P2`, …).
+    work_offset: Option<String>,
     /// The tool changes so far.
     pub(super) tool_changes: Vec<ToolChange>,
     /// The spindle speed changes so far.
@@ -251,6 +253,7 @@ impl<'a> Interpreter<'a> {
             block_delete: false,
             tool_diameter: None,
             prepared_tool: None,
+            work_offset: None,
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
             m92: false,
@@ -769,6 +772,25 @@ impl<'a> Interpreter<'a> {
                 Action::RotaryShortestPath(on) => self.shortest_path = on,
                 Action::RetractToolAxis => klartext.retract = true,
                 Action::RetractMax => klartext.retract_max = true,
+                Action::WorkOffset => {
+                    // G54.1 P n: the P word names the offset.
+                    let name = match block.letter('P') {
+                        Some(p) if text.contains('.') => format!("{text} P{}", p.value),
+                        _ => text.clone(),
+                    };
+                    if let Some(prev) = self.work_offset.replace(name.clone())
+                        && prev != name
+                    {
+                        self.warn(
+                            line,
+                            format!(
+                                "{name}: another work offset than {prev}, whose values feedopt \
+                                 does not know: the move to the next point is sized as if the \
+                                 two were equal (the program's coordinates are used as written)"
+                            ),
+                        );
+                    }
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
