@@ -466,8 +466,9 @@ fn cycle76_with_a_boring_list_reads_as_cycle86_and_a_spigot_call_is_an_error() {
 
 /// A Sinumerik call feedopt does not know (a cycle or subprogram with an argument list, here
 /// NX's thread-milling CYCLE90 from a Huron KX20 post) may move the tool: an error naming the
-/// line and the call, not a warning that drops it. CYCLE832 (tolerances) and MSG are read and
-/// ignored; a bare unknown word stays a warning.
+/// line and the call, not a warning that drops it. CYCLE832 (tolerances), MSG and SETMS (the
+/// master spindle; a 840D sl package's CAM test) are read and ignored; a bare unknown word stays
+/// a warning.
 #[test]
 fn an_unknown_sinumerik_call_is_an_error() {
     let text =
@@ -476,7 +477,7 @@ fn an_unknown_sinumerik_call_is_an_error() {
     assert!(e.contains("t.mpf:3") && e.contains("CYCLE90(…)"), "{e}");
     let tp = gcode(
         Dialect::Sinumerik,
-        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nFOO\nG0 X0 Y0 Z10\nG1 X10 F100\n",
+        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nSETMS(1)\nFOO\nG0 X0 Y0 Z10\nG1 X10 F100\n",
     );
     assert_eq!(tp.points.len(), 2);
     assert!(
@@ -486,6 +487,29 @@ fn an_unknown_sinumerik_call_is_an_error() {
         "{:?}",
         tp.warnings
     );
+}
+
+/// Haas G187 (the smoothness setting, written by many Haas posts: `G187 P1 E0.05`) moves
+/// nothing: read without a word (it was an unknown G code, an error). Its `E0.05` after a
+/// space is a word, not the exponent of `P1` (the Fanuc dialect removes spaces; `P1E0.05`
+/// written together stays an error, as exponent notation).
+#[test]
+fn haas_g187_is_read() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\nG187 P1 E0.05\nG0 X0. Y0. Z10.\nG1 X10. F100.\nG187\nM30\n",
+    );
+    assert_eq!(tp.points.len(), 2);
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    let e = message(
+        parse(
+            Path::new("t.nc"),
+            "G21 G90\nG187 P1E0.05\nM30\n",
+            Dialect::Fanuc,
+        )
+        .unwrap_err(),
+    );
+    assert!(e.contains("t.nc:2") && e.contains("exponent"), "{e}");
 }
 
 /// Fanuc G60 (single-direction positioning, one-shot; a Kuraki KBT post writes

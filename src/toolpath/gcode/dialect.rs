@@ -721,6 +721,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("234", Action::Tcp(Tcp::On)),
         ("254", Action::Ignored),
         ("255", Action::Ignored),
+        // Haas: the smoothness setting (P1 rough … P3 finish, E the corner tolerance); the
+        // control's corner rounding is not modelled either way.
+        ("187", Action::Ignored),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
         ("92", Unsup(OFFSETS)),
@@ -973,6 +976,8 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("STOPRE", Action::Ignored),
         ("MSG", Action::Ignored),
         ("CYCLE832", Action::Ignored),
+        // The master spindle (SETMS(1)): no motion.
+        ("SETMS", Action::Ignored),
     ],
     initial_motion: Some(Motion::Rapid),
     g94_clears_feed: false,

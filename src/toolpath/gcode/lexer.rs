@@ -162,6 +162,42 @@ fn scan_value(chars: &[char], mut i: usize) -> usize {
     i.min(chars.len())
 }
 
+/// Marks, in a block whose spaces are removed, a space that stood between a number and an `E`
+/// word (`G187 P1 E0.05`): without it the two read as exponent notation (`P1E0.05`), which is
+/// an error. [`lex_letters`] skips it.
+const WORD_BREAK: char = '\u{1f}';
+
+/// `block` without its spaces (a dialect where they mean nothing: `G1  X  16.339` is
+/// `G1X16.339`), with a [`WORD_BREAK`] where a space separated a number from an `E` word
+/// (outside `[ … ]`).
+fn compact(block: &str) -> String {
+    let chars: Vec<char> = block.chars().collect();
+    let mut out = String::with_capacity(block.len());
+    let (mut depth, mut space) = (0i32, false);
+    for (k, &c) in chars.iter().enumerate() {
+        if c.is_whitespace() {
+            space = true;
+            continue;
+        }
+        let e_word = matches!(c, 'E' | 'e')
+            && chars
+                .get(k + 1)
+                .is_some_and(|n| n.is_ascii_digit() || matches!(n, '+' | '-' | '.'));
+        if space && depth == 0 && e_word && out.ends_with(|p: char| p.is_ascii_digit() || p == '.')
+        {
+            out.push(WORD_BREAK);
+        }
+        space = false;
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            _ => {}
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// Reads `LNUMBER LNUMBER …` (single-letter words, no spaces), `#n=expr` assignments and
 /// expression values into `items`.
 fn lex_letters(
@@ -173,6 +209,10 @@ fn lex_letters(
     let chars: Vec<char> = text.chars().collect();
     let mut i = 0;
     while i < chars.len() {
+        if chars[i] == WORD_BREAK {
+            i += 1;
+            continue;
+        }
         let c = chars[i];
         if c == '#' {
             // An assignment `#100=…` (Fanuc macro B, LinuxCNC parameters).
@@ -303,8 +343,7 @@ pub(super) fn lex(
     match spec.spaces {
         Spaces::Klartext => return super::klartext::lex(spec, block, vars),
         Spaces::Ignored => {
-            let compact: String = block.chars().filter(|c| !c.is_whitespace()).collect();
-            lex_letters(spec, &compact, vars, &mut items)?;
+            lex_letters(spec, &compact(block), vars, &mut items)?;
         }
         Spaces::Separate => {
             let words = split_words(block);
