@@ -927,3 +927,21 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
         "{w:?}"
     );
 }
+
+/// Fanuc programs are told by their Fanuc-only words: besides TCP, tilted planes and M98, the
+/// look-ahead `G08 P1`, macro calls `G65 P…` and Haas `G187`, and an `O` number as the first
+/// block after a tool-list comment (NX's Mori SH8000 and Haas posts; read as LinuxCNC before,
+/// where their G87 is an error).
+#[test]
+fn fanuc_only_words_tell_the_dialect() {
+    use feedopt::toolpath::gcode::detect_dialect;
+    for text in [
+        "%\nG20\nG08 P01\nG0 X0 Y0\n",
+        "%\nG65 P9021 T1000\n",
+        "G187\nG0 X0\n",
+        "(TOOL LIST)\n(T1 D10)\nO1234\nG0 X0\n",
+    ] {
+        assert_eq!(detect_dialect(text), Some(Dialect::Fanuc), "{text}");
+    }
+    assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
+}

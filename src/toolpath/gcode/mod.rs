@@ -310,7 +310,8 @@ pub fn parse_configured(
 /// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
 /// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
-/// `G05.1`, `M98`, a first block `O1234`), LinuxCNC (`M428`–`M430`, `O<`).
+/// `G05.1`, `M98`, look-ahead `G08 P…`, macro calls `G65 P…`, Haas `G187`, a first block
+/// `O1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
     if is_klartext(upper) {
         return Some(Dialect::Heidenhain);
@@ -321,12 +322,17 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
     ]
     .iter()
     .any(|w| has(w));
-    let fanuc = ["G43.4", "G43.5", "G68.2", "G05.1", "G5.1", "M98"]
-        .iter()
-        .any(|w| has(w))
+    let fanuc = [
+        "G43.4", "G43.5", "G68.2", "G05.1", "G5.1", "M98", "G08 P", "G08P", "G65 P", "G65P", "G187",
+    ]
+    .iter()
+    .any(|w| has(w))
         || upper
             .lines()
-            .find(|l| !l.trim().is_empty() && !l.trim().starts_with('%'))
+            .find(|l| {
+                let l = l.trim();
+                !l.is_empty() && !l.starts_with('%') && !l.starts_with('(')
+            })
             .is_some_and(|l| {
                 let l = l.trim();
                 l.starts_with('O') && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
