@@ -823,3 +823,20 @@ fn cycle_208_mills_a_helix_of_the_hole_radius_minus_the_tool_radius() {
     let e = read(&def(10.0), None).unwrap_err().to_string();
     assert!(e.contains(":16:") && e.contains("--tool-diameter"), "{e}");
 }
+
+/// Inch Klartext is refused with a message that says so, for `INCH` and for NX's `IN` (which
+/// read as a program without its unit before).
+#[test]
+fn inch_programs_are_refused_as_inch() {
+    for unit in ["INCH", "IN"] {
+        let e = fails(&format!(
+            "0 BEGIN PGM PART {unit}\n1 L X+1 FMAX\n2 END PGM PART {unit}\n"
+        ));
+        assert!(
+            e.contains(&format!("BEGIN PGM … {unit}")) && e.contains("inch Klartext"),
+            "{e}"
+        );
+    }
+    let e = fails("0 BEGIN PGM PART\n1 L X+1 FMAX\n2 END PGM PART\n");
+    assert!(e.contains("without its unit"), "{e}");
+}

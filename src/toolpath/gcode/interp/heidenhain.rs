@@ -207,10 +207,13 @@ impl Interpreter<'_> {
                 self.feed_units = Units::Mm;
                 Ok(())
             }
-            Some("INCH") => Err(self.error(
+            // (NX's Heidenhain posts write `IN` for inch.)
+            Some(unit @ ("INCH" | "IN")) => Err(self.error(
                 line,
-                "BEGIN PGM … INCH: inch Klartext programs are not supported; post the program \
-                 in MM",
+                format!(
+                    "BEGIN PGM … {unit}: inch Klartext programs are not supported; post the \
+                     program in MM"
+                ),
             )),
             _ => Err(self.error(line, "BEGIN PGM without its unit: end the block with MM")),
         }
