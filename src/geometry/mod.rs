@@ -264,9 +264,9 @@ impl Path {
             // to short ones lets a cubic spline swing far out (an arc's 0.3 mm chords, then a
             // 185 mm line: 440 mm). Each such interval is cut into up to [`MAX_PIECES`] on its
             // programmed chord, the new points smoothed with the rest, until the tip is within
-            // the tolerance plus [`CHORD_SLACK_MM`] plus the chord's allowance
-            // ([`chord_allowance`]) everywhere, or the span has [`max_knots`]; `deviation`
-            // says how far it is (the rotary angles' too).
+            // the tolerance plus [`CHORD_SLACK_MM`] plus the chord's allowance (the sagitta at
+            // [`chord_curvature`]) everywhere, or the span has [`max_knots`]; `deviation` says
+            // how far it is (the rotary angles' too).
             // On a moving span only the tip is held to its chords: inserting knots where the
             // rotary angles leave their linear interpolation in u made jerk-limited
             // subproblems fail (Clarabel: DualInfeasible on the LinuxCNC boats); their
