@@ -896,36 +896,34 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
         "G21 G90 G54\nG0 X0. Y0. Z5.\nG1 X10. F100.\nG54 G0 Z10.\nM30\n",
     );
     assert!(warned(&one).is_empty(), "{:?}", one.warnings);
-    let two = ok_in(
-        Dialect::Fanuc,
-        "G21 G90 G54\nG0 X0. Y0. Z5.\nG1 X10. F100.\nG55 G0 X0. Y0.\nG1 X5.\nM30\n",
-    );
-    let w = warned(&two);
-    assert_eq!(w.len(), 1, "{w:?}");
-    assert!(
-        w[0].0 == 4 && w[0].1.contains("G55") && w[0].1.contains("G54"),
-        "{w:?}"
-    );
-    // Fanuc's extended offsets are told apart by P.
-    let ext = ok_in(
-        Dialect::Fanuc,
-        "G21 G90 G54.1 P1\nG0 X0. Y0. Z5.\nG54.1 P3 G0 X1.\nM30\n",
-    );
-    let w = warned(&ext);
-    assert!(
-        w.len() == 1 && w[0].0 == 3 && w[0].1.contains("P3"),
-        "{w:?}"
-    );
-    // Sinumerik's G505–G599 too.
-    let sin = ok_in(
-        Dialect::Sinumerik,
-        "G71 G90 G54\nG0 X0 Y0 Z5\nG505\nG0 X1\nM30\n",
-    );
-    let w = warned(&sin);
-    assert!(
-        w.len() == 1 && w[0].0 == 3 && w[0].1.contains("G505"),
-        "{w:?}"
-    );
+    // One warning each, at the line of the change, naming the offsets: G54 → G55; Fanuc's
+    // extended offsets told apart by P; Sinumerik's G505–G599 too.
+    for (dialect, text, line, names) in [
+        (
+            Dialect::Fanuc,
+            "G21 G90 G54\nG0 X0. Y0. Z5.\nG1 X10. F100.\nG55 G0 X0. Y0.\nG1 X5.\nM30\n",
+            4,
+            &["G55", "G54"][..],
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G90 G54.1 P1\nG0 X0. Y0. Z5.\nG54.1 P3 G0 X1.\nM30\n",
+            3,
+            &["P3"][..],
+        ),
+        (
+            Dialect::Sinumerik,
+            "G71 G90 G54\nG0 X0 Y0 Z5\nG505\nG0 X1\nM30\n",
+            3,
+            &["G505"][..],
+        ),
+    ] {
+        let w = warned(&ok_in(dialect, text));
+        assert!(
+            w.len() == 1 && w[0].0 == line && names.iter().all(|n| w[0].1.contains(n)),
+            "{text}: {w:?}"
+        );
+    }
 }
 
 /// Fanuc programs are told by their Fanuc-only words: besides TCP, tilted planes and M98, the

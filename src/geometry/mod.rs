@@ -37,8 +37,9 @@ pub struct GeometryOptions {
     /// Turning angle (degrees) above which a corner is an exact stop.
     pub corner_angle_deg: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm
-    /// (0: interpolate them exactly). See [`smooth_within`]. Between the points, the curve
-    /// stays within this plus [`CHORD_SLACK_MM`] of the programmed chords ([`Path::build`]).
+    /// (0: interpolate them exactly). See [`smooth_within`]. Between the points, the tip stays
+    /// within this plus [`CHORD_SLACK_MM`] plus the chord's sagitta allowance of the
+    /// programmed chords ([`Path::build`]).
     pub tolerance_mm: f64,
     /// How far the fitted rotary angles may stray from the programmed ones, degrees.
     pub tolerance_deg: f64,
@@ -395,14 +396,9 @@ fn max_knots(cl: usize) -> usize {
 /// the next point where that is trusted and the end chord is as long as the next, else 0.
 fn chord_curvature(values: &[[f64; PATH_DIM]]) -> Vec<f64> {
     let n = values.len();
-    let h: Vec<f64> = values
+    let h: Vec<f64> = chord_parameter(values, true)
         .windows(2)
-        .map(|w| {
-            (0..3)
-                .map(|j| (w[1][j] - w[0][j]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
+        .map(|u| u[1] - u[0])
         .collect();
     let even = |a: f64, b: f64| a > 0.0 && b > 0.0 && a.max(b) <= EVEN_SPACING * a.min(b);
     let mut kappa = vec![0.0f64; n];
@@ -789,12 +785,11 @@ pub fn chord_deviation(
                 let th = m as f64 / (CHORD_SAMPLES + 1) as f64;
                 let w = spline.eval_in(k, u[k] + th * (u[k + 1] - u[k])).value;
                 let ap = [w[0] - a[0], w[1] - a[1], w[2] - a[2]];
-                // The nearest point of the segment, and the fraction along it (the parameter's
-                // fraction where the tip does not move).
+                // The nearest point of the segment (its ends where the tip does not move).
                 let t = if len2 > 0.0 {
                     ((0..3).map(|j| ap[j] * ab[j]).sum::<f64>() / len2).clamp(0.0, 1.0)
                 } else {
-                    th
+                    0.0
                 };
                 let d = (0..3)
                     .map(|j| (ap[j] - t * ab[j]).powi(2))

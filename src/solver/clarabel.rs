@@ -83,8 +83,6 @@ use crate::error::{Error, Result};
 struct Layout {
     /// x_i's column; `None` where fixed (and at the end stations, constants).
     x: Vec<Option<usize>>,
-    /// c_i's column; `None` where fixed.
-    c: Vec<Option<usize>>,
     /// d_k's column; `None` on an interval between fixed stations.
     d: Vec<Option<usize>>,
     /// Columns in all.
@@ -96,12 +94,11 @@ impl Layout {
     /// the two end stations always fixed).
     fn new(p: &SpanProblem, fixed: &[Option<f64>]) -> Layout {
         let n = p.intervals();
-        let (mut x, mut c) = (vec![None; n + 1], vec![None; n + 1]);
+        let mut x = vec![None; n + 1];
         let mut next = 0;
         for i in 1..n {
             if fixed[i].is_none() {
                 x[i] = Some(next);
-                c[i] = Some(next + 1);
                 next += 2;
             }
         }
@@ -115,7 +112,12 @@ impl Layout {
                 next += 1;
             }
         }
-        Layout { x, c, d, len: next }
+        Layout { x, d, len: next }
+    }
+
+    /// c_i's column (next to x_i's); `None` where fixed.
+    fn c(&self, i: usize) -> Option<usize> {
+        self.x[i].map(|x| x + 1)
     }
 }
 
@@ -380,7 +382,7 @@ fn program(
     // Second-order cones (3 rows each), appended after the linear rows.
     let mut soc = Rows::default();
     for i in 1..n {
-        if let (Some(x), Some(c)) = (lay.x[i], lay.c[i]) {
+        if let (Some(x), Some(c)) = (lay.x[i], lay.c(i)) {
             // (x + 1, x − 1, 2c) ∈ SOC  ⇔  c² ≤ x.
             soc.push(&[(x, -1.0)], 1.0);
             soc.push(&[(x, -1.0)], -1.0);
@@ -401,10 +403,9 @@ fn program(
         let mut e_const = 0.0;
         let mut cs: Vec<usize> = Vec::with_capacity(2);
         for i in [k, k + 1] {
-            match (c_at(i), lay.c[i]) {
+            match (c_at(i), lay.c(i)) {
                 (Some(c), _) => e_const += c,
-                (None, Some(col)) => cs.push(col),
-                (None, None) => unreachable!("a station is fixed or has a column"),
+                (None, col) => cs.push(col.expect("a station is fixed or has a column")),
             }
         }
         // Rows of s = h − A z: s0 = d + e, s1 = (d − e − 2)/√2, s2 = (d − e + 2)/√2.

@@ -317,22 +317,9 @@ impl<'a> Reader<'a> {
     /// `SPINDL/RPM, n, CLW` (or `SPINDL/n, …`): the speed n from the next move on; `SPINDL/OFF`
     /// and a record without a number change nothing (the motion does not depend on it).
     fn spindle(&mut self, line: usize, args: &str) {
-        let Some(rpm) = args
-            .split(',')
-            .find_map(|a| a.trim().parse::<f64>().ok())
-            .map(f64::abs)
-            .filter(|n| n.is_finite() && *n > 0.0)
-        else {
-            return;
-        };
-        if self.spindle_changes.last().is_some_and(|c| c.rpm == rpm) {
-            return;
+        if let Some(rpm) = args.split(',').find_map(|a| a.trim().parse::<f64>().ok()) {
+            SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
         }
-        self.spindle_changes.push(SpindleChange {
-            point: self.points.len(),
-            line,
-            rpm,
-        });
     }
 
     /// `CUTTER/d, r, …` or NX's `TLDATA/MILL, d, r, length, taper, tip`: the tool from the

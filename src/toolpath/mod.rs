@@ -228,6 +228,17 @@ pub struct SpindleChange {
     pub rpm: f64,
 }
 
+impl SpindleChange {
+    /// Appends the speed `rpm` (its magnitude) to `changes` from CL point `point` on; a speed
+    /// that is not positive and finite, or the same as the last, changes nothing.
+    pub(crate) fn record(changes: &mut Vec<SpindleChange>, point: usize, line: usize, rpm: f64) {
+        let rpm = rpm.abs();
+        if rpm.is_finite() && rpm > 0.0 && changes.last().is_none_or(|c| c.rpm != rpm) {
+            changes.push(SpindleChange { point, line, rpm });
+        }
+    }
+}
+
 /// A reader's warning: a line and what about it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Warning {

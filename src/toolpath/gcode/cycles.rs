@@ -28,8 +28,9 @@
 //! P is seconds on LinuxCNC and milliseconds on Fanuc. A peck cycle with Q ≤ 0 or without Q
 //! drills in one pass, with a warning. A hole needs at most [`MAX_PECKS`] pecks, else it is an
 //! error. Repeats `L` (LinuxCNC) / `K` or `L` (Fanuc) drill the hole again, under G91 each one
-//! shifted by the X Y increment, at most [`MAX_REPEATS`]. On LinuxCNC, `K` in a cycle block
-//! and `G87` (back boring with I J K offsets) are errors.
+//! shifted by the X Y increment, at most [`MAX_REPEATS`] (the letters are the dialect's
+//! [`super::dialect::DialectSpec::cycle_repeat`]). On LinuxCNC, `K` in a cycle block and
+//! `G87` (back boring with I J K offsets) are errors.
 //!
 //! # Sinumerik (`CYCLE81`–`CYCLE89`, `MCALL`)
 //!

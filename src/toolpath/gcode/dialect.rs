@@ -416,6 +416,10 @@ pub struct DialectSpec {
     /// Sinumerik), which the machine file may give (`program_units`); otherwise the unit is
     /// the configuration's (LinuxCNC's INI file) or the program's own (Klartext `BEGIN PGM`).
     pub units_by_setting: bool,
+    /// The letters that repeat a G81–G89 canned cycle, the first given wins: `L` on LinuxCNC,
+    /// `K` (or `L`) on Fanuc. A `K` in a cycle block of a dialect whose repeat letters do not
+    /// include it is an error (LinuxCNC's K is G87's offset).
+    pub cycle_repeat: &'static [char],
 }
 
 use Action::{
@@ -558,7 +562,10 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("84", Action::Cycle(84)),
         ("85", Action::Cycle(85)),
         ("86", Action::Cycle(86)),
-        ("87", Action::Cycle(87)),
+        (
+            "87",
+            Unsup("LinuxCNC back boring (with its I J K offsets) is not supported"),
+        ),
         ("88", Action::Cycle(88)),
         ("89", Action::Cycle(89)),
         ("90", Dist(Distance::Absolute)),
@@ -602,6 +609,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     integer_increments: None,
     subprograms: Subprograms::OWordSub,
     units_by_setting: false,
+    cycle_repeat: &['L'],
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -765,6 +773,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     }),
     subprograms: Subprograms::OPrograms,
     units_by_setting: true,
+    cycle_repeat: &['K', 'L'],
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -984,6 +993,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     integer_increments: None,
     subprograms: Subprograms::Procs,
     units_by_setting: true,
+    cycle_repeat: &['K', 'L'],
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1223,6 +1233,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     integer_increments: None,
     subprograms: Subprograms::Labels,
     units_by_setting: false,
+    cycle_repeat: &['K', 'L'],
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

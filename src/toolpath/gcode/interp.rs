@@ -937,17 +937,7 @@ impl<'a> Interpreter<'a> {
     /// The spindle turns at `rpm` from the next move on (a speed that is not positive and
     /// finite, or the same as before, changes nothing).
     pub(super) fn set_spindle(&mut self, line: usize, rpm: f64) {
-        let rpm = rpm.abs();
-        if !(rpm.is_finite() && rpm > 0.0)
-            || self.spindle_changes.last().is_some_and(|c| c.rpm == rpm)
-        {
-            return;
-        }
-        self.spindle_changes.push(SpindleChange {
-            point: self.points.len(),
-            line,
-            rpm,
-        });
+        SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
     }
 
     /// `tool` goes into the spindle here: the next move is its first.
@@ -1268,28 +1258,21 @@ impl<'a> Interpreter<'a> {
             }
         }
         self.cycle = Some(c);
-        // Repeats: `L` on LinuxCNC, `K` (or `L`) on Fanuc. LinuxCNC has no K repeat: its K is
-        // G87's back-boring offset (with I and J), which is not modelled.
-        let linuxcnc = self.spec.name == "LinuxCNC";
-        if linuxcnc && (c.code == 87 || block.letter('K').is_some()) {
+        // Repeats: the dialect's letters ([`DialectSpec::cycle_repeat`]).
+        let repeat = self.spec.cycle_repeat;
+        if block.letter('K').is_some() && !repeat.contains(&'K') {
             return Err(self.error(
                 line,
-                if c.code == 87 {
-                    "G87: LinuxCNC back boring (with its I J K offsets) is not supported"
-                        .to_string()
-                } else {
-                    format!(
-                        "G{}: K is not a LinuxCNC canned-cycle word (LinuxCNC repeats with L)",
-                        c.code
-                    )
-                },
+                format!(
+                    "G{}: K is not a {} canned-cycle word ({} repeats with {})",
+                    c.code,
+                    self.spec.name,
+                    self.spec.name,
+                    repeat.iter().collect::<String>()
+                ),
             ));
         }
-        let count = if linuxcnc {
-            block.letter('L')
-        } else {
-            block.letter('K').or(block.letter('L'))
-        };
+        let count = repeat.iter().find_map(|&l| block.letter(l));
         let repeats = match count {
             None => 1,
             Some(n)
