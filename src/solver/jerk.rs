@@ -251,6 +251,16 @@ const ACTIVE_AT: f64 = 0.85;
 /// time; 0.4 or 0.7 gained less).
 const ACTIVE_NEAR_FRESH: f64 = 0.6;
 
+/// The lowest linearisation point b̄ of a subproblem, as a share of its scale B (the median
+/// b̄). The jerk row is the tangent of 1/√b at b̄, which lies below the curve at any b̄ > 0, so
+/// raising a smaller b̄ to this keeps every iterate jerk-feasible; it only stops the LP from
+/// degenerating where an iterate reached b ≈ 0. Without it, the LinuxCNC boats with jerk limits
+/// and `--tolerance 0` (a cubic through every point: q''' up to 10⁴ times the median) reached
+/// iterates with b ≈ 1e-12 B, objective weights of 1e149 and Clarabel's DualInfeasible, and
+/// the solve failed; with it they solve and verify (boat-xyzbc 441.59 s, boat-xyzac
+/// 621.45 s, the same to 2e-6 with a floor of 1e-4).
+const BBAR_FLOOR: f64 = 1e-6;
+
 /// Solves with part of the rows before all are taken (see [`subproblem`]).
 const ACTIVE_ROUNDS: usize = 6;
 
@@ -1657,6 +1667,15 @@ impl<'a> Program<'a> {
         let (p, lay, scale) = (self.p, &self.lay, self.scale);
         let n = p.intervals();
         let interior = |i: usize| i > 0 && i < n;
+        // b̄ no lower than B·BBAR_FLOOR (any b̄ > 0 keeps the jerk rows an inner approximation;
+        // at b̄ → 0 the objective's gradient and the tangent's slope 1/(3b̄) blow up).
+        let floor = BBAR_FLOOR * scale;
+        let floored: Vec<f64> = bbar
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| if interior(i) { b.max(floor) } else { b })
+            .collect();
+        let bbar = &floored[..];
         let nv = lay.len();
         let mut q = vec![0.0; nv];
         if lay.lp {
@@ -1681,7 +1700,10 @@ impl<'a> Program<'a> {
                 q[lay.d(k)] = if self.is_rest(k) { 3.0 } else { 2.0 } * p.du(k) / scale.sqrt();
             }
         }
-        let bbar_sites = self.bbar_at_sites(bbar, abar, sbar);
+        let mut bbar_sites = self.bbar_at_sites(bbar, abar, sbar);
+        for b in &mut bbar_sites {
+            *b = b.max(floor);
+        }
 
         // Active set over every row but the equalities and the velocity bounds at the stations:
         // most are far from binding. Start with those within ACTIVE_AT of their bound at the
