@@ -223,6 +223,10 @@ pub struct SolveOptions {
     /// changes the cycle time by less than 0.01 %).
     #[arg(long)]
     pub stations: Option<usize>,
+    /// Most stations the automatic refinement may use (it stops before a round that would
+    /// pass them, with its estimate and a warning); memory grows by about 0.5 kB a station.
+    #[arg(long, default_value_t = 4_000_000, value_name = "N")]
+    pub max_stations: usize,
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
     #[arg(long, default_value_t = 10.0)]
     pub corner_angle: f64,
@@ -320,6 +324,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("geometry.tolerance_deg", "--tolerance-deg"),
     ("geometry.feed_override", "--feed-override"),
     ("stations", "--stations"),
+    ("max_stations", "--max-stations"),
     ("start_feed", "--start-feed"),
     ("end_feed", "--end-feed"),
     ("verify.period", "--period"),
@@ -364,6 +369,7 @@ impl SolveArgs {
     fn options(&self) -> Result<Options> {
         let mut o = Options {
             stations: self.opts.stations,
+            max_stations: self.opts.max_stations,
             solver_kind: match self.opts.solver {
                 SolverChoice::Clarabel => SolverKind::Clarabel,
                 SolverChoice::Reach => SolverKind::Reach,
@@ -419,7 +425,15 @@ fn solve_with_progress(
     let bar = crate::progress::Spinner::new();
     #[cfg(not(feature = "progress"))]
     let bar = optimize::Silent;
-    optimize::optimize_input_observed(machine, input, options, &bar)
+    let solution = optimize::optimize_input_observed(machine, input, options, &bar)?;
+    if let (Some(why), Some(e)) = (&solution.unconverged, solution.error_estimate) {
+        eprintln!(
+            "feedopt: warning: the cycle time is estimated within {e:.1e} of the continuous \
+             optimum, not within the {:.0e} aimed at: {why}",
+            solution.error_target.unwrap_or(f64::NAN)
+        );
+    }
+    Ok(solution)
 }
 
 /// `feedopt solve`: returns what to print on stdout.

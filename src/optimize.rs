@@ -141,6 +141,12 @@ pub struct Solution {
     /// linearly with the interval length (Richardson). Jerk-limited: the relative change of
     /// the time from the last uniform level to the returned one.
     pub error_estimate: Option<f64>,
+    /// The relative error the automatic refinement aimed at (`None` on a fixed grid).
+    pub error_target: Option<f64>,
+    /// Why the automatic refinement stopped with its estimate above [`Self::error_target`],
+    /// if it did. The schedule is verified all the same; the estimate says how far its cycle
+    /// time may be from the continuous optimum.
+    pub unconverged: Option<String>,
     /// The re-simulation of the returned schedule at the servo period.
     pub verification: Verification,
     /// Its servo period, s.
@@ -260,6 +266,7 @@ fn optimize_path(
         path,
         progress,
     };
+    let (mut unconverged, mut error_target) = (None, None);
     let (mut lv, mut refinement, error_estimate) = match options.stations {
         Some(total) => {
             let lv = plan.solve_at(total, options)?;
@@ -269,13 +276,15 @@ fn optimize_path(
             };
             (lv, vec![r], None)
         }
-        None if plan.machine.has_jerk() => {
-            let (lv, refinement, estimate) = plan.solve_adaptive_jerk(options)?;
-            (lv, refinement, Some(estimate))
-        }
         None => {
-            let (lv, refinement, estimate) = plan.solve_adaptive(options)?;
-            (lv, refinement, Some(estimate))
+            let a = if plan.machine.has_jerk() {
+                plan.solve_adaptive_jerk(options)?
+            } else {
+                plan.solve_adaptive(options)?
+            };
+            unconverged = a.unconverged;
+            error_target = Some(a.target);
+            (a.level, a.refinement, Some(a.estimate))
         }
     };
     plan.progress.stage(&format!(
@@ -346,6 +355,8 @@ fn optimize_path(
         solve_time: lv.solve_time,
         refinement,
         error_estimate,
+        error_target,
+        unconverged,
         verification: v,
         verify_period: options.verify.period,
     })
@@ -524,19 +535,46 @@ const UNSEEN_RHO_MARGIN: f64 = 2.0;
 const MAX_SPLIT: usize = 2;
 
 /// The refinement threshold of a round: the smallest e_k, summing to half the `allowance`
-/// (tol · T), stay; every interval above it is halved.
+/// (tol · T), stay; every interval above it is halved. Errors equal to the first one that
+/// passes half the allowance are all above it: a program repeating one pattern has many equal
+/// e_k, and a threshold equal to them marked none (a Fusion post for Marlin stopped at an
+/// estimate of 1.24e-4 for a target of 1e-4, with nothing refined).
 fn threshold(e: impl Iterator<Item = f64>, allowance: f64) -> f64 {
     let mut all: Vec<f64> = e.collect();
     all.sort_unstable_by(f64::total_cmp);
-    let (mut acc, mut threshold) = (0.0, 0.0);
-    for &e in &all {
+    let mut acc = 0.0;
+    for (i, &e) in all.iter().enumerate() {
         acc += e;
         if acc > 0.5 * allowance {
-            break;
+            // The largest error below this one (0: every positive error is marked).
+            return all[..i]
+                .iter()
+                .rev()
+                .find(|&&x| x < e)
+                .copied()
+                .unwrap_or(0.0);
         }
-        threshold = e;
     }
-    threshold
+    all.last().copied().unwrap_or(0.0)
+}
+
+/// What [`Plan::refine_rounds`] ends with: the last rounds, the refinement history, the
+/// last estimate (s) and, where that estimate is above the target, why the rounds stopped.
+struct Refined<R> {
+    rounds: Vec<R>,
+    refinement: Vec<Refinement>,
+    estimate_s: f64,
+    unconverged: Option<String>,
+}
+
+/// An adaptive refinement's answer: the final level, the history, the relative estimate and
+/// the target it aimed at, and why it stopped short of that target, if it did.
+struct Adaptive {
+    level: Level,
+    refinement: Vec<Refinement>,
+    estimate: f64,
+    target: f64,
+    unconverged: Option<String>,
 }
 
 /// The solve of every span at one refinement level.
@@ -793,10 +831,15 @@ impl Plan<'_> {
     /// goes where a ramp ends inside it, and the spans with such intervals run the next round
     /// (the others keep theirs). Plateaus (feed cap, velocity bound) have e_k = 0 and are never
     /// refined: the stations go to ramps, rest ends, corners and curvature peaks.
-    fn solve_adaptive(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
+    fn solve_adaptive(&self, options: &Options) -> Result<Adaptive> {
         use rayon::prelude::*;
         self.progress.stage("refining stations");
-        let (rounds, refinement, estimate_s) = self.refine_rounds(
+        let Refined {
+            rounds,
+            refinement,
+            estimate_s,
+            unconverged,
+        } = self.refine_rounds(
             options,
             options.convergence,
             |si| {
@@ -810,15 +853,6 @@ impl Plan<'_> {
             |rounds: &[Round], _: &[Refinement], _| (rounds.iter().map(|r| r.estimate).sum(), true),
             |si, r, threshold| {
                 self.bisect(si, options, self.refined_grid(si, options, r, threshold))
-            },
-            |estimate, stations| {
-                format!(
-                    "the cycle time is still {estimate:.1e} (relative) from converged with \
-                     {stations} stations, and halving the intervals that carry that error would \
-                     pass the limit of {} stations; try a looser --tolerance (a smoother fitted \
-                     path), or --stations N for a fixed grid",
-                    options.max_stations
-                )
             },
         )?;
         self.progress.stage(&format!(
@@ -837,8 +871,14 @@ impl Plan<'_> {
             .into_iter()
             .collect::<Result<_>>()?;
         let (problems, solutions): (Vec<_>, Vec<_>) = solved.into_iter().unzip();
-        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
-        Ok((lv, refinement, estimate))
+        let (level, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
+        Ok(Adaptive {
+            level,
+            refinement,
+            estimate,
+            target: options.convergence,
+            unconverged,
+        })
     }
 
     /// Jerk-limited solves, refined adaptively as [`Plan::solve_adaptive`] refines the
@@ -880,11 +920,16 @@ impl Plan<'_> {
     /// of F, whose times are known, and the next F contains the last F. Its SCP starts from
     /// the last F ([`Warm`]); a window with no new station keeps its profile, so a round costs
     /// what it refines.
-    fn solve_adaptive_jerk(&self, options: &Options) -> Result<(Level, Vec<Refinement>, f64)> {
+    fn solve_adaptive_jerk(&self, options: &Options) -> Result<Adaptive> {
         self.progress.stage("refining stations (jerk-limited)");
         let mut rho = 0.5;
         let tol = options.convergence.max(10.0 * options.jerk.convergence);
-        let (rounds, refinement, estimate_s) = self.refine_rounds(
+        let Refined {
+            rounds,
+            refinement,
+            estimate_s,
+            unconverged,
+        } = self.refine_rounds(
             options,
             tol,
             |si| {
@@ -924,22 +969,19 @@ impl Plan<'_> {
                 )
             },
             |si, r, threshold| self.next_jerk_round(si, options, r, threshold),
-            |estimate, stations| {
-                format!(
-                    "the jerk-limited cycle time is still {estimate:.1e} (relative) from \
-                     converged with {stations} stations, and refining the intervals that carry \
-                     that error would pass the limit of {} stations; try --stations N for a \
-                     fixed grid, or --no-jerk",
-                    options.max_stations
-                )
-            },
         )?;
         let (problems, solutions): (Vec<_>, Vec<_>) = rounds
             .into_iter()
             .map(|r| (r.fine, r.fine_solution))
             .unzip();
-        let (lv, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
-        Ok((lv, refinement, estimate))
+        let (level, estimate) = self.estimated_level(problems, solutions, estimate_s)?;
+        Ok(Adaptive {
+            level,
+            refinement,
+            estimate,
+            target: tol,
+            unconverged,
+        })
     }
 
     /// The rounds both adaptive refinements share. Every span's first round comes from
@@ -947,13 +989,13 @@ impl Plan<'_> {
     /// error estimate of the whole path (`estimate(rounds, refinement so far, T)`: the
     /// estimate, s, and whether it may end the refinement yet) are recorded as a
     /// [`Refinement`] and reported. The rounds end when a settled estimate is within
-    /// `tol` · T, or after [`MAX_ADAPTIVE_ROUNDS`]; a round that would pass
-    /// `options.max_stations` is an error (`too_many(relative estimate, stations)` says what
-    /// to do). Otherwise every interval whose error exceeds one path-wide [`threshold`] (the
-    /// smallest errors summing to half the allowance stay; 0, every interval, while an
-    /// estimate within `tol` is not settled yet) is refined: `next(span, its round,
-    /// threshold)` for the spans that have such intervals, the others keep theirs. Returns
-    /// the last rounds, the refinement history and the last estimate, s.
+    /// `tol` · T; they also end, with the reason in [`Refined::unconverged`], after
+    /// [`MAX_ADAPTIVE_ROUNDS`], before a round that would pass `options.max_stations`, or
+    /// when no interval can be refined. Otherwise every interval whose error exceeds one
+    /// path-wide [`threshold`] (the smallest errors summing to half the allowance stay; 0,
+    /// every interval, while an estimate within `tol` is not settled yet) is refined:
+    /// `next(span, its round, threshold)` for the spans that have such intervals, the others
+    /// keep theirs.
     fn refine_rounds<R: AdaptiveRound>(
         &self,
         options: &Options,
@@ -961,8 +1003,7 @@ impl Plan<'_> {
         first: impl Fn(usize) -> Result<R> + Sync,
         mut estimate: impl FnMut(&[R], &[Refinement], f64) -> (f64, bool),
         next: impl Fn(usize, &R, f64) -> Result<R> + Sync,
-        too_many: impl Fn(f64, usize) -> String,
-    ) -> Result<(Vec<R>, Vec<Refinement>, f64)> {
+    ) -> Result<Refined<R>> {
         use rayon::prelude::*;
         let t0 = std::time::Instant::now();
         let mut rounds: Vec<R> = (0..self.path.spans.len())
@@ -988,11 +1029,31 @@ impl Plan<'_> {
             });
             self.progress.round(stations, estimate_s / time, tol);
             let within = estimate_s <= tol * time;
-            if (settled && within) || refinement.len() >= MAX_ADAPTIVE_ROUNDS {
-                return Ok((rounds, refinement, estimate_s));
+            let done = |rounds, refinement, why: Option<String>| {
+                Ok(Refined {
+                    rounds,
+                    refinement,
+                    estimate_s,
+                    unconverged: why.filter(|_| !within),
+                })
+            };
+            if settled && within {
+                return done(rounds, refinement, None);
+            }
+            if refinement.len() >= MAX_ADAPTIVE_ROUNDS {
+                let why = format!("the refinement stopped after {MAX_ADAPTIVE_ROUNDS} rounds");
+                return done(rounds, refinement, Some(why));
             }
             if 2 * stations > options.max_stations {
-                return Err(Error::Solver(too_many(estimate_s / time, stations)));
+                // The last round is solved (and is verified next): returned with its estimate,
+                // not refused (a 64,698-line hyperMILL finish stopped at 1.1e-4 with 2.7 M
+                // stations, its T settled to 1e-4 over the last rounds, and the user got
+                // nothing).
+                let why = format!(
+                    "another round would pass the limit of {} stations (--max-stations)",
+                    options.max_stations
+                );
+                return done(rounds, refinement, Some(why));
             }
             // Within tol but not settled: refine every interval, so that the next changes of
             // T are those of uniform halvings and show the order the estimate assumes.
@@ -1029,7 +1090,10 @@ impl Plan<'_> {
             if next.iter().all(Option::is_none) {
                 // Nothing to refine (every marked interval is one a round keeps whole): a
                 // further round would repeat this one. The estimate stands as it is.
-                return Ok((rounds, refinement, estimate_s));
+                let why = "the intervals that carry the error are ones the refinement keeps whole \
+                           (a jerk-limited ramp from rest)"
+                    .to_string();
+                return done(rounds, refinement, Some(why));
             }
             for (r, n) in rounds.iter_mut().zip(next) {
                 if let Some(n) = n {
@@ -1441,6 +1505,23 @@ impl Plan<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The smallest errors summing to half the allowance stay; the rest are marked (above the
+    /// threshold), ties with the first error that passes half the allowance included.
+    #[test]
+    fn the_threshold_marks_every_error_tied_with_the_first_one_over_the_allowance() {
+        let marked = |e: &[f64], allowance: f64| -> Vec<f64> {
+            let t = threshold(e.iter().copied(), allowance);
+            e.iter().copied().filter(|&x| x > t).collect()
+        };
+        // A repeated pattern: equal errors (a threshold equal to them marked none).
+        assert_eq!(marked(&[1.0; 4], 2.0), vec![1.0; 4]);
+        assert_eq!(marked(&[0.2, 1.0, 0.1, 1.0, 1.0], 0.8), vec![1.0; 3]);
+        assert_eq!(marked(&[0.1, 0.2, 0.3, 2.0], 1.3), vec![2.0]);
+        // Within half the allowance: nothing to mark.
+        assert!(marked(&[0.1, 0.2], 1.0).is_empty());
+        assert!(marked(&[0.0, 0.0], 0.0).is_empty());
+    }
 
     #[test]
     fn divide_splits_the_listed_intervals_into_equal_parts() {

@@ -186,6 +186,11 @@ pub struct Summary {
     /// Estimated relative error of `cycle_time_s` against the continuous optimum (automatic
     /// refinement; `null` on a fixed grid): see [`Solution::error_estimate`].
     pub error_estimate: Option<f64>,
+    /// The relative error the automatic refinement aimed at (`null` on a fixed grid).
+    pub error_target: Option<f64>,
+    /// Why the refinement stopped with `error_estimate` above `error_target` (`null`: it did
+    /// not): see [`Solution::unconverged`].
+    pub unconverged: Option<String>,
     /// The re-simulation at the servo period found every limit kept (within its tolerance).
     pub verified: bool,
     /// Servo period of the re-simulation, s.
@@ -321,6 +326,8 @@ impl Summary {
             binding,
             refinement: sol.refinement.clone(),
             error_estimate: sol.error_estimate,
+            error_target: sol.error_target,
+            unconverged: sol.unconverged.clone(),
             verified: sol.verification.verified,
             verify_period_s: sol.verify_period,
             worst_ratio: sol
@@ -437,12 +444,19 @@ impl fmt::Display for Summary {
             self.spans,
             steps.join(" → ")
         )?;
-        if let Some(e) = self.error_estimate {
-            writeln!(
+        match (self.error_estimate, &self.unconverged) {
+            (Some(e), Some(why)) => writeln!(
+                f,
+                "NOT converged estimated within {e:.1e} of the continuous optimum, above the \
+                 {:.0e} aimed at: {why}",
+                self.error_target.unwrap_or(f64::NAN)
+            )?,
+            (Some(e), None) => writeln!(
                 f,
                 "converged     within {e:.1e} of the continuous optimum (estimated from how \
                  each interval's time changed when it was halved)"
-            )?;
+            )?,
+            (None, _) => {}
         }
         let status = match self.status {
             Status::Optimal => "optimal",

@@ -332,6 +332,8 @@ impl Study<'_> {
             solve_time,
             refinement: Vec::new(),
             error_estimate: None,
+            error_target: None,
+            unconverged: None,
             verification,
             verify_period: self.options.verify.period,
         };

@@ -235,3 +235,49 @@ fn linuxcnc_impeller_by_default() {
     assert!(sol.stations() < 100_000, "{} stations", sol.stations());
     assert!(sol.verification.verified);
 }
+
+/// The station limit ends the refinement with the last round's answer, verified, its estimate
+/// and why it is above the target — not an error that leaves the user nothing (a 64,698-line
+/// hyperMILL finish stopped so at 1.1e-4 with 2.7 M stations).
+#[test]
+fn the_station_limit_returns_the_last_round_with_its_estimate() {
+    let m = machine(XYZ);
+    // One and a half turns of radius 10 mm in 200 chords, drifting 4 mm along X, at 500 mm/s:
+    // the curvature holds the feed down everywhere, and the refinement takes four rounds.
+    let pts: Vec<_> = (0..=200)
+        .map(|i| {
+            let a = 3.0 * std::f64::consts::PI * i as f64 / 200.0;
+            let p = Vector3::new(10.0 * a.cos() + 0.02 * i as f64, 10.0 * a.sin(), 0.0);
+            (p, UP)
+        })
+        .collect();
+    let t = toolpath(&pts, Some(500.0));
+    let free = optimize(&m, &t, &Options::default()).expect("solves");
+    assert!(free.unconverged.is_none(), "{:?}", free.unconverged);
+    let first = free.refinement[0].stations;
+    assert!(free.refinement.len() >= 2, "{:?}", free.refinement);
+    // A limit the first round's refinement would pass.
+    let capped = Options {
+        max_stations: 2 * first - 1,
+        ..Options::default()
+    };
+    let sol = optimize(&m, &t, &capped).expect("returns the last round");
+    let (est, target) = (
+        sol.error_estimate.expect("estimate"),
+        sol.error_target.expect("target"),
+    );
+    let why = sol.unconverged.as_deref().expect("says why it stopped");
+    assert!(est > target, "estimate {est:e}, target {target:e}");
+    assert!(
+        why.contains(&format!("{} stations", 2 * first - 1)),
+        "{why}"
+    );
+    assert!(sol.verification.verified);
+    assert_eq!(sol.refinement.len(), 1, "{:?}", sol.refinement);
+    // The estimate bounds its distance from the converged time.
+    let (tc, tf) = (sol.schedule.cycle_time, free.schedule.cycle_time);
+    assert!(
+        (tc - tf).abs() / tf <= est,
+        "{tc} vs {tf}, estimate {est:e}"
+    );
+}
