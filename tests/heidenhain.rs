@@ -840,3 +840,32 @@ fn inch_programs_are_refused_as_inch() {
     let e = fails("0 BEGIN PGM PART\n1 L X+1 FMAX\n2 END PGM PART\n");
     assert!(e.contains("without its unit"), "{e}");
 }
+
+/// Cycle 200 with its parameters spaced about `=` in three ways, one a line (`~`), at `L`
+/// line 5 and `CYCL DEF` line 6 (the parameters on lines 7–14); `{bad}` replaces Q206's
+/// value and `{tail}` follows Q204's.
+fn spaced_drill(bad: &str, tail: &str) -> String {
+    format!(
+        "{HEADER}4 L X+0 Y+0 Z+10 R0 FMAX\n5 CYCL DEF 200 DRILLING ~\n  Q200 = +2 ;SET-UP ~\n\
+         Q201= -10 ;DEPTH ~\n  Q206 ={bad} ;FEED ~\n  Q202=+4 ~\n  Q210=+0 ~\n  Q203=+0 ~\n\
+         Q204=+20 {tail};2ND SET-UP CLEARANCE ~\n  Q211=+0\n6 CYCL CALL\n"
+    )
+}
+
+/// Parameters of a `CYCL DEF` as posts space them (`Q200 = +2`, `Q201= -10`, `Q206 =+120`)
+/// are read, and an error in a parameter of a `CYCL DEF` written on several lines names the
+/// line of that parameter, not the `CYCL DEF`'s: a value that is no number, and a word after
+/// the parameters that is none (it could change what the cycle does).
+#[test]
+fn cycle_parameters_spaced_about_equals_and_errors_at_their_own_line() {
+    let tp = read(&spaced_drill("+120", ""));
+    let z: Vec<f64> = tp.points[1..].iter().map(|p| p.p.z).collect();
+    assert_eq!(z, [2.0, -4.0, 2.0, -2.0, -8.0, 2.0, -6.0, -10.0, 20.0]);
+    assert!(feed_time(&tp) > 0.0 && (feed_time(&tp) - 16.0 / 2.0).abs() < 1e-9);
+    let e = fails(&spaced_drill("FOO", ""));
+    assert!(e.contains("t.h:9:") && e.contains("`Q206 =FOO`"), "{e}");
+    let e = fails(&spaced_drill("+120", "BAR "));
+    assert!(e.contains("t.h:13:") && e.contains("`BAR`"), "{e}");
+    let e = fails(&spaced_drill("", ""));
+    assert!(e.contains("t.h:9:") && e.contains("no value"), "{e}");
+}

@@ -7,7 +7,8 @@
 //! A line is a block: an optional block number (`12 L X+10 FMAX`), then the statement. `;`
 //! starts a comment, a block starting with `*` is a structure comment (`* - ROUGHING`), a
 //! line ending in `~` continues on the next line (cycle definitions as the TNC 640 writes
-//! them), `/` before the block skips it (block delete, as in the G-code dialects: skipped with
+//! them; a `CYCL DEF` keeps where its lines ended, so that an error names the line of its
+//! parameter), `/` before the block skips it (block delete, as in the G-code dialects: skipped with
 //! a warning). Numbers carry their sign (`X+10`, `X-5`; `X10` is read too) and may use a comma
 //! as the decimal separator (`X-6,964`). A value may be a Q parameter (`X+Q1`, `FQ53`).
 //!
@@ -87,8 +88,12 @@
 //!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
 //! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle and `208` bore milling
-//!   (a helix whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]);
-//!   its Q parameters are read when it is called; `CYCL CALL`, `M99` in a block (after its move) and `M89`
+//!   (a helix whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]).
+//!   Its parameters `Q<n>=<value>` (spaces about `=` as posts write them, `Q200 = +2`; on the
+//!   lines that follow a `~`, or as blocks of their own) are assigned when it is defined and
+//!   read when it is called; a parameter that is not understood, or a word after the
+//!   parameters that is none, is an error naming its own line. `CYCL CALL`, `M99` in a block
+//!   (after its move) and `M89`
 //!   (after every block that positions X or Y, until `M99` or a new `CYCL DEF`) call it at
 //!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
 //!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at
@@ -168,6 +173,114 @@ fn comma_decimals(text: &str) -> String {
             }
         })
         .collect()
+}
+
+/// The mark that stands, in a `CYCL DEF` block joined from several lines, where a line ended
+/// (`~`): so that a parameter's line can be named.
+const LINE_MARK: &str = "~";
+
+/// A block continued on the next line (this one ended in `~`): `first` and `next` as one
+/// block. A `CYCL DEF` keeps a mark [`LINE_MARK`] where each line ended, read by
+/// [`cycle_arguments`]; other blocks are joined with a space.
+pub(super) fn join_continued(first: &str, next: &str) -> String {
+    let first = first.trim_end();
+    let first = first.strip_suffix('~').unwrap_or(first).trim_end();
+    let body = strip_block_number(first);
+    let cycle = body.len() >= 8 && body.is_char_boundary(8) && {
+        let head = body[..8].to_ascii_uppercase();
+        head == "CYCL DEF"
+    };
+    if cycle {
+        format!("{first} {LINE_MARK} {}", next.trim())
+    } else {
+        format!("{first} {}", next.trim())
+    }
+}
+
+/// One parameter of a `CYCL DEF`: `Q208= MAX` → name `Q208`, value `MAX`.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct CycleParameter {
+    /// Upper-cased (`Q208`).
+    pub(super) name: String,
+    /// As written after `=` (`+5`, `MAX`, `Q3`).
+    pub(super) value: String,
+    /// As written (`Q208= MAX`), for messages.
+    pub(super) written: String,
+    /// The line it is on, counted from the `CYCL DEF`'s (0).
+    pub(super) line: usize,
+}
+
+/// The arguments of a `CYCL DEF` (after `CYCL DEF`): its other words (the number, the name,
+/// `X+10` of cycle 7, `DWELL 1.5` of cycle 9) and its parameters `Q<n>=<value>` (spaces about
+/// `=` allowed, as Fusion writes `Q208= MAX`). After the first parameter every word must be
+/// one: another word is an error, with the line it is on (counted from the `CYCL DEF`'s).
+pub(super) fn cycle_arguments(
+    args: &str,
+) -> Result<(Vec<String>, Vec<CycleParameter>), (usize, String)> {
+    let mut words = Vec::new();
+    let mut params: Vec<CycleParameter> = Vec::new();
+    let mut line = 0;
+    let all = split_words(args);
+    let mut i = 0;
+    while i < all.len() {
+        let w = &all[i];
+        i += 1;
+        if w == LINE_MARK {
+            line += 1;
+            continue;
+        }
+        // `Q200=+5`, `Q208=` `MAX`, `Q208` `=MAX`, `Q208` `=` `MAX`.
+        let (name, after) = match w.split_once('=') {
+            Some((name, after)) => (name, Some(after)),
+            None => (w.as_str(), None),
+        };
+        let next_is =
+            |k: usize, f: &dyn Fn(&str) -> bool| all.get(k).is_some_and(|n| n != LINE_MARK && f(n));
+        let is_param = expr::is_q_parameter(name)
+            && (after.is_some() || next_is(i, &|n: &str| n.starts_with('=')));
+        if !is_param {
+            if let Some(p) = params.last() {
+                return Err((
+                    line,
+                    format!(
+                        "`{w}` after the parameter `{}`: a cycle's parameters are written \
+                         `Q<n>=<value>`, and a word feedopt does not understand may change what \
+                         the cycle does",
+                        p.written
+                    ),
+                ));
+            }
+            words.push(w.clone());
+            continue;
+        }
+        let mut written = w.clone();
+        let mut value = match after {
+            Some(a) => a.to_string(),
+            None => {
+                let eq = &all[i];
+                i += 1;
+                written.push(' ');
+                written.push_str(eq);
+                eq[1..].to_string()
+            }
+        };
+        if value.is_empty() && next_is(i, &|_| true) {
+            value = all[i].clone();
+            written.push(' ');
+            written.push_str(&value);
+            i += 1;
+        }
+        if value.is_empty() {
+            return Err((line, format!("`{written}`: the parameter has no value")));
+        }
+        params.push(CycleParameter {
+            name: name.to_ascii_uppercase(),
+            value,
+            written,
+            line,
+        });
+    }
+    Ok((words, params))
 }
 
 /// `Q5 = expr` (spaces anywhere): the parameter and the expression, or `None`.

@@ -301,11 +301,7 @@ impl Program {
                 };
                 if let Ok(blocks) = &mut self.lines[i].blocks {
                     match blocks.last_mut() {
-                        Some(last) => {
-                            let trimmed = last.trim_end();
-                            let trimmed = trimmed.strip_suffix('~').unwrap_or(trimmed);
-                            *last = format!("{trimmed} {}", add.trim());
-                        }
+                        Some(last) => *last = klartext::join_continued(last, &add),
                         None => blocks.push(add),
                     }
                 }

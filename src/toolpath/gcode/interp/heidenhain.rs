@@ -821,7 +821,10 @@ impl Interpreter<'_> {
     }
 
     fn cycle_def(&mut self, line: usize, args: &str) -> Result<()> {
-        let mut words = klartext::words(args);
+        // The TNC 640 writes the parameters on `~` lines: part of this block, each error
+        // naming the line of its parameter.
+        let (mut words, params) =
+            klartext::cycle_arguments(args).map_err(|(k, e)| self.error(line + k, e))?;
         // `CYCL DEF 9 .1 …`: the number's decimal part written apart.
         if words.len() >= 2
             && !words[0].contains(['.', ','])
@@ -844,14 +847,18 @@ impl Interpreter<'_> {
         }
         let whole = number.trunc() as u32;
         let sub = ((number - number.trunc()) * 10.0).round() as u32;
-        // The TNC 640 writes the parameters on `~` lines: part of this block.
-        for w in &words[1..] {
-            if let Some((name, text)) = w.split_once('=')
-                && super::super::expr::is_q_parameter(name)
-            {
-                let v = self.klartext_value(line, w, text)?;
-                self.vars.set(name, v);
-            }
+        for p in &params {
+            let at = line + p.line;
+            let v = klartext::value(&p.value, &self.vars).map_err(|e| {
+                self.error(
+                    at,
+                    format!(
+                        "`{}`: {e}; a cycle parameter is a number or a Q parameter",
+                        p.written
+                    ),
+                )
+            })?;
+            self.vars.set(&p.name, v);
         }
         let rest = &words[1..];
         match whole {
