@@ -869,3 +869,86 @@ fn cycle_parameters_spaced_about_equals_and_errors_at_their_own_line() {
     let e = fails(&spaced_drill("", ""));
     assert!(e.contains("t.h:9:") && e.contains("no value"), "{e}");
 }
+
+/// Cycle 203 as Fusion's Heidenhain post writes it (polymech_m7s_sides.h): `Q208= MAX`, the
+/// retraction feed at FMAX, as the TNC 640 stores it.
+const FUSION_203: &str = "0 BEGIN PGM Q208 MM\n1 TOOL CALL 4 Z S2911\n2 L X+0 Y+0 Z+15 R0 FMAX\n\
+    3 CYCL DEF 203 UNIVERSAL DRILLING ~\n    Q200=+5 ;SET-UP CLEARANCE ~\n\
+    Q201=-33 ;DEPTH ~\n    Q206=+437 ;FEED RATE FOR PLNGNG ~\n    Q202=+10 ;PLUNGING DEPTH ~\n\
+    Q210=+0 ;DWELL TIME AT TOP ~\n    Q203=+0 ;SURFACE COORDINATE ~\n\
+    Q204=+5 ;2ND SET-UP CLEARANCE ~\n    Q212=+0 ;DECREMENT ~\n    Q213=+2 ;NR OF BREAKS ~\n\
+    Q205=+10 ;MIN. PLUNGING DEPTH ~\n    Q211=+0 ;DWELL TIME AT DEPTH ~\n\
+    Q208= MAX ;RETRACTION FEED RATE ~\n    Q256=+1 ;DIST FOR CHIP BRKNG\n\
+    4 L X+10 FMAX M99\n5 END PGM Q208 MM\n";
+
+/// Feed parameters as the TNC 640 stores FMAX and FAUTO: `Q208=MAX` (Fusion: `Q208= MAX`)
+/// retracts at rapid; `Q206=AUTO` (or `FAUTO`, here on a line of its own as older programs
+/// write parameters) plunges at the `TOOL CALL`'s F. FMAX for the plunging feed, a word in a
+/// parameter that is not a feed, AUTO without a `TOOL CALL` F and an expression that reads such
+/// a parameter are errors.
+#[test]
+fn feed_parameters_max_and_auto_are_rapid_and_the_tool_calls_feed() {
+    let tp = read(FUSION_203);
+    // Over the hole at Z 15; rapid to 5; 10 mm infeeds with two chip breaks (up 1 mm at
+    // rapid), then the full retract at Q208 = FMAX, back to 5 above the depth, the last 3 mm,
+    // out at FMAX.
+    let moves: Vec<(f64, bool)> = tp.points[2..]
+        .iter()
+        .map(|p| (p.p.z, p.feed == Feed::Rapid))
+        .collect();
+    assert_eq!(
+        moves,
+        [
+            (5.0, true),
+            (-10.0, false),
+            (-9.0, true),
+            (-20.0, false),
+            (-19.0, true),
+            (-30.0, false),
+            (5.0, true),
+            (-25.0, true),
+            (-33.0, false),
+            (5.0, true)
+        ]
+    );
+    assert!(
+        tp.points[2..]
+            .iter()
+            .all(|p| p.feed == Feed::Rapid || p.feed == Feed::Programmed(437.0 / 60.0))
+    );
+    // Q206 = AUTO, FAUTO: the TOOL CALL's F (300 mm/min = 5 mm/s).
+    for auto in ["AUTO", "FAUTO"] {
+        let drill = DRILL_OLD.replace("Q206=120", &format!("Q206={auto}"));
+        let tp = read(&format!(
+            "0 BEGIN PGM T MM\n1 TOOL CALL 1 Z S5000 F300\n4 L X+10 Y+10 Z+50 R0 FMAX\n{drill}\
+             20 CYCL CALL\n"
+        ));
+        assert!(
+            tp.points.iter().any(|p| p.feed == Feed::Programmed(5.0)),
+            "{auto}: {:?}",
+            tp.points
+        );
+        assert!((feed_time(&tp) - 16.0 / 5.0).abs() < 1e-9, "{auto}");
+    }
+    let e = fails(&FUSION_203.replace("Q206=+437", "Q206=MAX"));
+    // Read when the cycle is called (line 18), naming its definition.
+    assert!(
+        e.contains(":18:") && e.contains("Q206 = MAX") && e.contains("CYCL DEF at line 4"),
+        "{e}"
+    );
+    let e = fails(&FUSION_203.replace("Q201=-33", "Q201=MAX"));
+    assert!(
+        e.contains("Q201 = MAX") && e.contains("feed parameter"),
+        "{e}"
+    );
+    let e = fails(&FUSION_203.replace("Q206=+437", "Q206=AUTO"));
+    assert!(
+        e.contains("Q206 = AUTO") && e.contains("no TOOL CALL gave F"),
+        "{e}"
+    );
+    let e = fails(&FUSION_203.replace("4 L X+10 FMAX M99", "4 L X+10 Z+Q208 FMAX"));
+    assert!(
+        e.contains(":18:") && e.contains("`Q208` holds `MAX`"),
+        "{e}"
+    );
+}

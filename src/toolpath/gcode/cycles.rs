@@ -73,6 +73,12 @@
 //! The chip break's retract speed is the machine's: taken as rapid. Q395 = 1 (depth to the
 //! full diameter, which needs the tool's point angle) is an error, as is a missing Q
 //! parameter the cycle needs.
+//!
+//! A feed parameter may be a word, as the TNC 640 stores them ([`QValue`]): `MAX` (FMAX,
+//! written `Q208=MAX` or `Q208= MAX`) is the machine's rapid traverse, `AUTO` (FAUTO) the feed
+//! of the `TOOL CALL`. Q208 (retraction feed) takes both; Q206 (plunging feed) takes AUTO only
+//! (the control offers no FMAX for it, and plunging at rapid is no drilling): `Q206=MAX` is an
+//! error, as is a word in a parameter that is not a feed.
 
 /// Clearance of a peck's rapid return above the last depth (and G73's retract), mm: LinuxCNC's
 /// 0.010 in; on Fanuc it is parameter 5114/5115.
@@ -240,10 +246,39 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
     Ok((s, note))
 }
 
+/// The value of a Heidenhain cycle's Q parameter: a number, or the word a feed parameter may
+/// hold instead.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum QValue {
+    Number(f64),
+    /// `MAX` (FMAX): the machine's rapid traverse.
+    Max,
+    /// `AUTO` (FAUTO): the feed of the `TOOL CALL`.
+    Auto,
+}
+
+/// A speed a cycle moves at: a feed (mm/min) or rapid traverse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Rate {
+    PerMinute(f64),
+    Rapid,
+}
+
+impl Rate {
+    /// The move to `z` at this rate.
+    fn to(self, z: f64) -> Step {
+        match self {
+            Rate::PerMinute(f) => Step::Feed(z, Some(f)),
+            Rate::Rapid => Step::Rapid(z),
+        }
+    }
+}
+
 /// Heidenhain drilling cycle `number` (200, 203, 207, 208) from its Q parameters (`q(200)`
-/// …), the spindle speed (rpm, for 207), the tool's diameter (mm, for 208: the control takes it
-/// from its tool table) and a raise of the surface Q203 by `offset` mm (a pattern point's Z).
-/// Starts from where the tool is (over the hole). The second value names assumptions, for
+/// …), the spindle speed (rpm, for 207), the `TOOL CALL`'s feed (mm/min, for a feed
+/// parameter given as `AUTO`), the tool's diameter (mm, for 208: the control takes it from its
+/// tool table) and a raise of the surface Q203 by `offset` mm (a pattern point's Z). Starts
+/// from where the tool is (over the hole). The second value names assumptions, for
 /// warnings.
 ///
 /// Cycle 208 (bore milling), as the TNC 640 runs it with one pass (no Q370): rapid to the
@@ -253,8 +288,9 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
 /// diameter the tool bores straight down. Climb (Q351 = +1) runs counter-clockwise with M3.
 pub fn heidenhain_steps(
     number: u32,
-    q: &dyn Fn(u32) -> Option<f64>,
+    q: &dyn Fn(u32) -> Option<QValue>,
     spindle_rpm: Option<f64>,
+    tool_feed: Option<f64>,
     tool_diameter: Option<f64>,
     offset: f64,
 ) -> Result<(Vec<Step>, Vec<&'static str>), String> {
@@ -265,8 +301,48 @@ pub fn heidenhain_steps(
              the operation as L moves"
         ));
     }
+    let raw = q;
+    // A parameter that is not a feed: a number, if given.
+    let q = |n: u32| -> Result<Option<f64>, String> {
+        match raw(n) {
+            None => Ok(None),
+            Some(QValue::Number(v)) => Ok(Some(v)),
+            Some(word) => Err(format!(
+                "cycle {number}: Q{n} = {}: only a feed parameter may be MAX (FMAX) or AUTO \
+                 (FAUTO)",
+                if word == QValue::Max { "MAX" } else { "AUTO" }
+            )),
+        }
+    };
+    // A feed parameter: its rate, if given (`MAX` only where `rapid_allowed`).
+    let rate = |n: u32, rapid_allowed: bool| -> Result<Option<Rate>, String> {
+        let f = match raw(n) {
+            None => return Ok(None),
+            Some(QValue::Max) if rapid_allowed => return Ok(Some(Rate::Rapid)),
+            Some(QValue::Max) => {
+                return Err(format!(
+                    "cycle {number}: Q{n} = MAX: this feed takes a value or AUTO (FAUTO), not \
+                     FMAX"
+                ));
+            }
+            Some(QValue::Auto) => tool_feed.filter(|f| f.is_finite()).ok_or_else(|| {
+                format!(
+                    "cycle {number}: Q{n} = AUTO (FAUTO) is the TOOL CALL's feed, and no TOOL \
+                     CALL gave F"
+                )
+            })?,
+            Some(QValue::Number(f)) => f,
+        };
+        if (1e-3..=1e9).contains(&f) {
+            Ok(Some(Rate::PerMinute(f)))
+        } else {
+            Err(format!(
+                "cycle {number}: feed Q{n} = {f} mm/min is out of range"
+            ))
+        }
+    };
     let need = |n: u32| {
-        q(n).ok_or_else(|| format!("cycle {number}: Q{n} is not defined (the CYCL DEF gives it)"))
+        q(n)?.ok_or_else(|| format!("cycle {number}: Q{n} is not defined (the CYCL DEF gives it)"))
     };
     let finite = |n: u32, v: f64| {
         if v.is_finite() && v.abs() <= crate::toolpath::MAX_COORDINATE_MM {
@@ -289,17 +365,17 @@ pub fn heidenhain_steps(
             vec!["depth Q201 = 0: the control does not run the cycle"],
         ));
     }
-    if q(395).is_some_and(|v| v != 0.0) {
+    if q(395)?.is_some_and(|v| v != 0.0) {
         return Err(format!(
             "cycle {number}: Q395 = 1 (the depth to the full diameter) needs the tool's point \
              angle: post with Q395 = 0"
         ));
     }
-    let second = finite(204, q(204).unwrap_or(0.0))?.max(0.0);
+    let second = finite(204, q(204)?.unwrap_or(0.0))?.max(0.0);
     let safe = surface + clearance;
     let bottom = surface + depth;
     let dwell = |n: u32| -> Result<f64, String> {
-        let v = q(n).unwrap_or(0.0);
+        let v = q(n)?.unwrap_or(0.0);
         if (0.0..=1e6).contains(&v) {
             Ok(v)
         } else {
@@ -308,37 +384,41 @@ pub fn heidenhain_steps(
             ))
         }
     };
-    let feed = |n: u32| -> Result<f64, String> {
-        let f = need(n)?;
-        if (1e-3..=1e9).contains(&f) {
-            Ok(f)
-        } else {
-            Err(format!(
-                "cycle {number}: feed Q{n} = {f} mm/min is out of range"
-            ))
+    // The plunging feed Q206: a value or AUTO.
+    let plunging = || -> Result<f64, String> {
+        match rate(206, false)? {
+            Some(Rate::PerMinute(f)) => Ok(f),
+            _ => Err(format!(
+                "cycle {number}: Q206 is not defined (the CYCL DEF gives it)"
+            )),
         }
     };
     let mut s = vec![Rapid(safe)];
     let mut notes = Vec::new();
     match number {
         200 | 203 => {
-            let f = feed(206)?;
+            let f = plunging()?;
             let plunge = finite(202, need(202)?)?.abs();
             if plunge == 0.0 {
                 return Err(format!("cycle {number}: plunging depth Q202 is 0"));
             }
             let (top, bottom_dwell) = (dwell(210)?, dwell(211)?);
             let (decrement, breaks, minimum, retract_feed, chip) = if number == 203 {
-                let f208 = finite(208, q(208).unwrap_or(0.0))?;
+                // Q208: MAX is rapid, 0 (or none) Q206.
+                let retract = match raw(208) {
+                    Some(QValue::Number(v)) if finite(208, v)? <= 0.0 => Rate::PerMinute(f),
+                    None => Rate::PerMinute(f),
+                    _ => rate(208, true)?.unwrap_or(Rate::PerMinute(f)),
+                };
                 (
-                    finite(212, q(212).unwrap_or(0.0))?.abs(),
-                    finite(213, q(213).unwrap_or(0.0))?.max(0.0).round() as u64,
-                    finite(205, q(205).unwrap_or(0.0))?.abs(),
-                    if f208 > 0.0 { f208 } else { f },
-                    finite(256, q(256).unwrap_or(0.0))?.abs(),
+                    finite(212, q(212)?.unwrap_or(0.0))?.abs(),
+                    finite(213, q(213)?.unwrap_or(0.0))?.max(0.0).round() as u64,
+                    finite(205, q(205)?.unwrap_or(0.0))?.abs(),
+                    retract,
+                    finite(256, q(256)?.unwrap_or(0.0))?.abs(),
                 )
             } else {
-                (0.0, 0, 0.0, f, 0.0)
+                (0.0, 0, 0.0, Rate::PerMinute(f), 0.0)
             };
             if breaks > 0 {
                 notes.push("the chip-breaking retract Q256 is taken at rapid traverse");
@@ -366,7 +446,7 @@ pub fn heidenhain_steps(
                 } else {
                     broken = 0;
                     if number == 203 {
-                        s.push(Feed(safe, Some(retract_feed)));
+                        s.push(retract_feed.to(safe));
                     } else {
                         s.push(Rapid(safe));
                     }
@@ -389,7 +469,7 @@ pub fn heidenhain_steps(
                 s.push(Dwell(bottom_dwell));
             }
             if number == 203 {
-                s.push(Feed(safe, Some(retract_feed)));
+                s.push(retract_feed.to(safe));
                 if second > clearance {
                     s.push(Rapid(surface + second));
                 }
@@ -398,9 +478,9 @@ pub fn heidenhain_steps(
             }
         }
         208 => {
-            let f = feed(206)?;
+            let f = plunging()?;
             let nominal = finite(335, need(335)?)?.abs();
-            if q(370).is_some_and(|v| v != 0.0) {
+            if q(370)?.is_some_and(|v| v != 0.0) {
                 return Err(
                     "cycle 208: Q370 (path overlap: several passes out to the diameter) is not \
                      supported; post with one pass (no Q370)"
@@ -421,7 +501,7 @@ pub fn heidenhain_steps(
                     "cycle 208: the tool ({d} mm) is wider than the hole Q335 = {nominal} mm"
                 ));
             }
-            let ccw = q(351).unwrap_or(1.0) >= 0.0;
+            let ccw = q(351)?.unwrap_or(1.0) >= 0.0;
             if radius <= 1e-6 {
                 // Q335 = the tool's diameter: straight down, no helix.
                 s.push(Feed(bottom, Some(f)));

@@ -6,7 +6,9 @@
 //! * Fanuc and LinuxCNC: numbered parameters `#100` (`#[expr]`), LinuxCNC named parameters
 //!   `#<name>`, assignments `#100=5.`, values `X#100`, `X-#100`, `X[#1+2]`; brackets group.
 //! * Heidenhain: Q parameters `Q1`, `QL1`, `QR1` (`Q1 = Q2 + 5`, `X+Q1`; see
-//!   [`super::klartext`]), unset until assigned.
+//!   [`super::klartext`]), unset until assigned. A cycle's feed parameter may hold a word
+//!   instead of a number (`Q208=MAX`, `Q206=AUTO`, [`Variables::set_word`]): the cycle reads
+//!   it, an expression that reads it is an error naming it.
 //!
 //! Operators `+ - * /` with the usual precedence, unary minus, parentheses (Sinumerik) or
 //! brackets (Fanuc, LinuxCNC), and the functions `SIN COS TAN` (degrees), `SQRT ABS ATAN`
@@ -27,6 +29,8 @@ pub const MAX_DEPTH: usize = 64;
 #[derive(Debug, Default, Clone)]
 pub struct Variables {
     values: HashMap<String, f64>,
+    /// Variables that hold a word instead of a number (upper-cased): Heidenhain's `Q208=MAX`.
+    words: HashMap<String, String>,
     /// Declared with `DEF` (value 0 until assigned).
     declared: HashMap<String, ()>,
     /// Changes so far ([`Variables::changes`]).
@@ -67,23 +71,51 @@ impl Variables {
         self.values.get(&name.to_ascii_uppercase()).copied()
     }
 
-    /// Whether `name` has a value (assigned, or declared).
+    /// Whether `name` has a value (assigned, or declared) or a word.
     pub fn is_set(&self, name: &str) -> bool {
-        self.values.contains_key(&name.to_ascii_uppercase())
+        let name = name.to_ascii_uppercase();
+        self.values.contains_key(&name) || self.words.contains_key(&name)
     }
 
     pub fn set(&mut self, name: &str, value: f64) {
+        let name = name.to_ascii_uppercase();
+        let had_word = self.words.remove(&name).is_some();
         // Bit for bit: -0 after 0 is a change (1/-0 is not 1/0).
-        let old = self.values.insert(name.to_ascii_uppercase(), value);
-        if old.map(f64::to_bits) != Some(value.to_bits()) {
+        let old = self.values.insert(name, value);
+        if had_word || old.map(f64::to_bits) != Some(value.to_bits()) {
             self.changes += 1;
         }
+    }
+
+    /// Gives `name` a word instead of a number: a Heidenhain cycle's feed parameter written
+    /// `Q208=MAX` (FMAX) or `Q206=AUTO` (FAUTO). The cycle reads it ([`Variables::word`]); an
+    /// expression that reads it is an error.
+    pub fn set_word(&mut self, name: &str, word: &str) {
+        let name = name.to_ascii_uppercase();
+        let word = word.to_ascii_uppercase();
+        let had_value = self.values.remove(&name).is_some();
+        let old = self.words.insert(name, word.clone());
+        if had_value || old.as_deref() != Some(word.as_str()) {
+            self.changes += 1;
+        }
+    }
+
+    /// The word `name` holds, if it holds one ([`Variables::set_word`]).
+    pub fn word(&self, name: &str) -> Option<&str> {
+        self.words
+            .get(&name.to_ascii_uppercase())
+            .map(String::as_str)
     }
 
     fn get(&self, name: &str) -> Result<f64, String> {
         let name = name.to_ascii_uppercase();
         if let Some(v) = self.values.get(&name) {
             return Ok(*v);
+        }
+        if let Some(word) = self.words.get(&name) {
+            return Err(format!(
+                "parameter `{name}` holds `{word}` (a cycle's feed keyword), not a number"
+            ));
         }
         if is_r_parameter(&name) {
             return Ok(0.0); // Sinumerik R parameters start at 0

@@ -89,11 +89,12 @@
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
 //! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle and `208` bore milling
 //!   (a helix whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]).
-//!   Its parameters `Q<n>=<value>` (spaces about `=` as posts write them, `Q200 = +2`; on the
+//!   Its parameters `Q<n>=<value>` (spaces about `=` as posts write them, `Q208= MAX`; on the
 //!   lines that follow a `~`, or as blocks of their own) are assigned when it is defined and
 //!   read when it is called; a parameter that is not understood, or a word after the
-//!   parameters that is none, is an error naming its own line. `CYCL CALL`, `M99` in a block
-//!   (after its move) and `M89`
+//!   parameters that is none, is an error naming its own line. A feed parameter may be `MAX`
+//!   (FMAX: rapid traverse) or `AUTO` (FAUTO: the `TOOL CALL`'s F), as the TNC 640 stores
+//!   them ([`super::cycles`]). `CYCL CALL`, `M99` in a block (after its move) and `M89`
 //!   (after every block that positions X or Y, until `M99` or a new `CYCL DEF`) call it at
 //!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
 //!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at
@@ -173,6 +174,16 @@ fn comma_decimals(text: &str) -> String {
             }
         })
         .collect()
+}
+
+/// The word a cycle's feed parameter may hold instead of a number, as the TNC 640 writes it
+/// (`Q208=MAX`, `Q206=AUTO`) or as typed (`FMAX`, `FAUTO`): `MAX` or `AUTO`.
+pub(super) fn feed_word(text: &str) -> Option<&'static str> {
+    match text.trim().to_ascii_uppercase().as_str() {
+        "MAX" | "FMAX" => Some("MAX"),
+        "AUTO" | "FAUTO" => Some("AUTO"),
+        _ => None,
+    }
 }
 
 /// The mark that stands, in a `CYCL DEF` block joined from several lines, where a line ended
@@ -332,6 +343,11 @@ pub(super) fn lex(
         return Ok(Vec::new());
     }
     if let Some((name, expression)) = assignment(text) {
+        // A cycle parameter on a line of its own (`Q208=MAX ;RETRACTION FEED RATE`).
+        if let Some(word) = feed_word(expression) {
+            vars.set_word(&name, word);
+            return Ok(vec![Item::Skipped]);
+        }
         let v = value(expression, vars).map_err(|e| format!("`{name} =`: {e}"))?;
         vars.set(&name, v);
         return Ok(vec![Item::Skipped]);

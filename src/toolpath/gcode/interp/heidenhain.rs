@@ -849,11 +849,16 @@ impl Interpreter<'_> {
         let sub = ((number - number.trunc()) * 10.0).round() as u32;
         for p in &params {
             let at = line + p.line;
+            if let Some(word) = klartext::feed_word(&p.value) {
+                self.vars.set_word(&p.name, word);
+                continue;
+            }
             let v = klartext::value(&p.value, &self.vars).map_err(|e| {
                 self.error(
                     at,
                     format!(
-                        "`{}`: {e}; a cycle parameter is a number or a Q parameter",
+                        "`{}`: {e}; a cycle parameter is a number, a Q parameter or, for a \
+                         feed, MAX (FMAX) or AUTO (FAUTO)",
                         p.written
                     ),
                 )
@@ -1099,9 +1104,19 @@ impl Interpreter<'_> {
         }
     }
 
-    /// The Q parameter `n` of the cycle, if set.
+    /// The Q parameter `n` of the cycle, if set, as a number.
     fn q(&self, n: u32) -> Option<f64> {
         self.vars.value(&format!("Q{n}"))
+    }
+
+    /// The Q parameter `n` of the cycle, if set: a number, or a feed's `MAX` or `AUTO`.
+    fn q_value(&self, n: u32) -> Option<cycles::QValue> {
+        let name = format!("Q{n}");
+        match self.vars.word(&name) {
+            Some("MAX") => Some(cycles::QValue::Max),
+            Some(_) => Some(cycles::QValue::Auto),
+            None => self.vars.value(&name).map(cycles::QValue::Number),
+        }
     }
 
     /// Calls the cycle at X Y `p[0..2]`, with the surface raised by `p[2]`: up to the cycle's
@@ -1145,8 +1160,9 @@ impl Interpreter<'_> {
         };
         let (steps, notes) = cycles::heidenhain_steps(
             number,
-            &|n| self.q(n),
+            &|n| self.q_value(n),
             self.klartext.spindle_rpm,
+            self.klartext.tool_feed,
             self.tool_diameter,
             offset,
         )
