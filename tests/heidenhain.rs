@@ -952,3 +952,52 @@ fn feed_parameters_max_and_auto_are_rapid_and_the_tool_calls_feed() {
         "{e}"
     );
 }
+
+/// Cycles active on definition that move nothing, as hyperMILL writes them at every tool
+/// (332 TUNING, 392 ATC), are skipped without a warning: the cycle a later `M99` runs is the
+/// machining cycle defined before them, and a call with none before is an error, as is a call of
+/// a cycle feedopt cannot expand. A pattern cycle (220, 221), which drills when it is defined,
+/// is an error at its definition.
+#[test]
+fn cycles_active_on_definition_that_move_nothing_are_skipped() {
+    const TUNING: &str = "CYCL DEF 332 TUNING ~\n     Q395=+3 ; TUNING MODE\n";
+    const ATC: &str = "CYCL DEF 392 ATC~\n  Q240=0 ;TUNING MODE~\n  Q241=1 ;WEIGHT MODE\n";
+    let tp = read(&format!(
+        "0 BEGIN PGM C332 MM\n1 TOOL CALL 1 Z S1000\n2 {TUNING}3 {ATC}4 L X+0 Y+0 Z+10 R0 FMAX\n\
+         5 L X+100 F600\n6 END PGM C332 MM\n"
+    ));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    assert_eq!(length(&tp.points), 100.0);
+    // Drilled at X 10 and, after both, at X 30 by the same cycle 200.
+    let tp = read(&format!(
+        "{HEADER}4 L X+10 Y+10 Z+50 R0 FMAX\n{DRILL_NEW}20 CYCL CALL\n21 {TUNING}22 {ATC}\
+         23 L X+30 Y+10 FMAX M99\n"
+    ));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    let bottoms: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.p.z == -10.0)
+        .map(|p| p.p)
+        .collect();
+    assert_eq!(bottoms, [v(10.0, 10.0, -10.0), v(30.0, 10.0, -10.0)]);
+    let e = fails(&format!("{HEADER}4 {TUNING}5 L X+0 Y+0 Z+10 R0 FMAX M99\n"));
+    assert!(e.contains(":7:") && e.contains("without a CYCL DEF"), "{e}");
+    let e = fails(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n\
+         Q200=3~\n Q201=-85\n6 {TUNING}7 L X+0 Y+0 FMAX M99\n"
+    ));
+    assert!(e.contains(":11:") && e.contains("cycle 241"), "{e}");
+    for (n, name) in [(220, "POLAR PATTERN"), (221, "CARTESIAN PATTERN")] {
+        let e = fails(&format!(
+            "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n{DRILL_NEW}6 CYCL DEF {n} {name} ~\n  Q216=+50 ~\n\
+             Q217=+50\n7 L Z+100 FMAX\n"
+        ));
+        assert!(
+            e.contains(":15:")
+                && e.contains(&format!("CYCL DEF {n}"))
+                && e.contains("when it is defined"),
+            "{e}"
+        );
+    }
+}

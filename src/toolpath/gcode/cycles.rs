@@ -79,6 +79,18 @@
 //! of the `TOOL CALL`. Q208 (retraction feed) takes both; Q206 (plunging feed) takes AUTO only
 //! (the control offers no FMAX for it, and plunging at rapid is no drilling): `Q206=MAX` is an
 //! error, as is a word in a parameter that is not a feed.
+//!
+//! # Heidenhain cycles active on definition
+//!
+//! Most cycles act when called (`CYCL CALL`, `M99`, `M89`); a `CYCL DEF` of one only
+//! defines it. Some act when defined: those that move nothing
+//! ([`HEIDENHAIN_DEFINITION_ONLY`]: tolerance, spindle orientation, contour data, the
+//! dynamics tuning cycles) are read and skipped, and are not the cycle a later call runs (a
+//! call after one runs the machining cycle defined before it, or is an error if there is
+//! none); those that move the tool when defined ([`HEIDENHAIN_MOVE_ON_DEFINITION`]: the point
+//! patterns, which run the cycle defined before at each point) are an error. Datum shift (7),
+//! dwell (9), preset (247) and the refused transformations (8, 10, 11, 19, 26) are read by the
+//! interpreter.
 
 /// Clearance of a peck's rapid return above the last depth (and G73's retract), mm: LinuxCNC's
 /// 0.010 in; on Fanuc it is parameter 5114/5115.
@@ -245,6 +257,29 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
     }
     Ok((s, note))
 }
+
+/// Heidenhain cycles that act when defined and move nothing: number and name. A `CYCL DEF` of
+/// one is skipped; it does not replace the cycle a later `CYCL CALL` or `M99` runs.
+pub const HEIDENHAIN_DEFINITION_ONLY: [(u32, &str); 7] = [
+    (13, "ORIENTATION"),
+    (14, "CONTOUR"),
+    (20, "CONTOUR DATA"),
+    (32, "TOLERANCE"),
+    (271, "OCM CONTOUR DATA"),
+    // Dynamics cycles, as hyperMILL posts them at every tool (332 for a Trimill, 392 for DMG
+    // MORI machines): they tune the axes for the machining mode and the workpiece's weight.
+    (332, "TUNING"),
+    (392, "ATC"),
+];
+
+/// Heidenhain cycles that move the tool when defined: number and name. They run the
+/// machining cycle defined before them at each point of a pattern, which feedopt does not
+/// expand: a `CYCL DEF` of one is an error.
+pub const HEIDENHAIN_MOVE_ON_DEFINITION: [(u32, &str); 3] = [
+    (220, "POLAR PATTERN"),
+    (221, "CARTESIAN PATTERN"),
+    (224, "DATAMATRIX CODE PATTERN"),
+];
 
 /// The value of a Heidenhain cycle's Q parameter: a number, or the word a feed parameter may
 /// hold instead.

@@ -99,10 +99,14 @@
 //!   the current position; `CYCL CALL PAT` at every `PATTERN DEF POS1 (X Y Z)` point (Z adds
 //!   to the surface Q203), rising first to Q203 + Z + max(Q200, Q204) and moving there at
 //!   rapid; `CYCL CALL POS X Y Z` at that point alike. The moves: [`super::cycles::heidenhain_steps`].
-//!   `CYCL DEF 9` is a dwell (`9.1 DWELL 1.5`: 1.5 s), `32` (tolerance) and `13` (spindle
-//!   orientation) move nothing, `247` (preset) is taken with a warning (the preset table is
-//!   the control's), and an error if a later one names another preset. Other cycles may be
-//!   defined (a warning); calling one is an error naming it.
+//!   `CYCL DEF 9` is a dwell (`9.1 DWELL 1.5`: 1.5 s). Cycles active on definition that move
+//!   nothing ([`super::cycles::HEIDENHAIN_DEFINITION_ONLY`]: 13 orientation, 14, 20 and 271
+//!   contour data, 32 tolerance, the dynamics tuning cycles 332 TUNING and 392 ATC) are
+//!   skipped: they are not the cycle a call runs, and their parameters (their own: 332's Q395
+//!   is a tuning mode) are not assigned. The pattern cycles 220, 221 and 224 run the cycle defined
+//!   before them when they are defined: an error. `247` (preset) is taken with a warning (the
+//!   preset table is the control's), and an error if a later one names another preset. Other
+//!   cycles may be defined (a warning); calling one is an error naming it.
 //! * `BEGIN PGM … MM` (`INCH` is an error), `TOOL CALL n Z S… F…` (S and F remembered; a
 //!   tool axis X or Y is an error), `BLK FORM`, `TOOL DEF`, `STOP` move nothing.
 //! * `RND` and `CHF` (rounding and chamfer between two contour elements) are errors naming

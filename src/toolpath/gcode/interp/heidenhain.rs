@@ -847,6 +847,30 @@ impl Interpreter<'_> {
         }
         let whole = number.trunc() as u32;
         let sub = ((number - number.trunc()) * 10.0).round() as u32;
+        if let Some((_, name)) = cycles::HEIDENHAIN_MOVE_ON_DEFINITION
+            .iter()
+            .find(|(n, _)| *n == whole)
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "CYCL DEF {whole} ({name}) moves the tool when it is defined: it runs the \
+                     cycle defined before it at each point of its pattern, which feedopt does \
+                     not expand; post the points as PATTERN DEF and CYCL CALL PAT, or as CYCL \
+                     CALL POS or M99 blocks"
+                ),
+            ));
+        }
+        if cycles::HEIDENHAIN_DEFINITION_ONLY
+            .iter()
+            .any(|(n, _)| *n == whole)
+        {
+            // Active when defined, moves nothing (tolerance, orientation, contour data, the
+            // dynamics tuning): not the cycle a call runs. Its parameters are its own
+            // (332's Q395, the tuning mode, is not cycle 200's depth reference Q395): not
+            // assigned.
+            return Ok(());
+        }
         for p in &params {
             let at = line + p.line;
             if let Some(word) = klartext::feed_word(&p.value) {
@@ -893,8 +917,6 @@ impl Interpreter<'_> {
                 }
                 Ok(())
             }
-            // Tolerance, spindle orientation: no move.
-            32 | 13 => Ok(()),
             247 => {
                 let preset = self.vars.value("Q339");
                 match self.klartext.preset {
