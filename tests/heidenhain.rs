@@ -1001,3 +1001,24 @@ fn cycles_active_on_definition_that_move_nothing_are_skipped() {
         );
     }
 }
+
+/// Q395 (depth reference) is a parameter of cycles 200 and 203 only: one that an earlier
+/// definition left at 1 does not stop a later rigid tapping cycle 207, which has none.
+#[test]
+fn q395_concerns_cycles_200_and_203_only() {
+    let tp = read(
+        "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
+         3 CYCL DEF 200 DRILLING~\n Q200=2~\n Q201=-5~\n Q206=100~\n Q202=5~\n Q203=0~\n\
+         Q204=5~\n Q395=+1 ;DEPTH REFERENCE\n\
+         4 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3~\n Q201=-12~\n Q239=+1.5~\n Q203=0~\n\
+         Q204=5\n5 L X+0 Y+0 R0 FMAX M99\n",
+    );
+    assert!(tp.points.iter().any(|p| p.p.z == -12.0));
+    // 200 itself still refuses it.
+    let e = fails(
+        "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
+         3 CYCL DEF 200 DRILLING~\n Q200=2~\n Q201=-5~\n Q206=100~\n Q202=5~\n Q203=0~\n\
+         Q204=5~\n Q395=+1 ;DEPTH REFERENCE\n4 CYCL CALL\n",
+    );
+    assert!(e.contains("Q395 = 1") && e.contains("point angle"), "{e}");
+}

@@ -72,7 +72,8 @@
 //!
 //! The chip break's retract speed is the machine's: taken as rapid. Q395 = 1 (depth to the
 //! full diameter, which needs the tool's point angle) is an error, as is a missing Q
-//! parameter the cycle needs.
+//! parameter the cycle needs. Only 200 and 203 have Q395: 207 and 208 do not read it (a Q395
+//! that an earlier definition left does not concern them).
 //!
 //! A feed parameter may be a word, as the TNC 640 stores them ([`QValue`]): `MAX` (FMAX,
 //! written `Q208=MAX` or `Q208= MAX`) is the machine's rapid traverse, `AUTO` (FAUTO) the feed
@@ -400,10 +401,13 @@ pub fn heidenhain_steps(
             vec!["depth Q201 = 0: the control does not run the cycle"],
         ));
     }
-    if q(395)?.is_some_and(|v| v != 0.0) {
+    // Depth reference: 200 and 203 have it (207 and 208 do not read Q395).
+    if matches!(number, 200 | 203)
+        && let Some(v) = q(395)?.filter(|v| *v != 0.0)
+    {
         return Err(format!(
-            "cycle {number}: Q395 = 1 (the depth to the full diameter) needs the tool's point \
-             angle: post with Q395 = 0"
+            "cycle {number}: Q395 = {v}: the depth is read to the tool's tip (Q395 = 0); Q395 = \
+             1 (to the full diameter) needs the tool's point angle: post with Q395 = 0"
         ));
     }
     let second = finite(204, q(204)?.unwrap_or(0.0))?.max(0.0);
