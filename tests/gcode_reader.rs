@@ -943,3 +943,53 @@ fn fanuc_only_words_tell_the_dialect() {
     }
     assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
 }
+
+/// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
+/// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
+/// with a call the subroutine was "defined twice". An O number followed by an O-word keyword
+/// marks LinuxCNC; a Fanuc program number (with or without a comment after it) stays Fanuc.
+#[test]
+fn numbered_oword_subroutines_tell_linuxcnc() {
+    use feedopt::toolpath::gcode::detect_dialect;
+    for text in [
+        "o100 sub\nG0 X7 Y8\no100 endsub\nG21 G90\nG0 X0 Y0 Z5\nG1 X10 F100\nM2\n",
+        "o100 sub\n  G1 X10 F600\no100 endsub\nG21 G90\nG0 X0 Y0 Z5\no100 call\nM2\n",
+        "(header)\nO0100SUB\nO0100 ENDSUB\n",
+        "G0 X0\nN20 o101 if [#1 GT 0]\no101 endif\n",
+        "G0 X0\no102 while [#1 LT 3]\no102 endwhile\n",
+        "G0 X0\no103 repeat [2]\no103 endrepeat\n",
+    ] {
+        assert_eq!(
+            detect_dialect(&text.to_uppercase()),
+            Some(Dialect::LinuxCnc),
+            "{text}"
+        );
+    }
+    for text in [
+        "O0100\nG0 X0\n",
+        "O1000 (SUB PROGRAM)\nG0 X0\n",
+        "O2000(CALLS)\nG0 X0\n",
+    ] {
+        assert_eq!(
+            detect_dialect(&text.to_uppercase()),
+            Some(Dialect::Fanuc),
+            "{text}"
+        );
+    }
+    // And the two repro programs read as LinuxCNC, through detection, with their moves.
+    for (text, length) in [
+        (
+            "o100 sub\nG0 X7 Y8\no100 endsub\nG21 G90\nG0 X0 Y0 Z5\nG1 X10 F100\nM2\n",
+            10.0,
+        ),
+        (
+            "o100 sub\n  G1 X10 F600\no100 endsub\nG21 G90\nG0 X0 Y0 Z5\no100 call\nM2\n",
+            10.0,
+        ),
+    ] {
+        let dialect = detect_dialect(&text.to_uppercase()).expect("a dialect");
+        let tp = ok_in(dialect, text);
+        let path: f64 = tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
+        assert!((path - length).abs() < 1e-9, "{text}: {path}");
+    }
+}

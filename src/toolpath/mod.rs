@@ -424,8 +424,8 @@ pub const GCODE_EXTENSIONS: &[&str] = &[
 /// Chooses the reader and dialect: the options first, then the file's content (a `GOTO/`
 /// record is APT; a first block `BEGIN PGM` is Heidenhain Klartext; `TRAORI`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`/`G700` are Sinumerik; `G43.4`, `G43.5`, `G68.2`,
-/// `G05.1`, `M98` or an `O1234` program number are Fanuc; `M428`–`M430` or `O<…>` are
-/// LinuxCNC), then the extension (`.mpf`, `.spf`: Sinumerik; `.h`: Heidenhain), else LinuxCNC.
+/// `G05.1`, `M98` or an `O1234` program number are Fanuc; `M428`–`M430`, `O<…>` or an O-word
+/// keyword after an `O` number, `o100 sub`, are LinuxCNC), then the extension (`.mpf`, `.spf`: Sinumerik; `.h`: Heidenhain), else LinuxCNC.
 pub fn detect(path: &Path, text: &str, options: &ReadOptions) -> Result<Detected> {
     let ext = path
         .extension()

@@ -311,7 +311,9 @@ pub fn parse_configured(
 /// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
 /// `G05.1`, `M98`, look-ahead `G08 P…`, macro calls `G65 P…`, Haas `G187`, a first block
-/// `O1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`).
+/// `O1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
+/// by an O-word keyword: `o100 sub`, `o100 call`, `o101 if`, …, which is not a Fanuc program
+/// number).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
     if is_klartext(upper) {
         return Some(Dialect::Heidenhain);
@@ -335,15 +337,66 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
             })
             .is_some_and(|l| {
                 let l = l.trim();
-                l.starts_with('O') && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
+                l.starts_with('O')
+                    && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
+                    && !is_oword_control(l)
             });
-    let linuxcnc = ["M428", "M429", "M430", "O<"].iter().any(|w| has(w));
+    let linuxcnc = ["M428", "M429", "M430", "O<"].iter().any(|w| has(w))
+        || upper.lines().any(is_oword_control);
     match (sinumerik, fanuc, linuxcnc) {
         (true, _, _) => Some(Dialect::Sinumerik),
         (false, true, _) => Some(Dialect::Fanuc),
         (false, false, true) => Some(Dialect::LinuxCnc),
         _ => None,
     }
+}
+
+/// LinuxCNC's O-word keywords: an `O` number followed by one of them is a subroutine or
+/// control-flow line (`o100 sub`, `o100 call [2]`, `o101 if [#1 GT 0]`), not a Fanuc program
+/// number.
+const OWORD_KEYWORDS: [&str; 15] = [
+    "SUB",
+    "ENDSUB",
+    "CALL",
+    "RETURN",
+    "IF",
+    "ELSEIF",
+    "ELSE",
+    "ENDIF",
+    "WHILE",
+    "ENDWHILE",
+    "DO",
+    "REPEAT",
+    "ENDREPEAT",
+    "BREAK",
+    "CONTINUE",
+];
+
+/// Whether an upper-cased line is a LinuxCNC O-word line with a numbered O word (`O100 SUB`,
+/// `N10 O100 CALL [1]`): the number, then a keyword, then the end of the line, a space, `[` or
+/// `(`.
+fn is_oword_control(line: &str) -> bool {
+    let l = line.trim_start();
+    let l = match l.strip_prefix('N') {
+        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) => rest
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start(),
+        _ => l,
+    };
+    let Some(rest) = l.strip_prefix('O') else {
+        return false;
+    };
+    let digits = rest.len() - rest.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+    if digits == 0 {
+        return false;
+    }
+    let tail = rest[digits..].trim_start();
+    OWORD_KEYWORDS.iter().any(|kw| {
+        tail.strip_prefix(kw).is_some_and(|after| {
+            after.is_empty()
+                || after.starts_with(|c: char| c.is_whitespace() || c == '[' || c == '(')
+        })
+    })
 }
 
 /// Whether a program's text (upper-cased) is Heidenhain Klartext: its first block (after
