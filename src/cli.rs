@@ -710,13 +710,18 @@ fn read_input_from(
         fallback_dialect,
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
-    // What the reader skipped or doubted: one line each on stderr, and in the summary.
+    // What the reader skipped or doubted: one line each on stderr, and in the summary; a
+    // message repeated on many lines once, at its first line, with the count of the others.
     let warnings: Vec<String> = match &input {
-        toolpath::Input::Cl(t) => t
-            .warnings
+        toolpath::Input::Cl(t) => toolpath::WarningGroup::group(&t.warnings)
             .iter()
-            .map(|w| {
-                let text = format!("{}:{}: {}", toolpath_file.display(), w.line, w.message);
+            .map(|g| {
+                let text = format!(
+                    "{}:{}: {}",
+                    toolpath_file.display(),
+                    g.first.line,
+                    g.message()
+                );
                 crate::files::escape_control(&text)
             })
             .collect(),

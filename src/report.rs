@@ -204,7 +204,8 @@ pub struct Summary {
     pub worst_chord_ratio: f64,
     /// Whether the schedule honours jerk limits (the machine file gives some).
     pub jerk_limited: bool,
-    /// The reader's warnings (`file:line: message`).
+    /// The reader's warnings (`file:line: message`), each message once at its first line,
+    /// with `(and N more like it, the last at line L)` where it repeats.
     pub warnings: Vec<String>,
     /// The input format read (`apt`, `gcode`, `csv`) and how it was chosen (`option`,
     /// `extension`, `content`).

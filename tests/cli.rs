@@ -1239,6 +1239,53 @@ fn g28_reference_default_and_cycle_alias_on_the_command_line() {
     );
 }
 
+/// The same warning on many lines (FreeCAD's grbl post writes `K0.000` on every G17 arc: 172
+/// lines of it) is printed once, at its first line, with the count of the others; different
+/// warnings each keep their line. The `--json` summary lists the same lines.
+#[test]
+fn a_warning_repeated_on_many_lines_is_printed_once_with_the_count() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write(
+        "k.ngc",
+        "G21 G90 G17\nG0 X0 Y0 Z0\nG2 X10 Y0 I5 J0 K0 F600\nG2 X0 Y0 I-5 J0 K0\n\
+         G2 X10 Y0 I5 J0 K0\nG1 X20 R3\nM2\n",
+    );
+    let args = [
+        "solve",
+        "-m",
+        "machine.json",
+        "k.ngc",
+        "--stations",
+        STATIONS,
+    ];
+    let out = w.run(&args);
+    assert_success(&out);
+    let err = stderr(&out);
+    let k: Vec<&str> = err.lines().filter(|l| l.contains("K is not")).collect();
+    assert_eq!(k.len(), 1, "{err}");
+    assert!(
+        k[0].contains("k.ngc:3:") && k[0].contains("(and 2 more like it, the last at line 5)"),
+        "{err}"
+    );
+    assert!(
+        err.lines()
+            .any(|l| l.contains("k.ngc:6:") && l.contains("R on a straight move")),
+        "{err}"
+    );
+    let out = w.run(&[&args[..], &["--json"]].concat());
+    assert_success(&out);
+    let v = parse_json(&stdout(&out), "stdout");
+    let warnings = v["warnings"].as_array().expect("warnings");
+    assert_eq!(warnings.len(), 2, "{v}");
+    assert!(
+        warnings[0]
+            .as_str()
+            .unwrap_or_default()
+            .contains("2 more like it")
+    );
+}
+
 #[test]
 fn block_delete_on_the_command_line() {
     let w = Work::new();

@@ -246,6 +246,54 @@ pub struct Warning {
     pub message: String,
 }
 
+/// A reader's warnings with the same message, told once: the first, and how many more.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WarningGroup {
+    /// The first occurrence (its line is the one to show).
+    pub first: Warning,
+    /// How many more warnings have the same message.
+    pub more: usize,
+    /// The line of the last of them (the first's when there is none).
+    pub last_line: usize,
+}
+
+impl WarningGroup {
+    /// Groups `warnings` by message, in the order of each message's first occurrence: a post
+    /// that writes `K0.` on every G17 arc gives one group, not one warning per arc.
+    pub fn group(warnings: &[Warning]) -> Vec<WarningGroup> {
+        let mut groups: Vec<WarningGroup> = Vec::new();
+        let mut index: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+        for w in warnings {
+            match index.get(w.message.as_str()) {
+                Some(&k) => {
+                    groups[k].more += 1;
+                    groups[k].last_line = w.line;
+                }
+                None => {
+                    index.insert(&w.message, groups.len());
+                    groups.push(WarningGroup {
+                        first: w.clone(),
+                        more: 0,
+                        last_line: w.line,
+                    });
+                }
+            }
+        }
+        groups
+    }
+
+    /// The message, with `(and N more like it, the last at line L)` when there are more.
+    pub fn message(&self) -> String {
+        match self.more {
+            0 => self.first.message.clone(),
+            n => format!(
+                "{} (and {n} more like it, the last at line {})",
+                self.first.message, self.last_line
+            ),
+        }
+    }
+}
+
 /// What a reader needs to know about the machine the program runs on: which axes it has (an
 /// axis word for any other is an error naming it), its reference positions (`G28`/`G30`) and
 /// how machine coordinates (`G53`, `SUPA`, the reference points) map to program coordinates.
