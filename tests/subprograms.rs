@@ -145,6 +145,54 @@ fn linuxcnc_o_word_subroutines() {
     );
 }
 
+/// `o<dm> call [10] [20]` passes its arguments as #1, #2 (round 3: "#1 is read before it is
+/// set"), evaluated where the call is; #1–#30 are the call's own: those past the arguments
+/// keep the caller's values, and all come back on return, as on LinuxCNC.
+#[test]
+fn linuxcnc_call_arguments_are_the_subroutines_1_to_30() {
+    let text = "o<dm> sub\n  G1 X#1 Y#2 F600\no<dm> endsub\nG21 G90\nG0 X0 Y0 Z5\n\
+                o<dm> call [10] [20]\nM2\n";
+    let tp = read(Dialect::LinuxCnc, text);
+    assert_eq!(points(&tp), [[0.0, 0.0, 5.0], [10.0, 20.0, 5.0]]);
+    assert_eq!(lines(&tp), [5, 2]);
+    // Expressions with the caller's parameters; #3 past the arguments is the caller's; a
+    // nested call has its own #1 and the outer body gets its #1 back; after the call the
+    // caller's #1 (5) and #2 (unset) are back.
+    let text = "o<in> sub\nG1 Z#1 F600\no<in> endsub\n\
+                o<out> sub\nG1 X#1 Y#3 F600\no<in> call [-1]\nG1 Y#1\no<out> endsub\n\
+                #1=5\n#3=7\nG0 X0 Y0 Z0\no<out> call [#1*2] [4]\nG1 X#1\nM2\n";
+    let tp = read(Dialect::LinuxCnc, text);
+    assert_eq!(
+        points(&tp),
+        [
+            [0.0, 0.0, 0.0],
+            [10.0, 7.0, 0.0],
+            [10.0, 7.0, -1.0],
+            [10.0, 10.0, -1.0],
+            [5.0, 10.0, -1.0]
+        ]
+    );
+    let e = fails(
+        Dialect::LinuxCnc,
+        "o<dm> sub\nG1 X#2 F600\no<dm> endsub\nG0 X0 Y0 Z0\no<dm> call [1]\nG1 Y#2\nM2\n",
+    );
+    assert!(
+        e.contains("t.nc:2:") && e.contains("#2") && e.contains("O<dm> call [1]"),
+        "{e}"
+    );
+    let e = fails(
+        Dialect::LinuxCnc,
+        "o<dm> sub\nG1 X#1 F600\no<dm> endsub\nG0 X0 Y0 Z0\no<dm> call 5\nM2\n",
+    );
+    assert!(e.contains("t.nc:5:") && e.contains("in brackets"), "{e}");
+    let many = "[1]".repeat(31);
+    let e = fails(
+        Dialect::LinuxCnc,
+        &format!("o<dm> sub\nG1 X#1 F600\no<dm> endsub\nG0 X0 Y0 Z0\no<dm> call {many}\nM2\n"),
+    );
+    assert!(e.contains("t.nc:5:") && e.contains("more than 30"), "{e}");
+}
+
 #[test]
 fn a_call_of_a_subprogram_not_in_the_file_is_an_error_naming_line_call_and_fix() {
     let e = fails(

@@ -107,6 +107,21 @@ impl Variables {
             .map(String::as_str)
     }
 
+    /// Gives `name` back the value it had (`None`: no value), as a LinuxCNC call's return
+    /// does for `#1`–`#30`.
+    pub fn restore(&mut self, name: &str, value: Option<f64>) {
+        match value {
+            Some(v) => self.set(name, v),
+            None => {
+                let name = name.to_ascii_uppercase();
+                let had_word = self.words.remove(&name).is_some();
+                if self.values.remove(&name).is_some() || had_word {
+                    self.changes += 1;
+                }
+            }
+        }
+    }
+
     fn get(&self, name: &str) -> Result<f64, String> {
         let name = name.to_ascii_uppercase();
         if let Some(v) = self.values.get(&name) {

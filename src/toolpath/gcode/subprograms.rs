@@ -18,8 +18,11 @@
 //!   PROC parameters are not passed: a body that reads one is an error naming it.
 //! * **LinuxCNC** ([`Subprograms::OWordSub`]): `o100 sub` … `o100 endsub` (or `o<name>`)
 //!   anywhere in the file; those lines are not part of the main program. `o100 call` runs the
-//!   body once, `o100 return` returns early. Call arguments are not passed (a body that reads
-//!   `#1` is an error naming it); other O-words (`if`, `while`, …) are errors.
+//!   body once, `o100 return` returns early. `o100 call [10] [#5+1]` passes its arguments,
+//!   each an expression in brackets evaluated where the call is, as `#1`, `#2`, … (at most
+//!   [`MAX_CALL_ARGUMENTS`]), as LinuxCNC does: `#1`–`#30` are local to the call, those past
+//!   the arguments keep the caller's values, and all thirty get the caller's values back on
+//!   return. Other O-words (`if`, `while`, …) are errors.
 //! * **Heidenhain** ([`Subprograms::Labels`]): one program with labels `LBL 5` / `LBL "NAME"`
 //!   (each defined once). `CALL LBL 5` runs from the label to `LBL 0` (or the end of the
 //!   program) and returns to the block after the call. `CALL LBL 5 REP m` with the label
@@ -54,6 +57,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::dialect::{DialectSpec, Subprograms};
+use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
 use super::lexer::{lex, split_blocks};
@@ -61,6 +65,10 @@ use crate::error::{Error, Result};
 
 /// Deepest nesting of subprogram calls (the main program is depth 0).
 pub const MAX_CALL_DEPTH: usize = 8;
+
+/// Most arguments a LinuxCNC `o… call` passes (`#1`–`#30`, the subroutine's local
+/// parameters).
+pub const MAX_CALL_ARGUMENTS: usize = 30;
 
 /// Most blocks a program may run past its own lines: what subprogram calls, repeats (nesting
 /// multiplied out) and jumps add. A block costs about 2 µs to read, so this bounds the blocks'
@@ -102,6 +110,8 @@ struct Frame {
     /// A Heidenhain label call: the index of the calling line (a section repeat's pass ends
     /// there) and the label's name.
     label: Option<(usize, String)>,
+    /// A LinuxCNC call with arguments: the caller's `#1`–`#30`, given back on return.
+    locals: Option<Vec<Option<f64>>>,
 }
 
 /// The state when a Klartext jump (`FN 9`–`12`) is taken: the count of variable changes
@@ -136,8 +146,9 @@ enum OWord {
     Return,
 }
 
-/// The name and keyword of a LinuxCNC O-word subroutine block (`None`: not one).
-fn oword(block: &str) -> Option<(String, OWord)> {
+/// The name and keyword of a LinuxCNC O-word subroutine block, and what follows the keyword
+/// (without spaces, upper-cased: a call's arguments) (`None`: not one).
+fn oword(block: &str) -> Option<(String, OWord, String)> {
     let compact: String = block
         .chars()
         .filter(|c| !c.is_whitespace())
@@ -159,9 +170,11 @@ fn oword(block: &str) -> Option<(String, OWord)> {
     } else {
         format!("O{}", name.trim_start_matches('0'))
     };
+    // After `call` come its arguments, checked when it runs (`o100 call 5` is an error
+    // saying how to write them).
     let word = |kw: &str| {
         tail.strip_prefix(kw)
-            .is_some_and(|t| t.is_empty() || t.starts_with('['))
+            .is_some_and(|t| t.is_empty() || t.starts_with('[') || kw == "call")
     };
     // `endsub` before `sub`: no keyword is a prefix of another that comes first.
     [
@@ -172,7 +185,51 @@ fn oword(block: &str) -> Option<(String, OWord)> {
     ]
     .into_iter()
     .find(|(kw, _)| word(kw))
-    .map(|(_, k)| (name, k))
+    .map(|(kw, k)| (name, k, tail[kw.len()..].to_ascii_uppercase()))
+}
+
+/// A LinuxCNC call's arguments `[a][b]…` (without spaces), each evaluated with `vars`.
+fn call_arguments(text: &str, vars: &Variables) -> std::result::Result<Vec<f64>, String> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut values = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        if chars[i] != '[' {
+            return Err(format!(
+                "`{}`: a call's arguments are expressions in brackets, `[10] [#2*2]`",
+                chars[i..].iter().collect::<String>()
+            ));
+        }
+        let mut depth = 0usize;
+        let mut end = i;
+        while end < chars.len() {
+            match chars[end] {
+                '[' => depth += 1,
+                ']' => depth -= 1,
+                _ => {}
+            }
+            end += 1;
+            if depth == 0 {
+                break;
+            }
+        }
+        if depth > 0 {
+            return Err("a call argument has no closing `]`".into());
+        }
+        let argument: String = chars[i..end].iter().collect();
+        values.push(
+            super::expr::eval(&argument, vars)
+                .map_err(|e| format!("argument `{argument}`: {e}"))?,
+        );
+        if values.len() > MAX_CALL_ARGUMENTS {
+            return Err(format!(
+                "more than {MAX_CALL_ARGUMENTS} arguments (#1–#{MAX_CALL_ARGUMENTS} are all a \
+                 subroutine has)"
+            ));
+        }
+        i = end;
+    }
+    Ok(values)
 }
 
 /// `N10 …` → `…` (lower or upper case).
@@ -369,7 +426,7 @@ impl Program {
         let mut open: Option<(usize, String)> = None;
         for i in 0..self.lines.len() {
             let number = self.lines[i].number;
-            let word = oword(self.first_block(i));
+            let word = oword(self.first_block(i)).map(|(name, kind, _)| (name, kind));
             match (&open, word) {
                 (None, Some((name, OWord::Sub))) => {
                     let k = self.add_section(source, name.clone(), number)?;
@@ -485,6 +542,7 @@ impl Program {
             runs: 1,
             call: None,
             label: None,
+            locals: None,
         }];
         // Every block run counts, and its length: past the file's own lines plus
         // MAX_EXPANDED_BLOCKS, or its own text plus MAX_EXPANDED_BYTES, repeats, calls or jumps
@@ -502,7 +560,7 @@ impl Program {
         {
             let Some(&index) = self.sections[section].lines.get(pos) else {
                 // The section ran out: a return.
-                if !self.ret(&mut stack) {
+                if !self.ret(&mut stack, &mut interp.vars) {
                     return Ok(());
                 }
                 continue;
@@ -567,7 +625,7 @@ impl Program {
                     Some(LabelOp::Label(_)) => continue,
                     Some(LabelOp::End) => {
                         // In the main program, a subprogram's end is run through.
-                        if stack.len() > 1 && !self.ret(&mut stack) {
+                        if stack.len() > 1 && !self.ret(&mut stack, &mut interp.vars) {
                             return Ok(());
                         }
                         continue;
@@ -579,7 +637,7 @@ impl Program {
                             .is_some_and(|(at, _)| *at == pos);
                         if own {
                             // A section repeat's pass is over.
-                            if !self.ret(&mut stack) {
+                            if !self.ret(&mut stack, &mut interp.vars) {
                                 return Ok(());
                             }
                         } else {
@@ -620,18 +678,43 @@ impl Program {
                 }
             }
             if self.style == Subprograms::OWordSub
-                && let Some((name, kind)) = oword(text)
+                && let Some((name, kind, tail)) = oword(text)
             {
                 match kind {
                     OWord::Call => {
+                        let written = if tail.is_empty() {
+                            format!("{name} call")
+                        } else {
+                            format!("{name} call {tail}")
+                        };
+                        let arguments = call_arguments(&tail, &interp.vars).map_err(|m| {
+                            self.located(
+                                Error::parse(source, number, format!("`{written}`: {m}")),
+                                &stack,
+                            )
+                        })?;
                         let call = Call {
-                            text: format!("{name} call"),
+                            text: written,
                             targets: vec![(name, 1)],
                         };
+                        let depth = stack.len();
                         self.enter(&mut stack, call, number, source)?;
+                        if stack.len() > depth
+                            && let Some(top) = stack.last_mut()
+                        {
+                            // #1–#30 are the call's own: the arguments, then the caller's
+                            // values, all given back on return.
+                            let saved: Vec<Option<f64>> = (1..=MAX_CALL_ARGUMENTS)
+                                .map(|k| interp.vars.value(&format!("#{k}")))
+                                .collect();
+                            for (k, v) in arguments.iter().enumerate() {
+                                interp.vars.set(&format!("#{}", k + 1), *v);
+                            }
+                            top.locals = Some(saved);
+                        }
                     }
                     OWord::Return | OWord::EndSub => {
-                        if !self.ret(&mut stack) {
+                        if !self.ret(&mut stack, &mut interp.vars) {
                             return Ok(());
                         }
                     }
@@ -656,7 +739,7 @@ impl Program {
                 self.enter(&mut stack, call, number, source)?;
             } else if interp.ended {
                 interp.ended = false;
-                if interp.end_of_program || !self.ret(&mut stack) {
+                if interp.end_of_program || !self.ret(&mut stack, &mut interp.vars) {
                     return Ok(());
                 }
             }
@@ -685,8 +768,9 @@ impl Program {
     }
 
     /// Returns from the running (sub)program: runs it again while repeats remain, else pops
-    /// it. `false`: the main program has ended.
-    fn ret(&self, stack: &mut Vec<Frame>) -> bool {
+    /// it (a LinuxCNC call with arguments gives the caller its `#1`–`#30` back). `false`: the
+    /// main program has ended.
+    fn ret(&self, stack: &mut Vec<Frame>, vars: &mut Variables) -> bool {
         if stack.len() <= 1 {
             return false;
         }
@@ -697,8 +781,14 @@ impl Program {
             top.runs -= 1;
             top.pos = top.start;
             top.block = 0;
-        } else {
-            stack.pop();
+        } else if let Some(Frame {
+            locals: Some(saved),
+            ..
+        }) = stack.pop()
+        {
+            for (k, v) in saved.into_iter().enumerate() {
+                vars.restore(&format!("#{}", k + 1), v);
+            }
         }
         true
     }
@@ -745,6 +835,7 @@ impl Program {
             runs,
             call: Some((call.text, number)),
             label: None,
+            locals: None,
         };
         self.call(stack, frame, number, source)
     }
@@ -848,6 +939,7 @@ impl Program {
             runs,
             call: Some((text, number)),
             label: Some((at, name.to_string())),
+            locals: None,
         };
         self.call(stack, frame, number, source)
     }
