@@ -629,3 +629,110 @@ fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm()
         tp.warnings
     );
 }
+
+/// `G95` (feed per revolution) with the spindle speed known: the feed at a move is F × S. The
+/// pitch form of rigid tapping in Fusion's Fanuc/Haas posts (round 3, fusion_efgarro_6686
+/// line 151: `G95 M29 S500`, `G84 … F1.75`) taps at 1.75 mm × 500 rpm = 875 mm/min; it was
+/// an error. Moves without S, or with S0, or under G96 (S a cutting speed) are errors naming
+/// the line; G94 comes back to F per minute, and F must be given again after a change of feed
+/// mode.
+#[test]
+fn g95_feed_per_revolution_is_f_times_s() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1000\nG21 G90 G17 G94\nG0 X16. Y-12. Z85.\nS500 M3\nG95 M29 S500\n\
+         G98 G84 X16. Y-12. Z64.627 R85. F1.75\nG80\nG94\nM30\n",
+    );
+    let tap: Vec<f64> = tp
+        .points
+        .iter()
+        .filter_map(|p| match p.feed {
+            Feed::Programmed(f) => Some(f),
+            _ => None,
+        })
+        .collect();
+    assert!(!tap.is_empty(), "{:?}", tp.points);
+    for f in tap {
+        assert!((f - 875.0 / 60.0).abs() < 1e-12, "{f}");
+    }
+    // LinuxCNC and Sinumerik, lines and arcs: 0.1 mm/rev at 1200 rpm = 120 mm/min = 2 mm/s.
+    for (dialect, text) in [
+        (
+            Dialect::LinuxCnc,
+            "G21 G90 G0 X0 Y0 Z0\nS1200 M3\nG95 G1 X10 F0.1\nG2 X20 Y0 R5\n",
+        ),
+        (
+            Dialect::Sinumerik,
+            "G71 G90 G0 X0 Y0 Z0\nS1200 M3\nG95 G1 X10 F0.1\nG2 X20 Y0 CR=5\n",
+        ),
+    ] {
+        let tp = gcode(dialect, text);
+        for p in &tp.points[1..] {
+            assert!(
+                matches!(p.feed, Feed::Programmed(f) if (f - 2.0).abs() < 1e-12),
+                "{text}"
+            );
+        }
+    }
+    // A new S changes the feed of the next move.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X0 Y0 Z0\nS600\nG95 G1 X10 F0.1\nS1200\nG1 X20\n",
+    );
+    let feeds: Vec<Feed> = tp.points[1..].iter().map(|p| p.feed).collect();
+    assert_eq!(feeds, [Feed::Programmed(1.0), Feed::Programmed(2.0)]);
+    // G94 again: F per minute, which the program gives again (an F per revolution is
+    // forgotten, not read as 0.1 mm/min).
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0 Y0 Z0\nS1000\nG95 G1 X10. F0.1\nG94 G1 X20.\nG1 X30. F600.\n",
+    );
+    let feeds: Vec<Feed> = tp.points[1..].iter().map(|p| p.feed).collect();
+    assert_eq!(
+        feeds,
+        [
+            Feed::Programmed(100.0 / 60.0),
+            Feed::Unspecified,
+            Feed::Programmed(10.0)
+        ]
+    );
+    for (dialect, text, line, needle) in [
+        (
+            Dialect::LinuxCnc,
+            "G21 G90 G0 X0 Y0 Z0\nG95 G1 X10 F0.1\n",
+            2,
+            "no spindle speed",
+        ),
+        (
+            Dialect::LinuxCnc,
+            "G21 G90 G0 X0 Y0 Z0\nS0\nG95 G1 X10 F0.1\n",
+            3,
+            "S0",
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G90 G0 X0 Y0 Z0\nG96 S200\nG95 G1 X10. F0.1\n",
+            3,
+            "G96",
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G90 G0 X0 Y0 Z0\nS1000\nG95 G84 X0. Y0. Z-10. R2. F2\n",
+            3,
+            "decimal point",
+        ),
+        (
+            Dialect::Sinumerik,
+            "G71 G90 G0 X0 Y0 Z0\nG96 S200\nG1 X10 F0.1\n",
+            3,
+            "G96",
+        ),
+    ] {
+        let e = parse(Path::new("t.ngc"), text, dialect).expect_err(text);
+        let m = message(e);
+        assert!(
+            m.contains(&format!("t.ngc:{line}:")) && m.contains(needle),
+            "{text}: {m}"
+        );
+    }
+}

@@ -203,6 +203,9 @@ pub enum FeedMode {
     InverseTime,
     /// G94: F is length units (or degrees) per minute.
     PerMinute,
+    /// G95: F is length units (or degrees) per spindle revolution; the feed at a move is F × S
+    /// (S the spindle speed programmed before it, rpm).
+    PerRevolution,
 }
 
 /// Tool-tip (TCP) mode.
@@ -232,6 +235,13 @@ pub enum Action {
     /// I J K absolute (LinuxCNC G90.1) or incremental (G91.1).
     ArcDistance(Distance),
     FeedMode(FeedMode),
+    /// Constant surface speed (`G96`: `on`, S is a cutting speed, not rpm) or not (`G97`: S is
+    /// rpm); `feed`: the code also sets the feed mode (Sinumerik, whose G96/G97 are in G94 and
+    /// G95's group: both feed per revolution).
+    SurfaceSpeed {
+        on: bool,
+        feed: Option<FeedMode>,
+    },
     Tcp(Tcp),
     /// G53: this block's axis words are machine coordinates.
     MachineCoordinates,
@@ -433,7 +443,7 @@ const OFFSETS: &str = "coordinate offsets that shift program coordinates (G92, G
                        supported";
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
-const PER_REV: &str = "feed per revolution (G95) is not supported";
+const PER_REV: &str = "feed per revolution is not supported";
 const COMP: &str = "cutter radius compensation is not applied: the programmed path is used";
 const G60: &str = "single-direction positioning approaches the end point from one side, past \
                    it by an amount the control's parameters set; that approach is not modelled: \
@@ -442,6 +452,15 @@ const G10: &str = "G10 sets a tool or work offset and moves nothing; the program
                    are used as written";
 const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
                    quill); the move would be lost: post the program without it";
+/// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
+const CSS_ON: Action = Action::SurfaceSpeed {
+    on: true,
+    feed: None,
+};
+const CSS_OFF: Action = Action::SurfaceSpeed {
+    on: false,
+    feed: None,
+};
 const TRANSFORM: &str = "coordinate transformations (polar, rotation, scaling, mirroring, tilted \
                          planes) are not supported";
 
@@ -578,9 +597,9 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("92.3", Unsup(OFFSETS)),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
-        ("95", Unsup(PER_REV)),
-        ("96", Action::Ignored),
-        ("97", Action::Ignored),
+        ("95", Fm(FeedMode::PerRevolution)),
+        ("96", CSS_ON),
+        ("97", CSS_OFF),
         ("98", Action::CycleReturn(false)),
         ("99", Action::CycleReturn(true)),
     ],
@@ -737,9 +756,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("92", Unsup(OFFSETS)),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
-        ("95", Unsup(PER_REV)),
-        ("96", Action::Ignored),
-        ("97", Action::Ignored),
+        ("95", Fm(FeedMode::PerRevolution)),
+        ("96", CSS_ON),
+        ("97", CSS_OFF),
         ("98", Action::CycleReturn(false)),
         ("99", Action::CycleReturn(true)),
     ],
@@ -870,9 +889,21 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("91", Dist(Distance::Incremental)),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
-        ("95", Unsup(PER_REV)),
-        ("96", Action::Ignored),
-        ("97", Action::Ignored),
+        ("95", Fm(FeedMode::PerRevolution)),
+        (
+            "96",
+            Action::SurfaceSpeed {
+                on: true,
+                feed: Some(FeedMode::PerRevolution),
+            },
+        ),
+        (
+            "97",
+            Action::SurfaceSpeed {
+                on: false,
+                feed: Some(FeedMode::PerRevolution),
+            },
+        ),
         ("110..112", Unsup(TRANSFORM)),
         ("153", MachineCoordinates),
         ("331", Unsup(THREADS)),

@@ -31,6 +31,8 @@ struct Block {
     turns: Option<f64>,
     extra_turns: Option<f64>,
     feed: Option<f64>,
+    /// F was written with a decimal point (or computed).
+    feed_point: Option<bool>,
     /// Every single-letter word's value as written (cycle and dwell parameters P Q R K L).
     letters: [Option<Num>; 26],
     /// Codes and keywords in the order written, with their text and `( … )` arguments.
@@ -71,12 +73,13 @@ impl Block {
     }
 }
 
-/// The modal G94 feed.
+/// The modal F: under G94 per minute; under G95 per revolution (see
+/// [`Interpreter::modal_feed`] for the feed at a move).
 #[derive(Debug, Clone, Copy)]
 struct ModalFeed {
-    /// Linear feed, mm/min.
+    /// Linear feed, mm/min (G95: mm per revolution).
     mm_per_min: f64,
-    /// F as written (degrees per minute on rotary-only moves).
+    /// F as written (degrees per minute on rotary-only moves; G95: per revolution).
     raw: f64,
 }
 
@@ -140,6 +143,11 @@ pub(super) struct Interpreter<'a> {
     plane: Plane,
     feed_mode: FeedMode,
     feed: Option<ModalFeed>,
+    /// The spindle speed S last programmed, rpm (`None`: none yet, or S under G96 is a
+    /// cutting speed); G95 feeds are F × this.
+    rpm: Option<f64>,
+    /// G96 (constant surface speed) is on: S is a cutting speed, not rpm.
+    surface_speed: bool,
     motion: Option<Motion>,
     tcp: Tcp,
     /// Modal position in program (frame) coordinates: X Y Z in mm, A B C in degrees.
@@ -224,6 +232,8 @@ impl<'a> Interpreter<'a> {
             plane: Plane::Xy,
             feed_mode: FeedMode::PerMinute,
             feed: None,
+            rpm: None,
+            surface_speed: false,
             motion: spec.initial_motion,
             tcp: Tcp::Off,
             pos: [0.0; 6],
@@ -443,6 +453,7 @@ impl<'a> Interpreter<'a> {
                 Address::Feed => {
                     duplicate(block.feed.is_some())?;
                     block.feed = Some(num.value);
+                    block.feed_point = Some(num.point);
                 }
                 Address::G | Address::M => {
                     let table = if address == Address::G {
@@ -657,13 +668,15 @@ impl<'a> Interpreter<'a> {
         }
         for (text, action, args) in &block.actions {
             match *action {
-                Action::FeedMode(mode) => {
-                    if (self.spec.g94_clears_feed && mode == FeedMode::PerMinute)
-                        || (self.feed_mode == FeedMode::InverseTime && mode != self.feed_mode)
-                    {
-                        self.feed = None;
+                Action::FeedMode(mode) => self.set_feed_mode(mode),
+                Action::SurfaceSpeed { on, feed } => {
+                    self.surface_speed = on;
+                    if on {
+                        self.rpm = None;
                     }
-                    self.feed_mode = mode;
+                    if let Some(mode) = feed {
+                        self.set_feed_mode(mode);
+                    }
                 }
                 Action::Motion(m) => {
                     if let Some((other, _)) = motion_code {
@@ -804,7 +817,12 @@ impl<'a> Interpreter<'a> {
             && !dwell
             && let Some(s) = block.letter('S')
         {
-            self.set_spindle(line, s.value);
+            if self.surface_speed {
+                // A cutting speed (m/min): the spindle's rpm follows the diameter.
+                self.rpm = None;
+            } else {
+                self.set_spindle(line, s.value);
+            }
         }
         if set_tool {
             // LinuxCNC `M61 Q<n>`: tool n is in the spindle from here on.
@@ -838,7 +856,21 @@ impl<'a> Interpreter<'a> {
             if f < 0.0 {
                 return Err(self.error(line, format!("F{f}: a feed cannot be negative")));
             }
-            if self.feed_mode == FeedMode::PerMinute {
+            if self.feed_mode == FeedMode::PerRevolution
+                && self.spec.integer_increments.is_some()
+                && block.feed_point == Some(false)
+                && f != 0.0
+            {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "F{f} under G95 without a decimal point: a Fanuc control reads it in \
+                         units its parameters set (0.01 or 0.001 mm per revolution on many); \
+                         write the feed per revolution with a decimal point (F{f}. for {f} mm)"
+                    ),
+                ));
+            }
+            if self.feed_mode != FeedMode::InverseTime {
                 self.feed = (f > 0.0).then(|| ModalFeed {
                     mm_per_min: f * self.feed_units.mm_per_unit(),
                     raw: f,
@@ -937,7 +969,61 @@ impl<'a> Interpreter<'a> {
     /// The spindle turns at `rpm` from the next move on (a speed that is not positive and
     /// finite, or the same as before, changes nothing).
     pub(super) fn set_spindle(&mut self, line: usize, rpm: f64) {
+        self.rpm = Some(rpm.abs());
         SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
+    }
+
+    /// G93, G94 or G95 from here on. Leaving G93 forgets F (an inverse time is no feed), and
+    /// so does a change to or from G95 (F per revolution and per minute are different
+    /// quantities: LinuxCNC sets F to 0 at G94 and G95, and a Fanuc program gives F again);
+    /// LinuxCNC's every `G94` sets F to 0.
+    fn set_feed_mode(&mut self, mode: FeedMode) {
+        let per_rev = |m: FeedMode| m == FeedMode::PerRevolution;
+        if (self.spec.g94_clears_feed && mode == FeedMode::PerMinute)
+            || (mode != self.feed_mode
+                && (self.feed_mode == FeedMode::InverseTime
+                    || per_rev(mode)
+                    || per_rev(self.feed_mode)))
+        {
+            self.feed = None;
+        }
+        self.feed_mode = mode;
+    }
+
+    /// The modal feed at a move of line `line` (not under G93): G94's F, or under G95 F × S,
+    /// the spindle speed last programmed; `None` when no F is in force. Under G95 a move
+    /// with an F and no spindle speed (none programmed, S0, or G96's cutting speed) is an
+    /// error naming the line.
+    fn modal_feed(&self, line: usize) -> Result<Option<ModalFeed>> {
+        let Some(f) = self.feed else {
+            return Ok(None);
+        };
+        if self.feed_mode != FeedMode::PerRevolution {
+            return Ok(Some(f));
+        }
+        let why = match self.rpm {
+            _ if self.surface_speed => {
+                "under G96 (constant surface speed) S is a cutting speed, and the spindle's rpm \
+                 follows the diameter: program G97 S<rpm>"
+            }
+            None => "no spindle speed S is programmed before it: program S<rpm> before the move",
+            Some(rpm) if rpm <= 0.0 || !rpm.is_finite() => {
+                "the spindle speed is S0: program S<rpm> before the move"
+            }
+            Some(rpm) => {
+                return Ok(Some(ModalFeed {
+                    mm_per_min: f.mm_per_min * rpm,
+                    raw: f.raw * rpm,
+                }));
+            }
+        };
+        Err(self.error(
+            line,
+            format!(
+                "G95 (feed per revolution): the feed of this move is F × S, and {why} (or G94 \
+                 and F per minute)"
+            ),
+        ))
     }
 
     /// `tool` goes into the spindle here: the next move is its first.
@@ -1373,7 +1459,11 @@ impl<'a> Interpreter<'a> {
                 }
                 Step::Feed(z, f) => {
                     q[2] = z;
-                    match f.or(self.feed.map(|f| f.mm_per_min)) {
+                    let modal = match f {
+                        Some(_) => None,
+                        None => self.modal_feed(line)?.map(|f| f.mm_per_min),
+                    };
+                    match f.or(modal) {
                         Some(mm_per_min) => Feed::Programmed(mm_per_min / 60.0),
                         None => Feed::Unspecified,
                     }
@@ -1735,7 +1825,7 @@ impl<'a> Interpreter<'a> {
         if self.feed_mode == FeedMode::InverseTime {
             return Ok(Feed::BlockTime(self.inverse_time(line, block)?));
         }
-        let Some(feed) = self.feed else {
+        let Some(feed) = self.modal_feed(line)? else {
             return Ok(Feed::Unspecified);
         };
         let moves_xyz = (0..3).any(|i| (end[i] - start[i]).abs() > XYZ_MOVE_THRESHOLD_MM);
@@ -1954,8 +2044,8 @@ impl<'a> Interpreter<'a> {
                     self.push(line, q, Feed::BlockTime(total * share));
                 }
             }
-            FeedMode::PerMinute => {
-                let feed = match self.feed {
+            FeedMode::PerMinute | FeedMode::PerRevolution => {
+                let feed = match self.modal_feed(line)? {
                     Some(f) => Feed::Programmed(f.mm_per_min / 60.0),
                     None => Feed::Unspecified,
                 };

@@ -61,7 +61,16 @@
 //!   block must carry its own F (an error naming the line otherwise) and gets
 //!   [`Feed::BlockTime`] = 60/F s; on an arc that time is split over the chords in proportion to
 //!   their length. Leaving G93 forgets F (LinuxCNC: every `G94` sets F to 0), so a feed move must
-//!   program F again.
+//!   program F again. Under `G95` (feed per revolution) F is mm (inch under G20) per spindle
+//!   revolution and a feed move gets [`Feed::Programmed`] F × S, S the spindle speed (rpm)
+//!   programmed last before it (rigid tapping `G95 M29 S500` … `G84 … F1.75` taps at 875
+//!   mm/min); a feed move under G95 with an F but no S before it, after `S0`, or under `G96`
+//!   (constant surface speed: S is a cutting speed, the rpm follows the diameter, and it is
+//!   not recorded as a spindle speed) is an error naming its line. A change to or from G95 forgets F too (F per minute and per revolution
+//!   are different quantities; LinuxCNC sets F to 0). Sinumerik's `G96` and `G97` are in the
+//!   feed-type group: both are feed per revolution (G96 with a cutting speed, so an error at
+//!   the first feed move). A Fanuc F without a decimal point under G95 is an error: the control
+//!   reads it in units its parameters set (0.01 or 0.001 mm per revolution on many).
 //! * **Tool-tip mode (TCP).** The codes above switch it on and off. In TCP mode X Y Z are the
 //!   tool tip in workpiece coordinates and A B C the rotary axis positions. A motion block that
 //!   has (or keeps) a rotary position or tool vector while TCP is off gets one warning per
@@ -136,7 +145,7 @@
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
 //!   silently: `G92`/`G52` offsets, splines, threading, probing, polar coordinates, scaling,
-//!   mirroring, feed per revolution, calls of subprograms not in the file, Haas `M97`, Sinumerik
+//!   mirroring, calls of subprograms not in the file, Haas `M97`, Sinumerik
 //!   `CYCLE76`/`CYCLE77` (spigot milling).
 
 pub mod cycles;
