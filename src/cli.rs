@@ -123,6 +123,11 @@ pub struct CheckArgs {
     /// G-code dialect (default: detected from the program).
     #[arg(long)]
     pub dialect: Option<crate::toolpath::gcode::Dialect>,
+    /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
+    /// parameter 3401#0 DPI = 0) or `calculator` (100 mm, DPI = 1); default: the machine
+    /// file's `decimal_point_input`, else increment with a warning.
+    #[arg(long, value_name = "increment|calculator")]
+    pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
     /// Factor on every programmed feed, as the machine would run it (0.001 to 1000).
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub feed_override: f64,
@@ -254,6 +259,11 @@ pub struct SolveOptions {
     /// delete) switch on does (default: run them, the program as posted).
     #[arg(long)]
     pub block_delete: bool,
+    /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
+    /// parameter 3401#0 DPI = 0) or `calculator` (100 mm, DPI = 1); default: the machine
+    /// file's `decimal_point_input`, else increment with a warning.
+    #[arg(long, value_name = "increment|calculator")]
+    pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
     /// Solver: `clarabel` (convex, the optimum of the discretisation) or `reach` (the O(N)
     /// reachability pass: within O(Δu²) of it, much faster).
     #[arg(long, value_enum, default_value_t = SolverChoice::Clarabel)]
@@ -586,6 +596,7 @@ pub fn check(args: &CheckArgs) -> Result<String> {
             cycle_alias: &[],
             block_delete: args.block_delete,
             tool_diameter: args.material.tool_diameter,
+            decimal_point_input: args.decimal_point_input,
         },
     )?;
     let Some(report) = apply_material(
@@ -644,6 +655,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
             cycle_alias: &args.opts.cycle_alias,
             block_delete: args.opts.block_delete,
             tool_diameter: args.opts.material.tool_diameter,
+            decimal_point_input: args.opts.decimal_point_input,
         },
     )
 }
@@ -656,6 +668,7 @@ struct Reading<'a> {
     cycle_alias: &'a [String],
     block_delete: bool,
     tool_diameter: Option<f64>,
+    decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
 
 /// Reads `toolpath_file` for the machine of `machine_file`; its reader's warnings are printed
@@ -672,6 +685,7 @@ fn read_input_from(
         cycle_alias,
         block_delete,
         tool_diameter,
+        decimal_point_input,
     } = reading;
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
@@ -708,6 +722,7 @@ fn read_input_from(
                 .and_then(|s| s.tool.diameter)
         }),
         fallback_dialect,
+        decimal_point_input,
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary; a

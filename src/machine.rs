@@ -304,6 +304,48 @@ pub struct References {
     /// and Sinumerik set it by a parameter or machine datum, not in the program); `None`: the
     /// file does not say.
     pub program_units: Option<LengthUnit>,
+    /// `"decimal_point_input"`: how the control reads a number written without a decimal
+    /// point (Fanuc parameter 3401#0, DPI); `None`: the file does not say.
+    pub decimal_point_input: Option<DecimalPointInput>,
+}
+
+/// How a Fanuc control reads an axis word written without a decimal point (`X100`):
+/// parameter 3401#0, DPI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DecimalPointInput {
+    /// DPI = 0, Fanuc's default: the number counts least input increments (`X100` is 0.1 mm
+    /// under G21, 0.01 inch under G20, 0.1° on a rotary axis).
+    Increment,
+    /// DPI = 1, "calculator-type" input: the number is in mm, inch or degrees (`X100` is
+    /// 100 mm), as LinuxCNC, grbl and Mach3 read it.
+    Calculator,
+}
+
+impl DecimalPointInput {
+    /// The name in machine files and on the command line (`increment`, `calculator`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DecimalPointInput::Increment => "increment",
+            DecimalPointInput::Calculator => "calculator",
+        }
+    }
+}
+
+impl std::str::FromStr for DecimalPointInput {
+    type Err = Error;
+
+    /// `increment` or `calculator`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "increment" => Ok(DecimalPointInput::Increment),
+            "calculator" => Ok(DecimalPointInput::Calculator),
+            other => Err(Error::Usage(format!(
+                "unknown decimal-point input `{other}`: expected increment (a Fanuc control \
+                 with parameter 3401#0 DPI = 0: X100 is 0.1 mm) or calculator (DPI = 1: X100 \
+                 is 100 mm)"
+            ))),
+        }
+    }
 }
 
 /// A program's length unit (F in that unit per minute).
@@ -396,11 +438,26 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             ));
         }
     };
+    let decimal_point_input = match value.get("decimal_point_input") {
+        None => None,
+        Some(Value::String(u)) if u == "increment" => Some(DecimalPointInput::Increment),
+        Some(Value::String(u)) if u == "calculator" => Some(DecimalPointInput::Calculator),
+        Some(v) => {
+            return Err(parser.err(
+                "decimal_point_input",
+                format!(
+                    "expected \"increment\" (a Fanuc control with parameter 3401#0 DPI = 0: \
+                     X100 is 0.1 mm) or \"calculator\" (DPI = 1: X100 is 100 mm), found {v}"
+                ),
+            ));
+        }
+    };
     Ok(References {
         file: source.to_path_buf(),
         axes,
         m92,
         program_units,
+        decimal_point_input,
     })
 }
 
@@ -619,6 +676,7 @@ impl Parser {
                 "tools",
                 "process",
                 "program_units",
+                "decimal_point_input",
             ],
         )?;
         let name = match obj.get("name") {

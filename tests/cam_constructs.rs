@@ -125,6 +125,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         travel: Default::default(),
         m92: [None; 3],
         program_units: None,
+        decimal_point_input: None,
     }
 }
 
@@ -735,4 +736,97 @@ fn g95_feed_per_revolution_is_f_times_s() {
             "{text}: {m}"
         );
     }
+}
+
+/// A Fanuc number without a decimal point counts least input increments (parameter 3401#0
+/// DPI = 0, Fanuc's default): round 3's `O0001 … G1 X100 Y50` read as a 0.118 mm path with no
+/// word said. The reading stays, with one warning at the first such word that is not 0, naming
+/// it, what it was read as and how to choose calculator-type input (DPI = 1: `X100` is 100 mm),
+/// which the read settings or the machine file's `decimal_point_input` select; either choice
+/// silences the warning. A dwell `G4 X2500` is 2.5 s in increments, `G4 P2500` always.
+#[test]
+fn fanuc_integer_words_are_increments_said_once_or_calculator_input_by_setting() {
+    use feedopt::machine::DecimalPointInput;
+    use feedopt::toolpath::gcode::{Settings, parse_configured};
+    let text = "O0001\nG21 G90 G94\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50 F600\nG4 X2500\nM30\n";
+    let read = |setting: Option<DecimalPointInput>, file: Option<DecimalPointInput>| {
+        let mut m = context("XYZ", Default::default(), [0.0; 3]);
+        m.decimal_point_input = file;
+        let settings = Settings {
+            decimal_point_input: setting,
+            ..Settings::default()
+        };
+        parse_configured(
+            Path::new("t.nc"),
+            text,
+            Dialect::Fanuc.spec(),
+            Some(&m),
+            &settings,
+        )
+        .unwrap()
+        .0
+    };
+    let length =
+        |tp: &Toolpath| -> f64 { tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum() };
+    let said = |tp: &Toolpath| -> Vec<Warning> {
+        tp.warnings
+            .iter()
+            .filter(|w| w.message.contains("decimal point"))
+            .cloned()
+            .collect()
+    };
+    let tp = read(None, None);
+    assert_close(tp.points.last().unwrap().p, v(0.1, 0.05, -0.001), 1e-12);
+    assert!((tp.dwells[0].seconds - 2.5).abs() < 1e-12);
+    let w = said(&tp);
+    assert_eq!(w.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(w[0].line, 3);
+    for needle in [
+        "`Z5`",
+        "0.005 mm",
+        "3401",
+        "calculator",
+        "decimal_point_input",
+        "5 mm",
+    ] {
+        assert!(w[0].message.contains(needle), "{needle}: {}", w[0].message);
+    }
+    // Calculator-type input, from the settings or the machine file: 117.8 mm, the program's
+    // length; increments chosen: the same 0.118 mm without the warning. The settings win.
+    for (setting, file) in [
+        (Some(DecimalPointInput::Calculator), None),
+        (None, Some(DecimalPointInput::Calculator)),
+        (
+            Some(DecimalPointInput::Calculator),
+            Some(DecimalPointInput::Increment),
+        ),
+    ] {
+        let tp = read(setting, file);
+        assert!(said(&tp).is_empty(), "{:?}", tp.warnings);
+        assert_close(tp.points.last().unwrap().p, v(100.0, 50.0, -1.0), 1e-12);
+        // Z5 → Z−1, then (0, 0) → (100, 50).
+        assert!((length(&tp) - (6.0 + 100f64.hypot(50.0))).abs() < 1e-9);
+        assert!((tp.dwells[0].seconds - 2500.0).abs() < 1e-9);
+    }
+    let tp = read(Some(DecimalPointInput::Increment), None);
+    assert!(said(&tp).is_empty(), "{:?}", tp.warnings);
+    assert_close(tp.points.last().unwrap().p, v(0.1, 0.05, -0.001), 1e-12);
+    // Only non-zero words tell: `X0 Y0` reads the same either way. Rotary words and I J K R
+    // are increments too (0.001°, 0.001 mm); LinuxCNC has no such reading.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G0 X0 Y0 Z0\nG1 X1. F100.\nG2 X3. I1000 J0\n",
+    );
+    let w = said(&tp);
+    assert!(
+        w.len() == 1 && w[0].line == 3 && w[0].message.contains("`I1000`"),
+        "{w:?}"
+    );
+    assert_close(tp.points.last().unwrap().p, v(3.0, 0.0, 0.0), 1e-9);
+    let tp = gcode(Dialect::Fanuc, "G21 G0 X0. Y0. Z0. A90000\n");
+    assert!(said(&tp)[0].message.contains("90°"), "{:?}", tp.warnings);
+    assert_eq!(tp.points[0].rotary.unwrap()[0], 90.0);
+    let tp = gcode(Dialect::LinuxCnc, "G21 G0 X100 Y0 Z0\n");
+    assert!(said(&tp).is_empty());
+    assert_eq!(tp.points[0].p.x, 100.0);
 }

@@ -1286,6 +1286,49 @@ fn a_warning_repeated_on_many_lines_is_printed_once_with_the_count() {
     );
 }
 
+/// `--decimal-point-input calculator` reads a Fanuc `X100` as 100 mm (round 3: the default
+/// increment reading made a 117.8 mm program 0.118 mm long, silently; it now warns once and
+/// says how to choose); a value other than increment or calculator is a usage error.
+#[test]
+fn decimal_point_input_on_the_command_line() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write(
+        "int.nc",
+        "O0001\nG21 G90 G94\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50 F600\nM30\n",
+    );
+    let args = [
+        "solve",
+        "-m",
+        "machine.json",
+        "int.nc",
+        "--stations",
+        STATIONS,
+        "--json",
+    ];
+    let length = |extra: &[&str]| {
+        let out = w.run(&[&args[..], extra].concat());
+        assert_success(&out);
+        (
+            num(
+                &parse_json(&stdout(&out), "stdout")["path_length_mm"],
+                "path_length_mm",
+            ),
+            stderr(&out),
+        )
+    };
+    let (l, err) = length(&[]);
+    assert!((l - 0.1178).abs() < 1e-3, "{l}");
+    assert_eq!(err.matches("decimal point").count(), 1, "{err}");
+    assert!(err.contains("int.nc:3:") && err.contains("--decimal-point-input calculator"));
+    let (l, err) = length(&["--decimal-point-input", "calculator"]);
+    assert!((l - (6.0 + 100f64.hypot(50.0))).abs() < 1e-6, "{l}");
+    assert!(!err.contains("decimal point"), "{err}");
+    let out = w.run(&[&args[..], &["--decimal-point-input", "dpi"]].concat());
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("calculator"), "{}", stderr(&out));
+}
+
 #[test]
 fn block_delete_on_the_command_line() {
     let w = Work::new();

@@ -1095,3 +1095,39 @@ fn program_units_is_mm_or_inch() {
         );
     }
 }
+
+/// `decimal_point_input`: "increment" or "calculator", how the control reads a Fanuc number
+/// without a decimal point (parameter 3401#0, DPI); anything else is an error naming the
+/// field and both choices.
+#[test]
+fn decimal_point_input_is_increment_or_calculator() {
+    use feedopt::machine::{DecimalPointInput, references_from_json};
+    let with = |u: &str| {
+        format!(
+            r#"{{"name": "xyz", "kinematics": {{"type": "xyz"}}, "decimal_point_input": {u},
+                "axes": {{"X": {{"velocity": 400, "acceleration": 2000}},
+                         "Y": {{"velocity": 400, "acceleration": 2000}},
+                         "Z": {{"velocity": 400, "acceleration": 2000}}}}}}"#
+        )
+    };
+    for (u, want) in [
+        ("\"increment\"", DecimalPointInput::Increment),
+        ("\"calculator\"", DecimalPointInput::Calculator),
+    ] {
+        let text = with(u);
+        let m = ok(&text);
+        let r = references_from_json(Path::new("m.json"), &text, &m).unwrap();
+        assert_eq!(r.decimal_point_input, Some(want));
+    }
+    for bad in ["\"dpi\"", "1", "true"] {
+        let text = with(bad);
+        let m = ok(&text);
+        let e = references_from_json(Path::new("m.json"), &text, &m)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("decimal_point_input") && e.contains("calculator") && e.contains("3401"),
+            "{bad}: {e}"
+        );
+    }
+}

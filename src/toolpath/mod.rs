@@ -318,6 +318,9 @@ pub struct MachineContext {
     /// The unit the control reads a program that selects none in (`program_units`), where the
     /// machine file gives it.
     pub program_units: Option<crate::machine::LengthUnit>,
+    /// How the control reads a Fanuc number without a decimal point (`decimal_point_input`),
+    /// where the machine file gives it.
+    pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
 
 impl MachineContext {
@@ -364,6 +367,7 @@ impl MachineContext {
                     .map(|(_, d)| *d)
             }),
             program_units: references.program_units,
+            decimal_point_input: references.decimal_point_input,
         }
     }
 
@@ -387,6 +391,9 @@ pub struct ReadOptions {
     pub block_delete: bool,
     /// The tool's diameter, mm ([`gcode::Settings::tool_diameter`]).
     pub tool_diameter: Option<f64>,
+    /// How a Fanuc number without a decimal point is read
+    /// ([`gcode::Settings::decimal_point_input`]; `None`: the machine file's, else increments).
+    pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
     /// The dialect of a G-code input whose content and extension name none (`None`: the
     /// default, LinuxCNC); [`Self::dialect`] overrides detection altogether.
     pub fallback_dialect: Option<gcode::Dialect>,
@@ -556,6 +563,7 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
                 cycle_aliases: options.cycle_aliases.clone(),
                 block_delete: options.block_delete,
                 tool_diameter: options.tool_diameter,
+                decimal_point_input: options.decimal_point_input,
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

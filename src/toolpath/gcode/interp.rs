@@ -13,6 +13,7 @@ use super::frames::{self, Frame};
 use super::lexer::{Item, Num};
 use super::*;
 use crate::error::{Error, Result};
+use crate::machine::DecimalPointInput;
 use crate::toolpath::{
     Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, SpindleChange, ToolChange,
     ToolSelect, Toolpath, Warning,
@@ -193,6 +194,14 @@ pub(super) struct Interpreter<'a> {
     pub(super) block_delete: bool,
     /// The tool's diameter, mm ([`super::Settings::tool_diameter`]).
     pub(super) tool_diameter: Option<f64>,
+    /// How a number without a decimal point is read: least input increments (the dialect's,
+    /// Fanuc), or `None` (as written: calculator-type input, and every other dialect).
+    increments: Option<IntegerIncrements>,
+    /// Whether the settings or the machine file chose `increments` (else it is the dialect's
+    /// default, and the first integer word read as increments is a warning); and whether that
+    /// warning was given.
+    increments_chosen: bool,
+    increments_warned: bool,
     /// The tool the last `T` word selected (`M6` puts it in the spindle).
     prepared_tool: Option<ToolSelect>,
     /// The work offset the program selected last (`G54`, `G54.1 P2`, …).
@@ -262,6 +271,9 @@ impl<'a> Interpreter<'a> {
             aliases_used: Vec::new(),
             block_delete: false,
             tool_diameter: None,
+            increments: spec.integer_increments,
+            increments_chosen: false,
+            increments_warned: false,
             prepared_tool: None,
             work_offset: None,
             tool_changes: Vec::new(),
@@ -269,6 +281,49 @@ impl<'a> Interpreter<'a> {
             m92: false,
             m92_warned: [false; 3],
         }
+    }
+
+    /// How numbers without a decimal point are read ([`super::Settings::decimal_point_input`]),
+    /// else the machine file's `decimal_point_input`, else the dialect's default.
+    pub(super) fn set_decimal_point_input(&mut self, setting: Option<DecimalPointInput>) {
+        let chosen = setting.or(self.machine.and_then(|m| m.decimal_point_input));
+        self.increments_chosen = chosen.is_some();
+        self.increments = match chosen {
+            Some(DecimalPointInput::Calculator) => None,
+            _ => self.spec.integer_increments,
+        };
+    }
+
+    /// The first axis word (or I J K R Q) without a decimal point that is read as least input
+    /// increments, when no setting chose that reading: one warning saying what it was read as
+    /// and how to choose the other reading.
+    fn note_increments(&mut self, line: usize, text: &str, num: Num, degrees: bool) {
+        let Some(inc) = self.increments else { return };
+        if self.increments_chosen || self.increments_warned || num.point || num.value == 0.0 {
+            return;
+        }
+        self.increments_warned = true;
+        let (step, unit) = match (degrees, self.units) {
+            (true, _) => (inc.deg, "°"),
+            (false, Units::Mm) => (inc.mm, " mm"),
+            (false, Units::Inch) => (inc.inch, " inch"),
+        };
+        // 117 × 0.001 is 0.11700000000000001 in binary: shown to the nanometre.
+        let read = crate::error::number((num.value * step * 1e9).round() / 1e9);
+        let written = crate::error::number(num.value);
+        let name = self.spec.name;
+        self.warn(
+            line,
+            format!(
+                "`{text}`: a number without a decimal point counts least input increments of \
+                 {step}{unit}, as a {name} control reads it by default (parameter 3401#0 DPI = \
+                 0): read as {read}{unit}, and so is every such word after it; a control set \
+                 for calculator-type input (DPI = 1) reads it as {written}{unit}: then set \
+                 \"decimal_point_input\": \"calculator\" in the machine file or pass \
+                 --decimal-point-input calculator (\"increment\" keeps this reading without \
+                 this warning)"
+            ),
+        );
     }
 
     fn error(&self, line: usize, message: impl Into<String>) -> Error {
@@ -392,6 +447,20 @@ impl<'a> Interpreter<'a> {
                     Ok(())
                 }
             };
+            match address {
+                Address::Axis(_)
+                | Address::IncrementalAxis(_)
+                | Address::ArcCentre(_)
+                | Address::Radius => {
+                    let degrees =
+                        matches!(address, Address::Axis(3..) | Address::IncrementalAxis(3..));
+                    self.note_increments(line, &text, num, degrees);
+                }
+                Address::Ignored if text.starts_with('Q') => {
+                    self.note_increments(line, &text, num, false);
+                }
+                _ => {}
+            }
             match address {
                 Address::Axis(i) => {
                     duplicate(block.axes[i].is_some())?;
@@ -601,7 +670,7 @@ impl<'a> Interpreter<'a> {
 
     /// Scale of a length word (mm per written unit), honouring integer increments.
     fn length(&self, num: Num) -> f64 {
-        let scale = match (self.spec.integer_increments, num.point) {
+        let scale = match (self.increments, num.point) {
             (Some(inc), false) => match self.units {
                 Units::Mm => inc.mm,
                 Units::Inch => inc.inch * MM_PER_INCH,
@@ -612,7 +681,7 @@ impl<'a> Interpreter<'a> {
     }
 
     fn angle(&self, num: Num) -> f64 {
-        match (self.spec.integer_increments, num.point) {
+        match (self.increments, num.point) {
             (Some(inc), false) => num.value * inc.deg,
             _ => num.value,
         }
@@ -857,7 +926,7 @@ impl<'a> Interpreter<'a> {
                 return Err(self.error(line, format!("F{f}: a feed cannot be negative")));
             }
             if self.feed_mode == FeedMode::PerRevolution
-                && self.spec.integer_increments.is_some()
+                && self.increments.is_some()
                 && block.feed_point == Some(false)
                 && f != 0.0
             {
@@ -1057,11 +1126,17 @@ impl<'a> Interpreter<'a> {
             }
         } else {
             match (block.letter('P'), block.axes[0]) {
+                // P counts milliseconds on Fanuc whatever DPI says (P takes no decimal
+                // point); X is seconds, in increments of 0.001 s when written without one
+                // (`G4 X2500` is 2.5 s) unless the input is calculator-type.
                 (Some(p), _) if self.spec.integer_increments.is_some() && !p.point => {
                     p.value / 1000.0
                 }
                 (Some(p), _) => p.value,
-                (None, Some(x)) => x.value,
+                (None, Some(x)) => match self.increments {
+                    Some(_) if !x.point => x.value / 1000.0,
+                    _ => x.value,
+                },
                 (None, None) => return Err(self.error(line, "G4 without P (the dwell time)")),
             }
         };
@@ -1109,7 +1184,7 @@ impl<'a> Interpreter<'a> {
     fn tilted_plane(&mut self, line: usize, block: &Block) -> Result<()> {
         let origin: [f64; 3] =
             std::array::from_fn(|i| block.axes[i].map_or(0.0, |n| self.length(n)));
-        let angle = |i: usize| block.centre[i].map_or(0.0, |n| n.value);
+        let angle = |i: usize| block.centre[i].map_or(0.0, |n| self.angle(n));
         if block.axes[3..].iter().any(Option::is_some) {
             return Err(self.error(line, "G68.2 with A/B/C words"));
         }

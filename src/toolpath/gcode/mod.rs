@@ -18,8 +18,19 @@
 //!   words; `G20`/`G21`; axis words before any G0–G3 are an error (LinuxCNC starts in G80).
 //! * [`FANUC`]: comments `( … )`, `;` ends a block; spaces ignored; TCP on `G43.4` (rotary
 //!   words) or `G43.5` (tool vector: `I J K` on G0/G1 blocks), off `G49`, `G43`, `G44`;
-//!   `G20`/`G21`; the motion mode starts as G0; a number without a decimal point in X Y Z A B C
-//!   I J K R counts least input increments (0.001 mm, 0.0001 inch, 0.001°), Fanuc's default.
+//!   `G20`/`G21`; the motion mode starts as G0. **Numbers without a decimal point**: in X Y Z
+//!   A B C, I J K (arc centres and the `G68.2` angles; a `G43.5` tool vector is normalised, so
+//!   its scale does not matter), R and Q one counts least input increments (0.001 mm, 0.0001
+//!   inch, 0.001°; `G4 X2500` is 2.5 s), Fanuc's default with parameter 3401#0 DPI = 0.
+//!   Calculator-type input (DPI = 1: `X100` is 100 mm, as LinuxCNC, grbl and Mach3 read it) is
+//!   chosen by [`Settings::decimal_point_input`] (the CLI's `--decimal-point-input`) or the
+//!   machine file's `decimal_point_input` (the settings win). Where neither chooses, the first
+//!   such word whose value is not 0 is one warning (not one per word) naming it, what it was
+//!   read as and how to choose (a 0 reads the same either way). Read as written under both:
+//!   F under G94 (F is in whole mm/min, or inch/min under G20, on these controls: `F600` is
+//!   600 mm/min), `G4 P` and cycle `P` (milliseconds: P takes no decimal point), S, T, H, D,
+//!   N, the repeat counts K and L, and program numbers. An F without a decimal point under
+//!   `G95` is an error (see Feeds).
 //! * [`SINUMERIK`]: `;` comments (parentheses are not comments); spaces separate words, which
 //!   may be keywords (`TRAORI`, `MSG("…")`) or `NAME=value`; TCP on `TRAORI`, off `TRAFOOF`;
 //!   tool vector `A3= B3= C3=`; `CR=` radius, `TURN=` extra turns; `G70`/`G71` inch/mm for
@@ -291,6 +302,11 @@ pub struct Settings {
     /// (Klartext `CYCL DEF 208`, bore milling): a control takes it from its tool table, which
     /// the program does not carry. `None`: such a cycle is an error that says so.
     pub tool_diameter: Option<f64>,
+    /// How a Fanuc control reads a number without a decimal point (parameter 3401#0, DPI),
+    /// before the machine file's `decimal_point_input`. Where neither says, as least input
+    /// increments (Fanuc's default), with one warning at the first such word whose value is
+    /// not 0. The other dialects have no such setting and ignore it.
+    pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
 
 /// As [`parse_assumed`], under the operator's `settings`.
@@ -308,6 +324,7 @@ pub fn parse_configured(
     interp.cycle_aliases = settings.cycle_aliases.clone();
     interp.block_delete = settings.block_delete;
     interp.tool_diameter = settings.tool_diameter;
+    interp.set_decimal_point_input(settings.decimal_point_input);
     program.run(spec, &mut interp, source)?;
     interp.note_units();
     let assumed = interp.assumed;
