@@ -917,6 +917,13 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
             3,
             &["G505"][..],
         ),
+        // LinuxCNC's eighth and ninth offsets (they were taken as codes without effect).
+        (
+            Dialect::LinuxCnc,
+            "G21 G90 G54\nG0 X0 Y0 Z5\nG59.2\nG0 X1\nM2\n",
+            3,
+            &["G59.2", "G54"][..],
+        ),
     ] {
         let w = warned(&ok_in(dialect, text));
         assert!(

@@ -131,7 +131,7 @@
 //!
 //! Line numbers `N`; `S`, `T`, `H`, `D` and the other parameter letters of the table; M codes
 //! of the table (spindle, coolant, tool change, pauses; Sinumerik `M202(0.0059)` arguments);
-//! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (LinuxCNC `G59.1`, Fanuc
+//! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
 //! `G54.1 P…`, Sinumerik `G505`–`G599`; a change from one to another is a warning, as the move
 //! between them is sized as if they were equal), path control
 //! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
