@@ -830,3 +830,209 @@ fn fanuc_integer_words_are_increments_said_once_or_calculator_input_by_setting()
     assert!(said(&tp).is_empty());
     assert_eq!(tp.points[0].p.x, 100.0);
 }
+
+fn xs(tp: &Toolpath) -> Vec<f64> {
+    tp.points.iter().map(|p| p.p.x).collect()
+}
+
+/// `G10 L2` on the work offset in force after moves made in it (round 3,
+/// repro_g10l2_active.ngc): the control moves 100 mm more than the program's coordinates say,
+/// by how much depends on the offset's old value, which the program does not give; it was a
+/// warning saying the coordinates are used as written. It is an error naming the G10 and the
+/// move. Set before the first move (CAMotics writes `G10 L2 P1 X0 Y0 Z0` at the top), or on
+/// an offset the program does not move in afterwards, it is none; two offsets set in machine
+/// coordinates lie exactly that far apart.
+#[test]
+fn g10_l2_on_the_offset_in_force_is_followed_or_refused() {
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21 G90 G54\nG0 X0 Y0 Z10\nG10 L2 P1 X100\nG0 X0\nG1 X10 F600\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap_err();
+    let m = message(e);
+    for needle in [
+        "t.ngc:3:",
+        "`G10 L2 P1 X100`",
+        "G54",
+        "line 4",
+        "G10 L20",
+        "G91 G10 L2",
+    ] {
+        assert!(m.contains(needle), "{needle}: {m}");
+    }
+    // Before the first move: the offsets' values place the program (no word said).
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG10 L2 P1 X0 Y0 Z0\nG10 L2 P2 X0 Y0 Z0\nG55\nG10 L2 P2 X0 Y0 Z0\nG55\n\
+         G0 X1 Y1 Z1\nG1 X2 F600\nM2\n",
+    );
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    assert_eq!(xs(&tp), [1.0, 2.0]);
+    // Two offsets set in machine coordinates: the move between them is 150 mm, said nowhere.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG10 L2 P1 X100 Y0 Z0\nG10 L2 P2 X250 Y0 Z0\nG54 G0 X0 Y0 Z0\nG55 G0 X0\n\
+         G54 G0 X1\nM2\n",
+    );
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+    assert_eq!(xs(&tp), [100.0, 250.0, 101.0]);
+    // Set on X only, G55's Y and Z are the control's: taken as G54's, and said.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG10 L2 P1 X100\nG10 L2 P2 X250\nG54 G0 X0 Y0 Z0\nG55 G0 X0\nM2\n",
+    );
+    assert_eq!(xs(&tp), [100.0, 250.0]);
+    assert!(
+        tp.warnings.len() == 1 && tp.warnings[0].line == 5,
+        "{:?}",
+        tp.warnings
+    );
+    // An offset set after moves but not moved in afterwards: no error.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G54 G0 X0 Y0 Z0\nG10 L2 P2 X100\nG1 X10 F600\nM2\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 10.0]);
+    // … unless the program then moves in it: the move into G55 is the one not known.
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21 G90 G54 G0 X0 Y0 Z0\nG10 L2 P2 X100\nG1 X10 F600\nG55\nG1 X0\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap_err();
+    let m = message(e);
+    assert!(
+        m.contains("t.ngc:2:") && m.contains("G55") && m.contains("line 5"),
+        "{m}"
+    );
+    // The reverse: moves in an offset set in machine coordinates, then back in the one the
+    // program started in (the control's own values). (An offset never named before is taken
+    // as equal to the one in force, with a warning, as any change of offset is.)
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21 G90\nG10 L2 P2 X100 Y0 Z0\nG55 G0 X0 Y0 Z0\nG54\nG0 X1\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap_err();
+    let m = message(e);
+    assert!(
+        m.contains("t.ngc:2:") && m.contains("line 5") && m.contains("does not set"),
+        "{m}"
+    );
+    // G53 stands outside: a machine-coordinate move between them does not count.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG10 L2 P1 X0 Y0 Z0\nG0 X5 Y0 Z0\nG53 G0 Z0\nG0 X6\nM2\n",
+    );
+    assert_eq!(xs(&tp), [5.0, 5.0, 6.0]);
+}
+
+/// Offsets changed relative to the current one are exact whatever the old values: LinuxCNC
+/// `G10 L20` (the current position becomes the given coordinates) and Fanuc `G91 G10 L2` (an
+/// increment; round 3's G10 L2 P1 X100 written so is the 110 mm the control runs), and
+/// Fanuc's external offset `P0` under G91. Tool data (`G10 L1`, `L10`, `L11`) moves nothing
+/// and is said; a G10 L2 without P, or with a P naming no offset or a rotation R, is an error.
+#[test]
+fn g10_relative_to_the_current_offset_is_exact() {
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X10 Y0 Z0\nG10 L20 P1 X0\nG0 X5\nG10 L20 P0 Y2\nG0 Y3\nM2\n",
+    );
+    assert_eq!(xs(&tp), [10.0, 15.0, 15.0]);
+    assert_eq!(tp.points.last().map(|p| p.p.y), Some(1.0));
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G54 G0 X0. Y0. Z10.\nG91 G10 L2 P1 X100.\nG90 G0 X0.\nG1 X10. F600.\nM30\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 100.0, 110.0]);
+    let path: f64 = tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
+    assert!((path - 110.0).abs() < 1e-9, "{path}");
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0. Y0. Z0.\nG91 G10 L2 P0 Z-2.\nG90 G0 Z0.\nM30\n",
+    );
+    assert_eq!(tp.points.last().map(|p| p.p.z), Some(-2.0));
+    // Fanuc L20 sets the extended offsets: G54.1 P3 in machine coordinates, before any move.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\nG10 L20 P3 X40.\nG54.1 P3 G0 X0. Y0. Z0.\nG1 X1. F100.\nM30\n",
+    );
+    assert_eq!(xs(&tp), [40.0, 41.0]);
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X0 Y0 Z0\nG10 L1 P1 Z1.5\nG10 L10 P1 Z1.5\nG1 X1 F100\nM2\n",
+    );
+    let said: Vec<usize> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("tool data"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(said, [2, 3]);
+    for (dialect, text, line, needle) in [
+        (
+            Dialect::LinuxCnc,
+            "G0 X0 Y0 Z0\nG10 L2 X1\n",
+            2,
+            "without P",
+        ),
+        (Dialect::LinuxCnc, "G0 X0 Y0 Z0\nG10 L2 P10 X1\n", 2, "P9"),
+        (Dialect::Fanuc, "G0 X0. Y0. Z0.\nG10 L2 P7 X1.\n", 2, "P6"),
+        (Dialect::LinuxCnc, "G10 L2 P1 X1 R30\n", 1, "R30"),
+        (
+            Dialect::LinuxCnc,
+            "G21 G90\nG10 L20 P1 X0\n",
+            2,
+            "not known",
+        ),
+    ] {
+        let e = parse(Path::new("t.ngc"), text, dialect).expect_err(text);
+        let m = message(e);
+        assert!(
+            m.contains(&format!("t.ngc:{line}:")) && m.contains(needle),
+            "{text}: {m}"
+        );
+    }
+}
+
+/// `G52`, the local shift: round 3's `G15 G52 X0 Y0` (Fusion's safety block,
+/// fusion_efgarro_6686.nc:18) cancels none and was refused; it is read. A shift moves the
+/// points by it, `G52 X0` cancels it, LinuxCNC's `G92.1` too; a G52 without axis words is an
+/// error, and so is one under G91 while a shift is in force (an increment on some controls,
+/// a value on others).
+#[test]
+fn g52_shifts_every_offset_and_zero_cancels() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1000\nG21 G90 G17 G94\nG15 G52 X0 Y0\nG0 X0. Y0. Z10.\nG1 X10. F600.\nM30\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 10.0]);
+    for dialect in [Dialect::Fanuc, Dialect::LinuxCnc] {
+        let tp = gcode(
+            dialect,
+            "G21 G90 G0 X0. Y0. Z0.\nG52 X5. Y-1.\nG0 X0.\nG0 Y0.\nG55\nG0 X1.\nG52 X0 Y0\n\
+             G0 X0.\n",
+        );
+        // The shift leaves the tool where it is: Y moves when Y is programmed.
+        assert_eq!(xs(&tp), [0.0, 5.0, 5.0, 6.0, 0.0], "{dialect:?}");
+        let ys: Vec<f64> = tp.points.iter().map(|p| p.p.y).collect();
+        assert_eq!(ys, [0.0, 0.0, -1.0, -1.0, -1.0], "{dialect:?}");
+    }
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X0 Y0 Z0\nG91 G52 X5\nG90 G0 X0\nG92.1\nG0 X0\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 5.0, 0.0]);
+    for (text, line, needle) in [
+        ("G21 G0 X0 Y0 Z0\nG52\n", 2, "without axis words"),
+        ("G21 G0 X0 Y0 Z0\nG52 X5\nG91 G52 X1\n", 3, "G90"),
+    ] {
+        let e = parse(Path::new("t.ngc"), text, Dialect::LinuxCnc).expect_err(text);
+        let m = message(e);
+        assert!(
+            m.contains(&format!("t.ngc:{line}:")) && m.contains(needle),
+            "{text}: {m}"
+        );
+    }
+}

@@ -308,16 +308,37 @@ pub enum Action {
     /// Klartext `MB MAX`: retract to the travel limit.
     RetractMax,
     /// A work offset (`G54`–`G59`, Fanuc `G54.1 P…`, Sinumerik `G505`–`G599`): the program's
-    /// coordinates are read in the frame it selects, whose values feedopt does not know. A
-    /// change from one to another is a warning: the move between them is sized as if the two
-    /// offsets were equal.
+    /// coordinates are read in the frame it selects (see [`super::offsets`]: a change to one
+    /// whose values the program does not give is a warning, the move between them sized as if
+    /// the two were equal).
     WorkOffset,
+    /// `G10`: with `L2` (and `L20`) sets a work offset's values (see [`super::offsets`]); the
+    /// P numbers name the offsets as the dialect does. Other `L` values set tool data or
+    /// parameters the toolpath does not use (a warning).
+    SetOffset(OffsetNumbering),
+    /// `G52`: the local shift of every work offset, by the block's axis words.
+    LocalOffset,
+    /// LinuxCNC `G92.1`, `G92.2`: the `G52`/`G92` shift is cancelled.
+    LocalOffsetCancel,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
     Note(&'static str),
     /// Rejected with this error.
     Unsupported(&'static str),
+}
+
+/// What `G10 L2 P…` and `G10 L20 P…` set, by dialect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OffsetNumbering {
+    /// LinuxCNC: `L2` sets P1–P9 = `G54`–`G59.3` (P0 the one in force) to machine
+    /// coordinates, whatever G90/G91; `L20` sets them so that the current position has the
+    /// given coordinates.
+    LinuxCnc,
+    /// Fanuc: `L2` sets P1–P6 = `G54`–`G59` (P0 the external offset, added to all) and `L20`
+    /// the extended offsets `G54.1 P1`… to machine coordinates, or under G91 moves them by
+    /// the values.
+    Fanuc,
 }
 
 /// Klartext path functions (see [`super::klartext`]).
@@ -439,8 +460,9 @@ use Action::{
 use Address::{ArcCentre, Axis};
 
 const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
-const OFFSETS: &str = "coordinate offsets that shift program coordinates (G92, G52) are not \
-                       supported";
+const OFFSETS: &str = "G92 (the current position taken as the given coordinates, a shift of \
+                       every offset) is not supported: set the work offset with G10 L2 or \
+                       G10 L20, or post the program without it";
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution is not supported";
@@ -448,8 +470,6 @@ const COMP: &str = "cutter radius compensation is not applied: the programmed pa
 const G60: &str = "single-direction positioning approaches the end point from one side, past \
                    it by an amount the control's parameters set; that approach is not modelled: \
                    the move goes straight to its end point";
-const G10: &str = "G10 sets a tool or work offset and moves nothing; the program's coordinates \
-                   are used as written";
 const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
                    quill); the move would be lost: post the program without it";
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
@@ -518,7 +538,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("5.3", Unsup(SPLINES)),
         ("7", Unsup("lathe diameter mode (G7) is not supported")),
         ("8", Action::Ignored),
-        ("10", NoMotion(G10)),
+        ("10", Action::SetOffset(OffsetNumbering::LinuxCnc)),
         ("17", Action::Plane(Plane::Xy)),
         ("18", Action::Plane(Plane::Zx)),
         ("19", Action::Plane(Plane::Yz)),
@@ -558,7 +578,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("43.1", Action::Ignored),
         ("43.2", Action::Ignored),
         ("49", Action::Ignored),
-        ("52", Unsup(OFFSETS)),
+        ("52", Action::LocalOffset),
         ("53", MachineCoordinates),
         ("54..59", Action::WorkOffset),
         ("59.1", Action::WorkOffset),
@@ -592,9 +612,15 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("90.1", ArcDistance(Distance::Absolute)),
         ("91.1", ArcDistance(Distance::Incremental)),
         ("92", Unsup(OFFSETS)),
-        ("92.1", Action::Ignored),
-        ("92.2", Action::Ignored),
-        ("92.3", Unsup(OFFSETS)),
+        ("92.1", Action::LocalOffsetCancel),
+        ("92.2", Action::LocalOffsetCancel),
+        (
+            "92.3",
+            Unsup(
+                "G92.3 (the G52/G92 shift restored from parameters 5211–5219, whose values the \
+                 program does not give) is not supported",
+            ),
+        ),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
         ("95", Fm(FeedMode::PerRevolution)),
@@ -677,7 +703,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("6.2", Unsup(SPLINES)),
         ("8", Action::Ignored),
         ("9", Action::Ignored),
-        ("10", NoMotion(G10)),
+        ("10", Action::SetOffset(OffsetNumbering::Fanuc)),
         ("11", Action::Ignored),
         ("15", Action::Ignored),
         ("16", Unsup(TRANSFORM)),
@@ -717,7 +743,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("51", Unsup(TRANSFORM)),
         ("50.1", Action::Ignored),
         ("51.1", Unsup(TRANSFORM)),
-        ("52", Unsup(OFFSETS)),
+        ("52", Action::LocalOffset),
         ("53", MachineCoordinates),
         ("53.1", Action::Ignored),
         ("54..59", Action::WorkOffset),

@@ -11,6 +11,7 @@ use super::dialect::*;
 use super::expr::Variables;
 use super::frames::{self, Frame};
 use super::lexer::{Item, Num};
+use super::offsets::{self, WorkOffsets};
 use super::*;
 use crate::error::{Error, Result};
 use crate::machine::DecimalPointInput;
@@ -120,6 +121,18 @@ pub(super) struct Call {
 
 const AXIS_NAMES: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
 
+/// A code as written (`G054`, `g55`) in its canonical form (`G54`, `G55`), so that offsets
+/// written differently compare equal.
+fn code_name(text: &str) -> String {
+    let mut chars = text.chars();
+    let letter = chars.next().map_or('G', |c| c.to_ascii_uppercase());
+    match chars.as_str().parse::<f64>() {
+        Ok(v) if v.fract() == 0.0 => format!("{letter}{}", v as u64),
+        Ok(v) => format!("{letter}{v}"),
+        Err(_) => text.to_ascii_uppercase(),
+    }
+}
+
 /// Largest coordinate a program may use, mm (and degrees of rotary travel, ×1000): past it a
 /// word is an error naming it, so that arc chord counts and cycle pecks stay bounded. The
 /// same bound as every reader's ([`crate::toolpath::MAX_COORDINATE_MM`]).
@@ -204,8 +217,14 @@ pub(super) struct Interpreter<'a> {
     increments_warned: bool,
     /// The tool the last `T` word selected (`M6` puts it in the spindle).
     prepared_tool: Option<ToolSelect>,
-    /// The work offset the program selected last (`G54`, `G54.1 P2`, …).
-    work_offset: Option<String>,
+    /// The work offsets, `G10` and `G52` ([`offsets`]).
+    offsets: WorkOffsets,
+    /// The point being made is in machine coordinates (`G53`, a reference point): outside the
+    /// work offsets' check.
+    machine_point: bool,
+    /// A point made across offsets on different bases ([`offsets::Mismatch`]): the error the
+    /// block returns.
+    offset_error: Option<Error>,
     /// The tool changes so far.
     pub(super) tool_changes: Vec<ToolChange>,
     /// The spindle speed changes so far.
@@ -275,7 +294,9 @@ impl<'a> Interpreter<'a> {
             increments_chosen: false,
             increments_warned: false,
             prepared_tool: None,
-            work_offset: None,
+            offsets: WorkOffsets::new("G54"),
+            machine_point: false,
+            offset_error: None,
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
             m92: false,
@@ -708,6 +729,16 @@ impl<'a> Interpreter<'a> {
 
     /// Interprets one block.
     pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
+        let done = self.block_words(line, items);
+        match self.offset_error.take() {
+            Some(e) => Err(e),
+            None => done,
+        }
+    }
+
+    /// Interprets one block's words ([`Self::block`] adds the work offsets' check of the
+    /// points they made).
+    fn block_words(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let block = self.collect(line, items)?;
         self.m92 = false;
 
@@ -728,6 +759,8 @@ impl<'a> Interpreter<'a> {
         let mut klartext = KlartextWords::default();
         let mut tool_change: Option<&str> = None;
         let mut set_tool = false;
+        let mut set_offset: Option<(&str, OffsetNumbering)> = None;
+        let mut local_offset = false;
         if let Some(name) = &block.tool_name {
             self.prepared_tool = Some(ToolSelect::Name(name.clone()));
         } else if self.spec.spaces != Spaces::Klartext
@@ -856,22 +889,26 @@ impl<'a> Interpreter<'a> {
                 Action::RetractMax => klartext.retract_max = true,
                 Action::WorkOffset => {
                     // G54.1 P n: the P word names the offset.
+                    let code = code_name(text);
                     let name = match block.letter('P') {
-                        Some(p) if text.contains('.') => format!("{text} P{}", p.value),
-                        _ => text.clone(),
+                        Some(p) if code.contains('.') => format!("{code} P{}", p.value),
+                        _ => code,
                     };
-                    if let Some(prev) = self.work_offset.replace(name.clone())
-                        && prev != name
-                    {
-                        self.warn(
-                            line,
-                            format!(
-                                "{name}: another work offset than {prev}, whose values feedopt \
-                                 does not know: the move to the next point is sized as if the \
-                                 two were equal (the program's coordinates are used as written)"
-                            ),
-                        );
+                    let before = self.offsets.shift();
+                    let used = if self.saw_rotary { 0..6 } else { 0..3 };
+                    if let Some(warning) = self.offsets.select(&name, used) {
+                        self.warn(line, warning);
                     }
+                    self.shift_changed(before);
+                }
+                Action::SetOffset(numbering) => set_offset = Some((text.as_str(), numbering)),
+                Action::LocalOffset => local_offset = true,
+                Action::LocalOffsetCancel => {
+                    let before = self.offsets.shift();
+                    for i in 0..6 {
+                        self.offsets.set_local(i, 0.0);
+                    }
+                    self.shift_changed(before);
                 }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
@@ -962,6 +999,14 @@ impl<'a> Interpreter<'a> {
             return self
                 .frame(line, text, op, &block)
                 .map(|()| self.end_if(end));
+        }
+        if let Some((text, numbering)) = set_offset {
+            return self
+                .g10(line, text, numbering, &block)
+                .map(|()| self.end_if(end));
+        }
+        if local_offset {
+            return self.g52(line, &block).map(|()| self.end_if(end));
         }
         if tilted_plane {
             return self.tilted_plane(line, &block).map(|()| self.end_if(end));
@@ -1195,12 +1240,280 @@ impl<'a> Interpreter<'a> {
         Ok(())
     }
 
-    /// The frame from program coordinates to workpiece coordinates.
-    fn frame_now(&self) -> Frame {
+    /// The frame from program coordinates to workpiece coordinates, without the work
+    /// offsets' shift.
+    fn frame_inner(&self) -> Frame {
         match &self.swivel {
             Some(s) => s.then_inner(&self.programmable),
             None => self.programmable,
         }
+    }
+
+    /// The frame from program coordinates to toolpath coordinates: the frames, then the work
+    /// offsets' shift ([`offsets`]; none until a program sets one).
+    fn frame_now(&self) -> Frame {
+        let inner = self.frame_inner();
+        let s = self.offsets.shift();
+        if s[..3] == [0.0; 3] {
+            inner
+        } else {
+            Frame::translation(Vector3::new(s[0], s[1], s[2])).then_inner(&inner)
+        }
+    }
+
+    /// The work offsets' shift was `before` and is now another: the position stays where it
+    /// is, so its program coordinates change (LinuxCNC and Fanuc show the new ones at once).
+    fn shift_changed(&mut self, before: [f64; 6]) {
+        let after = self.offsets.shift();
+        if after == before {
+            return;
+        }
+        let inner = self.frame_inner();
+        let d = Vector3::new(
+            before[0] - after[0],
+            before[1] - after[1],
+            before[2] - after[2],
+        );
+        let q =
+            inner.invert(&(inner.apply(&Vector3::new(self.pos[0], self.pos[1], self.pos[2])) + d));
+        self.pos[..3].copy_from_slice(q.as_slice());
+        for i in 3..6 {
+            self.pos[i] += before[i] - after[i];
+        }
+    }
+
+    /// `G10 L2 P…` / `G10 L20 P…`: sets a work offset ([`offsets`]); other `L` values set
+    /// tool data or parameters, which the toolpath does not use (a warning).
+    fn g10(
+        &mut self,
+        line: usize,
+        text: &str,
+        numbering: OffsetNumbering,
+        block: &Block,
+    ) -> Result<()> {
+        let l = block.letter('L').map(|n| n.value);
+        let l20 = match l {
+            Some(2.0) => false,
+            Some(20.0) => true,
+            _ => {
+                let which = l.map_or(String::new(), |v| format!(" L{v}"));
+                self.warn(
+                    line,
+                    format!(
+                        "{text}{which}: sets tool data or control parameters, which the \
+                         toolpath does not use; nothing moves"
+                    ),
+                );
+                return Ok(());
+            }
+        };
+        let code = if l20 { "G10 L20" } else { "G10 L2" };
+        let Some(p) = block.letter('P') else {
+            return Err(self.error(
+                line,
+                format!("{code} without P (the offset it sets): add P, e.g. {code} P1 X0 Y0 Z0"),
+            ));
+        };
+        let mut written = format!("{code} P{}", p.value);
+        for (i, axis) in block.axes.iter().enumerate() {
+            if let Some(n) = axis {
+                written.push_str(&format!(
+                    " {}{}",
+                    AXIS_NAMES[i],
+                    crate::error::number(n.value)
+                ));
+            }
+        }
+        if let Some(r) = block.radius
+            && r.value != 0.0
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{written} R{}`: R turns the coordinate system about Z, which feedopt does \
+                     not follow: post the program without the rotation",
+                    crate::error::number(r.value)
+                ),
+            ));
+        }
+        if self.swivel.is_some() {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{written}` under a tilted plane (G68.2): set work offsets before the plane"
+                ),
+            ));
+        }
+        const LINUXCNC: [&str; 9] = [
+            "G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3",
+        ];
+        let whole = (p.value >= 0.0 && p.value.fract() == 0.0).then_some(p.value as usize);
+        let target = match (numbering, l20, whole) {
+            (OffsetNumbering::LinuxCnc, _, Some(0)) => {
+                offsets::Target::Offset(self.offsets.active().to_string())
+            }
+            (OffsetNumbering::LinuxCnc, _, Some(n @ 1..=9)) => {
+                offsets::Target::Offset(LINUXCNC[n - 1].to_string())
+            }
+            (OffsetNumbering::Fanuc, false, Some(0)) => offsets::Target::External,
+            (OffsetNumbering::Fanuc, false, Some(n @ 1..=6)) => {
+                offsets::Target::Offset(LINUXCNC[n - 1].to_string())
+            }
+            (OffsetNumbering::Fanuc, true, Some(n @ 1..=300)) => {
+                offsets::Target::Offset(format!("G54.1 P{n}"))
+            }
+            _ => {
+                let range = match (numbering, l20) {
+                    (OffsetNumbering::LinuxCnc, _) => "P0 (the offset in force) to P9 (G59.3)",
+                    (OffsetNumbering::Fanuc, false) => {
+                        "P0 (the external offset) or P1 (G54) to P6 (G59)"
+                    }
+                    (OffsetNumbering::Fanuc, true) => "P1 to P300 (G54.1 P1 …)",
+                };
+                return Err(self.error(
+                    line,
+                    format!("`{written}`: P names no work offset; expected {range}"),
+                ));
+            }
+        };
+        let offset = match &target {
+            offsets::Target::Offset(name) => name.clone(),
+            offsets::Target::External => "the external offset".to_string(),
+        };
+        let cause = offsets::Cause {
+            line,
+            text: written.clone(),
+            offset,
+        };
+        let work = self.machine.map_or([0.0; 3], |c| c.work_offset);
+        let here = {
+            let p = self
+                .frame_now()
+                .apply(&Vector3::new(self.pos[0], self.pos[1], self.pos[2]));
+            let s = self.offsets.shift();
+            [
+                p.x,
+                p.y,
+                p.z,
+                self.pos[3] + s[3],
+                self.pos[4] + s[4],
+                self.pos[5] + s[5],
+            ]
+        };
+        let incremental =
+            numbering == OffsetNumbering::Fanuc && self.distance == Distance::Incremental;
+        let before = self.offsets.shift();
+        for i in 0..6 {
+            let Some(n) = block.axes[i] else { continue };
+            let v = if i < 3 { self.length(n) } else { self.angle(n) };
+            let how = if l20 && numbering == OffsetNumbering::LinuxCnc {
+                if i < 3 && !self.known[i] {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{written}` makes the current position {}{} in the offset, but \
+                             the current {} is not known yet (no absolute {} programmed \
+                             before): program a move first",
+                            AXIS_NAMES[i],
+                            crate::error::number(v),
+                            AXIS_NAMES[i],
+                            AXIS_NAMES[i]
+                        ),
+                    ));
+                }
+                offsets::Setting::Position {
+                    here: here[i],
+                    given: v,
+                }
+            } else if incremental {
+                offsets::Setting::Increment(v)
+            } else {
+                let w = match target {
+                    offsets::Target::Offset(_) if i < 3 => work[i],
+                    _ => 0.0,
+                };
+                offsets::Setting::Machine(v - w)
+            };
+            self.offsets.set(&target, i, how, &cause);
+        }
+        self.shift_changed(before);
+        Ok(())
+    }
+
+    /// `G52 X… Y…`: the local shift of every work offset on the named axes (`G52 X0 Y0`
+    /// cancels it). Under G91 the words would be increments on some controls and values on
+    /// others: the block is an error unless both read the same (no shift in force on the
+    /// named axes).
+    fn g52(&mut self, line: usize, block: &Block) -> Result<()> {
+        if block.axes.iter().all(Option::is_none) {
+            return Err(self.error(
+                line,
+                "G52 without axis words: name the axes it shifts (G52 X0 Y0 cancels the local \
+                 shift)",
+            ));
+        }
+        let before = self.offsets.shift();
+        for i in 0..6 {
+            let Some(n) = block.axes[i] else { continue };
+            let v = if i < 3 { self.length(n) } else { self.angle(n) };
+            if v == self.offsets.local(i) {
+                continue;
+            }
+            if self.swivel.is_some() {
+                return Err(self.error(
+                    line,
+                    "G52 under a tilted plane (G68.2): set the local shift before the plane",
+                ));
+            }
+            if self.distance == Distance::Incremental && self.offsets.local(i) != 0.0 {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "G52 {}{} under G91 while a local shift is in force on {}: controls read \
+                         it as a new value or as an increment; program G52 under G90",
+                        AXIS_NAMES[i],
+                        crate::error::number(n.value),
+                        AXIS_NAMES[i]
+                    ),
+                ));
+            }
+            self.offsets.set_local(i, v);
+        }
+        self.shift_changed(before);
+        Ok(())
+    }
+
+    /// The error of a point made across offsets on different bases ([`offsets::Mismatch`]),
+    /// at the `G10` behind it (the move at `line`).
+    fn offset_mismatch(&self, line: usize, m: offsets::Mismatch) -> Error {
+        let axis = AXIS_NAMES[m.axis];
+        let Some(cause) = m.cause else {
+            return self.error(
+                line,
+                format!(
+                    "the move's length in {axis} depends on work offsets feedopt does not know"
+                ),
+            );
+        };
+        let side = if m.ends_on_machine {
+            format!(
+                "the move at line {line} starts from a point made with the offsets as the \
+                 control had them before"
+            )
+        } else {
+            format!("the move at line {line} ends at a point in an offset the program does not set")
+        };
+        Error::parse(
+            self.source,
+            cause.line,
+            format!(
+                "`{}`: sets {} in machine coordinates, and {side}, whose values feedopt does not \
+                 know, so that move's length in {axis} is not known. Set the offsets the program \
+                 moves in with G10 L2 before its first move, or relative to the current position \
+                 (G10 L20 on LinuxCNC, G91 G10 L2 on Fanuc)",
+                cause.text, cause.offset
+            ),
+        )
     }
 
     /// The M92 datum of axis `i` (X Y Z), machine coordinates: the machine file's
@@ -1342,7 +1655,10 @@ impl<'a> Interpreter<'a> {
         if via != self.pos {
             self.push(line, &via, Feed::Rapid);
         }
+        // The reference point is a machine position: outside the work offsets' check.
+        self.machine_point = true;
         self.push(line, &target, Feed::Rapid);
+        self.machine_point = false;
         self.pos = target;
         for i in 0..3 {
             self.known[i] = true;
@@ -1791,7 +2107,10 @@ impl<'a> Interpreter<'a> {
             self.arc(line, motion, block, start, end)?;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
+            // A G53 point is a machine position: outside the work offsets' check.
+            self.machine_point = machine;
             self.push(line, &end, feed);
+            self.machine_point = false;
             let (a, b) = (end[0] - start[0], end[1] - start[1]);
             let len = a.hypot(b);
             self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
@@ -1831,6 +2150,14 @@ impl<'a> Interpreter<'a> {
     }
 
     fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
+        if !self.machine_point {
+            let axes = if self.saw_rotary { 0..6 } else { 0..3 };
+            if let Err(m) = self.offsets.check(axes)
+                && self.offset_error.is_none()
+            {
+                self.offset_error = Some(self.offset_mismatch(line, m));
+            }
+        }
         let frame = self.frame_now();
         if let Some(o) = self.klartext.stay_orientation {
             // Klartext PLANE … STAY: the rotary axes have not moved yet; the tool keeps the
@@ -1845,12 +2172,11 @@ impl<'a> Interpreter<'a> {
             });
             return;
         }
+        // Rotary axes shifted by their work offsets (none unless a G10 or G52 gives one).
+        let s = self.offsets.shift();
+        let q_rot = [q[3] + s[3], q[4] + s[4], q[5] + s[5]];
         let (p, o, rotary) = if frame.is_identity() {
-            (
-                Vector3::new(q[0], q[1], q[2]),
-                self.vector,
-                Some([q[3], q[4], q[5]]),
-            )
+            (Vector3::new(q[0], q[1], q[2]), self.vector, Some(q_rot))
         } else {
             let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
             let o = frame.r * self.vector;
@@ -1858,7 +2184,7 @@ impl<'a> Interpreter<'a> {
             let rotary = if self.swivel.is_some() {
                 None
             } else {
-                Some([q[3], q[4], q[5]])
+                Some(q_rot)
             };
             (p, o, rotary)
         };

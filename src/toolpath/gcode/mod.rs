@@ -112,6 +112,19 @@
 //!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
 //! * **Variables and expressions**: see [`expr`] (Sinumerik `DEF`, R parameters, Fanuc `#n`).
 //! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
+//! * **Work offsets**: see [`offsets`]. `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
+//!   `G54.1 P…`, Sinumerik `G505`–`G599`) select one; `G10 L2` / `L20` set one (LinuxCNC P0–P9,
+//!   Fanuc P0 the external offset, P1–P6, and `L20` the extended offsets) and `G52` shifts
+//!   them all (`G52 X0 Y0` cancels; LinuxCNC `G92.1`/`G92.2` too): the points follow as on the
+//!   control, the tool staying where it is when the offset changes. Where a move's length
+//!   would depend on values the program does not give — a `G10 L2` of the offset in force
+//!   after moves in it, in machine coordinates — it is an error naming the `G10` and the move;
+//!   a change relative to the current one (LinuxCNC `G10 L20`, Fanuc `G91 G10 L2`) is exact,
+//!   and a `G10` before the first move, or of an offset not used after it, is no error. A
+//!   change to an offset the program never set is a warning: the move is sized as if the two
+//!   were equal. Other `G10` (tool data `L1`, `L10`–`L13`, parameters `L50`) moves nothing and
+//!   is a warning; `G10 L2 R` (a rotation) is an error, as is `G52` under G91 while a shift is
+//!   in force (an increment on some controls, a value on others).
 //! * **Sinumerik units**: `G70`/`G71` change the geometry only; F stays in the control's basic
 //!   system, taken as the unit the program selects first (a warning when that is inch);
 //!   `G700`/`G710` change F too.
@@ -131,15 +144,12 @@
 //!
 //! Line numbers `N`; `S`, `T`, `H`, `D` and the other parameter letters of the table; M codes
 //! of the table (spindle, coolant, tool change, pauses; Sinumerik `M202(0.0059)` arguments);
-//! `G40`, `G43` (LinuxCNC), `G49`, work offsets `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
-//! `G54.1 P…`, Sinumerik `G505`–`G599`; a change from one to another is a warning, as the move
-//! between them is sized as if they were equal), path control
+//! `G40`, `G43` (LinuxCNC), `G49`, path control
 //! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
 //! coordinates either way; `G234` is TCP on); `%` lines; blank lines; nested `(( ))` comments. Program
 //! end (`M2`, `M30`; in the main program also Sinumerik `M17`, `RET`, Fanuc `M99`) stops
 //! reading: later lines are not parsed. These codes are accepted with a warning because the toolpath does not carry them:
-//! cutter radius compensation `G41`/`G42` (the programmed path is used), `G10` (sets an offset,
-//! moves nothing: its axis words are not a move). A block starting with `/` (block delete, or `/1` … `/9`)
+//! cutter radius compensation `G41`/`G42` (the programmed path is used). A block starting with `/` (block delete, or `/1` … `/9`)
 //! runs, as on a control whose block-skip switch is off, or is skipped under
 //! [`Settings::block_delete`]; either way with a warning. I J K or R on a straight move (outside G43.5) or without a
 //! move are skipped with a warning. U V W axis words are errors: they move an axis feedopt
@@ -155,7 +165,7 @@
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
-//!   silently: `G92`/`G52` offsets, splines, threading, probing, polar coordinates, scaling,
+//!   silently: `G92` offsets (`G92.3`), splines, threading, probing, polar coordinates, scaling,
 //!   mirroring, calls of subprograms not in the file, Haas `M97`, Sinumerik
 //!   `CYCLE76`/`CYCLE77` (spigot milling).
 
@@ -166,6 +176,7 @@ pub mod frames;
 mod interp;
 pub mod klartext;
 mod lexer;
+pub mod offsets;
 pub mod subprograms;
 
 use std::path::Path;
