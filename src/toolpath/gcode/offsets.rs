@@ -120,8 +120,9 @@ type Key = ((Basis, Basis), Option<Cause>);
 /// The offsets in force and those the program set.
 #[derive(Debug, Clone)]
 pub(super) struct WorkOffsets {
-    /// The offset in force.
+    /// The offset in force, and its index in `table`.
     active: String,
+    active_k: usize,
     /// The program has selected none yet: `active` is the control's default.
     implicit: bool,
     /// A `G10` set the default before the program selected any.
@@ -140,6 +141,7 @@ impl WorkOffsets {
     pub(super) fn new(default: &str) -> WorkOffsets {
         WorkOffsets {
             active: default.to_string(),
+            active_k: 0,
             implicit: true,
             default_set: false,
             table: vec![(default.to_string(), std::array::from_fn(|_| Some(START)))],
@@ -161,8 +163,9 @@ impl WorkOffsets {
     /// The origin of the offset in force on `axis` (always known: the start, set, or taken
     /// as equal to the one before it when selected).
     fn active_origin(&self, axis: usize) -> &Origin {
-        self.index(&self.active)
-            .and_then(|k| self.table[k].1[axis].as_ref())
+        self.table
+            .get(self.active_k)
+            .and_then(|(_, o)| o[axis].as_ref())
             .unwrap_or(&START)
     }
 
@@ -195,8 +198,8 @@ impl WorkOffsets {
         let known = self.index(name).is_some();
         if implicit && !known && !self.default_set {
             // The program names the offset it starts in.
-            if let Some(k) = self.index(&self.active) {
-                self.table[k].0 = name.to_string();
+            if let Some((n, _)) = self.table.get_mut(self.active_k) {
+                *n = name.to_string();
             }
             self.active = name.to_string();
             return None;
@@ -211,6 +214,7 @@ impl WorkOffsets {
                 self.table.len() - 1
             }
         };
+        self.active_k = k;
         let mut assumed = false;
         for (i, (slot, mut old)) in self.table[k].1.iter_mut().zip(before).enumerate() {
             let said = axes.contains(&i);
@@ -299,6 +303,11 @@ impl WorkOffsets {
         }
     }
 
+    /// The bases a point made now is on, per axis.
+    fn bases(&self, axis: usize) -> (Basis, Basis) {
+        (self.active_origin(axis).basis, self.external[axis].basis)
+    }
+
     /// The bases a point made now is on, and the cause of a machine basis, per axis.
     fn key(&self, axis: usize) -> Key {
         let o = self.active_origin(axis);
@@ -311,6 +320,10 @@ impl WorkOffsets {
     /// the point before (see the module docs).
     pub(super) fn check(&mut self, axes: std::ops::Range<usize>) -> Result<(), Mismatch> {
         for axis in axes {
+            // Every point comes here: the usual case, the same bases, costs no clone.
+            if matches!(&self.last[axis], Some((before, _)) if *before == self.bases(axis)) {
+                continue;
+            }
             let now = self.key(axis);
             match &self.last[axis] {
                 Some((before, cause)) if *before != now.0 => {
