@@ -823,6 +823,14 @@ fn fanuc_integer_words_are_increments_said_once_or_calculator_input_by_setting()
         "{w:?}"
     );
     assert_close(tp.points.last().unwrap().p, v(3.0, 0.0, 0.0), 1e-9);
+    // The unit the block selects: G20 before the word.
+    let tp = gcode(Dialect::Fanuc, "G20 G0 X1000 Y0. Z0.\n");
+    assert!(
+        said(&tp)[0].message.contains("0.1 inch"),
+        "{:?}",
+        tp.warnings
+    );
+    assert!((tp.points[0].p.x - 2.54).abs() < 1e-12);
     let tp = gcode(Dialect::Fanuc, "G21 G0 X0. Y0. Z0. A90000\n");
     assert!(said(&tp)[0].message.contains("90°"), "{:?}", tp.warnings);
     assert_eq!(tp.points[0].rotary.unwrap()[0], 90.0);

@@ -318,13 +318,23 @@ impl<'a> Interpreter<'a> {
     /// The first axis word (or I J K R Q) without a decimal point that is read as least input
     /// increments, when no setting chose that reading: one warning saying what it was read as
     /// and how to choose the other reading.
-    fn note_increments(&mut self, line: usize, text: &str, num: Num, degrees: bool) {
+    fn note_increments(&mut self, line: usize, block: &Block, text: &str, num: Num, degrees: bool) {
         let Some(inc) = self.increments else { return };
         if self.increments_chosen || self.increments_warned || num.point || num.value == 0.0 {
             return;
         }
         self.increments_warned = true;
-        let (step, unit) = match (degrees, self.units) {
+        // The unit in force, or the one this block selects (`G20 G0 X1000`).
+        let units = block
+            .actions
+            .iter()
+            .rev()
+            .find_map(|(_, a, _)| match a {
+                Action::Units { units, .. } => Some(*units),
+                _ => None,
+            })
+            .unwrap_or(self.units);
+        let (step, unit) = match (degrees, units) {
             (true, _) => (inc.deg, "°"),
             (false, Units::Mm) => (inc.mm, " mm"),
             (false, Units::Inch) => (inc.inch, " inch"),
@@ -475,10 +485,10 @@ impl<'a> Interpreter<'a> {
                 | Address::Radius => {
                     let degrees =
                         matches!(address, Address::Axis(3..) | Address::IncrementalAxis(3..));
-                    self.note_increments(line, &text, num, degrees);
+                    self.note_increments(line, &block, &text, num, degrees);
                 }
                 Address::Ignored if text.starts_with('Q') => {
-                    self.note_increments(line, &text, num, false);
+                    self.note_increments(line, &block, &text, num, false);
                 }
                 _ => {}
             }
