@@ -540,11 +540,13 @@ fn machine_case(path: PathBuf, bytes: Vec<u8>) -> Outcome {
     }
 }
 
-/// Fields of the summary that are `null` by design: no estimate on a fixed grid, no dialect
-/// for an APT or CSV input, no reference or units note when the reader assumed no G28/G30
-/// reference and no program unit.
-const OPTIONAL: [&str; 5] = [
+/// Fields of the summary that are `null` by design: no estimate or target on a fixed grid,
+/// no reason when the refinement converged, no dialect for an APT or CSV input, no reference
+/// or units note when the reader assumed no G28/G30 reference and no program unit.
+const OPTIONAL: [&str; 7] = [
     "summary.error_estimate",
+    "summary.error_target",
+    "summary.unconverged",
     "summary.dialect",
     "summary.dialect_by",
     "summary.reference",
