@@ -924,12 +924,34 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
             3,
             &["G59.2", "G54"][..],
         ),
+        // Sinumerik's G500 (no settable offset: the base frame) was ignored silently.
+        (
+            Dialect::Sinumerik,
+            "G71 G90 G54\nG0 X0 Y0 Z5\nG500\nG0 Z100\nM30\n",
+            3,
+            &["G500", "G54"][..],
+        ),
     ] {
         let w = warned(&ok_in(dialect, text));
         assert!(
             w.len() == 1 && w[0].0 == line && names.iter().all(|n| w[0].1.contains(n)),
             "{text}: {w:?}"
         );
+    }
+    // Before the first point a selection only names the frame the program starts in: a
+    // Sinumerik header's G500 then G54, or G54 then G55, say nothing.
+    for (dialect, text) in [
+        (
+            Dialect::Sinumerik,
+            "G17 G90 G500 G71\nG54\nG0 X0 Y0 Z10\nG1 X10 F100\nM30\n",
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G90 G54\nG55\nG0 X0. Y0. Z5.\nG1 X10. F100.\nM30\n",
+        ),
+    ] {
+        let tp = ok_in(dialect, text);
+        assert!(warned(&tp).is_empty(), "{text}: {:?}", tp.warnings);
     }
 }
 

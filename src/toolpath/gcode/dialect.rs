@@ -307,7 +307,8 @@ pub enum Action {
     RetractToolAxis,
     /// Klartext `MB MAX`: retract to the travel limit.
     RetractMax,
-    /// A work offset (`G54`–`G59`, Fanuc `G54.1 P…`, Sinumerik `G505`–`G599`): the program's
+    /// A work offset (`G54`–`G59`, Fanuc `G54.1 P…`, Sinumerik `G500` (none: the base frame)
+    /// and `G505`–`G599`): the program's
     /// coordinates are read in the frame it selects (see [`super::offsets`]: a change to one
     /// whose values the program does not give is a warning, the move between them sized as if
     /// the two were equal).
@@ -936,7 +937,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("332", Unsup(THREADS)),
         ("450", Action::Ignored),
         ("451", Action::Ignored),
-        ("500", Action::Ignored),
+        ("500", Action::WorkOffset),
         ("505..599", Action::WorkOffset),
         ("601..603", Action::Ignored),
         ("641..645", Action::Ignored),

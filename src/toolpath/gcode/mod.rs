@@ -113,7 +113,7 @@
 //! * **Variables and expressions**: see [`expr`] (Sinumerik `DEF`, R parameters, Fanuc `#n`).
 //! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
 //! * **Work offsets**: see [`offsets`]. `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
-//!   `G54.1 P…`, Sinumerik `G505`–`G599`) select one; `G10 L2` / `L20` set one (LinuxCNC P0–P9,
+//!   `G54.1 P…`, Sinumerik `G500` and `G505`–`G599`) select one; `G10 L2` / `L20` set one (LinuxCNC P0–P9,
 //!   Fanuc P0 the external offset, P1–P6, and `L20` the extended offsets) and `G52` shifts
 //!   them all (`G52 X0 Y0` cancels; LinuxCNC `G92.1`/`G92.2` too): the points follow as on the
 //!   control, the tool staying where it is when the offset changes. Where a move's length

@@ -31,8 +31,9 @@
 //!
 //! An offset the program selects without having set it is taken as equal to the one in force
 //! (as before this module: the change is a warning saying so), and from then on as known on
-//! that basis. The first offset the program selects names the start unless a `G10` has set
-//! the control's default (`G54`) before it. The local shift `G52` (LinuxCNC and Fanuc) applies
+//! that basis. An offset the program selects before its first point names the start (nothing
+//! has been made in the one it replaces: a Sinumerik header's `G500`, then `G54`), unless a
+//! `G10` has set the control's default (`G54`) before it. The local shift `G52` (LinuxCNC and Fanuc) applies
 //! to every offset until changed; LinuxCNC's `G92.1` and `G92.2` cancel it. At the start no
 //! local shift is in force (LinuxCNC can keep one from an earlier run: feedopt assumes the
 //! program starts clean).
@@ -191,7 +192,10 @@ impl WorkOffsets {
     /// by an assumption on one of `axes` (those the program uses): the new offset (or the one
     /// before) was never set there, and is taken as equal to the other.
     pub(super) fn select(&mut self, name: &str, axes: std::ops::Range<usize>) -> Option<String> {
-        let implicit = std::mem::replace(&mut self.implicit, false);
+        // Before the first point, a selection still names the start: nothing has been made
+        // in the offset it replaces (a Sinumerik header's `G500`, then `G54`).
+        let before_points = self.last.iter().all(Option::is_none);
+        let implicit = std::mem::replace(&mut self.implicit, false) || before_points;
         if name == self.active {
             return None;
         }
@@ -364,6 +368,12 @@ mod tests {
         let mut o = WorkOffsets::new("G54");
         assert_eq!(o.select("G55", 0..3), None);
         assert_eq!(o.active(), "G55");
+        // Before the first point, another selection still names the start.
+        assert_eq!(o.select("G57", 0..3), None);
+        assert_eq!(o.active(), "G57");
+        assert_eq!(o.select("G55", 0..3), None);
+        // A point made in it, then a change: assumed equal, said.
+        assert!(o.check(0..3).is_ok());
         assert!(o.select("G56", 0..3).is_some_and(|w| w.contains("G55")));
         assert_eq!(o.shift(), [0.0; AXES]);
         // Back to G55: the move is sized by the same assumption, so it is said again.
