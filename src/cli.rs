@@ -229,7 +229,7 @@ pub struct SolveOptions {
     #[arg(long)]
     pub stations: Option<usize>,
     /// Most stations the automatic refinement may use (it stops before a round that would
-    /// pass them, with its estimate and a warning); memory grows by about 0.5 kB a station.
+    /// pass them, with its estimate and a warning); memory grows by about 0.5–1 kB a station.
     #[arg(long, default_value_t = 4_000_000, value_name = "N")]
     pub max_stations: usize,
     /// Turning angle between CL moves (degrees) above which the path stops exactly.

@@ -76,6 +76,18 @@ struct Origin {
     cause: Option<Cause>,
 }
 
+impl Origin {
+    /// An origin a `G10` (`cause`) gives in machine coordinates.
+    fn machine(value: f64, cause: &Cause) -> Origin {
+        Origin {
+            value,
+            basis: Basis::Machine,
+            assumed: false,
+            cause: Some(cause.clone()),
+        }
+    }
+}
+
 const START: Origin = Origin {
     value: 0.0,
     basis: Basis::Start,
@@ -210,14 +222,7 @@ impl WorkOffsets {
         }
         let before: [Origin; AXES] = std::array::from_fn(|i| self.active_origin(i).clone());
         let prev = std::mem::replace(&mut self.active, name.to_string());
-        let k = match self.index(name) {
-            Some(k) => k,
-            None => {
-                self.table
-                    .push((name.to_string(), std::array::from_fn(|_| None)));
-                self.table.len() - 1
-            }
-        };
+        let k = self.entry(name);
         self.active_k = k;
         let mut assumed = false;
         for (i, (slot, mut old)) in self.table[k].1.iter_mut().zip(before).enumerate() {
@@ -242,6 +247,15 @@ impl WorkOffsets {
         })
     }
 
+    /// The index in `table` of offset `name`, added (origins unknown) if it is not there.
+    fn entry(&mut self, name: &str) -> usize {
+        self.index(name).unwrap_or_else(|| {
+            self.table
+                .push((name.to_string(), std::array::from_fn(|_| None)));
+            self.table.len() - 1
+        })
+    }
+
     /// Sets `target`'s origin on `axis` (a `G10`, `cause`). An increment of an origin not
     /// known leaves it unknown.
     pub(super) fn set(&mut self, target: &Target, axis: usize, how: Setting, cause: &Cause) {
@@ -252,14 +266,7 @@ impl WorkOffsets {
             Target::External => {
                 let e = &mut self.external[axis];
                 match how {
-                    Setting::Machine(v) => {
-                        *e = Origin {
-                            value: v,
-                            basis: Basis::Machine,
-                            assumed: false,
-                            cause: Some(cause.clone()),
-                        }
-                    }
+                    Setting::Machine(v) => *e = Origin::machine(v, cause),
                     Setting::Increment(d) => e.value += d,
                     Setting::Position { here, given } => {
                         e.value = here - here_origin.value - local - given;
@@ -271,26 +278,12 @@ impl WorkOffsets {
                 if self.implicit && *name == self.active {
                     self.default_set = true;
                 }
-                let k = match self.index(name) {
-                    Some(k) => k,
-                    None => {
-                        self.table
-                            .push((name.clone(), std::array::from_fn(|_| None)));
-                        self.table.len() - 1
-                    }
-                };
+                let k = self.entry(name);
                 &mut self.table[k].1[axis]
             }
         };
         match how {
-            Setting::Machine(v) => {
-                *slot = Some(Origin {
-                    value: v,
-                    basis: Basis::Machine,
-                    assumed: false,
-                    cause: Some(cause.clone()),
-                });
-            }
+            Setting::Machine(v) => *slot = Some(Origin::machine(v, cause)),
             Setting::Increment(d) => {
                 if let Some(o) = slot {
                     o.value += d;
