@@ -31,7 +31,7 @@ use crate::solver::jerk::{JerkData, JerkOptions, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
-use crate::verify::{Verification, VerifyOptions, verify};
+use crate::verify::{Verification, VerifyOptions, Violation, verify_marked};
 
 mod checks;
 pub(crate) use checks::inputs as check_inputs;
@@ -292,26 +292,29 @@ fn optimize_path(
         lv.schedule.stations.len(),
         options.verify.period * 1e3
     ));
-    let mut v = plan.verify(&lv, options)?;
+    // Intervals within LOCAL_MARK of the tolerance are divided with the violating ones.
+    let mark = LOCAL_MARK * options.verify.tolerance;
+    let (mut v, mut marks) = plan.verify_marked(&lv, options, mark)?;
     let mut round = 0;
     while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
         tracing::debug!(
-            "verify: {} intervals, worst {:?}",
+            "verify: {} intervals ({} marked), worst {:?}",
             v.violating_intervals,
+            marks.len(),
             v.violations.first()
         );
         let t0 = std::time::Instant::now();
         plan.progress
             .stage("adding stations where the re-simulation found a limit exceeded");
-        let touched = plan.refine_where_violated(&mut lv, &v, options)?;
+        let touched = plan.refine_where_violated(&mut lv, &marks, options)?;
         let solved = t0.elapsed().as_secs_f64();
         // The spans solved again first, on their own (the others passed and have not changed);
         // the whole path once they pass (its clock samples each span at other instants).
-        v = plan.verify_spans(&lv, &touched, options)?;
+        (v, marks) = plan.verify_spans(&lv, &touched, options, mark)?;
         if v.verified {
             lv.schedule =
                 Schedule::build(&plan.axes, &plan.path.spans, &lv.problems, &lv.solutions)?;
-            v = plan.verify(&lv, options)?;
+            (v, marks) = plan.verify_marked(&lv, options, mark)?;
         }
         tracing::debug!(
             "local refinement round {round}: {} spans solved in {solved:.2} s, verified in {:.2} s",
@@ -442,6 +445,12 @@ fn local_parts(ratio: f64, tolerance: f64) -> usize {
         MAX_LOCAL_SPLIT
     }
 }
+
+/// The share of the verification tolerance above which an interval is divided in a round of
+/// local refinement (once the re-simulation has found a limit exceeded). The jerk-limited
+/// impeller with the tolerance itself: four rounds, each finding over the tolerance intervals
+/// that were just under it (1.0011–1.0016 of a limit) on the clock of the round before.
+const LOCAL_MARK: f64 = 0.5;
 
 /// The most parts one round of local refinement divides an interval into.
 const MAX_LOCAL_SPLIT: usize = 8;
@@ -1333,50 +1342,71 @@ impl Plan<'_> {
     }
 
     /// Re-simulates one level's schedule.
-    fn verify(&self, lv: &Level, options: &Options) -> Result<Verification> {
-        verify(
+    /// The re-simulation of a level, and the intervals above `1 + mark` ([`verify_marked`]).
+    fn verify_marked(
+        &self,
+        lv: &Level,
+        options: &Options,
+        mark: f64,
+    ) -> Result<(Verification, Vec<Violation>)> {
+        verify_marked(
             self.machine,
             &self.kin,
             &self.path.spans,
             &lv.problems,
             &lv.solutions,
             &options.verify,
+            mark,
         )
     }
 
-    /// Divides every interval where the re-simulation found a limit exceeded into equal parts
-    /// (as many as its excess asks, [`local_parts`]) and solves the spans concerned again: the
-    /// excess between stations falls as Δu², so a round or two suffice, and only where the
-    /// path needs it. Returns the spans solved again; the level's schedule is left for the
-    /// caller to rebuild.
+    /// Divides every interval of `marks` (where the re-simulation found a limit exceeded, or
+    /// nearly: [`LOCAL_MARK`]) into equal parts (as many as its excess asks, [`local_parts`])
+    /// and solves the spans concerned again, in parallel: the excess between stations falls as
+    /// Δu², so a round or two suffice, and only where the path needs it. Returns the spans
+    /// solved again; the level's schedule is left for the caller to rebuild.
     fn refine_where_violated(
         &self,
         lv: &mut Level,
-        v: &Verification,
+        marks: &[Violation],
         options: &Options,
     ) -> Result<Vec<usize>> {
-        let mut touched = Vec::new();
+        use rayon::prelude::*;
         let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); lv.problems.len()];
-        for viol in &v.violations {
+        for viol in marks {
             let parts = local_parts(viol.ratio, options.verify.tolerance);
             split[viol.span].push((viol.interval, parts));
         }
-        for (si, mut ks) in split.into_iter().enumerate() {
-            if ks.is_empty() {
-                continue;
-            }
-            // One entry per interval (its worst violation's, the most parts).
-            ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
-            ks.dedup_by_key(|k| k.0);
-            let old = &lv.problems[si];
-            let u = divide(&old.u, &ks);
-            let mut p = SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
-            if let Some(c) = &options.verify.chord {
-                p.apply_chord(&self.path.spans[si], c);
-            }
-            self.check_travel(si, &p)?;
-            (p.b_start, p.b_end) = (old.b_start, old.b_end);
-            let s = self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true)?;
+        // The spans concerned in parallel (each span's windows join the same pool).
+        let jobs: Vec<(usize, Vec<(usize, usize)>)> = split
+            .into_iter()
+            .enumerate()
+            .filter(|(_, ks)| !ks.is_empty())
+            .collect();
+        let solved: Vec<(usize, SpanProblem, SpanSolution)> = jobs
+            .into_par_iter()
+            .map(|(si, mut ks)| {
+                // One entry per interval (its worst violation's, the most parts).
+                ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+                ks.dedup_by_key(|k| k.0);
+                let old = &lv.problems[si];
+                let u = divide(&old.u, &ks);
+                let mut p =
+                    SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
+                if let Some(c) = &options.verify.chord {
+                    p.apply_chord(&self.path.spans[si], c);
+                }
+                self.check_travel(si, &p)?;
+                (p.b_start, p.b_end) = (old.b_start, old.b_end);
+                let s =
+                    self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true)?;
+                Ok((si, p, s))
+            })
+            .collect::<Vec<Result<_>>>()
+            .into_iter()
+            .collect::<Result<_>>()?;
+        let mut touched = Vec::with_capacity(solved.len());
+        for (si, p, s) in solved {
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
@@ -1389,7 +1419,13 @@ impl Plan<'_> {
 
     /// Re-simulates spans `which` of a level on their own (each on its own clock, from 0), with
     /// the violations' span indices those of the path.
-    fn verify_spans(&self, lv: &Level, which: &[usize], options: &Options) -> Result<Verification> {
+    fn verify_spans(
+        &self,
+        lv: &Level,
+        which: &[usize],
+        options: &Options,
+        mark: f64,
+    ) -> Result<(Verification, Vec<Violation>)> {
         let spans: Vec<Span> = which
             .iter()
             .map(|&si| self.path.spans[si].clone())
@@ -1397,18 +1433,19 @@ impl Plan<'_> {
         let problems: Vec<SpanProblem> = which.iter().map(|&si| lv.problems[si].clone()).collect();
         let solutions: Vec<SpanSolution> =
             which.iter().map(|&si| lv.solutions[si].clone()).collect();
-        let mut v = verify(
+        let (mut v, mut marks) = verify_marked(
             self.machine,
             &self.kin,
             &spans,
             &problems,
             &solutions,
             &options.verify,
+            mark,
         )?;
-        for w in &mut v.violations {
+        for w in v.violations.iter_mut().chain(&mut marks) {
             w.span = which[w.span];
         }
-        Ok(v)
+        Ok((v, marks))
     }
 
     /// Solves one span's problem with the chosen solver, after the reach pass has checked that a

@@ -239,6 +239,32 @@ pub fn verify(
     solutions: &[SpanSolution],
     options: &VerifyOptions,
 ) -> Result<Verification> {
+    verify_marked(
+        machine,
+        kin,
+        spans,
+        problems,
+        solutions,
+        options,
+        options.tolerance,
+    )
+    .map(|(v, _)| v)
+}
+
+/// [`verify`], and besides the verdict every interval whose worst ratio exceeds `1 + mark`
+/// (`mark` ≤ the tolerance: those near a violation too), in the order checked. The local
+/// refinement divides these, so that a sample on another clock (a span's times change when it
+/// is solved again, and with them every later span's sample instants) does not find the ones
+/// just under the tolerance over it a round later.
+pub(crate) fn verify_marked(
+    machine: &Machine,
+    kin: &Kinematics,
+    spans: &[Span],
+    problems: &[SpanProblem],
+    solutions: &[SpanSolution],
+    options: &VerifyOptions,
+    mark: f64,
+) -> Result<(Verification, Vec<Violation>)> {
     let period = options.period;
     if !(period.is_finite() && period > 0.0) {
         return Err(Error::Usage(format!(
@@ -321,7 +347,7 @@ pub fn verify(
     let parts = crate::parallel::par_map(&chunks, threads, |&(si, i0, i1)| {
         let mut acc = Accumulator {
             limits: limits.clone(),
-            threshold: 1.0 + options.tolerance,
+            threshold: 1.0 + mark.min(options.tolerance),
             worst: vec![[0.0; 3]; na],
             worst_feed: 0.0,
             worst_chord: 0.0,
@@ -359,10 +385,13 @@ pub fn verify(
         worst_chord = worst_chord.max(acc.worst_chord);
         violations.extend(acc.violations);
     }
+    let marks = violations.clone();
+    let threshold = 1.0 + options.tolerance;
+    violations.retain(|v| v.ratio > threshold);
     let violating_intervals = violations.len();
     violations.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
     violations.truncate(MAX_VIOLATIONS);
-    Ok(Verification {
+    let v = Verification {
         verified: violating_intervals == 0,
         samples,
         station_checks,
@@ -382,7 +411,8 @@ pub fn verify(
         worst_chord,
         violating_intervals,
         violations,
-    })
+    };
+    Ok((v, marks))
 }
 
 /// Station intervals checked per task of the re-simulation.
@@ -789,6 +819,49 @@ mod tests {
         // T = 2√(L/a) = 63.2 ms: instants 0 … 63 ms and the end.
         assert_eq!(v.samples, 65);
         assert_eq!(v.station_checks, 16);
+    }
+
+    /// Intervals above `1 + mark` but within the tolerance are marked and do not fail the
+    /// verdict; those above the tolerance do both.
+    #[test]
+    fn marks_reach_below_the_tolerance_and_the_verdict_does_not() {
+        let (len, a) = (2.0, 2000.0);
+        let m = xyz(a, 1e4, None);
+        let kin = Kinematics::new(&m);
+        let span = line(len, f64::INFINITY);
+        let p = SpanProblem::build(
+            &span,
+            &kin,
+            &m,
+            Grid {
+                spacing: len / 8.0,
+                min_parts: 1,
+            },
+        );
+        let options = VerifyOptions::default();
+        let run = |excess: f64| {
+            // The triangular profile at (1 + excess) a: every interval exceeds by that much.
+            let b: Vec<f64> = (p.u.iter())
+                .map(|&u| 2.0 * a * (1.0 + excess) * u.min(len - u))
+                .collect();
+            let (spans, problems) = (std::slice::from_ref(&span), std::slice::from_ref(&p));
+            verify_marked(&m, &kin, spans, problems, &[solution(b)], &options, 5e-4).unwrap()
+        };
+        let (v, marks) = run(7e-4);
+        assert!(
+            v.verified && v.violations.is_empty() && v.violating_intervals == 0,
+            "{v:?}"
+        );
+        assert_eq!(marks.len(), 8, "{marks:?}");
+        assert!(
+            marks.iter().all(|x| (x.ratio - 1.0007).abs() < 1e-9),
+            "{marks:?}"
+        );
+        let (v, marks) = run(2e-3);
+        assert!(!v.verified && v.violating_intervals == 8, "{v:?}");
+        assert_eq!(marks.len(), 8);
+        let (v, marks) = run(0.0);
+        assert!(v.verified && marks.is_empty());
     }
 
     #[test]
