@@ -1044,3 +1044,59 @@ fn g52_shifts_every_offset_and_zero_cancels() {
         );
     }
 }
+
+/// `G92`: the current position gets the coordinates named (a shift of every offset; the tool
+/// does not move). It was refused ("not supported"). LinuxCNC keeps it in `G52`'s register
+/// (`G92.1` cancels it); Fanuc apart, and a `G52` and a `G92` both in force on one axis is an
+/// error there. A program that starts with `G92 X0 Y0 Z0` names the unknown start as its
+/// origin: its moves are exact relative to it, and nothing is said about an unknown start.
+#[test]
+fn g92_gives_the_current_position_the_coordinates_named() {
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        let tp = gcode(
+            dialect,
+            "G21 G90 G0 X10. Y0. Z0.\nG92 X0.\nG1 X5. F600.\nG55\nG1 X6.\nG91 G1 X1.\n",
+        );
+        assert_eq!(xs(&tp), [10.0, 15.0, 16.0, 17.0], "{dialect:?}");
+        // Inches: the named position is in the program's unit.
+        let tp = gcode(dialect, "G20 G90 G0 X1. Y0. Z0.\nG92 X0.\nG1 X1. F60.\n");
+        assert_eq!(xs(&tp), [25.4, 50.8], "{dialect:?}");
+        // From the unknown start: exact relative to it, no warning about it.
+        let tp = gcode(dialect, "G21 G90\nG92 X0 Y0 Z0\nG1 X5. F600.\nG1 Y5.\n");
+        assert_eq!(xs(&tp), [5.0, 5.0], "{dialect:?}");
+        assert!(tp.warnings.is_empty(), "{dialect:?}: {:?}", tp.warnings);
+    }
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G0 X10 Y0 Z0\nG92 X0\nG1 X5 F600\nG92.1\nG0 X0\nG92 X2\nG52 X0\nG0 X1\n",
+    );
+    // G92.1 cancels the shift (the position reads 15); G52 X0 too (G92 X2 had shifted by −2).
+    assert_eq!(xs(&tp), [10.0, 15.0, 0.0, 1.0], "{:?}", tp.points);
+    for (dialect, text, line, needle) in [
+        (
+            Dialect::LinuxCnc,
+            "G21 G0 X0 Y0 Z0\nG92\n",
+            2,
+            "without axis words",
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G0 X0 Y0 Z0\nG52 X5.\nG92 X0\n",
+            3,
+            "G52 local shift",
+        ),
+        (
+            Dialect::Fanuc,
+            "G21 G0 X0 Y0 Z0\nG92 X5.\nG52 X1.\n",
+            3,
+            "G92 shift",
+        ),
+    ] {
+        let e = parse(Path::new("t.ngc"), text, dialect).expect_err(text);
+        let m = message(e);
+        assert!(
+            m.contains(&format!("t.ngc:{line}:")) && m.contains(needle),
+            "{text}: {m}"
+        );
+    }
+}

@@ -321,6 +321,9 @@ pub enum Action {
     LocalOffset,
     /// LinuxCNC `G92.1`, `G92.2`: the `G52`/`G92` shift is cancelled.
     LocalOffsetCancel,
+    /// `G92 X… Y…`: the current position is given these coordinates, by a shift of every
+    /// work offset (LinuxCNC keeps it in `G52`'s register; Fanuc apart from it).
+    PositionOffset(OffsetNumbering),
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
@@ -461,9 +464,6 @@ use Action::{
 use Address::{ArcCentre, Axis};
 
 const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
-const OFFSETS: &str = "G92 (the current position taken as the given coordinates, a shift of \
-                       every offset) is not supported: set the work offset with G10 L2 or \
-                       G10 L20, or post the program without it";
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution is not supported";
@@ -612,7 +612,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("91", Dist(Distance::Incremental)),
         ("90.1", ArcDistance(Distance::Absolute)),
         ("91.1", ArcDistance(Distance::Incremental)),
-        ("92", Unsup(OFFSETS)),
+        ("92", Action::PositionOffset(OffsetNumbering::LinuxCnc)),
         ("92.1", Action::LocalOffsetCancel),
         ("92.2", Action::LocalOffsetCancel),
         (
@@ -780,7 +780,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("187", Action::Ignored),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
-        ("92", Unsup(OFFSETS)),
+        ("92", Action::PositionOffset(OffsetNumbering::Fanuc)),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
         ("95", Fm(FeedMode::PerRevolution)),

@@ -771,6 +771,7 @@ impl<'a> Interpreter<'a> {
         let mut set_tool = false;
         let mut set_offset: Option<(&str, OffsetNumbering)> = None;
         let mut local_offset = false;
+        let mut position_offset = None;
         if let Some(name) = &block.tool_name {
             self.prepared_tool = Some(ToolSelect::Name(name.clone()));
         } else if self.spec.spaces != Spaces::Klartext
@@ -913,6 +914,7 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::SetOffset(numbering) => set_offset = Some((text.as_str(), numbering)),
                 Action::LocalOffset => local_offset = true,
+                Action::PositionOffset(numbering) => position_offset = Some(numbering),
                 Action::LocalOffsetCancel => {
                     let before = self.offsets.shift();
                     for i in 0..6 {
@@ -1017,6 +1019,9 @@ impl<'a> Interpreter<'a> {
         }
         if local_offset {
             return self.g52(line, &block).map(|()| self.end_if(end));
+        }
+        if let Some(numbering) = position_offset {
+            return self.g92(line, numbering, &block).map(|()| self.end_if(end));
         }
         if tilted_plane {
             return self.tilted_plane(line, &block).map(|()| self.end_if(end));
@@ -1475,6 +1480,18 @@ impl<'a> Interpreter<'a> {
                     "G52 under a tilted plane (G68.2): set the local shift before the plane",
                 ));
             }
+            if self.offsets.position(i) != 0.0 {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "G52 {}{} while a G92 shift is in force on {}: controls differ on how \
+                         the two combine; program one of them",
+                        AXIS_NAMES[i],
+                        crate::error::number(n.value),
+                        AXIS_NAMES[i]
+                    ),
+                ));
+            }
             if self.distance == Distance::Incremental && self.offsets.local(i) != 0.0 {
                 return Err(self.error(
                     line,
@@ -1488,6 +1505,62 @@ impl<'a> Interpreter<'a> {
                 ));
             }
             self.offsets.set_local(i, v);
+        }
+        self.shift_changed(before);
+        Ok(())
+    }
+
+    /// `G92 X… Y…`: the current position gets the coordinates named, by a shift of every work
+    /// offset on those axes ([`offsets`]); the tool does not move. On an axis the program has
+    /// not placed yet, the position is the unknown start (taken as 0), and the moves after it
+    /// are exact relative to it. LinuxCNC keeps the shift in `G52`'s register; Fanuc apart from
+    /// it, and where both would be in force on an axis the block is an error (whether `G92`
+    /// cancels `G52` there is the control's matter).
+    fn g92(&mut self, line: usize, numbering: OffsetNumbering, block: &Block) -> Result<()> {
+        if block.axes.iter().all(Option::is_none) {
+            return Err(self.error(
+                line,
+                "G92 without axis words: name the axes whose current position it sets (G92 X0 \
+                 Y0 Z0 makes the current point the origin)",
+            ));
+        }
+        if block.axes[..3].iter().any(Option::is_some) && !self.frame_inner().is_identity() {
+            return Err(self.error(
+                line,
+                "G92 under a rotated, scaled or tilted frame (G68, G51, G68.2): set the position \
+                 before the frame",
+            ));
+        }
+        let before = self.offsets.shift();
+        for i in 0..6 {
+            let Some(n) = block.axes[i] else { continue };
+            let v = if i < 3 { self.length(n) } else { self.angle(n) };
+            // The shift that makes the position read v: pos − v more than the one in force.
+            let by = self.pos[i] - v;
+            match numbering {
+                OffsetNumbering::LinuxCnc => {
+                    self.offsets.set_local(i, self.offsets.local(i) + by);
+                }
+                OffsetNumbering::Fanuc => {
+                    if self.offsets.local(i) != 0.0 {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "G92 {}{} while a G52 local shift is in force on {}: cancel it \
+                                 first (G52 {}0)",
+                                AXIS_NAMES[i],
+                                crate::error::number(n.value),
+                                AXIS_NAMES[i],
+                                AXIS_NAMES[i]
+                            ),
+                        ));
+                    }
+                    self.offsets.set_position(i, self.offsets.position(i) + by);
+                }
+            }
+            if i < 3 {
+                self.known[i] = true;
+            }
         }
         self.shift_changed(before);
         Ok(())

@@ -114,8 +114,9 @@
 //! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
 //! * **Work offsets**: see [`offsets`]. `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
 //!   `G54.1 P…`, Sinumerik `G500` and `G505`–`G599`) select one; `G10 L2` / `L20` set one (LinuxCNC P0–P9,
-//!   Fanuc P0 the external offset, P1–P6, and `L20` the extended offsets) and `G52` shifts
-//!   them all (`G52 X0 Y0` cancels; LinuxCNC `G92.1`/`G92.2` too): the points follow as on the
+//!   Fanuc P0 the external offset, P1–P6, and `L20` the extended offsets), `G52` shifts
+//!   them all (`G52 X0 Y0` cancels; LinuxCNC `G92.1`/`G92.2` too) and `G92` shifts them so that
+//!   the current position has the coordinates named: the points follow as on the
 //!   control, the tool staying where it is when the offset changes. Where a move's length
 //!   would depend on values the program does not give — a `G10 L2` of the offset in force
 //!   after moves in it, in machine coordinates — it is an error naming the `G10` and the move;
@@ -165,7 +166,7 @@
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
 //!   block, axis words without a motion mode, a G93 feed block without F, a negative F,
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
-//!   silently: `G92` offsets (`G92.3`), splines, threading, probing, polar coordinates, scaling,
+//!   silently: the stored `G92` shift (`G92.3`), splines, threading, probing, polar coordinates, scaling,
 //!   mirroring, calls of subprograms not in the file, Haas `M97`, Sinumerik
 //!   `CYCLE76`/`CYCLE77` (spigot milling).
 

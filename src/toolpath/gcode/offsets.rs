@@ -1,5 +1,5 @@
-//! Work offsets as shifts: `G54`–`G59` (and the dialects' other offsets), `G10 L2`/`L20`, and
-//! the local shift `G52`.
+//! Work offsets as shifts: `G54`–`G59` (and the dialects' other offsets), `G10 L2`/`L20`, the
+//! local shift `G52`, and `G92`.
 //!
 //! # What feedopt knows of an offset
 //!
@@ -40,6 +40,12 @@
 //!
 //! Fanuc's external offset, `G10 L2 P0`, is added to every offset; it is tracked as one more
 //! origin with its own basis.
+//!
+//! `G92 X…` gives the current position the coordinates named: a shift of every offset, known
+//! on the start's basis like `G52`'s (LinuxCNC keeps it in `G52`'s register, so `G52` and
+//! `G92.1` change it; Fanuc apart). Before the program has placed an axis, its position is the
+//! unknown start, taken as 0 as everywhere: the moves after a `G92` are then exact relative to
+//! the point it names, which is what a program starting with `G92 X0 Y0 Z0` means.
 
 /// The axes X Y Z A B C.
 const AXES: usize = 6;
@@ -143,8 +149,11 @@ pub(super) struct WorkOffsets {
     /// Every offset set, selected or in force, with its origins (`None`: not known).
     table: Vec<(String, [Option<Origin>; AXES])>,
     external: [Origin; AXES],
-    /// `G52`, toolpath coordinates (known: the program gives it).
+    /// `G52`, toolpath coordinates (known: the program gives it); LinuxCNC's `G92` too.
     local: [f64; AXES],
+    /// Fanuc's `G92` shift of every offset, toolpath coordinates (known: the program gives the
+    /// position it makes the current one).
+    position: [f64; AXES],
     /// Per axis, the bases at the last point checked.
     last: [Option<Key>; AXES],
 }
@@ -160,6 +169,7 @@ impl WorkOffsets {
             table: vec![(default.to_string(), std::array::from_fn(|_| Some(START)))],
             external: std::array::from_fn(|_| START),
             local: [0.0; AXES],
+            position: [0.0; AXES],
             last: std::array::from_fn(|_| None),
         }
     }
@@ -183,11 +193,21 @@ impl WorkOffsets {
     }
 
     /// How far the offsets in force shift program coordinates, toolpath coordinates (mm,
-    /// degrees): the offset's origin, the external offset and `G52`.
+    /// degrees): the offset's origin, the external offset, `G52` and `G92`.
     pub(super) fn shift(&self) -> [f64; AXES] {
         std::array::from_fn(|i| {
-            self.active_origin(i).value + self.external[i].value + self.local[i]
+            self.active_origin(i).value + self.external[i].value + self.local[i] + self.position[i]
         })
+    }
+
+    /// Fanuc's `G92` shift on `axis`.
+    pub(super) fn position(&self, axis: usize) -> f64 {
+        self.position[axis]
+    }
+
+    /// Sets Fanuc's `G92` shift on `axis`.
+    pub(super) fn set_position(&mut self, axis: usize, value: f64) {
+        self.position[axis] = value;
     }
 
     /// `G52`'s shift on `axis`.
