@@ -235,6 +235,11 @@ pub struct SolveOptions {
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
     #[arg(long, default_value_t = 10.0)]
     pub corner_angle: f64,
+    /// Blend such corners between feed moves instead of stopping: a fillet whose middle lies
+    /// this far from the corner, mm, as a control does under a contour tolerance (G64 P,
+    /// CYCLE832, CYCL DEF 32). 0: exact stops.
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    pub corner_tolerance: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm (0: through
     /// every point exactly).
     #[arg(long, default_value_t = 0.005, value_name = "MM")]
@@ -330,6 +335,7 @@ pub enum SolverChoice {
 /// [`Error::InvalidOption`] (a nested struct's prefix `solve.` dropped).
 const FLAGS: &[(&str, &str)] = &[
     ("geometry.corner_angle_deg", "--corner-angle"),
+    ("geometry.corner_tolerance_mm", "--corner-tolerance"),
     ("geometry.tolerance_mm", "--tolerance"),
     ("geometry.tolerance_deg", "--tolerance-deg"),
     ("geometry.feed_override", "--feed-override"),
@@ -401,6 +407,7 @@ impl SolveArgs {
             ..Options::default()
         };
         o.geometry.corner_angle_deg = self.opts.corner_angle;
+        o.geometry.corner_tolerance_mm = self.opts.corner_tolerance;
         o.geometry.feed_override = self.opts.feed_override;
         o.geometry.ignore_programmed_feed = self.opts.ignore_programmed_feed;
         o.geometry.tolerance_mm = self.opts.tolerance;

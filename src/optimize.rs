@@ -151,6 +151,8 @@ pub struct Solution {
     pub verification: Verification,
     /// Its servo period, s.
     pub verify_period: f64,
+    /// Corners blended within [`GeometryOptions::corner_tolerance_mm`] instead of stopped at.
+    pub corners_blended: usize,
 }
 
 impl Solution {
@@ -181,6 +183,13 @@ pub fn optimize_observed(
         )));
     }
     let kin = Kinematics::new(machine);
+    // Corners blended within the contour tolerance, when one is given.
+    let (blended, corners_blended) = crate::geometry::blend::blend_corners(
+        toolpath,
+        options.geometry.corner_tolerance_mm,
+        options.geometry.corner_angle_deg,
+    );
+    let toolpath: &Toolpath = &blended;
     let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
     let mut path = Path::build(
         toolpath,
@@ -200,7 +209,9 @@ pub fn optimize_observed(
     if let Some(limits) = &options.process {
         limits.attach(&mut path, toolpath, machine.feed_max)?;
     }
-    optimize_path(machine, path, options, progress)
+    let mut solution = optimize_path(machine, path, options, progress)?;
+    solution.corners_blended = corners_blended;
+    Ok(solution)
 }
 
 /// Computes the time-optimal schedule of a joint-space path (axis positions along s) on a
@@ -362,6 +373,7 @@ fn optimize_path(
         unconverged,
         verification: v,
         verify_period: options.verify.period,
+        corners_blended: 0,
     })
 }
 

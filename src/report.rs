@@ -176,6 +176,9 @@ pub struct Summary {
     pub max_deviation_mm: f64,
     /// The same for the rotary angles, degrees.
     pub max_deviation_deg: f64,
+    /// Corners blended within the corner tolerance (`--corner-tolerance`) instead of stopped
+    /// at; the deviations above are from the path with those fillets.
+    pub corners_blended: usize,
     /// Per axis, in the machine's order (a JSON object keyed by axis name).
     #[serde(serialize_with = "as_map")]
     pub axes: Vec<(String, AxisPeaks)>,
@@ -326,6 +329,7 @@ impl Summary {
                 .collect(),
             binding,
             refinement: sol.refinement.clone(),
+            corners_blended: sol.corners_blended,
             error_estimate: sol.error_estimate,
             error_target: sol.error_target,
             unconverged: sol.unconverged.clone(),
@@ -420,8 +424,21 @@ impl fmt::Display for Summary {
         if self.max_deviation_mm > 0.0 || self.max_deviation_deg > 0.0 {
             writeln!(
                 f,
-                "fitted path   within {:.4} mm and {:.4}° of the programmed path (at and between its points)",
-                self.max_deviation_mm, self.max_deviation_deg
+                "fitted path   within {:.4} mm and {:.4}° of the programmed path (at and between its points{})",
+                self.max_deviation_mm,
+                self.max_deviation_deg,
+                if self.corners_blended > 0 {
+                    "; blended corners apart"
+                } else {
+                    ""
+                }
+            )?;
+        }
+        if self.corners_blended > 0 {
+            writeln!(
+                f,
+                "corners       {} blended within the corner tolerance instead of stopped at",
+                self.corners_blended
             )?;
         }
         if self.joint_space {

@@ -336,6 +336,7 @@ impl Study<'_> {
             unconverged: None,
             verification,
             verify_period: self.options.verify.period,
+            corners_blended: self.base.corners_blended,
         };
         let summary = Summary::new(&machine, &self.toolpath, &sol);
         Ok(Eval {

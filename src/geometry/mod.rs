@@ -13,6 +13,7 @@
 //! stops moving while the tool turns.
 
 pub mod biarc;
+pub mod blend;
 pub mod spline;
 
 use nalgebra::Vector3;
@@ -34,8 +35,13 @@ pub const SAME_ORIENTATION_RAD: f64 = 1e-9;
 /// Options of the geometry stage.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeometryOptions {
-    /// Turning angle (degrees) above which a corner is an exact stop.
+    /// Turning angle (degrees) above which a corner is an exact stop (unless blended).
     pub corner_angle_deg: f64,
+    /// How far a corner sharper than `corner_angle_deg` may be cut, mm, as a control does
+    /// under a contour tolerance (`G64 P`, `CYCLE832`, `CYCL DEF 32`): such a corner between
+    /// two feed moves becomes a fillet within it ([`blend::blend_corners`]). 0: every such
+    /// corner is an exact stop.
+    pub corner_tolerance_mm: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm
     /// (0: interpolate them exactly). See [`smooth_within`]. Between the points, the tip stays
     /// within this plus [`CHORD_SLACK_MM`] plus the chord's sagitta allowance of the
@@ -53,6 +59,7 @@ impl Default for GeometryOptions {
     fn default() -> Self {
         GeometryOptions {
             corner_angle_deg: 10.0,
+            corner_tolerance_mm: 0.0,
             tolerance_mm: 0.005,
             tolerance_deg: 0.01,
             feed_override: 1.0,
@@ -824,6 +831,7 @@ impl GeometryOptions {
             ));
         }
         non_negative("tolerance_mm", self.tolerance_mm, "mm")?;
+        non_negative("corner_tolerance_mm", self.corner_tolerance_mm, "mm")?;
         non_negative("tolerance_deg", self.tolerance_deg, "degrees")?;
         if !(MIN_FEED_OVERRIDE..=MAX_FEED_OVERRIDE).contains(&self.feed_override) {
             return Err(Error::option(

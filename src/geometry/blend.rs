@@ -1,0 +1,278 @@
+//! Corner blending within a contour tolerance: what a control does at a corner when the
+//! program lets it leave the programmed path by a given amount (LinuxCNC `G64 P…`, Sinumerik
+//! `CYCLE832`, Heidenhain `CYCL DEF 32 T…`).
+//!
+//! Without it every corner sharper than [`super::GeometryOptions::corner_angle_deg`] is an
+//! exact stop (the tool brakes to rest and starts again), which is what the programmed path
+//! asks of a machine that must not leave it. With a tolerance ε > 0 ([`blend_corners`]), such a
+//! corner between two feed moves is replaced by the circular arc tangent to both moves whose
+//! middle lies ε from the corner (a fillet): turning angle θ between the moves, radius
+//! r = ε cos(θ/2) / (1 − cos(θ/2)), tangent points d = r tan(θ/2) before and after the corner.
+//! Where d would pass [`MAX_SHARE`] of either move, r is cut back so it does not (the arc
+//! then stays closer than ε); the blends of neighbouring corners therefore never overlap. The
+//! arc is written as CL points turning at most half the corner angle from one to the next, so
+//! the geometry stage fits it as a smooth curve through them, not as corners.
+//!
+//! Not blended: a corner sharper than [`MAX_BLEND_ANGLE_DEG`] (a reversal, where any fillet
+//! within ε is so tight that the tool all but stops anyway), one where the tool dwells, and one
+//! next to a rapid move, a move without a feed or an inverse-time block (only corners between
+//! two moves at programmed feeds are blended).
+//!
+//! The new points carry the corner's source line; their feed is the lower of the two moves'
+//! feeds, their tool orientation and programmed rotary angles are interpolated along the moves
+//! (on the arc, between those of its ends).
+
+use nalgebra::Vector3;
+use std::borrow::Cow;
+
+use super::SAME_POSITION_MM;
+use crate::toolpath::{ClPoint, Feed, Toolpath};
+
+/// The sharpest corner blended, degrees of turning (see the module docs).
+pub const MAX_BLEND_ANGLE_DEG: f64 = 150.0;
+
+/// The largest share of each move a blend may take (at each end), so that the blends of
+/// neighbouring corners do not meet.
+pub const MAX_SHARE: f64 = 0.45;
+
+/// `toolpath` with every corner sharper than `corner_angle_deg` between two moves at
+/// programmed feeds replaced by a fillet within `tolerance_mm` of it (see the module docs),
+/// and the number of corners blended (`toolpath` itself, borrowed, when the tolerance is 0).
+/// The point indices of dwells, tool and spindle changes follow their points (a change at a
+/// blended corner moves to the blend's first point).
+pub fn blend_corners(
+    toolpath: &Toolpath,
+    tolerance_mm: f64,
+    corner_angle_deg: f64,
+) -> (Cow<'_, Toolpath>, usize) {
+    let pts = &toolpath.points;
+    let n = pts.len();
+    if tolerance_mm.is_nan() || tolerance_mm <= 0.0 || n < 3 {
+        return (Cow::Borrowed(toolpath), 0);
+    }
+    let corner_cos = corner_angle_deg.to_radians().cos();
+    let max_cos = MAX_BLEND_ANGLE_DEG.to_radians().cos();
+    // Half the corner angle per arc step: each step turns less than a corner.
+    let step = 0.5 * corner_angle_deg.to_radians().max(1e-3);
+    let mut out: Vec<ClPoint> = Vec::with_capacity(n);
+    let mut map = Vec::with_capacity(n);
+    let mut blended = 0;
+    for k in 0..n {
+        map.push(out.len());
+        let p = &pts[k];
+        let fillet = (k > 0 && k + 1 < n)
+            .then(|| {
+                let (f_in, f_out) = match (pts[k].feed, pts[k + 1].feed) {
+                    (Feed::Programmed(a), Feed::Programmed(b)) => (a, b),
+                    _ => return None,
+                };
+                if toolpath
+                    .dwells
+                    .iter()
+                    .any(|d| d.point == k && d.seconds > 0.0)
+                {
+                    return None;
+                }
+                let a = p.p - pts[k - 1].p;
+                let b = pts[k + 1].p - p.p;
+                let (la, lb) = (a.norm(), b.norm());
+                if la <= SAME_POSITION_MM || lb <= SAME_POSITION_MM {
+                    return None;
+                }
+                let (ua, ub) = (a / la, b / lb);
+                let c = ua.dot(&ub).clamp(-1.0, 1.0);
+                if c >= corner_cos || c < max_cos {
+                    return None;
+                }
+                Some(fillet(
+                    &pts[k - 1],
+                    p,
+                    &pts[k + 1],
+                    tolerance_mm,
+                    step,
+                    f_in.min(f_out),
+                ))
+            })
+            .flatten();
+        match fillet {
+            Some(arc) => {
+                out.extend(arc);
+                blended += 1;
+            }
+            None => out.push(p.clone()),
+        }
+    }
+    let mut tp = toolpath.clone();
+    tp.points = out;
+    for d in &mut tp.dwells {
+        d.point = map[d.point.min(n - 1)];
+    }
+    for c in &mut tp.tool_changes {
+        c.point = map[c.point.min(n - 1)];
+    }
+    for c in &mut tp.spindle_changes {
+        c.point = map[c.point.min(n - 1)];
+    }
+    (Cow::Owned(tp), blended)
+}
+
+/// The CL points of the fillet at corner `q` between the moves from `p` and to `r` (see the
+/// module docs): its first tangent point, the arc's points at most `step` radians apart, its
+/// last tangent point.
+fn fillet(p: &ClPoint, q: &ClPoint, r: &ClPoint, tol: f64, step: f64, feed: f64) -> Vec<ClPoint> {
+    let (a, b) = (q.p - p.p, r.p - q.p);
+    let (la, lb) = (a.norm(), b.norm());
+    let (ua, ub) = (a / la, b / lb);
+    let theta = ua.dot(&ub).clamp(-1.0, 1.0).acos();
+    let half = 0.5 * theta;
+    let mut radius = tol * half.cos() / (1.0 - half.cos());
+    let mut d = radius * half.tan();
+    let room = MAX_SHARE * la.min(lb);
+    if d > room {
+        d = room;
+        radius = d / half.tan();
+    }
+    // The unit normal of the first move towards the inside of the turn.
+    let inward = (ub - ua * ua.dot(&ub)).normalize();
+    let t1 = q.p - ua * d;
+    let centre = t1 + inward * radius;
+    // The orientation and rotary angles at the tangent points, along their moves.
+    let along = |from: &ClPoint, to: &ClPoint, s: f64| -> (Vector3<f64>, Option<[f64; 3]>) {
+        let o = (from.o * (1.0 - s) + to.o * s).normalize();
+        let rot = match (from.rotary, to.rotary) {
+            (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
+            _ => None,
+        };
+        (o, rot)
+    };
+    let (o1, rot1) = along(p, q, 1.0 - d / la);
+    let (o2, rot2) = along(q, r, d / lb);
+    let m = ((theta / step).ceil() as usize).max(2);
+    (0..=m)
+        .map(|j| {
+            let s = j as f64 / m as f64;
+            let alpha = theta * s;
+            let at = centre - inward * (radius * alpha.cos()) + ua * (radius * alpha.sin());
+            let o = (o1 * (1.0 - s) + o2 * s).normalize();
+            let rotary = match (rot1, rot2) {
+                (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
+                _ => None,
+            };
+            ClPoint {
+                p: at,
+                o: if o.iter().all(|x| x.is_finite()) {
+                    o
+                } else {
+                    q.o
+                },
+                // The first tangent point ends the straight part of the first move.
+                feed: Feed::Programmed(if j == 0 {
+                    match q.feed {
+                        Feed::Programmed(f) => f,
+                        _ => feed,
+                    }
+                } else {
+                    feed
+                }),
+                rotary,
+                line: q.line,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(x: f64, y: f64, feed: Feed) -> ClPoint {
+        ClPoint {
+            p: Vector3::new(x, y, 0.0),
+            o: Vector3::z(),
+            feed,
+            rotary: None,
+            line: 1,
+        }
+    }
+
+    fn toolpath(points: Vec<ClPoint>) -> Toolpath {
+        Toolpath::new("t.ngc".into(), points)
+    }
+
+    /// A 90° corner: the fillet's ends are tangent points d = r tan 45° = r from the corner,
+    /// every arc point is r from the centre, and its middle is ε from the corner.
+    #[test]
+    fn a_right_angle_gets_the_fillet_of_its_tolerance() {
+        let f = Feed::Programmed(10.0);
+        let tp = toolpath(vec![
+            pt(0.0, 0.0, Feed::Rapid),
+            pt(10.0, 0.0, f),
+            pt(10.0, 10.0, f),
+        ]);
+        let eps = 0.02;
+        let (out, n) = blend_corners(&tp, eps, 10.0);
+        assert_eq!(n, 1);
+        let r =
+            eps * (0.25 * std::f64::consts::PI).cos() / (1.0 - (0.25 * std::f64::consts::PI).cos());
+        let arc = &out.points[1..out.points.len() - 1];
+        assert!((arc[0].p - Vector3::new(10.0 - r, 0.0, 0.0)).norm() < 1e-12);
+        assert!((arc[arc.len() - 1].p - Vector3::new(10.0, r, 0.0)).norm() < 1e-12);
+        let centre = Vector3::new(10.0 - r, r, 0.0);
+        let corner = Vector3::new(10.0, 0.0, 0.0);
+        let nearest = arc
+            .iter()
+            .map(|q| (q.p - corner).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            arc.iter()
+                .all(|q| ((q.p - centre).norm() - r).abs() < 1e-12)
+        );
+        // The arc's middle (a point of it: an even number of steps) is ε from the corner.
+        assert!((nearest - eps).abs() < 1e-12, "{nearest}");
+        // Each step turns at most 5°.
+        for w in out.points.windows(3) {
+            let (u, v) = ((w[1].p - w[0].p).normalize(), (w[2].p - w[1].p).normalize());
+            assert!(u.dot(&v) >= 5f64.to_radians().cos() - 1e-12);
+        }
+    }
+
+    /// A short move limits the fillet to MAX_SHARE of it; reversals, rapids, dwells and gentle
+    /// turns are left alone; the dwell's index follows its point.
+    #[test]
+    fn short_moves_cap_the_fillet_and_other_corners_stay() {
+        let f = Feed::Programmed(10.0);
+        let tp = toolpath(vec![pt(0.0, 0.0, f), pt(1.0, 0.0, f), pt(1.0, 0.01, f)]);
+        let (out, n) = blend_corners(&tp, 0.5, 10.0);
+        assert_eq!(n, 1);
+        let last = &out.points[out.points.len() - 2];
+        assert!((last.p - Vector3::new(1.0, MAX_SHARE * 0.01, 0.0)).norm() < 1e-12);
+        for (points, why) in [
+            (
+                vec![pt(0.0, 0.0, f), pt(1.0, 0.0, f), pt(0.0, 0.01, f)],
+                "reversal",
+            ),
+            (
+                vec![pt(0.0, 0.0, f), pt(1.0, 0.0, Feed::Rapid), pt(1.0, 1.0, f)],
+                "rapid",
+            ),
+            (
+                vec![pt(0.0, 0.0, f), pt(1.0, 0.0, f), pt(2.0, 0.1, f)],
+                "gentle",
+            ),
+        ] {
+            let tp = toolpath(points.clone());
+            let (out, n) = blend_corners(&tp, 0.1, 10.0);
+            assert_eq!((n, &out.points), (0, &points), "{why}");
+        }
+        let mut tp = toolpath(vec![pt(0.0, 0.0, f), pt(1.0, 0.0, f), pt(1.0, 1.0, f)]);
+        tp.dwells.push(crate::toolpath::Dwell {
+            point: 1,
+            seconds: 1.0,
+            line: 1,
+        });
+        assert_eq!(blend_corners(&tp, 0.1, 10.0).1, 0);
+        tp.dwells[0].point = 2;
+        let (out, _) = blend_corners(&tp, 0.1, 10.0);
+        assert_eq!(out.dwells[0].point, out.points.len() - 1);
+    }
+}
