@@ -1100,3 +1100,20 @@ fn g92_gives_the_current_position_the_coordinates_named() {
         );
     }
 }
+
+/// LinuxCNC `G64 P0.02` (blending within 0.02 mm) is said with the option that applies it.
+#[test]
+fn g64_p_is_said_with_the_option_that_applies_it() {
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90 G64 P0.02\nG0 X0 Y0 Z0\nG1 X10 F600\nG64\n",
+    );
+    let said: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("--corner-tolerance 0.02"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(said[0].line, 1);
+    assert_eq!(xs(&tp), [0.0, 10.0]);
+}

@@ -1022,3 +1022,21 @@ fn q395_concerns_cycles_200_and_203_only() {
     );
     assert!(e.contains("Q395 = 1") && e.contains("point angle"), "{e}");
 }
+
+/// A program's contour tolerance (`CYCL DEF 32.1 T0.075`, as hyperMILL posts it) moves
+/// nothing and is said once, with the option that applies it; the path is unchanged.
+#[test]
+fn the_programs_contour_tolerance_is_said_with_the_option_that_applies_it() {
+    let tp = read(
+        "0 BEGIN PGM T MM\n1 CYCL DEF 32.0 TOLERANCE\n2 CYCL DEF 32.1 T0.075\n\
+         3 L X+0 Y+0 Z+5 FMAX\n4 L X+10 F1000\n5 END PGM T MM\n",
+    );
+    assert_eq!(tp.points.last().map(|p| p.p.x), Some(10.0));
+    let said: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("--corner-tolerance 0.075"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(said[0].line, 3);
+}

@@ -324,6 +324,9 @@ pub enum Action {
     /// `G92 X… Y…`: the current position is given these coordinates, by a shift of every
     /// work offset (LinuxCNC keeps it in `G52`'s register; Fanuc apart from it).
     PositionOffset(OffsetNumbering),
+    /// LinuxCNC `G64 P…`: path blending within the tolerance P. Corners stay exact stops
+    /// unless `--corner-tolerance` is given (a warning saying so, with P).
+    ContourTolerance,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
@@ -587,7 +590,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("59.3", Action::WorkOffset),
         ("61", Action::Ignored),
         ("61.1", Action::Ignored),
-        ("64", Action::Ignored),
+        ("64", Action::ContourTolerance),
         ("70..72", Unsup(CANNED)),
         ("73", Action::Cycle(73)),
         ("74", Action::Cycle(74)),

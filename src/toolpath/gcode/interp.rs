@@ -922,6 +922,15 @@ impl<'a> Interpreter<'a> {
                     }
                     self.shift_changed(before);
                 }
+                Action::ContourTolerance => {
+                    if let Some(p) = block.letter('P') {
+                        let mm = self.length(p);
+                        self.warn(
+                            line,
+                            contour_tolerance_note(&format!("{text} P{}", p.value), mm),
+                        );
+                    }
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -2541,4 +2550,15 @@ impl<'a> Interpreter<'a> {
         self.tangent = Some((arc_plane, tangent, self.points.len()));
         Ok(())
     }
+}
+
+/// The warning for a program's contour tolerance (`G64 P0.02`, `CYCL DEF 32.1 T0.075`, of
+/// `mm` mm): corners stay exact stops unless the user blends them.
+pub(super) fn contour_tolerance_note(text: &str, mm: f64) -> String {
+    format!(
+        "{text}: the program lets the control cut corners by {} mm; feedopt stops at every \
+         corner sharper than --corner-angle unless --corner-tolerance {} is given",
+        crate::error::number(mm),
+        crate::error::number(mm)
+    )
 }

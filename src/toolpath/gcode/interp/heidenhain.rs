@@ -868,7 +868,20 @@ impl Interpreter<'_> {
             // Active when defined, moves nothing (tolerance, orientation, contour data, the
             // dynamics tuning): not the cycle a call runs. Its parameters are its own
             // (332's Q395, the tuning mode, is not cycle 200's depth reference Q395): not
-            // assigned.
+            // assigned. The tolerance (`32.1 T0.075`) is said, with how to apply it.
+            if whole == 32 && sub == 1 {
+                let tol = words[1..].iter().find_map(|w| {
+                    let v = w.strip_prefix(['T', 't'])?;
+                    v.trim_start_matches('+')
+                        .replace(',', ".")
+                        .parse::<f64>()
+                        .ok()
+                });
+                if let Some(t) = tol.filter(|t| t.is_finite() && *t > 0.0) {
+                    let text = format!("CYCL DEF 32.1 T{t}");
+                    self.warn(line, super::contour_tolerance_note(&text, t));
+                }
+            }
             return Ok(());
         }
         for p in &params {
