@@ -1117,3 +1117,33 @@ fn g64_p_is_said_with_the_option_that_applies_it() {
     assert_eq!(said[0].line, 1);
     assert_eq!(xs(&tp), [0.0, 10.0]);
 }
+
+/// A leading `G28 G91 Z0` (Fusion's Fanuc and Haas posts) moves Z only: X and Y are still the
+/// unknown start, and the first move from there is said to be from X0 Y0, as after a leading
+/// `G0 Z0`. Round 4 found it counted in silence (+1101 mm on a Fusion program).
+#[test]
+fn a_reference_move_of_one_axis_leaves_the_others_unknown_and_says_so() {
+    let text = "G21 G90\nG28 G91 Z0\nG90\nG0 X100 Y0\nG1 X110 F600\n";
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        let tp = gcode(dialect, text);
+        let said: Vec<_> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("X, Y not programmed yet"))
+            .collect();
+        assert_eq!(said.len(), 1, "{dialect:?}: {:?}", tp.warnings);
+        assert_eq!(said[0].line, 2);
+    }
+    // Every axis named: nothing is unknown after it.
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG28 G91 X0 Y0 Z0\nG90\nG0 X100 Y0\n",
+    );
+    assert!(
+        tp.warnings
+            .iter()
+            .all(|w| !w.message.contains("not programmed yet")),
+        "{:?}",
+        tp.warnings
+    );
+}

@@ -1744,6 +1744,14 @@ impl<'a> Interpreter<'a> {
                 self.saw_rotary = true;
             }
         }
+        // Only the named axes move: the others stay where they are, and where the program has
+        // not placed them yet that is the unknown start (taken as 0, with the usual warning:
+        // a Fusion post's leading `G28 G91 Z0` had hidden it, and the first move from X0 Y0
+        // was counted in silence).
+        for &i in named.iter().filter(|&&i| i < 3) {
+            self.known[i] = true;
+        }
+        self.warn_unknown(line);
         if via != self.pos {
             self.push(line, &via, Feed::Rapid);
         }
@@ -1752,9 +1760,6 @@ impl<'a> Interpreter<'a> {
         self.push(line, &target, Feed::Rapid);
         self.machine_point = false;
         self.pos = target;
-        for i in 0..3 {
-            self.known[i] = true;
-        }
         Ok(())
     }
 
