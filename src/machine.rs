@@ -301,8 +301,8 @@ pub struct References {
     /// datum.
     pub m92: Vec<(String, f64)>,
     /// `"program_units"`: the unit the control reads a program in that selects none (Fanuc
-    /// and Sinumerik set it by a parameter or machine datum, not in the program); `None`: the
-    /// file does not say.
+    /// and Sinumerik set it by a parameter or machine datum, LinuxCNC in its INI file, not in
+    /// the program); `None`: the file does not say.
     pub program_units: Option<LengthUnit>,
     /// `"decimal_point_input"`: how the control reads a number written without a decimal
     /// point (Fanuc parameter 3401#0, DPI); `None`: the file does not say.

@@ -561,11 +561,12 @@ fn sinumerik_ac_and_ic_arc_centres() {
     assert_close(a[a.len() / 2].p, v(10.0, 29.0, 0.0), 1e-6);
 }
 
-/// A Fanuc or Sinumerik program that selects no unit is read in the unit the control is set
-/// to, which only the machine file can give (`program_units`). Without it: mm, a warning at the
-/// first move and the `units` note (an NX post for a Makino, "_in", with no G20 was read in
-/// mm with no word said). With `inch`: coordinates and F in inch.
-/// LinuxCNC (units from its INI file) and a program that selects its unit say nothing.
+/// A Fanuc, Sinumerik or LinuxCNC program that selects no unit is read in the unit the control
+/// is set to (parameters; LinuxCNC's INI file), which only the machine file can give
+/// (`program_units`). Without it: mm, a warning at the first move and the `units` note (an NX
+/// post for a Makino, "_in", with no G20 was read in mm with no word said; round 4, an inch
+/// LinuxCNC sample, 1.09 m for about 27.8 m). With `inch`: coordinates and F in inch. A program
+/// that selects its unit says nothing.
 #[test]
 fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm() {
     let text = "G90 G0 X1. Y0. Z0.\nG1 X2. F10.\n";
@@ -574,7 +575,7 @@ fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm()
         m.program_units = units;
         parse_assumed(Path::new("t.nc"), text, spec, Some(&m), &[]).unwrap()
     };
-    for d in [Dialect::Fanuc, Dialect::Sinumerik] {
+    for d in [Dialect::Fanuc, Dialect::Sinumerik, Dialect::LinuxCnc] {
         let (tp, assumed) = read(d.spec(), None);
         assert!(assumed.units_mm && assumed.units_note().unwrap().contains("program_units"));
         let w: Vec<&Warning> = tp
@@ -598,7 +599,11 @@ fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm()
             other => panic!("{other:?}"),
         }
         // The program's own G21 / G71 wins over the machine file.
-        let own = if d == Dialect::Fanuc { "G21 " } else { "G71 " };
+        let own = if d == Dialect::Sinumerik {
+            "G71 "
+        } else {
+            "G21 "
+        };
         let mut m = context("XYZ", Default::default(), [0.0; 3]);
         m.program_units = Some(LengthUnit::Inch);
         let (tp, assumed) = parse_assumed(
@@ -613,22 +618,16 @@ fn a_program_without_a_unit_is_read_in_the_machine_files_unit_or_said_to_be_mm()
         assert_close(tp.points[1].p, v(2.0, 0.0, 0.0), 1e-12);
         // F: Fanuc's G21 sets it in mm/min; Sinumerik's G71 changes lengths only, F stays in
         // the basic system the machine file gives (inch/min).
-        let f = if d == Dialect::Fanuc {
-            10.0
-        } else {
+        let f = if d == Dialect::Sinumerik {
             10.0 * 25.4
+        } else {
+            10.0
         };
         match tp.points[1].feed {
             Feed::Programmed(got) => assert!((got - f / 60.0).abs() < 1e-12, "{d:?}: {got}"),
             other => panic!("{other:?}"),
         }
     }
-    let (tp, assumed) = read(Dialect::LinuxCnc.spec(), None);
-    assert!(
-        !assumed.units_mm && tp.warnings.is_empty(),
-        "{:?}",
-        tp.warnings
-    );
 }
 
 /// `G95` (feed per revolution) with the spindle speed known: the feed at a move is F × S. The

@@ -421,7 +421,7 @@ pub struct Assumed {
     /// not give (`axes.Z.reference`): machine zero, machine coordinate 0, was used — the
     /// controls' default.
     pub reference_at_machine_zero: [bool; 6],
-    /// A Fanuc or Sinumerik program selected no unit (G20/G21, G70/G71, G700/G710) and the
+    /// A Fanuc, Sinumerik or LinuxCNC program selected no unit (G20/G21, G70/G71, G700/G710) and the
     /// machine file gives no `program_units`: it was read in mm, as a metric control does.
     pub units_mm: bool,
 }

@@ -450,9 +450,10 @@ pub struct DialectSpec {
     pub integer_increments: Option<IntegerIncrements>,
     /// How subprograms are written.
     pub subprograms: Subprograms,
-    /// A program that selects no unit is read in the unit a control parameter sets (Fanuc,
-    /// Sinumerik), which the machine file may give (`program_units`); otherwise the unit is
-    /// the configuration's (LinuxCNC's INI file) or the program's own (Klartext `BEGIN PGM`).
+    /// A program that selects no unit is read in the unit a control setting gives (Fanuc and
+    /// Sinumerik parameters, LinuxCNC's INI file), which the machine file may give
+    /// (`program_units`); otherwise in mm, with a warning. Klartext's unit is the program's
+    /// own (`BEGIN PGM … MM`).
     pub units_by_setting: bool,
     /// The letters that repeat a G81–G89 canned cycle, the first given wins: `L` on LinuxCNC,
     /// `K` (or `L`) on Fanuc. A `K` in a cycle block of a dialect whose repeat letters do not
@@ -657,7 +658,9 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     g94_clears_feed: true,
     integer_increments: None,
     subprograms: Subprograms::OWordSub,
-    units_by_setting: false,
+    // The INI file's start-up codes (RS274NGC_STARTUP_CODE) and LINEAR_UNITS set it: an inch
+    // program without G20 was read as mm in silence (round 4, 1.09 m for about 27.8 m).
+    units_by_setting: true,
     cycle_repeat: &['L'],
 };
 

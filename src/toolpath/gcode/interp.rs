@@ -368,7 +368,7 @@ impl<'a> Interpreter<'a> {
         });
     }
 
-    /// After the program: a Fanuc or Sinumerik program that selected no unit, on a machine
+    /// After the program: a Fanuc, Sinumerik or LinuxCNC program that selected no unit, on a machine
     /// whose file does not say which unit its control reads such a program in, was read in mm;
     /// a warning at its first move and [`Assumed::units_mm`] say so.
     pub(super) fn note_units(&mut self) {
