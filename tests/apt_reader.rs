@@ -452,3 +452,21 @@ fn unknown_records_are_skipped_with_a_warning_naming_the_line() {
     assert_eq!(t.warnings[0].line, 3);
     assert!(t.warnings[0].message.contains("FOOBAR"));
 }
+
+/// `CUTCOM/LEFT` (and `RIGHT`) is said, as G41/G42 are: the CL points may be a contour the
+/// control offsets by the tool radius, which feedopt does not do. `CUTCOM/OFF` says nothing.
+/// Round 4 found it skipped in silence (a SolidWorks CAM program with 20 of them).
+#[test]
+fn cutcom_on_is_said_and_off_is_not() {
+    let tp = ok(
+        "UNITS/MM\nGOTO/0,0,0\nFEDRAT/300,MMPM\nCUTCOM/LEFT\nGOTO/10,0,0\nCUTCOM/OFF\nGOTO/10,10,0\n",
+    );
+    assert_eq!(tp.points.len(), 3);
+    let said: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("compensation"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(said, [4], "{:?}", tp.warnings);
+}

@@ -435,6 +435,23 @@ impl<'a> Reader<'a> {
                         message: format!("unknown APT record `{}`: skipped", major),
                     });
                 }
+                // Compensation on (as G41/G42 and Klartext RL/RR say): the CL points may be
+                // the part contour the control offsets by the tool radius.
+                if major == "CUTCOM"
+                    && let Some(m) = minor
+                    && m.split(',')
+                        .next()
+                        .is_some_and(|w| matches!(w.trim(), "LEFT" | "RIGHT"))
+                {
+                    self.warnings.push(crate::toolpath::Warning {
+                        line,
+                        message: format!(
+                            "CUTCOM/{}: cutter radius compensation is not applied: the CL \
+                             points are taken as the tool path",
+                            m.trim()
+                        ),
+                    });
+                }
                 Ok(())
             }
         }
