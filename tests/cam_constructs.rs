@@ -1146,3 +1146,50 @@ fn a_reference_move_of_one_axis_leaves_the_others_unknown_and_says_so() {
         tp.warnings
     );
 }
+
+/// Sinumerik `G92 S3000` limits the spindle speed under G96 and moves nothing: it was refused
+/// as an unknown G code (round 4). Its S is no spindle speed: a G95 feed still takes the S in
+/// force before it. `G92` with axis words is an error there.
+#[test]
+fn sinumerik_g92_s_is_a_speed_limit_not_a_speed() {
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "G90 G71\nS1000 M3\nG0 X10 Y0 Z0\nG92 S3000\nG95 G1 X20 F0.1\n",
+    );
+    assert_eq!(xs(&tp), [10.0, 20.0]);
+    match tp.points[1].feed {
+        // 0.1 mm/rev × 1000 rpm = 100 mm/min.
+        Feed::Programmed(f) => assert!((f - 100.0 / 60.0).abs() < 1e-12, "{f}"),
+        other => panic!("{other:?}"),
+    }
+    let e = parse(
+        Path::new("t.mpf"),
+        "G90 G71\nG0 X10 Y0 Z0\nG92 X0\n",
+        Dialect::Sinumerik,
+    )
+    .expect_err("G92 X");
+    let m = message(e);
+    assert!(m.contains("t.mpf:3:") && m.contains("spindle"), "{m}");
+}
+
+/// LinuxCNC `G92.2` cancels the `G92` shift but keeps it in parameters 5211–5219, and `G92.3`
+/// restores it from there (round 4: it was refused, though the program had set them); after
+/// `G92.1` (which clears them) it restores 0. Before the program sets them they are the
+/// control's: an error.
+#[test]
+fn g92_3_restores_what_the_program_left_in_the_parameters() {
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG0 X10 Y0 Z0\nG92 X0\nG1 X5 F600\nG92.2\nG1 X0\nG92.3\nG1 X5\nG92.1\nG92.3\n\
+         G1 X1\n",
+    );
+    assert_eq!(xs(&tp), [10.0, 15.0, 0.0, 15.0, 1.0]);
+    let e = parse(
+        Path::new("t.ngc"),
+        "G21 G90\nG0 X10 Y0 Z0\nG92.3\n",
+        Dialect::LinuxCnc,
+    )
+    .expect_err("G92.3 first");
+    let m = message(e);
+    assert!(m.contains("t.ngc:3:") && m.contains("5211"), "{m}");
+}

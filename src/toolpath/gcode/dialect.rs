@@ -319,14 +319,25 @@ pub enum Action {
     SetOffset(OffsetNumbering),
     /// `G52`: the local shift of every work offset, by the block's axis words.
     LocalOffset,
-    /// LinuxCNC `G92.1`, `G92.2`: the `G52`/`G92` shift is cancelled.
-    LocalOffsetCancel,
+    /// LinuxCNC `G92.1`, `G92.2`: the `G52`/`G92` shift is cancelled; `G92.1` also clears the
+    /// parameters it is kept in (5211–5219), `G92.2` keeps them for a `G92.3`.
+    LocalOffsetCancel {
+        /// `G92.1`: the parameters are set to 0.
+        clear: bool,
+    },
+    /// LinuxCNC `G92.3`: the shift is restored from parameters 5211–5219: those a `G92`,
+    /// `G52` or `G92.1` of the program left there (an error where the program has set none:
+    /// their values are the control's).
+    LocalOffsetRestore,
     /// `G92 X… Y…`: the current position is given these coordinates, by a shift of every
     /// work offset (LinuxCNC keeps it in `G52`'s register; Fanuc apart from it).
     PositionOffset(OffsetNumbering),
     /// LinuxCNC `G64 P…`: path blending within the tolerance P. Corners stay exact stops
     /// unless `--corner-tolerance` is given (a warning saying so, with P).
     ContourTolerance,
+    /// Sinumerik `G92 S…`: the spindle speed limit under G96; moves nothing, and its S is no
+    /// spindle speed. Axis words with it are an error.
+    SpindleLimit,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
@@ -617,15 +628,9 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("90.1", ArcDistance(Distance::Absolute)),
         ("91.1", ArcDistance(Distance::Incremental)),
         ("92", Action::PositionOffset(OffsetNumbering::LinuxCnc)),
-        ("92.1", Action::LocalOffsetCancel),
-        ("92.2", Action::LocalOffsetCancel),
-        (
-            "92.3",
-            Unsup(
-                "G92.3 (the G52/G92 shift restored from parameters 5211–5219, whose values the \
-                 program does not give) is not supported",
-            ),
-        ),
+        ("92.1", Action::LocalOffsetCancel { clear: true }),
+        ("92.2", Action::LocalOffsetCancel { clear: false }),
+        ("92.3", Action::LocalOffsetRestore),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
         ("95", Fm(FeedMode::PerRevolution)),
@@ -920,6 +925,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("54..57", Action::WorkOffset),
         ("90", Dist(Distance::Absolute)),
         ("91", Dist(Distance::Incremental)),
+        ("92", Action::SpindleLimit),
         ("93", Fm(FeedMode::InverseTime)),
         ("94", Fm(FeedMode::PerMinute)),
         ("95", Fm(FeedMode::PerRevolution)),

@@ -168,6 +168,9 @@ pub(super) struct Interpreter<'a> {
     pos: [f64; 6],
     /// X Y Z set by an absolute word.
     known: [bool; 3],
+    /// LinuxCNC's parameters 5211–5219 (the `G52`/`G92` shift kept for `G92.3`), toolpath
+    /// coordinates: `None` until the program sets them (at the start they are the control's).
+    g92_params: Option<[f64; 6]>,
     unknown_warned: [bool; 3],
     vector: Vector3<f64>,
     saw_rotary: bool,
@@ -266,6 +269,7 @@ impl<'a> Interpreter<'a> {
             tcp: Tcp::Off,
             pos: [0.0; 6],
             known: [false; 3],
+            g92_params: None,
             unknown_warned: [false; 3],
             vector: Vector3::new(0.0, 0.0, 1.0),
             saw_rotary: false,
@@ -761,6 +765,7 @@ impl<'a> Interpreter<'a> {
         let mut fanuc_call = false;
         let mut reference: Option<u8> = None;
         let mut dwell = false;
+        let mut spindle_limit = false;
         let mut frame_op: Option<(&str, FrameOp)> = None;
         let mut new_cycle: Option<(&str, u32)> = None;
         let mut sinumerik_cycle: Option<(String, u32, String)> = None;
@@ -915,10 +920,30 @@ impl<'a> Interpreter<'a> {
                 Action::SetOffset(numbering) => set_offset = Some((text.as_str(), numbering)),
                 Action::LocalOffset => local_offset = true,
                 Action::PositionOffset(numbering) => position_offset = Some(numbering),
-                Action::LocalOffsetCancel => {
+                Action::LocalOffsetCancel { clear } => {
                     let before = self.offsets.shift();
                     for i in 0..6 {
                         self.offsets.set_local(i, 0.0);
+                    }
+                    if clear {
+                        self.g92_params = Some([0.0; 6]);
+                    }
+                    self.shift_changed(before);
+                }
+                Action::LocalOffsetRestore => {
+                    let Some(saved) = self.g92_params else {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "{text}: the G52/G92 shift restored from parameters 5211–5219, \
+                                 which the program has not set (their values are the \
+                                 control's): program the shift (G92 or G52) instead"
+                            ),
+                        ));
+                    };
+                    let before = self.offsets.shift();
+                    for (i, v) in saved.into_iter().enumerate() {
+                        self.offsets.set_local(i, v);
                     }
                     self.shift_changed(before);
                 }
@@ -931,6 +956,19 @@ impl<'a> Interpreter<'a> {
                         );
                     }
                 }
+                Action::SpindleLimit => {
+                    if block.axes.iter().any(Option::is_some) {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "{text} with axis words: on Sinumerik G92 limits the spindle \
+                                 speed (G92 S…) and moves nothing; set a position with a frame \
+                                 (TRANS, G54…)"
+                            ),
+                        ));
+                    }
+                    spindle_limit = true;
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -942,6 +980,7 @@ impl<'a> Interpreter<'a> {
         // revolutions; Klartext's comes with `TOOL CALL`).
         if self.spec.spaces != Spaces::Klartext
             && !dwell
+            && !spindle_limit
             && let Some(s) = block.letter('S')
         {
             if self.surface_speed {
@@ -1515,6 +1554,7 @@ impl<'a> Interpreter<'a> {
             }
             self.offsets.set_local(i, v);
         }
+        self.g92_params = Some(std::array::from_fn(|i| self.offsets.local(i)));
         self.shift_changed(before);
         Ok(())
     }
@@ -1570,6 +1610,9 @@ impl<'a> Interpreter<'a> {
             if i < 3 {
                 self.known[i] = true;
             }
+        }
+        if numbering == OffsetNumbering::LinuxCnc {
+            self.g92_params = Some(std::array::from_fn(|i| self.offsets.local(i)));
         }
         self.shift_changed(before);
         Ok(())
