@@ -1193,3 +1193,23 @@ fn g92_3_restores_what_the_program_left_in_the_parameters() {
     let m = message(e);
     assert!(m.contains("t.ngc:3:") && m.contains("5211"), "{m}");
 }
+
+/// Siemens allows blanks after an address letter and around `=` (round 4: `R1 = 100` was
+/// "malformed word `=`", `G1 X 100` "`X` has no number", in hand-written 840D programs). Each
+/// reads as its compact form, an expression's terms included.
+#[test]
+fn sinumerik_blanks_after_an_address_and_around_equals_read_as_the_compact_form() {
+    let compact = gcode(
+        Dialect::Sinumerik,
+        "G90 G71\nDEF REAL OFF\nR1=100\nOFF=R1+5\nG0 X0 Y0 Z0\nG1 X=OFF F600\nG1 X=R1-2*3\nG1 X100\n\
+         R2=SIN(30)+1\nG1 X=R2\n",
+    );
+    let spaced = gcode(
+        Dialect::Sinumerik,
+        "G90 G71\nDEF REAL OFF\nR1 = 100\nOFF = R1 + 5\nG0 X 0 Y 0 Z 0\nG1 X = OFF F 600\n\
+         G1 X= R1 - 2 * 3\nG1 X 100\nR2 = SIN(30) + 1\nG1 X = R2\n",
+    );
+    assert_eq!(xs(&compact), [0.0, 105.0, 94.0, 100.0, 1.5]);
+    assert_eq!(xs(&spaced), xs(&compact));
+    assert_eq!(spaced.points[1].feed, compact.points[1].feed);
+}

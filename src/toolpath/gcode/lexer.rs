@@ -325,6 +325,56 @@ pub(super) fn split_words(text: &str) -> Vec<String> {
     words
 }
 
+/// Words split at blanks that Siemens allows inside a statement, joined again: after an
+/// address letter (`X 100` is `X100`), around `=` (`R1 = 100`, `X= 10`) and between the terms
+/// of a value (`R1 = R2 + 3`: a word that starts with an operator, or follows one, continues
+/// the value before it). A lone letter followed by a number, an `=` word, and operators are
+/// never words of their own, so nothing that was read before reads differently.
+fn join_blanks(words: Vec<String>) -> Vec<String> {
+    let op = |c: char| matches!(c, '+' | '-' | '*' | '/');
+    let mut out: Vec<String> = Vec::with_capacity(words.len());
+    // Whether the last word is an assignment whose value may continue.
+    let mut in_value = false;
+    for w in words {
+        let joined = match out.last_mut() {
+            // `NAME` `=…`, or `NAME=` `value`.
+            Some(last) if w.starts_with('=') && !last.contains('=') => {
+                last.push_str(&w);
+                true
+            }
+            Some(last) if last.ends_with('=') => {
+                last.push_str(&w);
+                true
+            }
+            // `X` `100`: a lone letter and a number.
+            Some(last)
+                if last.len() == 1
+                    && last.chars().all(|c| c.is_ascii_alphabetic())
+                    && w.starts_with(|c: char| {
+                        c.is_ascii_digit() || matches!(c, '.' | '-' | '+')
+                    }) =>
+            {
+                last.push_str(&w);
+                true
+            }
+            // `R1=R2` `+` `3`: the value goes on.
+            Some(last) if in_value && (w.starts_with(op) || last.ends_with(op)) => {
+                last.push_str(&w);
+                true
+            }
+            _ => false,
+        };
+        if !joined {
+            out.push(w);
+        }
+        in_value = out
+            .last()
+            .and_then(|l| l.split_once('='))
+            .is_some_and(|(name, _)| !name.contains('('));
+    }
+    out
+}
+
 fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
     chars
@@ -358,7 +408,7 @@ pub(super) fn lex(
             {
                 return declare(&words[k + 1..], vars).map(|()| Vec::new());
             }
-            for word in words {
+            for word in join_blanks(words) {
                 lex_separate_word(spec, &word, vars, &mut items)?;
             }
         }
