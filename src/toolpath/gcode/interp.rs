@@ -2604,8 +2604,8 @@ impl<'a> Interpreter<'a> {
 /// `mm` mm): corners stay exact stops unless the user blends them.
 pub(super) fn contour_tolerance_note(text: &str, mm: f64) -> String {
     format!(
-        "{text}: the program lets the control cut corners by {} mm; feedopt stops at every \
-         corner sharper than --corner-angle unless --corner-tolerance {} is given",
+        "{text}: the program lets the control cut corners by {} mm; --corner-tolerance {} \
+         does so, without it feedopt stops at every corner sharper than --corner-angle",
         crate::error::number(mm),
         crate::error::number(mm)
     )
