@@ -470,3 +470,28 @@ fn cutcom_on_is_said_and_off_is_not() {
         .collect();
     assert_eq!(said, [4], "{:?}", tp.warnings);
 }
+
+/// SolidWorks CAM's `CYCLE/DEEP2` (round 4: refused, in three of four of its programs) is a
+/// deep peck cycle whose first peck (`1STPECK`) differs from the others (`SUBPECK`), read as
+/// `CYCLE/DEEP` with that first peck, with a warning saying so: from the clearance 2 mm above
+/// the point, pecks to −2 (4 mm), −5, −8 and the depth −10 (3 mm each), at the feed.
+#[test]
+fn deep2_pecks_first_by_its_first_peck_then_by_the_others() {
+    let text = "UNITS/MM\nRAPID\nGOTO/0,0,20\nCYCLE/DEEP2,FEDTO,10.,1STPECK,4.,SUBPECK,3.,MMPM,200.,\
+                RAPTO,2.,RTRCTO,20.\nGOTO/0,0,0\nCYCLE/OFF\n";
+    let tp = ok(text);
+    let pecks: Vec<f64> = tp
+        .points
+        .iter()
+        .filter(|p| matches!(p.feed, Feed::Programmed(_)))
+        .map(|p| p.p.z)
+        .collect();
+    assert_eq!(pecks, [-2.0, -5.0, -8.0, -10.0], "{:?}", tp.points);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 4 && w.message.contains("DEEP2")),
+        "{:?}",
+        tp.warnings
+    );
+}

@@ -75,7 +75,9 @@
 //!   origin and the directions of its X and Y axes in world coordinates (Z = X × Y). Every
 //!   later point becomes origin + R·p and every tool vector R·v; `MSYS/` without numbers (or
 //!   an identity) ends it.
-//! * `CYCLE/DRILL|FACE|DEEP|BRKCHP|TAP|BORE|REAM, …` with the keywords `FEDTO d` (depth below
+//! * `CYCLE/DRILL|FACE|DEEP|BRKCHP|TAP|BORE|REAM, …` (and SolidWorks CAM's `DEEP2`: `DEEP`
+//!   whose first peck `1STPECK p` differs from the others, `SUBPECK s`; with a warning) with
+//!   the keywords `FEDTO d` (depth below
 //!   the point), `MMPM|IPM f` (feed), `RAPTO c` (clearance above the point), `RTRCTO r`
 //!   (retract level above the point; default: the clearance), `STEP s` (peck, DEEP and
 //!   BRKCHP), `DWELL t` (seconds), or the positional NX form `CYCLE/DRILL,d,MMPM,f,c`: every
@@ -286,6 +288,8 @@ struct AptCycle {
     clearance: f64,
     retract: f64,
     step: Option<f64>,
+    /// The first peck, where it differs from the others (`CYCLE/DEEP2 … 1STPECK`).
+    first_step: Option<f64>,
     dwell: f64,
 }
 
@@ -830,6 +834,18 @@ impl<'a> Reader<'a> {
             "DRILL" => "DRILL",
             "FACE" => "FACE",
             "DEEP" => "DEEP",
+            // SolidWorks CAM (CAMWorks): a deep peck cycle with its first peck (1STPECK)
+            // apart from the others (SUBPECK).
+            "DEEP2" => {
+                self.warnings.push(crate::toolpath::Warning {
+                    line,
+                    message: "CYCLE/DEEP2: read as CYCLE/DEEP with its first peck \
+                              (1STPECK) apart from the others (SUBPECK): a rapid back to the \
+                              clearance after every peck"
+                        .into(),
+                });
+                "DEEP"
+            }
             "BRKCHP" => "BRKCHP",
             "TAP" => "TAP",
             "BORE" => "BORE",
@@ -849,6 +865,7 @@ impl<'a> Reader<'a> {
             clearance: 0.0,
             retract: f64::NAN,
             step: None,
+            first_step: None,
             dwell: 0.0,
         };
         let mut positional = 0;
@@ -871,7 +888,8 @@ impl<'a> Reader<'a> {
                 "IPM" => c.feed = Some(next(k)? * 25.4 / 60.0),
                 "RAPTO" | "CLEAR" => c.clearance = next(k)? * scale,
                 "RTRCTO" => c.retract = next(k)? * scale,
-                "STEP" | "INCR" => c.step = Some(next(k)?.abs() * scale),
+                "STEP" | "INCR" | "SUBPECK" => c.step = Some(next(k)?.abs() * scale),
+                "1STPECK" => c.first_step = Some(next(k)?.abs() * scale),
                 "DWELL" => c.dwell = next(k)?.max(0.0),
                 "MMPR" | "IPR" => {
                     return Err(self.error(line, "CYCLE: feed per revolution is not supported"));
@@ -923,8 +941,10 @@ impl<'a> Reader<'a> {
         match (c.kind, c.step) {
             ("DEEP" | "BRKCHP", Some(step)) => {
                 let mut h = c.clearance;
+                let mut this = c.first_step.filter(|s| *s > 0.0).unwrap_or(step);
                 loop {
-                    let next = (h - step).max(bottom);
+                    let next = (h - this).max(bottom);
+                    this = step;
                     self.emit(at(next), feed, line);
                     if next <= bottom {
                         break;
