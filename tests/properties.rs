@@ -534,3 +534,82 @@ fn random_paths_are_reproducible() {
         _ => panic!("seed 8 is a CL path"),
     }
 }
+
+/// Corner blending (`--corner-tolerance`) on seeded random 3-axis polylines: 4–24 moves of
+/// 0.01–20 mm turning 0–175° (reversals, gentle turns and tiny moves among them), programmed
+/// feeds 5–100 mm/s, tolerances 1e-4–0.5 mm. Every solve succeeds and verifies, and with the
+/// acceleration limits alone the blended path is no slower than the exact stops (beyond the
+/// refinement's own 1e-4 each).
+#[test]
+fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
+    let machine = Machine::from_json(
+        "xyz.json".as_ref(),
+        r#"{"kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 500, "acceleration": 2000},
+                     "Y": {"velocity": 500, "acceleration": 1500},
+                     "Z": {"velocity": 300, "acceleration": 1000}}}"#,
+    )
+    .expect("machine");
+    let (mut blended_total, mut cases) = (0, 0);
+    for seed in 0..40u64 {
+        let mut g = Lcg::new(seed + 7000);
+        let moves = g.int(4, 24);
+        let mut p = Vector3::zeros();
+        let mut dir = Vector3::new(1.0, 0.0, 0.0);
+        let mut points = vec![ClPoint {
+            p,
+            o: Vector3::z(),
+            feed: Feed::Rapid,
+            rotary: None,
+            line: 1,
+        }];
+        for k in 0..moves {
+            // Turn by 0–175° about a random axis near +Z (some moves climb or dive).
+            let turn = g.range(0.0, 175f64.to_radians());
+            let axis = Vector3::new(g.range(-0.3, 0.3), g.range(-0.3, 0.3), 1.0).normalize();
+            dir = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), turn)
+                * dir;
+            let len = if g.unit() < 0.2 {
+                g.range(0.01, 0.1)
+            } else {
+                g.range(0.5, 20.0)
+            };
+            p += dir * len;
+            points.push(ClPoint {
+                p,
+                o: Vector3::z(),
+                feed: Feed::Programmed(g.range(5.0, 100.0)),
+                rotary: None,
+                line: k + 2,
+            });
+        }
+        let path = Toolpath {
+            source: PathBuf::from(format!("blend_{seed}.cls")),
+            points,
+            warnings: Vec::new(),
+            dwells: Vec::new(),
+            tool_changes: Vec::new(),
+            spindle_changes: Vec::new(),
+        };
+        let tolerance = 10f64.powf(g.range(-4.0, -0.3));
+        let stop = optimize(&machine, &path, &Options::default())
+            .unwrap_or_else(|e| panic!("seed {seed}, exact stops: {e}"));
+        let mut options = Options::default();
+        options.geometry.corner_tolerance_mm = tolerance;
+        let sol = optimize(&machine, &path, &options)
+            .unwrap_or_else(|e| panic!("seed {seed}, tolerance {tolerance}: {e}"));
+        assert!(sol.verification.verified, "seed {seed}");
+        let (t, t0) = (sol.schedule.cycle_time, stop.schedule.cycle_time);
+        assert!(
+            t <= t0 * (1.0 + 2e-4),
+            "seed {seed}, tolerance {tolerance}: blended {t} s, stops {t0} s"
+        );
+        blended_total += sol.corners_blended;
+        cases += 1;
+    }
+    // The draw blends corners (most turns exceed the 10° corner angle).
+    assert!(
+        blended_total > 5 * cases,
+        "{blended_total} corners in {cases} paths"
+    );
+}

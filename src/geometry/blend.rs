@@ -28,9 +28,12 @@
 //! next to a rapid move, a move without a feed or an inverse-time block (only corners between
 //! two moves at programmed feeds are blended).
 //!
-//! The new points carry the corner's source line; their feed is the lower of the two moves'
-//! feeds, their tool orientation and programmed rotary angles are interpolated along the moves
-//! (on the blend, between those of its ends).
+//! The new points carry the corner's source line. The first half of the blend keeps the first
+//! move's feed and the second half the second's: a control changes the feed where the blocks
+//! meet. (With the lower of the two over the whole blend, a blend into a slow move took 45 %
+//! of a fast one at the slow feed: a random path ran 5 % slower blended than with exact
+//! stops.) Their tool orientation and programmed rotary angles are interpolated along the
+//! moves (on the blend, between those of its ends).
 
 use nalgebra::Vector3;
 use std::borrow::Cow;
@@ -107,7 +110,7 @@ pub fn blend_corners(
                     &pts[k + 1],
                     tolerance_mm,
                     step,
-                    f_in.min(f_out),
+                    (f_in, f_out),
                 ))
             })
             .flatten();
@@ -142,7 +145,7 @@ fn blend_points(
     r: &ClPoint,
     tol: f64,
     step: f64,
-    feed: f64,
+    feeds: (f64, f64),
 ) -> Vec<ClPoint> {
     let (a, b) = (q.p - p.p, r.p - q.p);
     let (la, lb) = (a.norm(), b.norm());
@@ -209,8 +212,7 @@ fn blend_points(
     let (o2, rot2) = along(q, r, d / lb);
     points
         .into_iter()
-        .enumerate()
-        .map(|(j, (at, s))| {
+        .map(|(at, s)| {
             let o = (o1 * (1.0 - s) + o2 * s).normalize();
             let rotary = match (rot1, rot2) {
                 (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
@@ -224,14 +226,9 @@ fn blend_points(
                     q.o
                 },
                 // The first tangent point ends the straight part of the first move.
-                feed: Feed::Programmed(if j == 0 {
-                    match q.feed {
-                        Feed::Programmed(f) => f,
-                        _ => feed,
-                    }
-                } else {
-                    feed
-                }),
+                // The first half of the blend is the first move's, the second the other's: the
+                // feed changes where the blocks meet, at its middle.
+                feed: Feed::Programmed(if s <= 0.5 { feeds.0 } else { feeds.1 }),
                 rotary,
                 line: q.line,
             }
