@@ -549,3 +549,32 @@ fn exact_interpolation_of_the_boats_solves_with_jerk_limits() {
         assert_verified_with_jerk(&sol, name);
     }
 }
+
+/// A corner tolerance with jerk limits is refused, naming the way out: the jerk-limited solve
+/// is ill-conditioned on the blends (minutes on random 20-move paths). Without the jerk limits
+/// the same path blends and verifies.
+#[test]
+fn a_corner_tolerance_with_jerk_limits_is_refused_with_the_way_out() {
+    let m = common::machine(
+        r#"{"kinematics": {"type": "xyz"}, "axes": {
+        "X": {"velocity": 500, "acceleration": 3000, "jerk": 30000},
+        "Y": {"velocity": 500, "acceleration": 3000, "jerk": 30000},
+        "Z": {"velocity": 500, "acceleration": 3000, "jerk": 30000}}}"#,
+    );
+    let pts = [
+        (Vector3::new(0.0, 0.0, 0.0), UP),
+        (Vector3::new(10.0, 0.0, 0.0), UP),
+        (Vector3::new(10.0, 10.0, 0.0), UP),
+    ];
+    let tp = common::toolpath(&pts, Some(20.0));
+    let mut o = Options::default();
+    o.geometry.corner_tolerance_mm = 0.05;
+    let e = optimize(&m, &tp, &o).expect_err("refused").to_string();
+    assert!(
+        e.contains("--no-jerk") && e.contains("--corner-tolerance"),
+        "{e}"
+    );
+    o.jerk_limited = false;
+    let sol = optimize(&m, &tp, &o).expect("blends without jerk limits");
+    assert!(sol.verification.verified && sol.corners_blended == 1);
+}

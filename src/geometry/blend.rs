@@ -21,7 +21,10 @@
 //! within 0.02 mm took 4.6586 s against 4.5179 s with exact stops, and this blend 4.5223 s
 //! (0.1 mm: 4.4818 and 4.4363 s). Acceleration-limited, the two are within 0.06 % (the fillet's
 //! curvature is the lower). Under jerk limits a small tolerance gains little or nothing: a blend
-//! of length ~3ε with curvature ~1/ε passes at V ~ (j ε²)^(1/3).
+//! of length ~3ε with curvature ~1/ε passes at V ~ (j ε²)^(1/3). And the jerk-limited solve is
+//! ill-conditioned on such short, tight curves next to long moves (on seeded random polylines
+//! its subproblems hit Clarabel's iteration cap and a 20-move path took minutes), so a corner
+//! tolerance with jerk limits is refused for now ([`crate::optimize::optimize`]).
 //!
 //! Not blended: a corner sharper than [`MAX_BLEND_ANGLE_DEG`] (a reversal, where any blend
 //! within ε is so tight that the tool all but stops anyway), one where the tool dwells, and one

@@ -39,8 +39,8 @@ pub struct GeometryOptions {
     pub corner_angle_deg: f64,
     /// How far a corner sharper than `corner_angle_deg` may be cut, mm, as a control does
     /// under a contour tolerance (`G64 P`, `CYCLE832`, `CYCL DEF 32`): such a corner between
-    /// two feed moves becomes a fillet within it ([`blend::blend_corners`]). 0: every such
-    /// corner is an exact stop.
+    /// two feed moves becomes a blend within it ([`blend::blend_corners`]). 0: every such
+    /// corner is an exact stop. Refused with jerk limits (see [`blend`]).
     pub corner_tolerance_mm: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm
     /// (0: interpolate them exactly). See [`smooth_within`]. Between the points, the tip stays
