@@ -53,7 +53,7 @@ pub const MAX_SHARE: f64 = 0.45;
 
 /// Where the blend's control points lie on each move, as shares of its length d along it
 /// from the corner (the first at the tangent point).
-const SHAPE: [f64; 3] = [1.0, 2.0 / 3.0, 1.0 / 3.0];
+pub const SHAPE: [f64; 3] = [1.0, 2.0 / 3.0, 1.0 / 3.0];
 
 /// The most points one blend is written as.
 const MAX_BLEND_POINTS: usize = 1024;
