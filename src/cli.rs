@@ -235,9 +235,9 @@ pub struct SolveOptions {
     /// Turning angle between CL moves (degrees) above which the path stops exactly.
     #[arg(long, default_value_t = 10.0)]
     pub corner_angle: f64,
-    /// Blend such corners between feed moves instead of stopping: a fillet whose middle lies
+    /// Blend such corners between feed moves instead of stopping: a curve whose middle lies
     /// this far from the corner, mm, as a control does under a contour tolerance (G64 P,
-    /// CYCLE832, CYCL DEF 32). 0: exact stops.
+    /// CYCLE832, CYCL DEF 32). 0: exact stops. Not with jerk limits (--no-jerk).
     #[arg(long, default_value_t = 0.0, value_name = "MM")]
     pub corner_tolerance: f64,
     /// How far the fitted path may stray from the programmed tool-tip positions, mm (0: through

@@ -349,3 +349,38 @@ fn the_cli_writes_a_program_and_rejects_joint_space_input() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("joint-space"));
     assert!(!out2.exists());
 }
+
+/// With a corner tolerance the program is written as the schedule runs it: the blends as G1
+/// blocks through their points, the feeds still implying the schedule's cycle time. (It was
+/// an error: the writer planned the spans of the unblended toolpath.)
+#[test]
+fn blended_corners_are_written_as_the_blends_the_schedule_runs() {
+    let (m, t) = bundled("xyz_pocket", "pocket_contour.cls");
+    let mut options = reach();
+    options.geometry.corner_tolerance_mm = 0.05;
+    let sol = optimize(&m, &t, &options).unwrap();
+    assert!(sol.corners_blended > 0);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.ngc");
+    let o = GcodeOptions {
+        dialect: Dialect::LinuxCnc,
+        max_rotation_deg: None,
+    };
+    let prog = write_gcode(&out, &m, &t, &sol, &options.geometry, &o).unwrap();
+    let back =
+        match toolpath::read_as(&out, Some(toolpath::Format::Gcode), Dialect::LinuxCnc).unwrap() {
+            toolpath::Input::Cl(t) => t,
+            toolpath::Input::Joint(_) => unreachable!(),
+        };
+    let time = programmed_time(&back).unwrap();
+    let cycle = sol.schedule.cycle_time;
+    assert!((time - cycle).abs() <= 5e-3 * cycle, "{time} vs {cycle}");
+    assert!(
+        back.points.len() > t.points.len() + 2 * sol.corners_blended,
+        "{} points written for {} input points and {} blends",
+        back.points.len(),
+        t.points.len(),
+        sol.corners_blended
+    );
+    assert_eq!(back.points.len(), prog.blocks + 1);
+}

@@ -385,7 +385,9 @@ fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<V
 }
 
 /// Writes the toolpath back as G-code with the schedule's feed per block (see the module doc).
-/// `geometry` must be the options the solution was computed with.
+/// `geometry` must be the options the solution was computed with. Corners blended under
+/// `geometry.corner_tolerance_mm` are written as the blends the schedule runs (G1 blocks
+/// through their points, on the corner's line).
 pub fn program(
     machine: &Machine,
     toolpath: &Toolpath,
@@ -393,6 +395,12 @@ pub fn program(
     geometry: &GeometryOptions,
     options: &GcodeOptions,
 ) -> Result<Program> {
+    let (blended, _) = crate::geometry::blend::blend_corners(
+        toolpath,
+        geometry.corner_tolerance_mm,
+        geometry.corner_angle_deg,
+    );
+    let toolpath: &Toolpath = &blended;
     let w = words(options.dialect)?;
     let kin = &solution.kinematics;
     if matches!(kin, Kinematics::Joint { .. }) {
