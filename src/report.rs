@@ -177,7 +177,7 @@ pub struct Summary {
     /// The same for the rotary angles, degrees.
     pub max_deviation_deg: f64,
     /// Corners blended within the corner tolerance (`--corner-tolerance`) instead of stopped
-    /// at; the deviations above are from the path with those fillets.
+    /// at; the deviations above are from the path with those blends.
     pub corners_blended: usize,
     /// Per axis, in the machine's order (a JSON object keyed by axis name).
     #[serde(serialize_with = "as_map")]
@@ -225,7 +225,7 @@ pub struct Summary {
     /// What the reader assumed for `G28`/`G30` where the machine file gives no reference
     /// point (machine zero, the controls' default; the fields to set), else `null`.
     pub reference: Option<String>,
-    /// What the reader assumed of the unit of a Fanuc or Sinumerik program that selects none
+    /// What the reader assumed of the unit of a Fanuc, Sinumerik or LinuxCNC program that selects none
     /// where the machine file gives no `program_units` (mm), else `null`.
     pub units: Option<String>,
 }

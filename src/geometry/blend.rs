@@ -42,7 +42,7 @@ use nalgebra::Vector3;
 use std::borrow::Cow;
 
 use super::SAME_POSITION_MM;
-use crate::toolpath::{ClPoint, Feed, Toolpath};
+use crate::toolpath::{ClPoint, Dwell, Feed, SpindleChange, ToolChange, Toolpath};
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
 pub const MAX_BLEND_ANGLE_DEG: f64 = 150.0;
@@ -82,82 +82,82 @@ pub fn blend_corners(
     let mut blended = 0;
     for k in 0..n {
         map.push(out.len());
-        let p = &pts[k];
-        let blend = (k > 0 && k + 1 < n)
-            .then(|| {
-                let (f_in, f_out) = match (pts[k].feed, pts[k + 1].feed) {
-                    (Feed::Programmed(a), Feed::Programmed(b)) => (a, b),
-                    _ => return None,
-                };
-                if toolpath
-                    .dwells
-                    .iter()
-                    .any(|d| d.point == k && d.seconds > 0.0)
-                {
-                    return None;
-                }
-                let a = p.p - pts[k - 1].p;
-                let b = pts[k + 1].p - p.p;
-                let (la, lb) = (a.norm(), b.norm());
-                if la <= SAME_POSITION_MM || lb <= SAME_POSITION_MM {
-                    return None;
-                }
-                let (ua, ub) = (a / la, b / lb);
-                let c = ua.dot(&ub).clamp(-1.0, 1.0);
-                if c >= corner_cos || c < max_cos {
-                    return None;
-                }
-                Some(blend_points(
-                    &pts[k - 1],
-                    p,
-                    &pts[k + 1],
-                    tolerance_mm,
-                    step,
-                    (f_in, f_out),
-                ))
-            })
-            .flatten();
+        let blend = if k > 0 && k + 1 < n {
+            let feeds = match (pts[k].feed, pts[k + 1].feed) {
+                (Feed::Programmed(a), Feed::Programmed(b)) => Some((a, b)),
+                _ => None,
+            };
+            let dwells = toolpath
+                .dwells
+                .iter()
+                .any(|d| d.point == k && d.seconds > 0.0);
+            let corner = [&pts[k - 1], &pts[k], &pts[k + 1]];
+            feeds
+                .filter(|_| !dwells)
+                .and_then(|f| blend_points(corner, (corner_cos, max_cos), tolerance_mm, step, f))
+        } else {
+            None
+        };
         match blend {
             Some(points) => {
                 out.extend(points);
                 blended += 1;
             }
-            None => out.push(p.clone()),
+            None => out.push(pts[k].clone()),
         }
     }
-    let mut tp = toolpath.clone();
-    tp.points = out;
-    for d in &mut tp.dwells {
-        d.point = map[d.point.min(n - 1)];
-    }
-    for c in &mut tp.tool_changes {
-        c.point = map[c.point.min(n - 1)];
-    }
-    for c in &mut tp.spindle_changes {
-        c.point = map[c.point.min(n - 1)];
-    }
+    let moved = |i: usize| map[i.min(n - 1)];
+    let tp = Toolpath {
+        source: toolpath.source.clone(),
+        points: out,
+        warnings: toolpath.warnings.clone(),
+        dwells: (toolpath.dwells.iter())
+            .map(|d| Dwell {
+                point: moved(d.point),
+                ..*d
+            })
+            .collect(),
+        tool_changes: (toolpath.tool_changes.iter())
+            .map(|c| ToolChange {
+                point: moved(c.point),
+                ..c.clone()
+            })
+            .collect(),
+        spindle_changes: (toolpath.spindle_changes.iter())
+            .map(|c| SpindleChange {
+                point: moved(c.point),
+                ..*c
+            })
+            .collect(),
+    };
     (Cow::Owned(tp), blended)
 }
 
 /// The CL points of the blend at corner `q` between the moves from `p` and to `r` (see the
 /// module docs): from its first tangent point to its last, turning at most `step` radians from
-/// one chord to the next.
+/// one chord to the next; `None` where the corner is not one to blend (a move shorter than
+/// [`SAME_POSITION_MM`], a turn whose cosine is not within `cos_range`: below the corner
+/// angle's, at or above [`MAX_BLEND_ANGLE_DEG`]'s). Each half keeps its move's feed of `feeds`.
 fn blend_points(
-    p: &ClPoint,
-    q: &ClPoint,
-    r: &ClPoint,
+    [p, q, r]: [&ClPoint; 3],
+    cos_range: (f64, f64),
     tol: f64,
     step: f64,
     feeds: (f64, f64),
-) -> Vec<ClPoint> {
+) -> Option<Vec<ClPoint>> {
     let (a, b) = (q.p - p.p, r.p - q.p);
     let (la, lb) = (a.norm(), b.norm());
+    if la <= SAME_POSITION_MM || lb <= SAME_POSITION_MM {
+        return None;
+    }
     let (ua, ub) = (a / la, b / lb);
-    let theta = ua.dot(&ub).clamp(-1.0, 1.0).acos();
+    let c = ua.dot(&ub).clamp(-1.0, 1.0);
+    if c >= cos_range.0 || c < cos_range.1 {
+        return None;
+    }
+    let theta = c.acos();
     let half = 0.5 * theta;
     let room = MAX_SHARE * la.min(lb);
-    // The curve's points and, for each, how far along it (0 at its first tangent point, 1 at
-    // its last) for the orientations.
     // The quintic Bézier with three control points on each move (at SHAPE · d from the
     // corner): curvature 0 where it joins them. Its middle lies d · S · sin(θ/2) / 16 from the
     // corner (S = SHAPE₀ + 5 SHAPE₁ + 10 SHAPE₂), which d makes the tolerance.
@@ -187,56 +187,61 @@ fn blend_points(
     // Points at equal steps of t, as many as keep every turn from one chord to the next
     // within `step` (the curvature peaks in the middle), an even number (the middle is one).
     let mut m = (2 * (theta / step).ceil() as usize).max(2);
-    let points: Vec<(Vector3<f64>, f64)> = loop {
+    let points = loop {
         let pts: Vec<Vector3<f64>> = (0..=m).map(|j| at(j as f64 / m as f64)).collect();
         let worst = pts
             .windows(3)
             .map(|w| super::angle_between(&(w[1] - w[0]), &(w[2] - w[1])))
             .fold(0.0f64, f64::max);
         if worst <= step || m >= MAX_BLEND_POINTS {
-            break pts
-                .into_iter()
-                .enumerate()
-                .map(|(j, x)| (x, j as f64 / m as f64))
-                .collect();
+            break pts;
         }
         m *= 2;
     };
-    // The orientation and rotary angles at the tangent points, along their moves.
-    let along = |from: &ClPoint, to: &ClPoint, s: f64| -> (Vector3<f64>, Option<[f64; 3]>) {
-        let o = (from.o * (1.0 - s) + to.o * s).normalize();
-        let rot = match (from.rotary, to.rotary) {
-            (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
-            _ => None,
-        };
-        (o, rot)
+    // The tool orientation and rotary angles at the tangent points, along their moves, and
+    // between them on the blend by t.
+    let start = mix(p, q, 1.0 - d / la);
+    let end = mix(q, r, d / lb);
+    Some(
+        (points.into_iter().enumerate())
+            .map(|(j, at)| {
+                let t = j as f64 / m as f64;
+                let (o, rotary) = mix_of(start, end, t);
+                ClPoint {
+                    p: at,
+                    o: if o.iter().all(|x| x.is_finite()) {
+                        o
+                    } else {
+                        q.o
+                    },
+                    // The first half of the blend is the first move's, the second the
+                    // other's: the feed changes where the blocks meet, at its middle.
+                    feed: Feed::Programmed(if t <= 0.5 { feeds.0 } else { feeds.1 }),
+                    rotary,
+                    line: q.line,
+                }
+            })
+            .collect(),
+    )
+}
+
+/// Tool orientation and programmed rotary angles.
+type Pose = (Vector3<f64>, Option<[f64; 3]>);
+
+/// The pose a share `s` of the way from `from`'s to `to`'s.
+fn mix(from: &ClPoint, to: &ClPoint, s: f64) -> Pose {
+    mix_of((from.o, from.rotary), (to.o, to.rotary), s)
+}
+
+/// The pose a share `s` of the way from `a` to `b`: orientations interpolated and normalised
+/// (NaN where they are opposite), rotary angles interpolated where both are given.
+fn mix_of(a: Pose, b: Pose, s: f64) -> Pose {
+    let o = (a.0 * (1.0 - s) + b.0 * s).normalize();
+    let rotary = match (a.1, b.1) {
+        (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
+        _ => None,
     };
-    let (o1, rot1) = along(p, q, 1.0 - d / la);
-    let (o2, rot2) = along(q, r, d / lb);
-    points
-        .into_iter()
-        .map(|(at, s)| {
-            let o = (o1 * (1.0 - s) + o2 * s).normalize();
-            let rotary = match (rot1, rot2) {
-                (Some(x), Some(y)) => Some(std::array::from_fn(|i| x[i] + s * (y[i] - x[i]))),
-                _ => None,
-            };
-            ClPoint {
-                p: at,
-                o: if o.iter().all(|x| x.is_finite()) {
-                    o
-                } else {
-                    q.o
-                },
-                // The first tangent point ends the straight part of the first move.
-                // The first half of the blend is the first move's, the second the other's: the
-                // feed changes where the blocks meet, at its middle.
-                feed: Feed::Programmed(if s <= 0.5 { feeds.0 } else { feeds.1 }),
-                rotary,
-                line: q.line,
-            }
-        })
-        .collect()
+    (o, rotary)
 }
 
 #[cfg(test)]
