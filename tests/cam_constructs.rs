@@ -1213,3 +1213,16 @@ fn sinumerik_blanks_after_an_address_and_around_equals_read_as_the_compact_form(
     assert_eq!(xs(&spaced), xs(&compact));
     assert_eq!(spaced.points[1].feed, compact.points[1].feed);
 }
+
+/// A machine-coordinate position of a rotary axis (`G53 A…`, the `G28` reference) is not
+/// shifted by a work offset on that axis: with `G52 A10` in force, `A5` is at 15° and
+/// `G53 A30` at 30° (it was put at 40°, the shift added to a machine coordinate).
+#[test]
+fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
+    let tp = gcode(
+        Dialect::LinuxCnc,
+        "G21 G90\nG0 X0 Y0 Z0 A0\nG52 A10\nG0 A5\nG53 G0 A30\nG0 A0\n",
+    );
+    let a: Vec<f64> = tp.points.iter().map(|p| p.rotary.unwrap()[0]).collect();
+    assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
+}

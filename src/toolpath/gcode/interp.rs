@@ -1749,7 +1749,8 @@ impl<'a> Interpreter<'a> {
             if i < 3 {
                 machine_xyz[i] = r;
             } else {
-                target[i] = r;
+                // A machine coordinate, as the program coordinate the offsets take to it.
+                target[i] = r - self.offsets.shift()[i];
             }
         }
         if !defaulted.is_empty() {
@@ -2151,6 +2152,13 @@ impl<'a> Interpreter<'a> {
             }
             let incremental =
                 (self.distance == Distance::Incremental || block.incremental[i]) && !machine;
+            // A rotary machine coordinate: the program coordinate that the offsets in force
+            // take to it (`push` adds their shift; the X Y Z are converted below).
+            let value = if machine {
+                value - self.offsets.shift()[i]
+            } else {
+                value
+            };
             end[i] = if incremental {
                 start[i] + value
             } else if i >= 3 && self.shortest_path {
