@@ -872,10 +872,7 @@ impl Interpreter<'_> {
             if whole == 32 && sub == 1 {
                 let tol = words[1..].iter().find_map(|w| {
                     let v = w.strip_prefix(['T', 't'])?;
-                    v.trim_start_matches('+')
-                        .replace(',', ".")
-                        .parse::<f64>()
-                        .ok()
+                    klartext::value(v, &self.vars).ok()
                 });
                 if let Some(t) = tol.filter(|t| t.is_finite() && *t > 0.0) {
                     let text = format!("CYCL DEF 32.1 T{t}");
