@@ -110,7 +110,8 @@ struct Frame {
     /// A Heidenhain label call: the index of the calling line (a section repeat's pass ends
     /// there) and the label's name.
     label: Option<(usize, String)>,
-    /// A LinuxCNC call with arguments: the caller's `#1`–`#30`, given back on return.
+    /// A LinuxCNC O-word call (with arguments or without): the caller's `#1`–`#30`, given back
+    /// on return.
     locals: Option<Vec<Option<f64>>>,
 }
 
@@ -768,7 +769,7 @@ impl Program {
     }
 
     /// Returns from the running (sub)program: runs it again while repeats remain, else pops
-    /// it (a LinuxCNC call with arguments gives the caller its `#1`–`#30` back). `false`: the
+    /// it (a LinuxCNC O-word call gives the caller its `#1`–`#30` back). `false`: the
     /// main program has ended.
     fn ret(&self, stack: &mut Vec<Frame>, vars: &mut Variables) -> bool {
         if stack.len() <= 1 {
