@@ -204,6 +204,7 @@ pub fn optimize_observed(
     );
     let toolpath: &Toolpath = &blended;
     let angles = kin.rotary_angles(&toolpath.points, &machine.axes)?;
+    checks::travel(machine, &kin, toolpath, &angles)?;
     let mut path = Path::build(
         toolpath,
         &angles,

@@ -123,8 +123,10 @@ fn leaving_an_axis_travel_is_an_error_naming_the_axis_and_line() {
     let err = optimize(&m, &t, &Options::default()).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, Error::Infeasible(_)), "{msg}");
+    // Checked on the CL points before the path is fitted: the program's line, at once.
     assert!(
-        msg.contains("axis X") && msg.contains("travel") && msg.contains("CL line"),
+        msg.contains("test.cls:3: axis X would be at 25.0000")
+            && msg.contains("outside its travel [-10, 10]"),
         "{msg}"
     );
 }

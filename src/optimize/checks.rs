@@ -2,8 +2,11 @@
 //! table in [`crate::validate`]) and the machine. Beside `optimize.rs` so that the library's
 //! lower modules can share the range checks of [`crate::validate`] without a loop.
 
+use crate::base::{MAX_AXES, PATH_DIM};
 use crate::error::{Error, Result, number};
+use crate::kinematics::Kinematics;
 use crate::machine::Machine;
+use crate::toolpath::Toolpath;
 use crate::validate::{MAX_END_FEED, at_least};
 
 use super::Options;
@@ -84,4 +87,43 @@ impl Options {
 pub fn inputs(machine: &Machine, options: &Options) -> Result<()> {
     machine.validate()?;
     options.validate_for(machine)
+}
+
+/// Every CL point within every axis's travel (`angles`: the rotary angles the kinematics chose
+/// for the points, radians), or an error naming the program line and the axis: checked before
+/// the path is fitted, so that a point off the machine fails at once rather than after the
+/// smoothing and the solve (the stations are checked again, [`super::Plan`]).
+pub fn travel(
+    machine: &Machine,
+    kin: &Kinematics,
+    toolpath: &Toolpath,
+    angles: &[[f64; 2]],
+) -> Result<()> {
+    if machine.axes.iter().all(|a| a.travel.is_none()) {
+        return Ok(());
+    }
+    for (p, a) in toolpath.points.iter().zip(angles) {
+        let mut w = [0.0; PATH_DIM];
+        w[..5].copy_from_slice(&[p.p.x, p.p.y, p.p.z, a[0], a[1]]);
+        let mut q = [0.0; MAX_AXES];
+        kin.axis_positions(w, &mut q);
+        for (j, axis) in machine.axes.iter().enumerate() {
+            let Some((lo, hi)) = axis.travel else {
+                continue;
+            };
+            let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
+            if !(lo - tol..=hi + tol).contains(&q[j]) {
+                return Err(Error::Infeasible(format!(
+                    "{}:{}: axis {} would be at {:.4} here, outside its travel [{lo}, {hi}]; \
+                     check the program's work offset and units, or the travel in the machine \
+                     file",
+                    toolpath.source.display(),
+                    p.line,
+                    axis.name,
+                    q[j]
+                )));
+            }
+        }
+    }
+    Ok(())
 }
