@@ -281,3 +281,69 @@ fn the_station_limit_returns_the_last_round_with_its_estimate() {
         "{tc} vs {tf}, estimate {est:e}"
     );
 }
+
+/// A window of the final solve is left on the feasible reach profile only with a certificate:
+/// the lattice relaxation's time (a lower bound on the window's optimum) within Clarabel's own
+/// relative gap of the profile's. On a serpentine of 20 mm lines and R5 half circles at 200
+/// mm/s (the half circles limit the speed to √(3000·5) ≈ 122 mm/s; at each crest X's or Y's
+/// velocity crosses zero and the relaxation leaves rows out, as on hyperMILL's finishing
+/// paths), every span whose relaxation breaks a row and that took no interior-point iteration
+/// lies within that gap of its lower bound, and the default answer stays within 1e-6 of
+/// Clarabel on every span in one piece.
+#[test]
+fn windows_left_on_the_reach_profile_carry_a_certificate() {
+    use feedopt::solver::{Status, optimal, reach};
+    let m = machine(XYZ);
+    let mut pts = vec![(Vector3::zeros(), UP)];
+    for i in 0..6 {
+        let d = if i % 2 == 0 { 1.0 } else { -1.0 };
+        let (x0, y0) = (pts.last().unwrap().0.x, pts.last().unwrap().0.y);
+        for k in 1..=40 {
+            pts.push((Vector3::new(x0 + d * 0.5 * k as f64, y0, 0.0), UP));
+        }
+        let (cx, cy) = (x0 + d * 20.0, y0 + 5.0);
+        for k in 1..=30 {
+            let th = -std::f64::consts::FRAC_PI_2 + d * std::f64::consts::PI * k as f64 / 30.0;
+            pts.push((
+                Vector3::new(cx + 5.0 * d * th.cos(), cy + 5.0 * th.sin(), 0.0),
+                UP,
+            ));
+        }
+    }
+    let t = toolpath(&pts, Some(200.0));
+    let sol = optimize(&m, &t, &Options::default()).expect("solves");
+    let settings = SolverSettings::default();
+    let every = SolverSettings {
+        window: usize::MAX,
+        ..SolverSettings::default()
+    };
+    let time = |p, b: &feedopt::solver::SpanSolution| -> f64 {
+        interval_times(p, b).expect("finite").iter().sum()
+    };
+    let (mut certified, mut solved) = (0, 0);
+    for p in &sol.problems {
+        let greedy = reach::solve(p).expect("feasible");
+        let relaxed = reach::solve_lattice(p).expect("feasible");
+        if reach::lattice_violations(p, &relaxed.b, 1e-9).is_empty() {
+            continue;
+        }
+        let s = optimal(p, &greedy, &settings).expect("solves");
+        let (c, _) = clarabel::solve_rows(p, &every, clarabel::Rows0::Every).expect("solves");
+        let (ts, tc, lower) = (time(p, &s), time(p, &c), time(p, &relaxed));
+        assert!(lower <= ts * (1.0 + 1e-12), "{lower} > {ts}");
+        // (Clarabel stops within its gap of the optimum: a solved window may end a little
+        // slower than the reach profile.)
+        assert!(ts <= time(p, &greedy) * (1.0 + settings.tol_gap));
+        assert!((ts - tc).abs() <= 1e-6 * tc, "{ts} vs all-Clarabel {tc}");
+        if s.iterations == 0 && s.status == Status::Optimal {
+            assert!(ts - lower <= settings.tol_gap * ts, "{ts} vs {lower}");
+            certified += 1;
+        } else {
+            solved += 1;
+        }
+    }
+    assert!(
+        certified > 0,
+        "no span left on a certified reach profile ({solved} solved)"
+    );
+}
