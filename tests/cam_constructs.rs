@@ -685,17 +685,43 @@ fn g95_feed_per_revolution_is_f_times_s() {
     // forgotten, not read as 0.1 mm/min).
     let tp = gcode(
         Dialect::Fanuc,
-        "G21 G90 G0 X0 Y0 Z0\nS1000\nG95 G1 X10. F0.1\nG94 G1 X20.\nG1 X30. F600.\n",
+        "G21 G90 G0 X0 Y0 Z0\nS1000\nG95 G1 X10. F0.1\nG94 G1 X20. F600.\n",
     );
     let feeds: Vec<Feed> = tp.points[1..].iter().map(|p| p.feed).collect();
     assert_eq!(
         feeds,
-        [
-            Feed::Programmed(100.0 / 60.0),
-            Feed::Unspecified,
-            Feed::Programmed(10.0)
-        ]
+        [Feed::Programmed(100.0 / 60.0), Feed::Programmed(10.0)]
     );
+    // A feed move after the F is forgotten stops the control, as before any F or after F0
+    // (LinuxCNC "Cannot do G1 with zero feed rate", Fanuc PS0011, Sinumerik 10860): an error
+    // naming the line, never a move at the machine's maximum feed.
+    for (dialect, text, line) in [
+        (
+            Dialect::Fanuc,
+            "G21 G90 G0 X0 Y0 Z0\nS1000\nG95 G1 X10. F0.1\nG94 G1 X20.\n",
+            4,
+        ),
+        (Dialect::LinuxCnc, "G21 G90 G0 X0 Y0 Z5\nG1 Z-1\n", 2),
+        (Dialect::LinuxCnc, "G21 G90 G0 X0 Y0 Z5\nG1 Z-1 F0\n", 2),
+        (
+            Dialect::LinuxCnc,
+            "G21 G90 G0 X0 Y0 Z5\nF100\nG1 Z-1 F0.\nG1 X50\n",
+            3,
+        ),
+        (
+            Dialect::LinuxCnc,
+            "G20 G90 G0 X0 Y0 Z0.4\nS400 M3\nG98 G84 X0 Y0 Z-0.48 R0.1 F0.\n",
+            3,
+        ),
+        (Dialect::Sinumerik, "G71 G90 G0 X0 Y0 Z5\nG1 X10\n", 2),
+        (Dialect::Fanuc, "G21 G90 G0 X0 Y0 Z5\nG2 X10 Y0 R5\n", 2),
+    ] {
+        let e = message(parse(Path::new("t.ngc"), text, dialect).unwrap_err());
+        assert!(
+            e.starts_with(&format!("t.ngc:{line}: a feed move with no feed rate")),
+            "{e}\n{text}"
+        );
+    }
     for (dialect, text, line, needle) in [
         (
             Dialect::LinuxCnc,

@@ -140,10 +140,12 @@ fn modal_g0_g1_and_feeds() {
 }
 
 #[test]
-fn feed_before_any_f_is_unspecified() {
-    let tp = ok("G0 X0 Y0 Z0\nG1 X1\nF120 X2\n");
-    assert_eq!(tp.points[1].feed, Feed::Unspecified);
-    assert_eq!(tp.points[2].feed, Feed::Programmed(2.0));
+fn a_feed_move_before_any_f_or_at_f0_is_an_error() {
+    // LinuxCNC: "Cannot do G1 with zero feed rate"; not a move at the machine's maximum feed.
+    err("G0 X0 Y0 Z0\nG1 X1\nF120 X2\n", 2, &["no feed rate"]);
+    err("G0 X0 Y0 Z0\nG1 X1 F0\n", 2, &["no feed rate", "F0"]);
+    let tp = ok("G0 X0 Y0 Z0\nF120\nG1 X1\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(2.0));
 }
 
 #[test]
@@ -191,9 +193,13 @@ fn g93_inverse_time() {
     err("G0 X0 Y0 Z0\nG93\nG1 X1 F10\nX2\n", 4, &["G93", "F"]);
     err("G0 X0 Y0 Z0\nG93 G1 X1 F0\n", 2, &["F"]);
     // Leaving G93 forgets F (LinuxCNC: G94 sets F to 0).
-    let tp = ok("G0 X0 Y0 Z0\nG93 G1 X1 F10\nG94 G1 X2\nX3 F60\n");
-    assert_eq!(tp.points[2].feed, Feed::Unspecified);
-    assert_eq!(tp.points[3].feed, Feed::Programmed(1.0));
+    err(
+        "G0 X0 Y0 Z0\nG93 G1 X1 F10\nG94 G1 X2\nX3 F60\n",
+        3,
+        &["no feed rate"],
+    );
+    let tp = ok("G0 X0 Y0 Z0\nG93 G1 X1 F10\nG94 G1 X3 F60\n");
+    assert_eq!(tp.points[2].feed, Feed::Programmed(1.0));
 }
 
 #[test]
@@ -545,7 +551,7 @@ fn other_errors_name_the_line() {
         2,
         &["G87", "back boring"],
     );
-    let tp = ok("G0 X0 Y0 Z5\nG91 G81 X5 Y0 Z-3 R-4 L3\n");
+    let tp = ok("G0 X0 Y0 Z5\nG91 G81 X5 Y0 Z-3 R-4 L3 F100\n");
     let bottoms = tp
         .points
         .iter()
@@ -554,7 +560,7 @@ fn other_errors_name_the_line() {
     assert_eq!(bottoms, 3, "L3: three holes");
     let tp = ok_in(
         Dialect::Fanuc,
-        "G21 G90\nG0 X0. Y0. Z5.\nG91 G81 X5. Y0. Z-3. R-4. K3\nM30\n",
+        "G21 G90\nG0 X0. Y0. Z5.\nG91 G81 X5. Y0. Z-3. R-4. K3 F100.\nM30\n",
     );
     let bottoms = tp
         .points

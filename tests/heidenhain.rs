@@ -716,7 +716,7 @@ fn block_delete_runs_slash_blocks_unless_the_switch_is_on() {
             .any(|w| w.line == 7 && w.message.contains("block skipped"))
     );
     // Outside Klartext a skip level may follow the mark: `/2 G1 X10`.
-    let g = "G21 G90 G17\nG0 X0. Y0. Z5.\n/2 G1 X10. F600.\nG1 Y10.\nM30\n";
+    let g = "G21 G90 G17\nG0 X0. Y0. Z5.\nF600.\n/2 G1 X10.\nG1 Y10.\nM30\n";
     for (block_delete, want) in [(false, vec![0.0, 10.0, 10.0]), (true, vec![0.0, 0.0])] {
         let settings = feedopt::toolpath::gcode::Settings {
             block_delete,

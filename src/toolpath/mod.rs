@@ -101,7 +101,8 @@ pub enum Feed {
     Rapid,
     /// G-code inverse-time feed (G93): the block is programmed to take this long, seconds.
     BlockTime(f64),
-    /// No feed was programmed before this move: the machine's maximum feed applies.
+    /// No feed was programmed before this move (APT: a `GOTO` before the first `FEDRAT`; a
+    /// G-code feed move without a feed is an error): the machine's maximum feed applies.
     Unspecified,
 }
 

@@ -1173,7 +1173,13 @@ impl<'a> Interpreter<'a> {
     /// error naming the line.
     fn modal_feed(&self, line: usize) -> Result<Option<ModalFeed>> {
         let Some(f) = self.feed else {
-            return Ok(None);
+            // Every control refuses it (LinuxCNC: "Cannot do G1 with zero feed rate"; Fanuc:
+            // alarm PS0011; Sinumerik: alarm 10860; grbl: error 22): it is not a rapid.
+            return Err(self.error(
+                line,
+                "a feed move with no feed rate (no F programmed before it, or F0): the control \
+                 stops here; program F before the move",
+            ));
         };
         if self.feed_mode != FeedMode::PerRevolution {
             return Ok(Some(f));

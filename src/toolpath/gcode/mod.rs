@@ -67,8 +67,10 @@
 //!   mm/min (under G20, F × 25.4); a G1/G2/G3 block whose X, Y or Z moves by more than
 //!   [`XYZ_MOVE_THRESHOLD_MM`] gets [`Feed::Programmed`] (F/60 mm/s). When only rotary axes move,
 //!   LinuxCNC's length rule makes F degrees per minute over the A B C distance, so the block gets
-//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). Before any F, or
-//!   after `F0`, feed moves get [`Feed::Unspecified`]. Under `G93` (inverse time) every G1/G2/G3
+//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). A feed move
+//!   before any F, after `F0`, or after a mode change forgot F is an error naming its line:
+//!   every control stops there (LinuxCNC "Cannot do G1 with zero feed rate", Fanuc alarm
+//!   PS0011, Sinumerik alarm 10860); it is not a move at the machine's maximum feed. Under `G93` (inverse time) every G1/G2/G3
 //!   block must carry its own F (an error naming the line otherwise) and gets
 //!   [`Feed::BlockTime`] = 60/F s; on an arc that time is split over the chords in proportion to
 //!   their length. Leaving G93 forgets F (LinuxCNC: every `G94` sets F to 0), so a feed move must
