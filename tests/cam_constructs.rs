@@ -157,6 +157,50 @@ fn g28_goes_via_the_intermediate_point() {
     assert!(tp.points[1..].iter().all(|p| p.feed == Feed::Rapid));
 }
 
+/// LinuxCNC (and Tormach's PathPilot, which Fusion's Tormach post writes for): `G28` or `G30`
+/// without axis words sends every axis the machine has straight to its stored position (no
+/// intermediate point); Fanuc's axis words say which axes return, so there it stays an error.
+/// `G50` (PathPilot's scaling cancel, in that post's safe-start line) moves nothing.
+#[test]
+fn bare_g28_and_g30_send_every_axis_home_on_linuxcnc() {
+    let refs = [
+        vec![-200.0, -100.0],
+        vec![0.0, 50.0],
+        vec![150.0, 120.0],
+        vec![],
+        vec![],
+        vec![],
+    ];
+    let m = context("XYZ", refs, [0.0, 0.0, 100.0]);
+    let tp = parse_for(
+        Path::new("t.ngc"),
+        "G90 G54 G64 G50 G17\nG0 X10 Y10 Z5\nG28\nG0 X10 Y10 Z5\nG30\n",
+        Dialect::LinuxCnc.spec(),
+        Some(&m),
+    )
+    .unwrap();
+    let p: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    // Program = machine − work offset (0, 0, 100).
+    assert_eq!(
+        p,
+        [
+            v(10.0, 10.0, 5.0),
+            v(-200.0, 0.0, 50.0),
+            v(10.0, 10.0, 5.0),
+            v(-100.0, 50.0, 20.0),
+        ]
+    );
+    assert!(tp.points[1..].iter().all(|p| p.feed == Feed::Rapid));
+    let e = parse_for(
+        Path::new("t.nc"),
+        "G90 G0 X10. Y10. Z5.\nG28\n",
+        Dialect::Fanuc.spec(),
+        Some(&m),
+    )
+    .unwrap_err();
+    assert!(message(e).contains("t.nc:2: G28 without axis words"));
+}
+
 #[test]
 fn g28_without_a_reference_goes_to_machine_zero_and_says_so() {
     // No reference in the machine file: machine zero, the controls' default. Machine = program

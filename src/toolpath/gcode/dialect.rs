@@ -458,6 +458,10 @@ pub struct DialectSpec {
     pub initial_motion: Option<Motion>,
     /// Every `G94` sets F to 0 (LinuxCNC); otherwise only leaving G93 forgets F.
     pub g94_clears_feed: bool,
+    /// `G28`/`G30` without axis words send every axis straight to its reference position
+    /// (LinuxCNC); otherwise such a block is an error (Fanuc: the axis words say which axes
+    /// return).
+    pub bare_reference_moves_all: bool,
     pub integer_increments: Option<IntegerIncrements>,
     /// How subprograms are written.
     pub subprograms: Subprograms,
@@ -594,6 +598,10 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("43.1", Action::Ignored),
         ("43.2", Action::Ignored),
         ("49", Action::Ignored),
+        // Tormach PathPilot (LinuxCNC) cancels scaling with G50; Fusion's Tormach post writes
+        // it in every program's safe-start line. G51 (scaling on) is not read, so no scaling
+        // is ever in force and G50 changes nothing.
+        ("50", Action::Ignored),
         ("52", Action::LocalOffset),
         ("53", MachineCoordinates),
         ("54..59", Action::WorkOffset),
@@ -661,6 +669,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     keywords: &[],
     initial_motion: None,
     g94_clears_feed: true,
+    bare_reference_moves_all: true,
     integer_increments: None,
     subprograms: Subprograms::OWordSub,
     // The INI file's start-up codes (RS274NGC_STARTUP_CODE) and LINEAR_UNITS set it: an inch
@@ -823,6 +832,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     keywords: &[],
     initial_motion: Some(Motion::Rapid),
     g94_clears_feed: false,
+    bare_reference_moves_all: false,
     integer_increments: Some(IntegerIncrements {
         mm: 0.001,
         inch: 0.0001,
@@ -1060,6 +1070,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     ],
     initial_motion: Some(Motion::Rapid),
     g94_clears_feed: false,
+    bare_reference_moves_all: false,
     integer_increments: None,
     subprograms: Subprograms::Procs,
     units_by_setting: true,
@@ -1300,6 +1311,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     ],
     initial_motion: None,
     g94_clears_feed: false,
+    bare_reference_moves_all: false,
     integer_increments: None,
     subprograms: Subprograms::Labels,
     units_by_setting: false,

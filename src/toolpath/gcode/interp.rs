@@ -1696,6 +1696,8 @@ impl<'a> Interpreter<'a> {
     /// (program coordinates, absolute or incremental), to the reference point of the same
     /// axes (machine coordinates from the machine file; where it gives none, machine zero,
     /// with a warning and [`Assumed::reference_at_machine_zero`]). Both moves are rapids.
+    /// Without axis words, LinuxCNC sends every axis the machine has straight to its
+    /// reference ([`DialectSpec::bare_reference_moves_all`]); elsewhere that is an error.
     fn reference(&mut self, line: usize, k: u8, block: &Block) -> Result<()> {
         let k = match (k, block.letter('P')) {
             (2, Some(p)) if (2.0..=4.0).contains(&p.value) && p.value.fract() == 0.0 => {
@@ -1707,7 +1709,15 @@ impl<'a> Interpreter<'a> {
             (k, _) => k as usize,
         };
         let code = if k == 1 { "G28" } else { "G30" };
-        let named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
+        let mut named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
+        if named.is_empty() && self.spec.bare_reference_moves_all {
+            // LinuxCNC: straight to the stored position, every axis the machine has (X Y Z
+            // where the machine file is not known).
+            named = match self.machine.and_then(|m| m.axes.as_ref()) {
+                Some(axes) => (0..6).filter(|&i| axes.contains(&AXIS_NAMES[i])).collect(),
+                None => vec![0, 1, 2],
+            };
+        }
         if named.is_empty() {
             return Err(self.error(
                 line,
