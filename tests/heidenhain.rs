@@ -424,10 +424,10 @@ fn cycle_203_with_chip_breaking_and_207_tapping() {
     );
     // A cycle feedopt cannot expand: defined with a warning, called with an error.
     let e = fails(&format!(
-        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n Q200=3~\n\
-         Q201=-85\n6 L X+0 Y+0 FMAX M99\n"
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 204 BACK BORING~\n Q200=3~\n\
+         Q249=+5\n6 L X+0 Y+0 FMAX M99\n"
     ));
-    assert!(e.contains(":9:") && e.contains("cycle 241"), "{e}");
+    assert!(e.contains(":9:") && e.contains("cycle 204"), "{e}");
 }
 
 #[test]
@@ -984,10 +984,10 @@ fn cycles_active_on_definition_that_move_nothing_are_skipped() {
     let e = fails(&format!("{HEADER}4 {TUNING}5 L X+0 Y+0 Z+10 R0 FMAX M99\n"));
     assert!(e.contains(":7:") && e.contains("without a CYCL DEF"), "{e}");
     let e = fails(&format!(
-        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n\
-         Q200=3~\n Q201=-85\n6 {TUNING}7 L X+0 Y+0 FMAX M99\n"
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 204 BACK BORING~\n\
+         Q200=3~\n Q249=+5\n6 {TUNING}7 L X+0 Y+0 FMAX M99\n"
     ));
-    assert!(e.contains(":11:") && e.contains("cycle 241"), "{e}");
+    assert!(e.contains(":11:") && e.contains("cycle 204"), "{e}");
     for (n, name) in [(220, "POLAR PATTERN"), (221, "CARTESIAN PATTERN")] {
         let e = fails(&format!(
             "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n{DRILL_NEW}6 CYCL DEF {n} {name} ~\n  Q216=+50 ~\n\
