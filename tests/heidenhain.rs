@@ -424,10 +424,10 @@ fn cycle_203_with_chip_breaking_and_207_tapping() {
     );
     // A cycle feedopt cannot expand: defined with a warning, called with an error.
     let e = fails(&format!(
-        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n Q200=3~\n\
-         Q201=-85\n6 L X+0 Y+0 FMAX M99\n"
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 204 BACK BORING~\n Q200=3~\n\
+         Q249=+5\n6 L X+0 Y+0 FMAX M99\n"
     ));
-    assert!(e.contains(":9:") && e.contains("cycle 241"), "{e}");
+    assert!(e.contains(":9:") && e.contains("cycle 204"), "{e}");
 }
 
 #[test]
@@ -984,10 +984,10 @@ fn cycles_active_on_definition_that_move_nothing_are_skipped() {
     let e = fails(&format!("{HEADER}4 {TUNING}5 L X+0 Y+0 Z+10 R0 FMAX M99\n"));
     assert!(e.contains(":7:") && e.contains("without a CYCL DEF"), "{e}");
     let e = fails(&format!(
-        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 241 SINGLE-LIP DEEP-HOLE DRILLING~\n\
-         Q200=3~\n Q201=-85\n6 {TUNING}7 L X+0 Y+0 FMAX M99\n"
+        "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n5 CYCL DEF 204 BACK BORING~\n\
+         Q200=3~\n Q249=+5\n6 {TUNING}7 L X+0 Y+0 FMAX M99\n"
     ));
-    assert!(e.contains(":11:") && e.contains("cycle 241"), "{e}");
+    assert!(e.contains(":11:") && e.contains("cycle 204"), "{e}");
     for (n, name) in [(220, "POLAR PATTERN"), (221, "CARTESIAN PATTERN")] {
         let e = fails(&format!(
             "{HEADER}4 L X+0 Y+0 Z+10 FMAX\n{DRILL_NEW}6 CYCL DEF {n} {name} ~\n  Q216=+50 ~\n\
@@ -1039,4 +1039,397 @@ fn the_programs_contour_tolerance_is_said_with_the_option_that_applies_it() {
         .collect();
     assert_eq!(said.len(), 1, "{:?}", tp.warnings);
     assert_eq!(said[0].line, 3);
+}
+
+/// The Z and feed (mm/s; `None`: rapid) of every point from `from` on, at X Y `at`.
+fn z_feeds(tp: &Toolpath, from: usize) -> Vec<(f64, Option<f64>)> {
+    tp.points[from..]
+        .iter()
+        .map(|p| {
+            let f = match p.feed {
+                Feed::Programmed(f) => Some(f),
+                _ => None,
+            };
+            (p.p.z, f)
+        })
+        .collect()
+}
+
+fn warned(tp: &Toolpath, text: &str) -> bool {
+    tp.warnings.iter().any(|w| w.message.contains(text))
+}
+
+/// Cycle 201 (reaming) at X 10 Y 20: surface 0, set-up clearance 2, depth −15, plunging
+/// 120 mm/min, dwell 0.5 s, retraction 600 mm/min, 2nd set-up clearance 20; by `M99` at two
+/// holes. Retraction feed 0 is the plunging feed, `MAX` rapid; a missing Q206 an error at the
+/// call naming the parameter.
+#[test]
+fn cycle_201_reams_in_and_out_at_its_two_feeds() {
+    let program = |q208: &str| {
+        format!(
+            "0 BEGIN PGM R MM\n1 TOOL CALL 1 Z S1000\n2 L X+10 Y+20 Z+50 R0 FMAX\n\
+             3 CYCL DEF 201 REAMING~\n Q200=2 ;SET-UP CLEARANCE~\n Q201=-15 ;DEPTH~\n\
+             Q206=120 ;FEED RATE FOR PLNGNG~\n Q211=0.5 ;DWELL TIME AT DEPTH~\n\
+             Q208={q208} ;RETRACTION FEED RATE~\n Q203=+0 ;SURFACE COORDINATE~\n\
+             Q204=20 ;2ND SET-UP CLEARANCE\n4 L X+10 Y+20 R0 FMAX M99\n5 L X+40 FMAX M99\n"
+        )
+    };
+    let tp = read(&program("600"));
+    // Down at 2 mm/s, 0.5 s at the depth, up at 10 mm/s to the set-up clearance, rapid to 20.
+    let hole = [
+        (2.0, None),
+        (-15.0, Some(2.0)),
+        (2.0, Some(10.0)),
+        (20.0, None),
+    ];
+    // (Point 1 is the block at line 3.)
+    assert_eq!(tp.points[1].p, v(10.0, 20.0, 50.0));
+    assert_eq!(z_feeds(&tp, 2)[..4], hole);
+    assert!(
+        tp.points[2..6]
+            .iter()
+            .all(|p| p.p.x == 10.0 && p.p.y == 20.0)
+    );
+    // The second hole at X 40, over from the 2nd set-up clearance.
+    assert_eq!(tp.points[6].p, v(40.0, 20.0, 20.0));
+    assert_eq!(z_feeds(&tp, 7), hole);
+    // Per hole 17 mm at 2 mm/s and 17 mm at 10 mm/s, 0.5 s of dwell; 48 + 34 + 18 mm, and
+    // 30 mm across.
+    assert!(
+        (feed_time(&tp) - 2.0 * (8.5 + 1.7)).abs() < 1e-9,
+        "{}",
+        feed_time(&tp)
+    );
+    assert!((tp.dwell_time() - 1.0).abs() < 1e-12);
+    let holes = (48.0 + 34.0 + 18.0) + 30.0 + (18.0 + 34.0 + 18.0);
+    assert!((length(&tp.points[1..]) - holes).abs() < 1e-9);
+    // Q208 = 0: out at the plunging feed; Q208 = MAX: out at rapid.
+    let tp = read(&program("0"));
+    assert_eq!(z_feeds(&tp, 2)[2], (2.0, Some(2.0)));
+    let tp = read(&program("MAX"));
+    assert_eq!(z_feeds(&tp, 2)[2], (2.0, None));
+    // Without Q206: an error at the call (line 12), naming Q206 and the definition.
+    let e = fails(&program("600").replace("Q206=120 ;FEED RATE FOR PLNGNG~\n", ""));
+    assert!(
+        e.contains("t.h:11:") && e.contains("Q206 is not defined") && e.contains("line 4"),
+        "{e}"
+    );
+}
+
+/// Cycle 202 (boring) as 201, retracting at the plunging feed (Q208 = 0): at the depth the
+/// tool moves 0.2 mm off the wall in the direction Q214 (3: +X, 2: −Y), feeds out there,
+/// returns over the centre and rises to the 2nd set-up clearance. Q214 = 0 stays on the
+/// axis; a direction that is none is an error.
+#[test]
+fn cycle_202_moves_off_the_wall_before_it_retracts() {
+    let program = |q214: &str| {
+        format!(
+            "0 BEGIN PGM B MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+20 Z+50 R0 FMAX\n\
+             3 CYCL DEF 202 BORING~\n Q200=2 ;SET-UP CLEARANCE~\n Q201=-15 ;DEPTH~\n\
+             Q206=120 ;FEED RATE FOR PLNGNG~\n Q211=0.5 ;DWELL TIME AT DEPTH~\n\
+             Q208=0 ;RETRACTION FEED RATE~\n Q203=+0 ;SURFACE COORDINATE~\n\
+             Q204=20 ;2ND SET-UP CLEARANCE~\n Q214={q214} ;DISENGAGING DIRECTN~\n\
+             Q336=0 ;ANGLE OF SPINDLE\n4 L X+10 Y+20 R0 FMAX M99\n"
+        )
+    };
+    let tp = read(&program("3"));
+    let path: Vec<(Vector3<f64>, Feed)> = tp.points[2..].iter().map(|p| (p.p, p.feed)).collect();
+    assert_eq!(
+        path,
+        [
+            (v(10.0, 20.0, 2.0), Feed::Rapid),
+            (v(10.0, 20.0, -15.0), Feed::Programmed(2.0)),
+            (v(10.2, 20.0, -15.0), Feed::Rapid),
+            (v(10.2, 20.0, 2.0), Feed::Programmed(2.0)),
+            (v(10.0, 20.0, 2.0), Feed::Rapid),
+            (v(10.0, 20.0, 20.0), Feed::Rapid),
+        ]
+    );
+    assert!((tp.dwell_time() - 0.5).abs() < 1e-12);
+    assert!((feed_time(&tp) - 17.0).abs() < 1e-9, "{}", feed_time(&tp));
+    let hole = 48.0 + 17.0 + 0.2 + 17.0 + 0.2 + 18.0;
+    assert!((length(&tp.points[1..]) - hole).abs() < 1e-9);
+    assert!(warned(&tp, "cycle 202: the oriented spindle stop"));
+    let tp = read(&program("2"));
+    assert_eq!(tp.points[4].p, v(10.0, 19.8, -15.0));
+    let tp = read(&program("0"));
+    assert!(
+        tp.points[1..]
+            .iter()
+            .all(|p| p.p.x == 10.0 && p.p.y == 20.0)
+    );
+    assert!((length(&tp.points[1..]) - 100.0).abs() < 1e-9);
+    let e = fails(&program("5"));
+    assert!(e.contains("t.h:14:") && e.contains("Q214 = 5"), "{e}");
+}
+
+/// Cycle 209 (tapping with chip breaking), S 500 and pitch 1.5: tapping at 750 mm/min
+/// (12.5 mm/s), in steps of Q257 = 8 to −20, backing out Q256 = 2 pitches (3 mm) at Q403 = 2
+/// times the feed (25 mm/s), out at that speed; with Q256 = 0 fully out to the set-up
+/// clearance each time; called at two pattern points.
+#[test]
+fn cycle_209_taps_in_infeeds_and_backs_out_at_the_rpm_factor() {
+    let program = |q256: &str, tail: &str| {
+        format!(
+            "0 BEGIN PGM T MM\n1 TOOL CALL 1 Z S500\n2 L X+0 Y+0 Z+50 R0 FMAX\n\
+             3 CYCL DEF 209 TAPPING W/ CHIP BRKG~\n Q200=2 ;SET-UP CLEARANCE~\n\
+             Q201=-20 ;DEPTH~\n Q239=+1.5 ;THREAD PITCH~\n Q203=+0 ;SURFACE COORDINATE~\n\
+             Q204=10 ;2ND SET-UP CLEARANCE~\n Q257=8 ;DEPTH FOR CHIP BRKNG~\n\
+             Q256={q256} ;DIST FOR CHIP BRKNG~\n Q336=0 ;ANGLE OF SPINDLE{tail}\n\
+             4 L X+0 Y+0 R0 FMAX M99\n"
+        )
+    };
+    let tp = read(&program("2", "~\n Q403=2 ;RPM FACTOR"));
+    let (f, b) = (Some(12.5), Some(25.0));
+    assert_eq!(
+        z_feeds(&tp, 2),
+        [
+            (2.0, None),
+            (-8.0, f),
+            (-5.0, b),
+            (-16.0, f),
+            (-13.0, b),
+            (-20.0, f),
+            (2.0, b),
+            (10.0, None)
+        ]
+    );
+    // In: 10 + 11 + 7 mm at 12.5 mm/s; out: 3 + 3 + 22 mm at 25 mm/s.
+    assert!((feed_time(&tp) - (28.0 / 12.5 + 28.0 / 25.0)).abs() < 1e-9);
+    // Q256 = 0: out to the set-up clearance after each infeed; without Q403 out at the
+    // tapping feed.
+    let tp = read(&program("0", ""));
+    assert_eq!(
+        z_feeds(&tp, 2),
+        [
+            (2.0, None),
+            (-8.0, f),
+            (2.0, f),
+            (-16.0, f),
+            (2.0, f),
+            (-20.0, f),
+            (2.0, f),
+            (10.0, None)
+        ]
+    );
+    assert!((feed_time(&tp) - 100.0 / 12.5).abs() < 1e-9);
+    // At every PATTERN DEF point: the same hole at X 10 and X 30.
+    let pat = program("2", "").replace(
+        "4 L X+0 Y+0 R0 FMAX M99\n",
+        "4 PATTERN DEF ~\n POS1 (X+10 Y+0 Z+0) ~\n POS2 (X+30 Y+0 Z+0)\n5 CYCL CALL PAT\n",
+    );
+    let tp = read(&pat);
+    let bottoms: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.p.z == -20.0)
+        .map(|p| p.p)
+        .collect();
+    assert_eq!(bottoms, [v(10.0, 0.0, -20.0), v(30.0, 0.0, -20.0)]);
+    // Tapping needs the spindle speed.
+    let e = fails(&program("2", "").replace("TOOL CALL 1 Z S500", "TOOL CALL 1 Z"));
+    assert!(
+        e.contains("t.h:13:") && e.contains("no TOOL CALL gave S"),
+        "{e}"
+    );
+}
+
+/// Cycle 241 (single-lip deep-hole drilling) as in the user's repro: from the set-up
+/// clearance (2) at Q253 = 750 mm/min to Q200 above the deepened starting point Q379 = 7.5
+/// (Z −5.5), drilling at 150 mm/min to −40, dwell 1 s, out at Q208 = 1000 mm/min, rapid to
+/// the 2nd set-up clearance 50. With a dwell depth Q435 = 20 and Q401 = 50 %: a dwell at −20
+/// and the rest at 75 mm/min. Q253 = MAX positions at rapid; a Q202 shorter than the depth
+/// (several infeeds) is an error.
+#[test]
+fn cycle_241_prepositions_to_the_deepened_start_and_drills_at_its_feeds() {
+    let program = |q253: &str, q435: &str, tail: &str| {
+        format!(
+            "0 BEGIN PGM C241 MM\n1 TOOL CALL 1 Z S1000\n2 L X+0 Y+0 Z+50 R0 FMAX\n\
+             3 CYCL DEF 241 SINGLE-LIP D.H.DRLNG ~\n Q200=2 ;SET-UP CLEARANCE ~\n\
+             Q201=-40 ;DEPTH ~\n Q206=150 ;FEED RATE FOR PLNGNG ~\n\
+             Q211=1 ;DWELL TIME AT DEPTH ~\n Q203=+0 ;SURFACE COORDINATE ~\n\
+             Q204=50 ;2ND SET-UP CLEARANCE ~\n Q379=7.5 ;STARTING POINT ~\n\
+             Q253={q253} ;F PRE-POSITIONING ~\n Q208=1000 ;RETRACTION FEED RATE ~\n\
+             Q426=3 ;DIR. OF SPINDLE ROT. ~\n Q427=1000 ;ROT.SPEED INFEED/OUT ~\n\
+             Q428=1000 ;ROT. SPEED DRILLING ~\n Q429=8 ;COOLANT ON ~\n Q430=9 ;COOLANT OFF ~\n\
+             Q435={q435} ;DWELL DEPTH{tail}\n4 L X+10 Y+10 R0 FMAX M99\n"
+        )
+    };
+    let tp = read(&program("750", "0", ""));
+    let out = 1000.0 / 60.0;
+    assert_eq!(tp.points[1].p, v(10.0, 10.0, 50.0));
+    assert_eq!(
+        z_feeds(&tp, 2),
+        [
+            (2.0, None),
+            (-5.5, Some(12.5)),
+            (-40.0, Some(2.5)),
+            (2.0, Some(out)),
+            (50.0, None)
+        ]
+    );
+    // 7.5 mm at 12.5 mm/s, 34.5 mm at 2.5 mm/s, 42 mm at 1000/60 mm/s; one 1 s dwell.
+    let want = 0.6 + 13.8 + 42.0 / out;
+    assert!((feed_time(&tp) - want).abs() < 1e-9, "{}", feed_time(&tp));
+    assert!((tp.dwell_time() - 1.0).abs() < 1e-12);
+    let moves = 48.0 + 42.0 + 42.0 + 48.0;
+    assert!((length(&tp.points[1..]) - moves).abs() < 1e-9);
+    assert!(warned(&tp, "Q426–Q428"));
+    // Dwell depth 20 and feed factor 50 %.
+    let tp = read(&program("750", "20", "~\n Q401=50 ;FEED FACTOR"));
+    assert_eq!(
+        z_feeds(&tp, 2),
+        [
+            (2.0, None),
+            (-5.5, Some(12.5)),
+            (-20.0, Some(2.5)),
+            (-40.0, Some(1.25)),
+            (2.0, Some(out)),
+            (50.0, None)
+        ]
+    );
+    assert!((tp.dwell_time() - 2.0).abs() < 1e-12);
+    assert!((feed_time(&tp) - (0.6 + 5.8 + 16.0 + 42.0 / out)).abs() < 1e-9);
+    // Q253 = MAX: to the deepened start at rapid.
+    let tp = read(&program("MAX", "0", ""));
+    assert_eq!(z_feeds(&tp, 2)[1], (-5.5, None));
+    // Several infeeds (Q202 = 10 of 34.5 mm) are refused.
+    let e = fails(&program("750", "0", "~\n Q202=10 ;MAX. PLUNGING DEPTH"));
+    assert!(e.contains("t.h:21:") && e.contains("Q202"), "{e}");
+}
+
+/// Cycle 262 (thread milling) of an M10 × 1.5 thread, 9 mm deep, with a 6 mm tool about
+/// (30, 40): the tool centre runs on a helix of radius R = (10 − 6)/2 = 2 mm at 1.5 mm a
+/// turn, 9 / 1.5 = 6 turns. Right-hand and climb: upwards and counter-clockwise, from Q253
+/// positioning down the axis to a quarter pitch below the depth, an approach half circle of
+/// radius 1 rising 0.375 onto the circle, the helix from −9 to 0, the departure half circle
+/// to the centre at 0.375, rapid up. Lengths in closed form; up-cut works downwards and
+/// clockwise; Q355 = 0 is one turn at the depth; without the tool's diameter, or with a tool
+/// as wide as the thread, an error.
+#[test]
+fn cycle_262_mills_the_thread_on_a_helix_with_approach_and_departure_arcs() {
+    let program = |q351: &str, q355: &str| {
+        format!(
+            "0 BEGIN PGM TH MM\n1 TOOL CALL 5 Z S3000\n2 L X+30 Y+40 Z+50 R0 FMAX\n\
+             3 CYCL DEF 262 THREAD MILLING~\n Q335=10 ;NOMINAL DIAMETER~\n\
+             Q239=+1.5 ;THREAD PITCH~\n Q201=-9 ;THREAD DEPTH~\n\
+             Q355={q355} ;THREADS PER STEP~\n Q253=300 ;F PRE-POSITIONING~\n\
+             Q351={q351} ;CLIMB OR UP-CUT~\n Q200=2 ;SET-UP CLEARANCE~\n\
+             Q203=+0 ;SURFACE COORDINATE~\n Q204=20 ;2ND SET-UP CLEARANCE~\n\
+             Q207=600 ;FEED RATE MILLING\n4 L X+30 Y+40 R0 FMAX M99\n"
+        )
+    };
+    let read = |text: &str, tool: Option<f64>| {
+        let settings = feedopt::toolpath::gcode::Settings {
+            tool_diameter: tool,
+            ..Default::default()
+        };
+        feedopt::toolpath::gcode::parse_configured(
+            Path::new("t.h"),
+            text,
+            Dialect::Heidenhain.spec(),
+            None,
+            &settings,
+        )
+        .map(|(tp, _)| tp)
+    };
+    let (r, p, depth) = (2.0, 1.5, 9.0);
+    let turns = depth / p;
+    let tp = read(&program("+1", "1"), Some(6.0)).unwrap();
+    // Down the axis at 300 mm/min to −9 − 1.5/4.
+    assert_eq!(tp.points[2].p, v(30.0, 40.0, 2.0));
+    assert_eq!(tp.points[3].p, v(30.0, 40.0, -9.375));
+    assert_eq!(tp.points[3].feed, Feed::Programmed(5.0));
+    let milled: Vec<&ClPoint> = tp
+        .points
+        .iter()
+        .filter(|p| p.feed == Feed::Programmed(10.0))
+        .collect();
+    // The helix: the points on the circle of radius 2 from the approach's end (32, 40, −9)
+    // on; Z = −9 + 1.5 × (angle turned)/2π; 6 turns counter-clockwise to (32, 40, 0).
+    let on_circle = |q: &ClPoint| ((q.p.x - 30.0).hypot(q.p.y - 40.0) - r).abs() < 1e-9;
+    let start = milled.iter().position(|q| on_circle(q)).unwrap();
+    let end = milled.iter().rposition(|q| on_circle(q)).unwrap();
+    assert!(close(milled[start].p, v(32.0, 40.0, -9.0), 1e-9));
+    assert!(close(milled[end].p, v(32.0, 40.0, 0.0), 1e-9));
+    let mut angle = 0.0;
+    let mut last = 0.0f64;
+    for q in &milled[start..=end] {
+        assert!(on_circle(q), "{:?}", q.p);
+        let a = (q.p.y - 40.0).atan2(q.p.x - 30.0);
+        let mut d = a - last;
+        while d < -PI {
+            d += 2.0 * PI;
+        }
+        while d > PI {
+            d -= 2.0 * PI;
+        }
+        assert!(d >= 0.0, "counter-clockwise");
+        angle += d;
+        last = a;
+        assert!(
+            (q.p.z - (-9.0 + p * angle / (2.0 * PI))).abs() < 1e-9,
+            "{:?}",
+            q.p
+        );
+    }
+    assert!((angle - turns * 2.0 * PI).abs() < 1e-9, "{angle}");
+    // The approach and departure points lie on the half circles of radius 1 about (31, 40).
+    for q in milled[..start].iter().chain(&milled[end + 1..]) {
+        assert!(
+            ((q.p.x - 31.0).hypot(q.p.y - 40.0) - 1.0).abs() < 1e-9,
+            "{:?}",
+            q.p
+        );
+    }
+    assert!(close(milled.last().unwrap().p, v(30.0, 40.0, 0.375), 1e-9));
+    // Milled length: helix √((6·2π·2)² + 9²) and two half circles √((π·1)² + 0.375²).
+    let helix = ((turns * 2.0 * PI * r).powi(2) + depth * depth).sqrt();
+    let arc = (PI.powi(2) + 0.375f64.powi(2)).sqrt();
+    let want = helix + 2.0 * arc;
+    let mut fed = vec![tp.points[3].clone()];
+    fed.extend(milled.iter().map(|q| (*q).clone()));
+    let got = length(&fed);
+    // Chords within 1 µm of a 1 mm circle are shorter by at most e/(3r) = 3.4e-4 relative.
+    assert!(
+        got <= want + 1e-9 && want - got <= 3.4e-4 * want,
+        "{got} vs {want}"
+    );
+    // Time at the feeds: 11.375 mm at 5 mm/s and the milled length at 10 mm/s.
+    assert!((feed_time(&tp) - (11.375 / 5.0 + got / 10.0)).abs() < 1e-9);
+    // Up, then to the 2nd set-up clearance.
+    let n = tp.points.len();
+    assert_eq!(tp.points[n - 2].p, v(30.0, 40.0, 2.0));
+    assert_eq!(tp.points[n - 1].p, v(30.0, 40.0, 20.0));
+    assert!(warned(&tp, "half circles"));
+    // Up-cut: from the surface down, clockwise; the positioning stops a quarter pitch above.
+    let tp = read(&program("-1", "1"), Some(6.0)).unwrap();
+    assert_eq!(tp.points[3].p, v(30.0, 40.0, 0.375));
+    let first = tp
+        .points
+        .iter()
+        .position(|q| q.feed == Feed::Programmed(10.0))
+        .unwrap();
+    assert!(tp.points[first].p.y > 40.0, "clockwise approach passes +Y");
+    let zs: Vec<f64> = tp.points.iter().map(|q| q.p.z).collect();
+    assert!(zs.iter().any(|z| *z == -9.0) && zs.iter().all(|z| *z >= -9.375));
+    // Q355 = 0: one turn at the depth, from −9 to −7.5.
+    let tp = read(&program("+1", "0"), Some(6.0)).unwrap();
+    let top = tp
+        .points
+        .iter()
+        .filter(|q| q.feed == Feed::Programmed(10.0))
+        .map(|q| q.p.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!((top - (-7.5 + 0.375)).abs() < 1e-9, "{top}");
+    // The tool's diameter is needed, and must be less than the thread's.
+    let e = read(&program("+1", "1"), None).unwrap_err().to_string();
+    assert!(
+        e.contains("t.h:15:") && e.contains("--tool-diameter"),
+        "{e}"
+    );
+    let e = read(&program("+1", "1"), Some(10.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not narrower"), "{e}");
 }

@@ -56,7 +56,7 @@
 //! `--cycle-alias CYCLE76=CYCLE85`) says which one a machine's CYCLE76 is. A cycle
 //! whose RTP lies below RFP + SDIS retracts into the part as written, with a warning.
 //!
-//! # Heidenhain (`CYCL DEF 200`, `203`, `207`)
+//! # Heidenhain (`CYCL DEF 200`, `201`, `202`, `203`, `207`, `208`, `209`, `241`, `262`)
 //!
 //! Q parameters (mm, mm/min, s): Q200 set-up clearance (above the surface), Q201 depth
 //! (negative, from the surface; 0: the cycle does nothing), Q203 surface coordinate, Q204 2nd
@@ -69,6 +69,41 @@
 //! | 200 DRILLING | rapid to S; per infeed: feed Q206 to the depth, then (not after the last) rapid to S, dwell Q210, rapid to Q200 above the depth reached; at the depth dwell Q211, rapid to Q203 + max(Q200, Q204) |
 //! | 203 UNIVERSAL DRILLING | as 200, but each infeed Q212 shorter (never below Q205); after an infeed, Q213 times a chip break (rapid up Q256, feed on), then a full retract (feed Q208 to S, dwell Q210, rapid to Q200 above the depth); at the depth dwell Q211, feed Q208 to S, rapid to Q203 + Q204 if higher (Q208 = 0: Q206) |
 //! | 207 RIGID TAPPING | rapid to S, feed |Q239| × S (pitch × the `TOOL CALL`'s spindle speed) to the depth and back to S, rapid to Q203 + Q204 if higher |
+//! | 201 REAMING | rapid to S, feed Q206 to the depth, dwell Q211, feed Q208 to S (Q208 = 0: Q206; MAX: rapid), rapid to Q203 + Q204 if higher |
+//! | 202 BORING | as 201, but after the dwell (the spindle stops oriented to Q336: not timed) the tool moves off the wall by [`BORING_DISENGAGE_MM`] in the direction Q214 (0 none, 1 −X, 2 −Y, 3 +X, 4 +Y; at rapid), feeds Q208 to S, moves back over the centre at rapid, then to Q204 |
+//! | 209 TAPPING WITH CHIP BREAKING | rapid to S; feed |Q239| × S to Q203 − Q257, back by Q256 × |Q239| (Q256 = 0: out to S) at Q403 × that feed, in again to the next Q257, … to the depth (Q257 = 0: in one pass); out to S at Q403 × |Q239| × S, rapid to Q204 |
+//! | 241 SINGLE-LIP DEEP-HOLE DRILLING | rapid to S; feed Q253 (or rapid: MAX) to Q200 above the deepened starting point Q203 − Q379; feed Q206 to the depth (with a dwell depth Q435: to Q203 − Q435, dwell Q211, on at Q206 × Q401 %); dwell Q211; feed Q208 to S (0: Q206), rapid to Q204 |
+//! | 262 THREAD MILLING | see below |
+//!
+//! Sources: HEIDENHAIN TNC 640 user's manual for cycle programming (34059x), the sections
+//! "REAMING (Cycle 201)", "BORING (Cycle 202)", "TAPPING WITH CHIP BREAKING (Cycle 209)"
+//! (§4.4 of the 34059x-01 edition: Q256 is a multiple of the pitch, 0 retracts to the set-up
+//! clearance; Q403 raises the speed and so the feed of the retraction), "SINGLE-LIP
+//! DEEP-HOLE DRILLING (Cycle 241)" (Q379 counts from Q203 and takes Q200 into account: the
+//! tool feeds at Q253 to Q200 above it) and "THREAD MILLING (Cycle 262)" (TNC 426/430
+//! manual §8.3 for its parameters). Assumed where the manual is silent (each said in a
+//! warning where it applies): 202's move off the wall and back to the centre at rapid; 209's
+//! retraction not limited by the spindle's maximum speed; 241's dwell at Q435 as long as
+//! Q211. 241's spindle and coolant parameters (Q426–Q430) move no axis and are not timed;
+//! its newer parameters Q401 and Q202 (and 209's Q403, 262's Q512) are read only from the
+//! cycle's own `CYCL DEF` (an older definition lacks them; a value an earlier cycle left
+//! does not concern it); 241 with Q202 shorter than the depth (several infeeds) is an
+//! error.
+//!
+//! 262 THREAD MILLING: Q335 nominal diameter, Q239 pitch (+ right-hand, − left-hand), Q201
+//! thread depth, Q355 threads per step, Q253 pre-positioning feed, Q351 climb (+1) or up-cut
+//! (−1) with M3, Q207 milling feed (Q512, feed for approaching, if given and not 0). The tool
+//! centre runs on a helix of radius R = (Q335 − tool diameter)/2 (the diameter as for 208),
+//! at the pitch |Q239|, counter-clockwise when climb. It works upwards (Z+) for a
+//! right-hand thread climb or a left-hand one up-cut, else downwards. Q355 = 1: one helix
+//! over the thread, from Q203 + Q201 to Q203 (or down), |Q201| / |Q239| turns; Q355 = 0:
+//! one turn at the depth; Q355 = n > 1: one turn in every band of n threads from the depth
+//! up (assumed). Each helix: from S at Q253 down the hole's axis to a quarter pitch before
+//! the helix's start, an approach half circle of radius R/2 onto the thread's circle
+//! (tangent to it, rising a quarter pitch: the thread's lead angle), the helix, the same
+//! half circle back to the centre; at the end rapid to S and Q204. The control says only
+//! that it approaches and departs "tangentially in a helical movement": the half circles
+//! are assumed (a warning says so). The feeds are the tool centre's (no M109).
 //!
 //! The chip break's retract speed is the machine's: taken as rapid. Q395 = 1 (depth to the
 //! full diameter, which needs the tool's point angle) is an error, as is a missing Q
@@ -117,11 +152,25 @@ pub enum Step {
     /// A straight move in the working plane to the hole centre plus (dx, dy), mm, at the
     /// current Z, at this feed (mm/min).
     Across(f64, f64, f64),
+    /// A rapid straight move in the working plane to the hole centre plus (dx, dy), mm, at the
+    /// current Z.
+    RapidAcross(f64, f64),
     /// A helix about the hole centre: radius (mm), from the current point (on the circle) by
     /// `sweep` radians (counter-clockwise when positive) while Z goes to `z`, at `feed`
     /// (mm/min).
     Helix {
         radius: f64,
+        sweep: f64,
+        z: f64,
+        feed: f64,
+    },
+    /// A circular (helical when Z changes) arc about the point (cx, cy) from the hole centre,
+    /// mm: from the current point, whose distance to that point is the radius, by `sweep`
+    /// radians (counter-clockwise when positive) while Z goes linearly to `z`, at `feed`
+    /// (mm/min). A thread's approach and departure arcs.
+    Arc {
+        cx: f64,
+        cy: f64,
         sweep: f64,
         z: f64,
         feed: f64,
@@ -282,6 +331,20 @@ pub const HEIDENHAIN_MOVE_ON_DEFINITION: [(u32, &str); 3] = [
     (224, "DATAMATRIX CODE PATTERN"),
 ];
 
+/// The Heidenhain machining cycles feedopt expands when called.
+pub const HEIDENHAIN_EXPANDED: [u32; 9] = [200, 201, 202, 203, 207, 208, 209, 241, 262];
+
+/// [`HEIDENHAIN_EXPANDED`] for messages: "200, 201, … and 262 are".
+pub fn expanded_list() -> String {
+    let n: Vec<String> = HEIDENHAIN_EXPANDED.iter().map(u32::to_string).collect();
+    format!("{} and {} are", n[..n.len() - 1].join(", "), n[n.len() - 1])
+}
+
+/// Cycle 202: how far the tool moves off the wall at the depth in the disengaging direction
+/// Q214, mm: "0.2 mm (fixed value)" (TNC 640 cycle programming manual, BORING, Cycle 202,
+/// cycle run step 5).
+pub const BORING_DISENGAGE_MM: f64 = 0.2;
+
 /// The value of a Heidenhain cycle's Q parameter: a number, or the word a feed parameter may
 /// hold instead.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -310,31 +373,35 @@ impl Rate {
     }
 }
 
-/// Heidenhain drilling cycle `number` (200, 203, 207, 208) from its Q parameters (`q(200)`
-/// …), the spindle speed (rpm, for 207), the `TOOL CALL`'s feed (mm/min, for a feed
-/// parameter given as `AUTO`), the tool's diameter (mm, for 208: the control takes it from its
-/// tool table) and a raise of the surface Q203 by `offset` mm (a pattern point's Z). Starts
-/// from where the tool is (over the hole). The second value names assumptions, for
-/// warnings.
+/// Heidenhain machining cycle `number` ([`HEIDENHAIN_EXPANDED`]) from its Q parameters
+/// (`q(200)` …; `given(n)`: the cycle's own `CYCL DEF` gave Qn), the spindle speed (rpm, for
+/// 207 and 209), the `TOOL CALL`'s feed (mm/min, for a feed parameter given as `AUTO`), the
+/// tool's diameter (mm, for 208 and 262: the control takes it from its tool table) and a
+/// raise of the surface Q203 by `offset` mm (a pattern point's Z). Starts from where the tool
+/// is (over the hole). The second value names assumptions, for warnings. The moves of each
+/// cycle: the module's documentation.
 ///
 /// Cycle 208 (bore milling), as the TNC 640 runs it with one pass (no Q370): rapid to the
 /// set-up clearance, over to the circle of radius (Q335 − D)/2 about the hole, a helix down
 /// at Q206 with Q334 per turn to the depth, one more full circle there, back to the centre and
 /// up at rapid to the set-up clearance (or the second, Q204). Where Q335 equals the tool's
 /// diameter the tool bores straight down. Climb (Q351 = +1) runs counter-clockwise with M3.
+#[allow(clippy::too_many_arguments)]
 pub fn heidenhain_steps(
     number: u32,
     q: &dyn Fn(u32) -> Option<QValue>,
+    given: &dyn Fn(u32) -> bool,
     spindle_rpm: Option<f64>,
     tool_feed: Option<f64>,
     tool_diameter: Option<f64>,
     offset: f64,
 ) -> Result<(Vec<Step>, Vec<&'static str>), String> {
     use Step::*;
-    if !matches!(number, 200 | 203 | 207 | 208) {
+    if !HEIDENHAIN_EXPANDED.contains(&number) {
         return Err(format!(
-            "cycle {number} is not a cycle feedopt can expand (200, 203, 207 and 208 are): post \
-             the operation as L moves"
+            "cycle {number} is not a cycle feedopt can expand ({}): post the operation as L \
+             moves",
+            expanded_list()
         ));
     }
     let raw = q;
@@ -432,9 +499,351 @@ pub fn heidenhain_steps(
             )),
         }
     };
+    // The retraction feed Q208 (203, 201, 202, 241): MAX is rapid, 0 (or none) the plunging
+    // feed `f`.
+    let retraction = |f: f64| -> Result<Rate, String> {
+        Ok(match raw(208) {
+            Some(QValue::Number(v)) if finite(208, v)? <= 0.0 => Rate::PerMinute(f),
+            None => Rate::PerMinute(f),
+            _ => rate(208, true)?.unwrap_or(Rate::PerMinute(f)),
+        })
+    };
+    // The spindle speed × pitch Q239 of the tapping cycles (207, 209): the feed, mm/min, and
+    // the pitch, mm.
+    let tapping = || -> Result<(f64, f64), String> {
+        let pitch = finite(239, need(239)?)?.abs();
+        if pitch == 0.0 {
+            return Err(format!("cycle {number}: the thread pitch Q239 is 0"));
+        }
+        let Some(rpm) = spindle_rpm.filter(|r| r.is_finite() && *r > 0.0) else {
+            return Err(format!(
+                "cycle {number}: rigid tapping feeds at pitch × spindle speed, and no TOOL CALL \
+                 gave S"
+            ));
+        };
+        let f = pitch * rpm;
+        if !(1e-3..=1e9).contains(&f) {
+            return Err(format!(
+                "cycle {number}: the tapping feed Q239 × S = {f} mm/min is out of range"
+            ));
+        }
+        Ok((f, pitch))
+    };
+    // Up to the 2nd set-up clearance, where it is above the set-up clearance.
+    let second_clearance = |s: &mut Vec<Step>| {
+        if second > clearance {
+            s.push(Rapid(surface + second));
+        }
+    };
     let mut s = vec![Rapid(safe)];
     let mut notes = Vec::new();
     match number {
+        201 | 202 => {
+            let f = plunging()?;
+            let bottom_dwell = dwell(211)?;
+            let retract = retraction(f)?;
+            s.push(Feed(bottom, Some(f)));
+            if bottom_dwell > 0.0 {
+                s.push(Dwell(bottom_dwell));
+            }
+            // 202: the spindle stops oriented to Q336 (no axis moves), then the tool moves off
+            // the wall in the direction Q214.
+            let off = if number == 202 {
+                let direction = finite(214, need(214)?)?;
+                let d = BORING_DISENGAGE_MM;
+                let whole = if direction.fract() == 0.0 {
+                    direction as i64
+                } else {
+                    -1
+                };
+                let off = match whole {
+                    0 => None,
+                    1 => Some((-d, 0.0)),
+                    2 => Some((0.0, -d)),
+                    3 => Some((d, 0.0)),
+                    4 => Some((0.0, d)),
+                    _ => {
+                        let v = direction;
+                        return Err(format!(
+                            "cycle 202: disengaging direction Q214 = {v}: it is 0 (none), 1 \
+                             (−X), 2 (−Y), 3 (+X) or 4 (+Y)"
+                        ));
+                    }
+                };
+                notes.push(
+                    "the oriented spindle stop (Q336) at the depth is not timed; the move off the \
+                     wall (Q214, 0.2 mm) and back to the centre at the set-up clearance are \
+                     taken at rapid traverse",
+                );
+                off
+            } else {
+                None
+            };
+            if let Some((dx, dy)) = off {
+                s.push(RapidAcross(dx, dy));
+            }
+            s.push(retract.to(safe));
+            if off.is_some() {
+                s.push(RapidAcross(0.0, 0.0));
+            }
+            second_clearance(&mut s);
+        }
+        209 => {
+            let (f, pitch) = tapping()?;
+            // Q403 (RPM factor for retraction): a TNC 640 parameter an older 209 lacks; read
+            // from this definition only.
+            let factor = if given(403) {
+                let v = q(403)?.unwrap_or(1.0);
+                if !(v > 0.0 && v <= 10.0) {
+                    return Err(format!(
+                        "cycle 209: RPM factor for retraction Q403 = {v}: it is 0.0001 to 10"
+                    ));
+                }
+                v
+            } else {
+                1.0
+            };
+            let back = f * factor;
+            let infeed = finite(257, need(257)?)?.abs();
+            let mut depth_now = surface;
+            if infeed > 0.0 && infeed < surface - bottom {
+                let retract = finite(256, need(256)?)?.abs() * pitch;
+                let mut n = 0usize;
+                loop {
+                    let next = (depth_now - infeed).max(bottom);
+                    s.push(Feed(next, Some(f)));
+                    depth_now = next;
+                    n += 1;
+                    if depth_now <= bottom {
+                        break;
+                    }
+                    if n >= MAX_PECKS {
+                        return Err(format!(
+                            "cycle 209: more than {MAX_PECKS} infeeds in one hole: check Q257"
+                        ));
+                    }
+                    // Q256 = 0: out of the hole to the set-up clearance.
+                    let up = if retract > 0.0 {
+                        (depth_now + retract).min(safe)
+                    } else {
+                        safe
+                    };
+                    s.push(Feed(up, Some(back)));
+                }
+            } else {
+                s.push(Feed(bottom, Some(f)));
+            }
+            s.push(Feed(safe, Some(back)));
+            second_clearance(&mut s);
+            notes.push(
+                "the spindle orientation Q336 is not timed, and the retraction speed Q403 × S is \
+                 taken as programmed (the control limits it to the gear range's maximum speed)",
+            );
+        }
+        241 => {
+            let f = plunging()?;
+            let retract = retraction(f)?;
+            let pre = rate(253, true)?.ok_or_else(|| {
+                "cycle 241: Q253 is not defined (the CYCL DEF gives it)".to_string()
+            })?;
+            let start = finite(379, need(379)?)?;
+            if start < 0.0 || surface - start < bottom {
+                return Err(format!(
+                    "cycle 241: the deepened starting point Q379 = {start} is not between the \
+                     surface and the depth Q201"
+                ));
+            }
+            // Newer parameters (TNC 640): read from this definition only, else as the cycle
+            // without them (one infeed, no feed factor).
+            if given(202) {
+                let plunge = finite(202, q(202)?.unwrap_or(0.0))?.abs();
+                if plunge > 0.0 && plunge < surface - start - bottom {
+                    return Err(format!(
+                        "cycle 241: maximum plunging depth Q202 = {plunge} mm is less than the \
+                         depth: several infeeds (Q202, Q212, Q205) are not supported; post the \
+                         cycle with Q202 = 0 or at least the depth"
+                    ));
+                }
+            }
+            let factor = if given(401) {
+                let v = q(401)?.unwrap_or(100.0);
+                if !(v > 0.0 && v <= 100.0) {
+                    return Err(format!(
+                        "cycle 241: feed rate factor Q401 = {v} %: it is 0.0001 to 100"
+                    ));
+                }
+                v / 100.0
+            } else {
+                1.0
+            };
+            let bottom_dwell = dwell(211)?;
+            // From the set-up clearance at Q253 to Q200 above the deepened starting point.
+            let pre_z = surface - start + clearance;
+            if pre_z < safe {
+                s.push(pre.to(pre_z));
+            }
+            // Q435 (dwell depth, from the surface): dwell there, then on at Q206 × Q401.
+            let dwell_depth = surface - finite(435, q(435)?.unwrap_or(0.0))?.abs();
+            if dwell_depth < surface && dwell_depth > bottom && dwell_depth < pre_z {
+                s.push(Feed(dwell_depth, Some(f)));
+                if bottom_dwell > 0.0 {
+                    s.push(Dwell(bottom_dwell));
+                }
+                s.push(Feed(bottom, Some(f * factor)));
+                notes.push(
+                    "the dwell at the dwell depth Q435 is taken as long as the dwell at the \
+                     depth Q211",
+                );
+            } else {
+                s.push(Feed(bottom, Some(f)));
+            }
+            if bottom_dwell > 0.0 {
+                s.push(Dwell(bottom_dwell));
+            }
+            s.push(retract.to(safe));
+            second_clearance(&mut s);
+            if [426, 427, 428, 429, 430].iter().any(|&n| given(n)) {
+                notes.push(
+                    "the spindle direction and speeds Q426–Q428 and the coolant functions \
+                     Q429/Q430 move no axis: not timed",
+                );
+            }
+        }
+        262 => {
+            let mill = match rate(207, false)? {
+                Some(Rate::PerMinute(f)) => f,
+                _ => return Err("cycle 262: Q207 is not defined (the CYCL DEF gives it)".into()),
+            };
+            let pre = rate(253, true)?.ok_or_else(|| {
+                "cycle 262: Q253 is not defined (the CYCL DEF gives it)".to_string()
+            })?;
+            // Q512 (feed for approaching, TNC 640): from this definition only; 0 is Q207.
+            let approach = match raw(512) {
+                Some(QValue::Number(v)) if given(512) && v == 0.0 => mill,
+                Some(_) if given(512) => match rate(512, false)? {
+                    Some(Rate::PerMinute(f)) => f,
+                    _ => mill,
+                },
+                _ => mill,
+            };
+            let nominal = finite(335, need(335)?)?.abs();
+            let signed_pitch = finite(239, need(239)?)?;
+            let pitch = signed_pitch.abs();
+            if pitch == 0.0 {
+                return Err("cycle 262: the thread pitch Q239 is 0".to_string());
+            }
+            let per_step = finite(355, need(355)?)?;
+            if per_step < 0.0 || per_step.fract() != 0.0 {
+                return Err(format!(
+                    "cycle 262: threads per step Q355 = {per_step}: it is 0, 1 or a whole number \
+                     of threads"
+                ));
+            }
+            let climb = finite(351, need(351)?)? >= 0.0;
+            let Some(d) = tool_diameter.filter(|d| d.is_finite() && *d > 0.0) else {
+                return Err(
+                    "cycle 262 mills a helix of radius (Q335 − tool diameter)/2, and the control \
+                     takes the diameter from its tool table: give it (--tool-diameter, or the \
+                     machine file's tool.diameter)"
+                        .to_string(),
+                );
+            };
+            let radius = (nominal - d) / 2.0;
+            if radius <= 1e-6 {
+                return Err(format!(
+                    "cycle 262: the tool ({d} mm) is not narrower than the thread Q335 = \
+                     {nominal} mm"
+                ));
+            }
+            let length = surface - bottom;
+            // The working direction: Z+ (from the depth up) for a right-hand thread milled
+            // climb or a left-hand one up-cut, else Z−; climb milling with M3 runs
+            // counter-clockwise.
+            let up = (signed_pitch > 0.0) == climb;
+            let (dz, turn) = (if up { 1.0 } else { -1.0 }, if climb { 1.0 } else { -1.0 });
+            // The helical passes (start Z, end Z): Q355 = 1 one over the thread's length;
+            // 0 one turn at the depth; n > 1 one turn in every band of n threads from the depth
+            // up (the tool offset by n × Q239 between them), taken in the working direction.
+            let mut passes: Vec<(f64, f64)> = Vec::new();
+            if per_step == 1.0 {
+                passes.push(if up {
+                    (bottom, surface)
+                } else {
+                    (surface, bottom)
+                });
+            } else {
+                let band = if per_step == 0.0 {
+                    length
+                } else {
+                    per_step * pitch
+                };
+                let k = (length / band).ceil().max(1.0);
+                if k > MAX_PECKS as f64 {
+                    return Err(format!(
+                        "cycle 262: more than {MAX_PECKS} helical passes: check Q355"
+                    ));
+                }
+                for j in 0..k as usize {
+                    let base = bottom + j as f64 * band;
+                    passes.push(if up {
+                        (base, base + pitch)
+                    } else {
+                        (base + pitch, base)
+                    });
+                }
+                if !up {
+                    passes.reverse();
+                }
+                notes.push(
+                    "threads per step Q355 ≠ 1: one 360° helix at the depth (0) or in every band \
+                     of Q355 threads from the depth up (> 1) is assumed",
+                );
+            }
+            let tau = std::f64::consts::TAU;
+            let quarter = pitch / 4.0;
+            for &(from, to) in &passes {
+                let sweep = turn * tau * (to - from).abs() / pitch;
+                if sweep.abs() / tau > MAX_PECKS as f64 {
+                    return Err(format!(
+                        "cycle 262: more than {MAX_PECKS} helix turns: check Q239 and Q201"
+                    ));
+                }
+                // To the start of the approach arc, on the hole's axis: at Q253.
+                let start = from - dz * quarter;
+                s.push(pre.to(start));
+                // The approach: a half circle of radius R/2 from the centre onto the thread's
+                // circle at +X, tangent to it, rising Q239/4 (the thread's lead angle).
+                s.push(Arc {
+                    cx: radius / 2.0,
+                    cy: 0.0,
+                    sweep: turn * std::f64::consts::PI,
+                    z: from,
+                    feed: approach,
+                });
+                s.push(Helix {
+                    radius,
+                    sweep,
+                    z: to,
+                    feed: mill,
+                });
+                // The departure: the same half circle back to the centre.
+                let end = sweep;
+                s.push(Arc {
+                    cx: radius / 2.0 * end.cos(),
+                    cy: radius / 2.0 * end.sin(),
+                    sweep: turn * std::f64::consts::PI,
+                    z: to + dz * quarter,
+                    feed: approach,
+                });
+            }
+            s.push(Rapid(safe));
+            second_clearance(&mut s);
+            notes.push(
+                "the approach and departure are taken as half circles of half the helix radius \
+                 from and to the hole's centre, rising a quarter pitch each (the manual gives no \
+                 dimensions)",
+            );
+        }
         200 | 203 => {
             let f = plunging()?;
             let plunge = finite(202, need(202)?)?.abs();
@@ -443,12 +852,7 @@ pub fn heidenhain_steps(
             }
             let (top, bottom_dwell) = (dwell(210)?, dwell(211)?);
             let (decrement, breaks, minimum, retract_feed, chip) = if number == 203 {
-                // Q208: MAX is rapid, 0 (or none) Q206.
-                let retract = match raw(208) {
-                    Some(QValue::Number(v)) if finite(208, v)? <= 0.0 => Rate::PerMinute(f),
-                    None => Rate::PerMinute(f),
-                    _ => rate(208, true)?.unwrap_or(Rate::PerMinute(f)),
-                };
+                let retract = retraction(f)?;
                 (
                     finite(212, q(212)?.unwrap_or(0.0))?.abs(),
                     finite(213, q(213)?.unwrap_or(0.0))?.max(0.0).round() as u64,
@@ -585,24 +989,9 @@ pub fn heidenhain_steps(
         }
         _ => {
             // 207
-            let pitch = finite(239, need(239)?)?.abs();
-            let Some(rpm) = spindle_rpm.filter(|r| r.is_finite() && *r > 0.0) else {
-                return Err(
-                    "cycle 207: rigid tapping feeds at pitch × spindle speed, and no TOOL CALL \
-                     gave S"
-                        .to_string(),
-                );
-            };
-            let f = pitch * rpm;
-            if !(1e-3..=1e9).contains(&f) {
-                return Err(format!(
-                    "cycle 207: the tapping feed Q239 × S = {f} mm/min is out of range"
-                ));
-            }
+            let (f, _) = tapping()?;
             s.extend([Feed(bottom, Some(f)), Feed(safe, Some(f))]);
-            if second > clearance {
-                s.push(Rapid(surface + second));
-            }
+            second_clearance(&mut s);
         }
     }
     Ok((s, notes))

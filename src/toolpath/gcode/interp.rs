@@ -2025,28 +2025,30 @@ impl<'a> Interpreter<'a> {
                     q[1] = centre[1] + dy;
                     Feed::Programmed(f / 60.0)
                 }
+                Step::RapidAcross(dx, dy) => {
+                    q[0] = centre[0] + dx;
+                    q[1] = centre[1] + dy;
+                    Feed::Rapid
+                }
                 Step::Helix {
                     radius,
                     sweep,
                     z,
                     feed,
                 } => {
-                    let chords = crate::toolpath::arc_chords(sweep, radius)
-                        .map_err(|e| self.error(line, e))?;
-                    self.check_room(line, "the cycle's helix", chords)?;
-                    let (x, y) = (self.pos[0] - centre[0], self.pos[1] - centre[1]);
-                    let start = y.atan2(x);
-                    let z0 = self.pos[2];
-                    for k in 1..=chords {
-                        let t = k as f64 / chords as f64;
-                        let phi = start + t * sweep;
-                        let mut p = self.pos;
-                        p[0] = centre[0] + radius * phi.cos();
-                        p[1] = centre[1] + radius * phi.sin();
-                        p[2] = z0 + t * (z - z0);
-                        self.push(line, &p, Feed::Programmed(feed / 60.0));
-                        self.pos = p;
-                    }
+                    self.cycle_arc(line, centre, radius, sweep, z, feed)?;
+                    continue;
+                }
+                Step::Arc {
+                    cx,
+                    cy,
+                    sweep,
+                    z,
+                    feed,
+                } => {
+                    let c = [centre[0] + cx, centre[1] + cy];
+                    let radius = (self.pos[0] - c[0]).hypot(self.pos[1] - c[1]);
+                    self.cycle_arc(line, c, radius, sweep, z, feed)?;
                     continue;
                 }
                 Step::Dwell(s) => {
@@ -2058,6 +2060,36 @@ impl<'a> Interpreter<'a> {
                 self.push(line, &q, feed);
                 self.pos = q;
             }
+        }
+        Ok(())
+    }
+
+    /// A cycle's arc (a helix when Z changes) about `c` (X Y), `radius` mm, from the current
+    /// point (at that distance from `c`) by `sweep` radians (counter-clockwise when positive),
+    /// Z linearly to `z`, at `feed` mm/min: chords within the arc tolerance.
+    fn cycle_arc(
+        &mut self,
+        line: usize,
+        c: [f64; 2],
+        radius: f64,
+        sweep: f64,
+        z: f64,
+        feed: f64,
+    ) -> Result<()> {
+        let chords = crate::toolpath::arc_chords(sweep, radius).map_err(|e| self.error(line, e))?;
+        self.check_room(line, "the cycle's helix", chords)?;
+        let (x, y) = (self.pos[0] - c[0], self.pos[1] - c[1]);
+        let start = y.atan2(x);
+        let z0 = self.pos[2];
+        for k in 1..=chords {
+            let t = k as f64 / chords as f64;
+            let phi = start + t * sweep;
+            let mut p = self.pos;
+            p[0] = c[0] + radius * phi.cos();
+            p[1] = c[1] + radius * phi.sin();
+            p[2] = z0 + t * (z - z0);
+            self.push(line, &p, Feed::Programmed(feed / 60.0));
+            self.pos = p;
         }
         Ok(())
     }

@@ -87,8 +87,9 @@
 //!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
 //!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
-//! * **Cycles**: `CYCL DEF 200`, `203`, `207` define a drilling cycle and `208` bore milling
-//!   (a helix whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]).
+//! * **Cycles**: `CYCL DEF 200`, `201`, `202`, `203`, `207`, `209`, `241` define a drilling,
+//!   reaming, boring or tapping cycle, `208` bore milling and `262` thread milling (helices
+//!   whose radius needs the tool's diameter, [`super::Settings::tool_diameter`]).
 //!   Its parameters `Q<n>=<value>` (spaces about `=` as posts write them, `Q208= MAX`; on the
 //!   lines that follow a `~`, or as blocks of their own) are assigned when it is defined and
 //!   read when it is called; a parameter that is not understood, or a word after the

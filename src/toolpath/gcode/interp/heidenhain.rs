@@ -10,9 +10,6 @@ use super::super::klartext;
 use super::super::lexer::Num;
 use super::*;
 
-/// Cycles the reader expands when called.
-const CALLABLE: [u32; 4] = [200, 203, 207, 208];
-
 /// The Klartext words of a block the interpreter acts on after the modal settings.
 #[derive(Debug, Default)]
 pub(in crate::toolpath::gcode) struct KlartextWords {
@@ -42,6 +39,9 @@ pub(super) struct State {
     spindle_rpm: Option<f64>,
     /// The cycle `CYCL DEF` defined and its line.
     cycle: Option<(u32, usize)>,
+    /// The Q parameters (numbers) that `CYCL DEF` gave: a parameter that newer software added
+    /// to a cycle is read from its own definition only, not from an earlier cycle's.
+    cycle_params: Vec<u32>,
     /// `M89` in force.
     modal_call: bool,
     /// `PATTERN DEF` points: X, Y (program coordinates, mm) and Z (added to Q203).
@@ -967,13 +967,18 @@ impl Interpreter<'_> {
             )),
             _ => {
                 self.klartext.cycle = Some((whole, line));
+                self.klartext.cycle_params = params
+                    .iter()
+                    .filter_map(|p| p.name.strip_prefix('Q')?.parse().ok())
+                    .collect();
                 self.klartext.modal_call = false;
-                if !CALLABLE.contains(&whole) {
+                if !cycles::HEIDENHAIN_EXPANDED.contains(&whole) {
                     self.warn(
                         line,
                         format!(
-                            "CYCL DEF {whole}: feedopt cannot expand this cycle (200, 203, 207 \
-                             and 208 it can): calling it is an error"
+                            "CYCL DEF {whole}: feedopt cannot expand this cycle ({}): calling it \
+                             is an error",
+                            cycles::expanded_list()
                         ),
                     );
                 }
@@ -1193,6 +1198,7 @@ impl Interpreter<'_> {
         let (steps, notes) = cycles::heidenhain_steps(
             number,
             &|n| self.q_value(n),
+            &|n| self.klartext.cycle_params.contains(&n),
             self.klartext.spindle_rpm,
             self.klartext.tool_feed,
             self.tool_diameter,
