@@ -212,6 +212,38 @@ fn g94_rotary_only_move_uses_degrees() {
     assert!((block_time(tp.points[1].feed) - 60.0).abs() < 1e-12);
 }
 
+#[test]
+fn fanuc_g94_feed_with_a_rotary_axis_is_along_the_combined_distance() {
+    // The Fanuc manual's example: G91 G01 X20.0 C40.0 F300.0 takes √(20²+40²)/300 min.
+    let fanuc = |text: &str| ok_in(Dialect::Fanuc, text);
+    let tp = fanuc("G21 G90 G94 G0 X0. Y0. Z0. C0.\nG91 G1 X20. C40. F300.\n");
+    let want = (20f64.powi(2) + 40f64.powi(2)).sqrt() / 300.0 * 60.0;
+    assert!((want - 0.14907 * 60.0).abs() < 1e-3, "{want}");
+    assert!((block_time(tp.points[1].feed) - want).abs() < 1e-9);
+    // X, Y and two rotary axes all count: √(3²+4²+12²+(−84)²) mm/° = √(9+16+144+7056) = 85.
+    let tp = fanuc("G21 G90 G0 X0. Y0. Z0. A0. B0.\nG1 X3. Y4. A12. B-84. F170.\n");
+    assert!((block_time(tp.points[1].feed) - 85.0 / 170.0 * 60.0).abs() < 1e-9);
+    // Under G20 the linear part is in inch and F in inch/min: √(1²+1²)/10 min.
+    let tp = fanuc("G20 G90 G0 X0. Y0. Z0. A0.\nG1 X1. A1. F10.\n");
+    assert!((block_time(tp.points[1].feed) - 2f64.sqrt() / 10.0 * 60.0).abs() < 1e-9);
+    // A linear block keeps F as a speed; a pure rotary block is |ΔC|/F as before: 30° at
+    // 90 °/min = 20 s.
+    let tp = fanuc("G21 G90 G0 X0. Y0. Z0. C0.\nG1 X30. F300.\nC30. F90.\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    assert!((block_time(tp.points[2].feed) - 20.0).abs() < 1e-12);
+    // In tool-tip mode (G43.4) F is the tool tip's speed.
+    let tp = fanuc("G21 G90 G43.4 H1\nG0 X0. Y0. Z0. C0.\nG1 X20. C40. F300.\nG49\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    // LinuxCNC (and Sinumerik) keep F along X Y Z when they move.
+    let tp = ok("G21 G90 G0 X0 Y0 Z0 C0\nG91 G1 X20 C40 F300\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G71 G90 G0 X0 Y0 Z0 C0\nG91 G1 X20 C40 F300\n",
+    );
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Arcs
 // ---------------------------------------------------------------------------------------------

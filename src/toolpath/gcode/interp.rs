@@ -2382,6 +2382,16 @@ impl<'a> Interpreter<'a> {
             .map(|i| (end[i] - start[i]).powi(2))
             .sum::<f64>()
             .sqrt();
+        if rotary > 0.0 && self.spec.rotary_feed == RotaryFeed::Combined && self.tcp == Tcp::Off {
+            // Fanuc: F over the combined distance, linear axes in F's unit (mm or inch),
+            // rotary axes in degrees: a degree counts as one unit of length.
+            let unit = self.feed_units.mm_per_unit();
+            let linear = (0..3)
+                .map(|i| ((end[i] - start[i]) / unit).powi(2))
+                .sum::<f64>();
+            let distance = (linear + rotary * rotary).sqrt();
+            return Ok(Feed::BlockTime(distance / (feed.raw / 60.0)));
+        }
         Ok(if !moves_xyz && rotary > 0.0 {
             Feed::BlockTime(rotary / (feed.raw / 60.0))
         } else {

@@ -67,7 +67,17 @@
 //!   mm/min (under G20, F × 25.4); a G1/G2/G3 block whose X, Y or Z moves by more than
 //!   [`XYZ_MOVE_THRESHOLD_MM`] gets [`Feed::Programmed`] (F/60 mm/s). When only rotary axes move,
 //!   LinuxCNC's length rule makes F degrees per minute over the A B C distance, so the block gets
-//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). Before any F, or
+//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). That is the
+//!   rule of LinuxCNC, Sinumerik (F applies to the geometry axes, the default FGROUP) and
+//!   Klartext ([`RotaryFeed::Xyz`]). A Fanuc control feeds a block that turns a rotary axis,
+//!   with or without linear axes, along the combined distance ([`RotaryFeed::Combined`]):
+//!   outside tool-tip mode such a block gets [`Feed::BlockTime`] = √(ΔX²+ΔY²+ΔZ²+ΔA²+ΔB²+ΔC²)
+//!   / (F/60) s, X Y Z in F's unit (mm, or inch under G20) and A B C in degrees, so
+//!   `G91 G1 X20 C40 F300` takes √(20²+40²)/300 min = 8.94 s (Fanuc operator's manual,
+//!   "Linear interpolation (G01)"); a pure rotary block is the same |ΔA B C|/F as above. A
+//!   Haas control, read in this dialect, instead turns degrees into a length through the
+//!   rotary axis' diameter (settings 34/79), which feedopt does not read. Arcs keep F along
+//!   the chords in every dialect. Before any F, or
 //!   after `F0`, feed moves get [`Feed::Unspecified`]. Under `G93` (inverse time) every G1/G2/G3
 //!   block must carry its own F (an error naming the line otherwise) and gets
 //!   [`Feed::BlockTime`] = 60/F s; on an arc that time is split over the chords in proportion to
