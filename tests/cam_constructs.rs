@@ -1226,3 +1226,89 @@ fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
     let a: Vec<f64> = tp.points.iter().map(|p| p.rotary.unwrap()[0]).collect();
     assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
 }
+
+/// Fanuc macro B: arithmetic on constants after `#n=` (round 5: `#4=63./2.` was "unexpected
+/// character `/`" while `#4=#1/2.` read), functions, and blanks.
+#[test]
+fn fanuc_macro_assignments_of_constant_expressions() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\n#4= 63. / 2.\n#5=80./2.+#4+5.\n#6=SIN[30.]*4.\n#7 = 10. * 2. - 1.\n\
+         G0 X#4 Y#5 Z#6\nG0 X#7\n",
+    );
+    assert_close(tp.points[0].p, v(31.5, 76.5, 2.0), 1e-12);
+    assert_eq!(tp.points[1].p.x, 19.0);
+}
+
+fn fanuc_error(text: &str) -> String {
+    message(parse(Path::new("t.nc"), text, Dialect::Fanuc).unwrap_err())
+}
+
+/// Fanuc macro B control flow: WHILE … DO m / END m, IF … GOTO n, GOTO n, IF … THEN, with
+/// EQ NE GT GE LT LE and AND/OR (round 5: `WHILE` was read as a W axis word).
+#[test]
+fn fanuc_macro_while_if_goto() {
+    // Three passes: X 0, 10, 20, each a 10 mm feed move, at F600 (1 s each but the first).
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\n#1=0.\nG0 X-10. Y0. Z5.\nWHILE [#1 LT 3.] DO1\nG1 X[#1*10.] F600.\n\
+         #1=#1+1.\nEND1\nG0 Z10.\n",
+    );
+    assert_eq!(xs(&tp), [-10.0, 0.0, 10.0, 20.0, 20.0]);
+    assert!((feed_time(&tp) - 3.0).abs() < 1e-9);
+    // Nested loops take different numbers: 2 × 3 points.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0. Y0. Z0.\n#1=0\nWHILE[#1LT2]DO1\n#2=0\nWHILE[#2LT3]DO2\n\
+         G1 X#2 Y#1 F100.\n#2=#2+1\nEND2\n#1=#1+1\nEND1\n",
+    );
+    assert_eq!(tp.points.len(), 7);
+    assert_eq!(tp.points[6].p, v(2.0, 1.0, 0.0));
+    // A false condition at the start skips the loop.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G0 X0. Y0. Z0.\n#1=5.\nWHILE [#1 LT 3.] DO1\nG1 X1. F100.\nEND1\nG0 X2.\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 2.0]);
+    // IF … THEN runs its statement when the condition holds; AND / OR join comparisons.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "#1=0.\n#2=0.\nIF [#1 LT 3.] THEN #1=5.\nIF [[#1 GT 4.] AND [#1 LE 5.]] THEN #2=7.\n\
+         IF [[#1 EQ 0] OR [#2 NE 7.]] THEN #2=9.\nG0 X#1 Y#2 Z0.\n",
+    );
+    assert_eq!(tp.points[0].p, v(5.0, 7.0, 0.0));
+    // IF … GOTO skips forward; GOTO jumps back (a counted loop): X 1, 2, 3, then 10.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G0 X0. Y0. Z0.\n#1=0\nN10 #1=#1+1\nG0 X#1\nIF [#1 GE 3] GOTO 20\nGOTO 10\n\
+         G0 X99.\nN20 G0 X10.\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 1.0, 2.0, 3.0, 10.0]);
+    // In a subprogram, GOTO looks for the block number there.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1\nG0 X0. Y0. Z0.\nM98 P2\nM30\nO2\nGOTO 5\nG0 X99.\nN5 G0 X5.\nM99\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 5.0]);
+}
+
+/// A macro loop that cannot end is an error naming the file and line, not a hang: at once
+/// when nothing its condition reads has changed since its last pass; after the bound on the
+/// blocks a program may run otherwise. Malformed or unmatched statements are errors too.
+#[test]
+fn fanuc_macro_loops_are_bounded_and_checked() {
+    let e = fanuc_error("#1=0\nG0 X0. Y0. Z0.\nWHILE [#1 LT 3] DO1\nG91 G1 X1. F100.\nEND1\n");
+    assert!(e.contains("t.nc:5") && e.contains("for ever"), "{e}");
+    let e = fanuc_error("#1=0\nG0 X0. Y0. Z0.\nWHILE [#1 GE 0] DO1\n#1=#1+1\nEND1\n");
+    assert!(e.contains("t.nc:") && e.contains("blocks"), "{e}");
+    let e = fanuc_error("G0 X0. Y0. Z0.\nEND1\n");
+    assert!(e.contains("t.nc:2") && e.contains("END1 has no DO1"), "{e}");
+    let e = fanuc_error("#1=5\nWHILE [#1 LT 3] DO1\nG0 X1. Y0. Z0.\n");
+    assert!(e.contains("t.nc:2") && e.contains("no END1"), "{e}");
+    let e = fanuc_error("G0 X0. Y0. Z0.\nGOTO 50\n");
+    assert!(e.contains("t.nc:2") && e.contains("N50"), "{e}");
+    let e = fanuc_error("#1=0\nIF [#1 FOO 3] GOTO 5\n");
+    assert!(e.contains("t.nc:2") && e.contains("FOO"), "{e}");
+    let e = fanuc_error("#1=0\nWHILE #1 LT 3 DO1\n");
+    assert!(e.contains("t.nc:2") && e.contains("WHILE"), "{e}");
+}

@@ -133,11 +133,23 @@ fn letter_address(spec: &DialectSpec, letter: char) -> Option<Address> {
 
 /// The end of a value starting at `i`: a sign, then a number, a `#` parameter or a `[ … ]`
 /// group, then (for parameters and groups) more operators and operands up to the next
-/// letter outside brackets.
-fn scan_value(chars: &[char], mut i: usize) -> usize {
+/// letter outside brackets. `assignment`: the right side of `#n=`, an expression from its
+/// start (Fanuc macro B: `#4=63./2.`, `#5=SIN[30.]*2.`), whose functions are read with it.
+fn scan_value(chars: &[char], mut i: usize, assignment: bool) -> usize {
     let mut depth = 0usize;
-    let mut expression = false;
+    let mut expression = assignment;
     while i < chars.len() {
+        if assignment && depth == 0 && chars[i].is_ascii_alphabetic() {
+            // A function name followed by `[`: part of the expression.
+            let end = (i..chars.len())
+                .find(|&k| !chars[k].is_ascii_alphabetic())
+                .unwrap_or(chars.len());
+            let name: String = chars[i..end].iter().collect();
+            if chars.get(end) == Some(&'[') && expr::is_function(&name) {
+                i = end;
+                continue;
+            }
+        }
         let c = chars[i];
         match c {
             '[' => {
@@ -145,6 +157,13 @@ fn scan_value(chars: &[char], mut i: usize) -> usize {
                 expression = true;
             }
             ']' => depth = depth.saturating_sub(1),
+            // `N10#1=…`: a `#` right after a number starts the next word (an assignment).
+            '#' if depth == 0
+                && i > 0
+                && (chars[i - 1].is_ascii_digit() || chars[i - 1] == '.') =>
+            {
+                break;
+            }
             '#' => expression = true,
             '<' if expression => {
                 // LinuxCNC #<name>
@@ -226,7 +245,7 @@ fn lex_letters(
                     "`{name}` without `=`: a parameter must be assigned"
                 ));
             }
-            let end = scan_value(&chars, name_end + 1);
+            let end = scan_value(&chars, name_end + 1, true);
             let text: String = chars[name_end + 1..end].iter().collect();
             let v = expr::eval(&text, vars).map_err(|e| format!("`{name}=`: {e}"))?;
             vars.set(&key, v);
@@ -242,7 +261,7 @@ fn lex_letters(
         }
         let letter = c.to_ascii_uppercase();
         let address = letter_address(spec, letter);
-        let end = scan_value(&chars, i + 1);
+        let end = scan_value(&chars, i + 1, false);
         let text_value: String = chars[i + 1..end].iter().collect();
         if let Some(Address::Unsupported(message)) = address {
             return Err(format!("`{letter}{text_value}`: {message}"));

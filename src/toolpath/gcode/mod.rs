@@ -145,6 +145,11 @@
 //!   program makes at most [`crate::toolpath::MAX_POINTS`] CL points: an arc, a cycle (with
 //!   its repeats) or a block that would take it past that is an error naming its line, before
 //!   its points are made, however the program got there (repeats, calls, jumps).
+//! * **Fanuc macro control flow**: `WHILE [#1 LT 3.] DO1` … `END1`, `IF [cond] GOTO n`,
+//!   `GOTO n`, `IF [cond] THEN #1=5.` with `EQ NE GT GE LT LE` and `AND OR XOR` (module
+//!   `macro_b`); every block a loop runs counts against the bound on blocks a program may run
+//!   ([`subprograms::MAX_EXPANDED_BLOCKS`]), and a jump back with no macro variable changed
+//!   since it was last taken is an error at once, so no program hangs.
 //! * **Subprograms in the file**: see [`subprograms`] (Fanuc/Haas `M98 P L` with `O<n> … M99`,
 //!   Sinumerik `PROC NAME … RET` and `L123`, LinuxCNC `o100 sub` / `o100 call`): expanded
 //!   where called, nesting and expansion bounded; a call of one not in the file is an error.
@@ -187,6 +192,7 @@ pub mod frames;
 mod interp;
 pub mod klartext;
 mod lexer;
+mod macro_b;
 pub mod offsets;
 pub mod subprograms;
 
