@@ -1227,6 +1227,20 @@ fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
     assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
 }
 
+/// Siemens treats a blank as a separator, so `CYCLE81 (10,0,2,-5)` (NX's Huron post) is the
+/// call `CYCLE81(10,0,2,-5)` (round 5: "unexpected character `(`").
+#[test]
+fn sinumerik_blank_before_an_argument_list() {
+    let program = |call: &str| {
+        format!("G71 G90 G17 G94\nS1000 M3\nG0 X0 Y0 Z50\nF100\n{call}\nMCALL {call}\nX20\nMCALL\n")
+    };
+    let compact = gcode(Dialect::Sinumerik, &program("CYCLE81(10,0,2,-5)"));
+    let spaced = gcode(Dialect::Sinumerik, &program("CYCLE81 (10,0,2,-5)"));
+    assert_eq!(spaced.points, compact.points);
+    // Hole at X0 and X20: 7 mm of feed each (RFP + SDIS = 2 down to −5).
+    assert!((feed_time(&compact) - 2.0 * 7.0 / (100.0 / 60.0)).abs() < 1e-9);
+}
+
 /// Fanuc macro B: arithmetic on constants after `#n=` (round 5: `#4=63./2.` was "unexpected
 /// character `/`" while `#4=#1/2.` read), functions, and blanks.
 #[test]

@@ -347,8 +347,9 @@ pub(super) fn split_words(text: &str) -> Vec<String> {
 /// Words split at blanks that Siemens allows inside a statement, joined again: after an
 /// address letter (`X 100` is `X100`), around `=` (`R1 = 100`, `X= 10`) and between the terms
 /// of a value (`R1 = R2 + 3`: a word that starts with an operator, or follows one, continues
-/// the value before it). A lone letter followed by a number, an `=` word, and operators are
-/// never words of their own, so nothing that was read before reads differently.
+/// the value before it), and between a name and its argument list (`CYCLE81 (10,0,2,-5)`). A
+/// lone letter followed by a number, an `=` word, operators and a `( … )` are never words of
+/// their own, so nothing that was read before reads differently.
 fn join_blanks(words: Vec<String>) -> Vec<String> {
     let op = |c: char| matches!(c, '+' | '-' | '*' | '/');
     let mut out: Vec<String> = Vec::with_capacity(words.len());
@@ -373,6 +374,11 @@ fn join_blanks(words: Vec<String>) -> Vec<String> {
                         c.is_ascii_digit() || matches!(c, '.' | '-' | '+')
                     }) =>
             {
+                last.push_str(&w);
+                true
+            }
+            // `CYCLE81` `(10,0,2,-5)`: a name and its argument list (NX's Huron post).
+            Some(last) if w.starts_with('(') && is_identifier(last) => {
                 last.push_str(&w);
                 true
             }
