@@ -1227,6 +1227,53 @@ fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
     assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
 }
 
+
+/// Sinumerik CYCLE84 (rigid tapping) feeds at pitch × speed, as the 840D's cycle does: PIT
+/// (or the metric size MPIT) × SST in, × SST1 out (round 5: it tapped at the last F, 68.6 s
+/// for about 7 s). CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1).
+#[test]
+fn sinumerik_cycle84_taps_at_pitch_times_speed() {
+    let tap = |call: &str| {
+        gcode(
+            Dialect::Sinumerik,
+            &format!("G71 G90 G17 G94\nS800 M3\nG0 X0 Y0 Z50\nF60\nMCALL {call}\nX10\nMCALL\n"),
+        )
+    };
+    // RFP 3, SDIS 0, DP −30.875: 33.875 mm in at 1.25 × 500 mm/min, out at 1.25 × 400.
+    let depth = 33.875;
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,1.25,0,500,400)");
+    let want = depth / (1.25 * 500.0 / 60.0) + depth / (1.25 * 400.0 / 60.0);
+    assert!((feed_time(&tp) - want).abs() < 1e-9, "{}", feed_time(&tp));
+    assert!(tp.warnings.iter().all(|w| !w.message.contains("CYCLE84")));
+    // SST1 empty or 0: out at SST too. MPIT 10 is M10, pitch 1.5 mm.
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,10,,0,500,0)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.5 * 500.0 / 60.0)).abs() < 1e-9);
+    // _PTAB 2: PIT in threads per inch (20 tpi: 1.27 mm).
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,20,0,500,,,2)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.27 * 500.0 / 60.0)).abs() < 1e-9);
+    // Without SST: the S programmed before the call (800 rpm).
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,1.25)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.25 * 800.0 / 60.0)).abs() < 1e-9);
+    // Without a pitch: the programmed F (60 mm/min), with a warning.
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,,0,500)");
+    assert!((feed_time(&tp) - 2.0 * depth).abs() < 1e-9);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.message.contains("without a pitch"))
+    );
+    // A thread size that is not a metric coarse thread is an error naming the line.
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G71 G90 G17\nS500 M3\nG0 X0 Y0 Z50\nCYCLE84(3,3,,-10,,,3,7)\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(e.contains("t.mpf:4") && e.contains("MPIT 7"), "{e}");
+}
+
 /// Siemens treats a blank as a separator, so `CYCLE81 (10,0,2,-5)` (NX's Huron post) is the
 /// call `CYCLE81(10,0,2,-5)` (round 5: "unexpected character `(`").
 #[test]

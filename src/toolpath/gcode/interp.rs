@@ -1083,7 +1083,7 @@ impl<'a> Interpreter<'a> {
             if modal_call {
                 // The call's errors and notes depend on its arguments only: said once, where
                 // the program calls it, not at every position after it.
-                let (steps, notes) = cycles::sinumerik_steps(number, &args)
+                let (steps, notes) = cycles::sinumerik_steps(number, &args, self.rpm)
                     .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
                 for n in notes {
                     self.warn(line, format!("MCALL {text}: {n}"));
@@ -2050,10 +2050,20 @@ impl<'a> Interpreter<'a> {
     fn sinumerik_cycle_units(&self, number: u32, args: Vec<Option<f64>>) -> Vec<Option<f64>> {
         let length = self.units.mm_per_unit();
         let feed = self.feed_units.mm_per_unit();
+        let ptab = args.get(13).copied().flatten().map_or(0, |v| v as i64);
         args.into_iter()
             .enumerate()
             .map(|(k, a)| {
                 a.map(|v| {
+                    // CYCLE84's PIT in the unit _PTAB names (0: the program's).
+                    if number == 84 && k == 8 {
+                        return match ptab {
+                            1 => v,
+                            2 if v != 0.0 => MM_PER_INCH / v,
+                            3 => v * MM_PER_INCH,
+                            _ => v * length,
+                        };
+                    }
                     let is_length = k <= 4 || (number == 83 && (5..=7).contains(&k));
                     let is_feed = number == 85 && (6..=7).contains(&k);
                     if is_length {
@@ -2076,7 +2086,7 @@ impl<'a> Interpreter<'a> {
         args: &[Option<f64>],
     ) -> Result<()> {
         self.cycle_plane(line, text)?;
-        let (steps, notes) = cycles::sinumerik_steps(number, args)
+        let (steps, notes) = cycles::sinumerik_steps(number, args, self.rpm)
             .map_err(|e| self.error(line, format!("{text}: {e}")))?;
         for n in notes {
             self.warn(line, format!("{text}: {n}"));
