@@ -468,8 +468,10 @@ fn cycle76_with_a_boring_list_reads_as_cycle86_and_a_spigot_call_is_an_error() {
 /// A Sinumerik call feedopt does not know (a cycle or subprogram with an argument list, here
 /// NX's thread-milling CYCLE90 from a Huron KX20 post) may move the tool: an error naming the
 /// line and the call, not a warning that drops it. CYCLE832 (tolerances), MSG and SETMS (the
-/// master spindle; a 840D sl package's CAM test) are read and ignored; a bare unknown word stays
-/// a warning.
+/// master spindle; a 840D sl package's CAM test) are read and ignored. A bare unknown name is
+/// a command or a subprogram call on an 840D (its alarm stops the program): an error too,
+/// with the keyword a typo stands for (NX's Cincinnati post writes `TRAOOF` for TRAFOOF,
+/// which left TRAORI on). An unknown M code stays a warning.
 #[test]
 fn an_unknown_sinumerik_call_is_an_error() {
     let text =
@@ -478,15 +480,24 @@ fn an_unknown_sinumerik_call_is_an_error() {
     assert!(e.contains("t.mpf:3") && e.contains("CYCLE90(…)"), "{e}");
     let tp = gcode(
         Dialect::Sinumerik,
-        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nSETMS(1)\nFOO\nG0 X0 Y0 Z10\nG1 X10 F100\n",
+        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nSETMS(1)\nM204\nG0 X0 Y0 Z10\nG1 X10 F100\n",
     );
     assert_eq!(tp.points.len(), 2);
     assert!(
         tp.warnings
             .iter()
-            .any(|w| w.message.contains("unknown word `FOO`")),
+            .any(|w| w.message.contains("unknown word `M204`")),
         "{:?}",
         tp.warnings
+    );
+    let text = "G90 G54\nG0 X0 Y0 Z10\nFOO\nG1 X10 F100\n";
+    let e = message(parse(Path::new("t.mpf"), text, Dialect::Sinumerik).unwrap_err());
+    assert!(e.contains("t.mpf:3") && e.contains("`FOO`"), "{e}");
+    let text = "G71 G90 G17 G94\nTRAORI(1)\nG0 X1 Y0 Z1 A0 C0\nG1 X2 F10\nTRAOOF\nG0 Z2\n";
+    let e = message(parse(Path::new("t.mpf"), text, Dialect::Sinumerik).unwrap_err());
+    assert!(
+        e.contains("t.mpf:5") && e.contains("`TRAOOF`") && e.contains("`TRAFOOF`"),
+        "{e}"
     );
 }
 
@@ -1227,7 +1238,6 @@ fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
     assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
 }
 
-
 /// Sinumerik CYCLE84 (rigid tapping) feeds at pitch × speed, as the 840D's cycle does: PIT
 /// (or the metric size MPIT) × SST in, × SST1 out (round 5: it tapped at the last F, 68.6 s
 /// for about 7 s). CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1).
@@ -1372,4 +1382,18 @@ fn fanuc_macro_loops_are_bounded_and_checked() {
     assert!(e.contains("t.nc:2") && e.contains("FOO"), "{e}");
     let e = fanuc_error("#1=0\nWHILE #1 LT 3 DO1\n");
     assert!(e.contains("t.nc:2") && e.contains("WHILE"), "{e}");
+}
+
+/// NX's Haas post leaves `O ENTER OP AND LAST 3 DIGITS` for the program number: the error says
+/// that `O` needs one, in either dialect (it said "O-word control flow … is not supported").
+#[test]
+fn an_o_without_a_number_says_so() {
+    let text = "%\nO ENTER OP AND LAST 3 DIGITS\nG90 G0 X0. Y0. Z1.\nM30\n%\n";
+    let e = fanuc_error(text);
+    assert!(e.contains("t.nc:2") && e.contains("program number"), "{e}");
+    let e = message(parse(Path::new("t.ngc"), text, Dialect::LinuxCnc).unwrap_err());
+    assert!(
+        e.contains("t.ngc:2") && e.contains("`O` without a number"),
+        "{e}"
+    );
 }

@@ -511,15 +511,21 @@ fn unknown_word_warns_with_its_line() {
         others(&tp)[0]
     );
     err("G0 X0 Y0 Z0\nG1 X1 F100 G43.4\n", 2, &["G43.4", "move"]);
-    // Sinumerik: an unknown keyword and an unknown named word.
+    // Sinumerik: an unknown named word is a warning; an unknown bare name is a command or a
+    // subprogram call on the control, which may move the tool: an error naming it.
     let tp = ok_in(
         Dialect::Sinumerik,
-        "G71 G0 X0 Y0 Z0\nFOO G1 X1 F100\nBAR=3 Y1\n",
+        "G71 G0 X0 Y0 Z0\nG1 X1 F100\nBAR=3 Y1\n",
     );
     assert_eq!(tp.points.len(), 3);
-    assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
-    assert!(tp.warnings[0].line == 2 && tp.warnings[0].message.contains("FOO"));
-    assert!(tp.warnings[1].line == 3 && tp.warnings[1].message.contains("BAR"));
+    assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
+    assert!(tp.warnings[0].line == 3 && tp.warnings[0].message.contains("BAR"));
+    err_in(
+        Dialect::Sinumerik,
+        "G71 G0 X0 Y0 Z0\nFOO G1 X1 F100\n",
+        2,
+        &["`FOO`", "subprogram"],
+    );
     // U V W move axes feedopt does not model: an error naming the word, in LinuxCNC and
     // Fanuc (a warning before, and the move was lost).
     err(

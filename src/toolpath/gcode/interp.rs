@@ -453,6 +453,26 @@ impl<'a> Interpreter<'a> {
                         ),
                     ));
                 }
+                Item::Unknown { text, call: false }
+                    if self.spec.spaces == Spaces::Separate
+                        && text.len() > 1
+                        && text.chars().all(|c| c.is_ascii_alphabetic() || c == '_') =>
+                {
+                    // Sinumerik: a bare name is a command or a subprogram call, either of which
+                    // may change the motion (`TRAOOF` for TRAFOOF leaves TRAORI on).
+                    let like = nearest_keyword(self.spec, &text)
+                        .map(|k| format!(" (did the post mean `{k}`?)"))
+                        .unwrap_or_default();
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{text}`: not a {name} command feedopt knows{like}; a bare name \
+                             switches a function or calls a subprogram, which may change the \
+                             motion, so it is not skipped: correct it, remove it, or define \
+                             PROC {text} … RET in this file"
+                        ),
+                    ));
+                }
                 Item::Unknown { text, call: false } => {
                     self.warn(
                         line,
@@ -2626,6 +2646,31 @@ impl<'a> Interpreter<'a> {
         self.tangent = Some((arc_plane, tangent, self.points.len()));
         Ok(())
     }
+}
+
+/// The dialect's keyword closest to `word` (an edit or two away: a post's typo), if any.
+fn nearest_keyword(spec: &DialectSpec, word: &str) -> Option<&'static str> {
+    fn distance(a: &str, b: &str) -> usize {
+        let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+        let mut row: Vec<usize> = (0..=b.len()).collect();
+        for (i, ca) in a.iter().enumerate() {
+            let mut prev = row[0];
+            row[0] = i + 1;
+            for (j, cb) in b.iter().enumerate() {
+                let here = row[j + 1];
+                row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(here + 1);
+                prev = here;
+            }
+        }
+        row[b.len()]
+    }
+    let upper = word.to_ascii_uppercase();
+    spec.keywords
+        .iter()
+        .map(|&(k, _)| (distance(&upper, k), k))
+        .filter(|&(d, k)| d <= 2 && d < k.len() / 2)
+        .min()
+        .map(|(_, k)| k)
 }
 
 /// The warning for a program's contour tolerance (`G64 P0.02`, `CYCL DEF 32.1 T0.075`, of

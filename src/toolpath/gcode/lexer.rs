@@ -1,7 +1,7 @@
 //! Lexing: comments, blocks and words, resolved through a dialect table; variables and
 //! expressions ([`super::expr`]) are evaluated here, left to right, as the block is read.
 
-use super::dialect::{Action, Address, DialectSpec, Semicolon, Spaces};
+use super::dialect::{Action, Address, DialectSpec, Semicolon, Spaces, Subprograms};
 use super::expr::{self, Variables};
 
 /// Removes comments and splits a line into block texts (more than one only where `;` ends a
@@ -263,6 +263,17 @@ fn lex_letters(
         let address = letter_address(spec, letter);
         let end = scan_value(&chars, i + 1, false);
         let text_value: String = chars[i + 1..end].iter().collect();
+        if letter == 'O' && text_value.is_empty() {
+            return Err(match spec.subprograms {
+                Subprograms::OWordSub => "`O` without a number or name: an O-word is written \
+                                          `o100 …` or `o<name> …` (a post's placeholder such \
+                                          as `O ENTER …` needs the program number filled in)"
+                    .to_string(),
+                _ => "`O` without a program number: a program is headed `O1234` (a post's \
+                      placeholder such as `O ENTER …` needs the program number filled in)"
+                    .to_string(),
+            });
+        }
         if let Some(Address::Unsupported(message)) = address {
             return Err(format!("`{letter}{text_value}`: {message}"));
         }

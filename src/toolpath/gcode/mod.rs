@@ -174,8 +174,12 @@
 //! # What is rejected
 //!
 //! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
-//!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
-//!   [`Warning`] naming the word and its line, never silently.
+//!   So is a Sinumerik name the table does not know, written alone (`TRAOOF`: letters only, no
+//!   value, no `=`): on an 840D a bare name is a command or a subprogram call, either of which
+//!   may change the motion (a post's typo `TRAOOF` for `TRAFOOF` left TRAORI on); the message
+//!   names the keyword one or two letters away, if there is one. Any other unknown word
+//!   (letter, M code, named word) is skipped with a [`Warning`] naming the word and its line,
+//!   never silently.
 //! * Errors ([`crate::error::Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
 //!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
