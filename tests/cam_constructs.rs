@@ -512,8 +512,10 @@ fn cycle76_with_a_boring_list_reads_as_cycle86_and_a_spigot_call_is_an_error() {
 /// A Sinumerik call feedopt does not know (a cycle or subprogram with an argument list, here
 /// NX's thread-milling CYCLE90 from a Huron KX20 post) may move the tool: an error naming the
 /// line and the call, not a warning that drops it. CYCLE832 (tolerances), MSG and SETMS (the
-/// master spindle; a 840D sl package's CAM test) are read and ignored; a bare unknown word stays
-/// a warning.
+/// master spindle; a 840D sl package's CAM test) are read and ignored. A bare unknown name is
+/// a command or a subprogram call on an 840D (its alarm stops the program): an error too,
+/// with the keyword a typo stands for (NX's Cincinnati post writes `TRAOOF` for TRAFOOF,
+/// which left TRAORI on). An unknown M code stays a warning.
 #[test]
 fn an_unknown_sinumerik_call_is_an_error() {
     let text =
@@ -522,15 +524,24 @@ fn an_unknown_sinumerik_call_is_an_error() {
     assert!(e.contains("t.mpf:3") && e.contains("CYCLE90(…)"), "{e}");
     let tp = gcode(
         Dialect::Sinumerik,
-        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nSETMS(1)\nFOO\nG0 X0 Y0 Z10\nG1 X10 F100\n",
+        "CYCLE832(0.01,_ORI_FINISH,1)\nMSG(\"roughing\")\nSETMS(1)\nM204\nG0 X0 Y0 Z10\nG1 X10 F100\n",
     );
     assert_eq!(tp.points.len(), 2);
     assert!(
         tp.warnings
             .iter()
-            .any(|w| w.message.contains("unknown word `FOO`")),
+            .any(|w| w.message.contains("unknown word `M204`")),
         "{:?}",
         tp.warnings
+    );
+    let text = "G90 G54\nG0 X0 Y0 Z10\nFOO\nG1 X10 F100\n";
+    let e = message(parse(Path::new("t.mpf"), text, Dialect::Sinumerik).unwrap_err());
+    assert!(e.contains("t.mpf:3") && e.contains("`FOO`"), "{e}");
+    let text = "G71 G90 G17 G94\nTRAORI(1)\nG0 X1 Y0 Z1 A0 C0\nG1 X2 F10\nTRAOOF\nG0 Z2\n";
+    let e = message(parse(Path::new("t.mpf"), text, Dialect::Sinumerik).unwrap_err());
+    assert!(
+        e.contains("t.mpf:5") && e.contains("`TRAOOF`") && e.contains("`TRAFOOF`"),
+        "{e}"
     );
 }
 
@@ -1295,4 +1306,164 @@ fn rotary_machine_coordinates_are_not_shifted_by_the_offsets() {
     );
     let a: Vec<f64> = tp.points.iter().map(|p| p.rotary.unwrap()[0]).collect();
     assert_eq!(a, [0.0, 15.0, 30.0, 10.0], "{:?}", tp.points);
+}
+
+/// Sinumerik CYCLE84 (rigid tapping) feeds at pitch × speed, as the 840D's cycle does: PIT
+/// (or the metric size MPIT) × SST in, × SST1 out (round 5: it tapped at the last F, 68.6 s
+/// for about 7 s). CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1).
+#[test]
+fn sinumerik_cycle84_taps_at_pitch_times_speed() {
+    let tap = |call: &str| {
+        gcode(
+            Dialect::Sinumerik,
+            &format!("G71 G90 G17 G94\nS800 M3\nG0 X0 Y0 Z50\nF60\nMCALL {call}\nX10\nMCALL\n"),
+        )
+    };
+    // RFP 3, SDIS 0, DP −30.875: 33.875 mm in at 1.25 × 500 mm/min, out at 1.25 × 400.
+    let depth = 33.875;
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,1.25,0,500,400)");
+    let want = depth / (1.25 * 500.0 / 60.0) + depth / (1.25 * 400.0 / 60.0);
+    assert!((feed_time(&tp) - want).abs() < 1e-9, "{}", feed_time(&tp));
+    assert!(tp.warnings.iter().all(|w| !w.message.contains("CYCLE84")));
+    // SST1 empty or 0: out at SST too. MPIT 10 is M10, pitch 1.5 mm.
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,10,,0,500,0)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.5 * 500.0 / 60.0)).abs() < 1e-9);
+    // _PTAB 2: PIT in threads per inch (20 tpi: 1.27 mm).
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,20,0,500,,,2)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.27 * 500.0 / 60.0)).abs() < 1e-9);
+    // Without SST: the S programmed before the call (800 rpm).
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,1.25)");
+    assert!((feed_time(&tp) - 2.0 * depth / (1.25 * 800.0 / 60.0)).abs() < 1e-9);
+    // Without a pitch: the programmed F (60 mm/min), with a warning.
+    let tp = tap("CYCLE84(3,3,,-30.875,,,3,,,0,500)");
+    assert!((feed_time(&tp) - 2.0 * depth).abs() < 1e-9);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.message.contains("without a pitch"))
+    );
+    // A thread size that is not a metric coarse thread is an error naming the line.
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G71 G90 G17\nS500 M3\nG0 X0 Y0 Z50\nCYCLE84(3,3,,-10,,,3,7)\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(e.contains("t.mpf:4") && e.contains("MPIT 7"), "{e}");
+}
+
+/// Siemens treats a blank as a separator, so `CYCLE81 (10,0,2,-5)` (NX's Huron post) is the
+/// call `CYCLE81(10,0,2,-5)` (round 5: "unexpected character `(`").
+#[test]
+fn sinumerik_blank_before_an_argument_list() {
+    let program = |call: &str| {
+        format!("G71 G90 G17 G94\nS1000 M3\nG0 X0 Y0 Z50\nF100\n{call}\nMCALL {call}\nX20\nMCALL\n")
+    };
+    let compact = gcode(Dialect::Sinumerik, &program("CYCLE81(10,0,2,-5)"));
+    let spaced = gcode(Dialect::Sinumerik, &program("CYCLE81 (10,0,2,-5)"));
+    assert_eq!(spaced.points, compact.points);
+    // Hole at X0 and X20: 7 mm of feed each (RFP + SDIS = 2 down to −5).
+    assert!((feed_time(&compact) - 2.0 * 7.0 / (100.0 / 60.0)).abs() < 1e-9);
+}
+
+/// Fanuc macro B: arithmetic on constants after `#n=` (round 5: `#4=63./2.` was "unexpected
+/// character `/`" while `#4=#1/2.` read), functions, and blanks.
+#[test]
+fn fanuc_macro_assignments_of_constant_expressions() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\n#4= 63. / 2.\n#5=80./2.+#4+5.\n#6=SIN[30.]*4.\n#7 = 10. * 2. - 1.\n\
+         G0 X#4 Y#5 Z#6\nG0 X#7\n",
+    );
+    assert_close(tp.points[0].p, v(31.5, 76.5, 2.0), 1e-12);
+    assert_eq!(tp.points[1].p.x, 19.0);
+}
+
+fn fanuc_error(text: &str) -> String {
+    message(parse(Path::new("t.nc"), text, Dialect::Fanuc).unwrap_err())
+}
+
+/// Fanuc macro B control flow: WHILE … DO m / END m, IF … GOTO n, GOTO n, IF … THEN, with
+/// EQ NE GT GE LT LE and AND/OR (round 5: `WHILE` was read as a W axis word).
+#[test]
+fn fanuc_macro_while_if_goto() {
+    // Three passes: X 0, 10, 20, each a 10 mm feed move, at F600 (1 s each but the first).
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90\n#1=0.\nG0 X-10. Y0. Z5.\nWHILE [#1 LT 3.] DO1\nG1 X[#1*10.] F600.\n\
+         #1=#1+1.\nEND1\nG0 Z10.\n",
+    );
+    assert_eq!(xs(&tp), [-10.0, 0.0, 10.0, 20.0, 20.0]);
+    assert!((feed_time(&tp) - 3.0).abs() < 1e-9);
+    // Nested loops take different numbers: 2 × 3 points.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0. Y0. Z0.\n#1=0\nWHILE[#1LT2]DO1\n#2=0\nWHILE[#2LT3]DO2\n\
+         G1 X#2 Y#1 F100.\n#2=#2+1\nEND2\n#1=#1+1\nEND1\n",
+    );
+    assert_eq!(tp.points.len(), 7);
+    assert_eq!(tp.points[6].p, v(2.0, 1.0, 0.0));
+    // A false condition at the start skips the loop.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G0 X0. Y0. Z0.\n#1=5.\nWHILE [#1 LT 3.] DO1\nG1 X1. F100.\nEND1\nG0 X2.\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 2.0]);
+    // IF … THEN runs its statement when the condition holds; AND / OR join comparisons.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "#1=0.\n#2=0.\nIF [#1 LT 3.] THEN #1=5.\nIF [[#1 GT 4.] AND [#1 LE 5.]] THEN #2=7.\n\
+         IF [[#1 EQ 0] OR [#2 NE 7.]] THEN #2=9.\nG0 X#1 Y#2 Z0.\n",
+    );
+    assert_eq!(tp.points[0].p, v(5.0, 7.0, 0.0));
+    // IF … GOTO skips forward; GOTO jumps back (a counted loop): X 1, 2, 3, then 10.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G0 X0. Y0. Z0.\n#1=0\nN10 #1=#1+1\nG0 X#1\nIF [#1 GE 3] GOTO 20\nGOTO 10\n\
+         G0 X99.\nN20 G0 X10.\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 1.0, 2.0, 3.0, 10.0]);
+    // In a subprogram, GOTO looks for the block number there.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1\nG0 X0. Y0. Z0.\nM98 P2\nM30\nO2\nGOTO 5\nG0 X99.\nN5 G0 X5.\nM99\n",
+    );
+    assert_eq!(xs(&tp), [0.0, 5.0]);
+}
+
+/// A macro loop that cannot end is an error naming the file and line, not a hang: at once
+/// when nothing its condition reads has changed since its last pass; after the bound on the
+/// blocks a program may run otherwise. Malformed or unmatched statements are errors too.
+#[test]
+fn fanuc_macro_loops_are_bounded_and_checked() {
+    let e = fanuc_error("#1=0\nG0 X0. Y0. Z0.\nWHILE [#1 LT 3] DO1\nG91 G1 X1. F100.\nEND1\n");
+    assert!(e.contains("t.nc:5") && e.contains("for ever"), "{e}");
+    let e = fanuc_error("#1=0\nG0 X0. Y0. Z0.\nWHILE [#1 GE 0] DO1\n#1=#1+1\nEND1\n");
+    assert!(e.contains("t.nc:") && e.contains("blocks"), "{e}");
+    let e = fanuc_error("G0 X0. Y0. Z0.\nEND1\n");
+    assert!(e.contains("t.nc:2") && e.contains("END1 has no DO1"), "{e}");
+    let e = fanuc_error("#1=5\nWHILE [#1 LT 3] DO1\nG0 X1. Y0. Z0.\n");
+    assert!(e.contains("t.nc:2") && e.contains("no END1"), "{e}");
+    let e = fanuc_error("G0 X0. Y0. Z0.\nGOTO 50\n");
+    assert!(e.contains("t.nc:2") && e.contains("N50"), "{e}");
+    let e = fanuc_error("#1=0\nIF [#1 FOO 3] GOTO 5\n");
+    assert!(e.contains("t.nc:2") && e.contains("FOO"), "{e}");
+    let e = fanuc_error("#1=0\nWHILE #1 LT 3 DO1\n");
+    assert!(e.contains("t.nc:2") && e.contains("WHILE"), "{e}");
+}
+
+/// NX's Haas post leaves `O ENTER OP AND LAST 3 DIGITS` for the program number: the error says
+/// that `O` needs one, in either dialect (it said "O-word control flow … is not supported").
+#[test]
+fn an_o_without_a_number_says_so() {
+    let text = "%\nO ENTER OP AND LAST 3 DIGITS\nG90 G0 X0. Y0. Z1.\nM30\n%\n";
+    let e = fanuc_error(text);
+    assert!(e.contains("t.nc:2") && e.contains("program number"), "{e}");
+    let e = message(parse(Path::new("t.ngc"), text, Dialect::LinuxCnc).unwrap_err());
+    assert!(
+        e.contains("t.ngc:2") && e.contains("`O` without a number"),
+        "{e}"
+    );
 }

@@ -218,6 +218,47 @@ fn g94_rotary_only_move_uses_degrees() {
     assert!((block_time(tp.points[1].feed) - 60.0).abs() < 1e-12);
 }
 
+#[test]
+fn fanuc_g94_feed_with_a_rotary_axis_is_along_the_combined_distance() {
+    // The Fanuc manual's example: G91 G01 X20.0 C40.0 F300.0 takes √(20²+40²)/300 min.
+    let fanuc = |text: &str| ok_in(Dialect::Fanuc, text);
+    let tp = fanuc("G21 G90 G94 G0 X0. Y0. Z0. C0.\nG91 G1 X20. C40. F300.\n");
+    let want = (20f64.powi(2) + 40f64.powi(2)).sqrt() / 300.0 * 60.0;
+    assert!((want - 0.14907 * 60.0).abs() < 1e-3, "{want}");
+    assert!((block_time(tp.points[1].feed) - want).abs() < 1e-9);
+    // Said at the block (a Haas converts degrees otherwise).
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 2 && w.message.contains("combined distance")),
+        "{:?}",
+        tp.warnings
+    );
+    // X, Y and two rotary axes all count: √(3²+4²+12²+(−84)²) mm/° = √(9+16+144+7056) = 85.
+    let tp = fanuc("G21 G90 G0 X0. Y0. Z0. A0. B0.\nG1 X3. Y4. A12. B-84. F170.\n");
+    assert!((block_time(tp.points[1].feed) - 85.0 / 170.0 * 60.0).abs() < 1e-9);
+    // Under G20 the linear part is in inch and F in inch/min: √(1²+1²)/10 min.
+    let tp = fanuc("G20 G90 G0 X0. Y0. Z0. A0.\nG1 X1. A1. F10.\n");
+    assert!((block_time(tp.points[1].feed) - 2f64.sqrt() / 10.0 * 60.0).abs() < 1e-9);
+    // A linear block keeps F as a speed; a pure rotary block is |ΔC|/F as before: 30° at
+    // 90 °/min = 20 s.
+    let tp = fanuc("G21 G90 G0 X0. Y0. Z0. C0.\nG1 X30. F300.\nC30. F90.\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    assert!((block_time(tp.points[2].feed) - 20.0).abs() < 1e-12);
+    assert!(tp.warnings.iter().all(|w| !w.message.contains("combined")));
+    // In tool-tip mode (G43.4) F is the tool tip's speed.
+    let tp = fanuc("G21 G90 G43.4 H1\nG0 X0. Y0. Z0. C0.\nG1 X20. C40. F300.\nG49\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    // LinuxCNC (and Sinumerik) keep F along X Y Z when they move.
+    let tp = ok("G21 G90 G0 X0 Y0 Z0 C0\nG91 G1 X20 C40 F300\n");
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G71 G90 G0 X0 Y0 Z0 C0\nG91 G1 X20 C40 F300\n",
+    );
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Arcs
 // ---------------------------------------------------------------------------------------------
@@ -485,15 +526,21 @@ fn unknown_word_warns_with_its_line() {
         others(&tp)[0]
     );
     err("G0 X0 Y0 Z0\nG1 X1 F100 G43.4\n", 2, &["G43.4", "move"]);
-    // Sinumerik: an unknown keyword and an unknown named word.
+    // Sinumerik: an unknown named word is a warning; an unknown bare name is a command or a
+    // subprogram call on the control, which may move the tool: an error naming it.
     let tp = ok_in(
         Dialect::Sinumerik,
-        "G71 G0 X0 Y0 Z0\nFOO G1 X1 F100\nBAR=3 Y1\n",
+        "G71 G0 X0 Y0 Z0\nG1 X1 F100\nBAR=3 Y1\n",
     );
     assert_eq!(tp.points.len(), 3);
-    assert_eq!(tp.warnings.len(), 2, "{:?}", tp.warnings);
-    assert!(tp.warnings[0].line == 2 && tp.warnings[0].message.contains("FOO"));
-    assert!(tp.warnings[1].line == 3 && tp.warnings[1].message.contains("BAR"));
+    assert_eq!(tp.warnings.len(), 1, "{:?}", tp.warnings);
+    assert!(tp.warnings[0].line == 3 && tp.warnings[0].message.contains("BAR"));
+    err_in(
+        Dialect::Sinumerik,
+        "G71 G0 X0 Y0 Z0\nFOO G1 X1 F100\n",
+        2,
+        &["`FOO`", "subprogram"],
+    );
     // U V W move axes feedopt does not model: an error naming the word, in LinuxCNC and
     // Fanuc (a warning before, and the move was lost).
     err(

@@ -232,3 +232,20 @@ fn a_c_word_on_an_a_b_trunnion_is_an_error_naming_c() {
     let msg = e.to_string();
     assert!(msg.contains(":3:") && msg.contains("no C axis"), "{msg}");
 }
+
+#[test]
+fn a_fanuc_block_turning_a_rotary_axis_takes_the_combined_distance_over_f() {
+    // G1 X100. A90. F1000. outside tool-tip mode: a Fanuc control feeds √(100²+90²) at
+    // 1000 per minute, 8.07 s (LinuxCNC's rule would give 100 mm at 1000 mm/min, 6 s). The
+    // axes' limits are far above what the block needs, so only the ramps add a little.
+    let m = machine(TRUNNION_AB);
+    let tp = ab_program(
+        &m,
+        "G21 G90 G94 G17\nG0 X0. Y0. Z0. A0. B0.\nG1 X100. A90. F1000.\nM30\n",
+    )
+    .unwrap();
+    let sol = optimize(&m, &tp, &Options::default()).unwrap();
+    let want = (100f64.powi(2) + 90f64.powi(2)).sqrt() / 1000.0 * 60.0;
+    let t = sol.schedule.cycle_time;
+    assert!(t >= want * (1.0 - 1e-3) && t < want * 1.02, "{t} vs {want}");
+}

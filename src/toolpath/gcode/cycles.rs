@@ -41,9 +41,14 @@
 //! RFP − FDPR, later steps each DAM shorter (never below DAM); VARI = 1 (swarf removal): rapid
 //! to RFP + SDIS after each step, dwell DTS, rapid back to [`PECK_CLEARANCE_MM`] above the
 //! depth; VARI = 0 (chip breaking): retract by [`SINUMERIK_CHIP_BREAK_MM`] (the cycle's default
-//! _VRT); dwell DTB at the final depth. CYCLE84 (rigid tapping): feed to DP, dwell DTB, feed
-//! back to RFP + SDIS — at the programmed F (the post's pitch × speed; MPIT/PIT are not read,
-//! a warning). CYCLE85 (…, DTB, FFR, RFF): feed FFR in, dwell, feed RFF out (0 or empty: the
+//! _VRT); dwell DTB at the final depth. CYCLE84 (rigid tapping: RTP, RFP, SDIS, DP, DPR,
+//! DTB, SDAC, MPIT, PIT, POSS, SST, SST1, _AXN, _PTAB, …): feed to DP at |PIT| × SST, dwell
+//! DTB, feed back to RFP + SDIS at |PIT| × SST1 (SST where SST1 is 0 or empty). PIT is in the
+//! program's unit (_PTAB 0), mm (1), threads per inch (2) or inch per revolution (3); without
+//! PIT, MPIT names a metric coarse thread (MPIT 10: M10, pitch 1.5 mm); without SST, the S
+//! programmed before the call. A call without a pitch, or without any speed, taps at the
+//! programmed F (a warning); chip breaking or removal steps (_VARI 1/2 with _DAM) are tapped
+//! in one pass (a warning). CYCLE85 (…, DTB, FFR, RFF): feed FFR in, dwell, feed RFF out (0 or empty: the
 //! programmed F). CYCLE86: feed, dwell, rapid out (the lift-off moves RPA/RPO/RPAP are not
 //! read). CYCLE87/CYCLE88: feed, (CYCLE88: dwell), the operator's stop (M0: not timed, a
 //! warning), rapid out. CYCLE89: feed, dwell, feed out. `CYCLE76`/`CYCLE77` are Sinumerik's
@@ -997,10 +1002,40 @@ pub fn heidenhain_steps(
     Ok((s, notes))
 }
 
-/// Sinumerik `CYCLE8x(...)` parameters, lengths in mm (already scaled), positional.
+/// The pitch (mm) of ISO metric coarse thread `M<size>`, as CYCLE84's MPIT names it (3 to 48).
+pub fn metric_coarse_pitch(size: f64) -> Option<f64> {
+    const TABLE: [(f64, f64); 21] = [
+        (3.0, 0.5),
+        (4.0, 0.7),
+        (5.0, 0.8),
+        (6.0, 1.0),
+        (8.0, 1.25),
+        (10.0, 1.5),
+        (12.0, 1.75),
+        (14.0, 2.0),
+        (16.0, 2.0),
+        (18.0, 2.5),
+        (20.0, 2.5),
+        (22.0, 2.5),
+        (24.0, 3.0),
+        (27.0, 3.0),
+        (30.0, 3.5),
+        (33.0, 3.5),
+        (36.0, 4.0),
+        (39.0, 4.0),
+        (42.0, 4.5),
+        (45.0, 4.5),
+        (48.0, 5.0),
+    ];
+    TABLE.iter().find(|(m, _)| *m == size).map(|&(_, p)| p)
+}
+
+/// Sinumerik `CYCLE8x(...)` parameters, lengths in mm (already scaled), positional; `rpm`: the
+/// spindle speed programmed before the call (CYCLE84 taps at pitch × SST, or × this).
 pub fn sinumerik_steps(
     number: u32,
     p: &[Option<f64>],
+    rpm: Option<f64>,
 ) -> Result<(Vec<Step>, Vec<&'static str>), String> {
     use Step::*;
     let get = |k: usize| p.get(k).copied().flatten();
@@ -1070,8 +1105,45 @@ pub fn sinumerik_steps(
             }
         }
         84 => {
-            notes.push("CYCLE84 taps at the programmed F (pitch MPIT/PIT not read)");
-            s.extend([Feed(dp, None), Dwell(dwell(5)), Feed(safe, None)]);
+            // CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1, _AXN,
+            // _PTAB, _TECHNO, _VARI, _DAM, …): PIT in mm here (the caller converted _PTAB).
+            let pitch = match (get(8).filter(|v| *v != 0.0), get(7).filter(|v| *v != 0.0)) {
+                (Some(pit), _) => Some(pit.abs()),
+                (None, Some(mpit)) => Some(metric_coarse_pitch(mpit.abs()).ok_or_else(|| {
+                    format!(
+                        "{name}: MPIT {mpit} is not a metric thread size M3 … M48 whose coarse \
+                         pitch the cycle takes: give the pitch as PIT"
+                    )
+                })?),
+                (None, None) => None,
+            };
+            let speed = |k: usize| get(k).map(f64::abs).filter(|v| *v > 0.0);
+            let tap = speed(10).or(rpm.filter(|r| *r > 0.0));
+            let (down, up) = match (pitch, tap) {
+                (Some(pitch), Some(tap)) => {
+                    (Some(pitch * tap), Some(pitch * speed(11).unwrap_or(tap)))
+                }
+                (Some(_), None) => {
+                    notes.push(
+                        "CYCLE84 without a speed (SST, or S before the call): taps at the \
+                         programmed F",
+                    );
+                    (None, None)
+                }
+                (None, _) => {
+                    notes.push("CYCLE84 without a pitch (MPIT or PIT): taps at the programmed F");
+                    (None, None)
+                }
+            };
+            if matches!(get(15), Some(v) if v == 1.0 || v == 2.0)
+                && get(16).is_some_and(|d| d != 0.0)
+            {
+                notes.push(
+                    "CYCLE84 with _VARI 1 or 2 (chip breaking or removal in steps _DAM): the \
+                     steps are not modelled, the hole is tapped in one pass",
+                );
+            }
+            s.extend([Feed(dp, down), Dwell(dwell(5)), Feed(safe, up)]);
         }
         85 => {
             let feed = |k: usize| get(k).filter(|f| *f > 0.0);
@@ -1109,7 +1181,7 @@ pub fn sinumerik_steps(
                 // "boring, no drag" operation: read it so, and say so where it applies. Every
                 // boring variant CYCLE85–89 moves along the same line (down to DP, back to RTP);
                 // they differ in the retract's feed and the dwell, which an alias chooses.
-                let (steps, mut notes) = sinumerik_steps(86, p)?;
+                let (steps, mut notes) = sinumerik_steps(86, p, rpm)?;
                 notes.push(if number == 76 {
                     "CYCLE76 without the spigot's length and width (_LENG, _WID), which a \
                      standard 840D would refuse, has CYCLE86's list (RTP, RFP, SDIS, DP, DPR, \

@@ -104,6 +104,20 @@ pub enum Spaces {
     Klartext,
 }
 
+/// What F means on a G94 (or G95) feed block that turns a rotary axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotaryFeed {
+    /// LinuxCNC (NIST RS274): F is the speed along X Y Z when any of them moves; the rotary
+    /// axes follow. Only when X Y Z stay is F degrees per minute over the A B C distance.
+    Xyz,
+    /// Fanuc: F is the speed along the combined distance √(ΔX²+ΔY²+ΔZ²+ΔA²+ΔB²+ΔC²), linear
+    /// axes in the program's unit and rotary axes in degrees (a degree counts as a mm, or an
+    /// inch under G20). `G91 G1 X20 C40 F300` takes √(20²+40²)/300 = 0.149 min (Fanuc
+    /// operator's manuals, "Linear interpolation (G01)"). Not in tool-tip mode (G43.4/G43.5),
+    /// where F is the tool tip's speed.
+    Combined,
+}
+
 /// What a letter or named word addresses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Address {
@@ -474,6 +488,8 @@ pub struct DialectSpec {
     /// `K` (or `L`) on Fanuc. A `K` in a cycle block of a dialect whose repeat letters do not
     /// include it is an error (LinuxCNC's K is G87's offset).
     pub cycle_repeat: &'static [char],
+    /// What F means on a feed block that turns a rotary axis.
+    pub rotary_feed: RotaryFeed,
 }
 
 use Action::{
@@ -676,6 +692,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     // program without G20 was read as mm in silence (round 4, 1.09 m for about 27.8 m).
     units_by_setting: true,
     cycle_repeat: &['L'],
+    rotary_feed: RotaryFeed::Xyz,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -841,6 +858,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     subprograms: Subprograms::OPrograms,
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
+    rotary_feed: RotaryFeed::Combined,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -1075,6 +1093,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     subprograms: Subprograms::Procs,
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
+    rotary_feed: RotaryFeed::Xyz,
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1316,6 +1335,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     subprograms: Subprograms::Labels,
     units_by_setting: false,
     cycle_repeat: &['K', 'L'],
+    rotary_feed: RotaryFeed::Xyz,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

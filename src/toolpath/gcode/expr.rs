@@ -323,17 +323,7 @@ impl Parser<'_> {
                 }
                 let name: String = self.chars[start..self.at].iter().collect();
                 let upper = name.to_ascii_uppercase();
-                let function: Option<fn(f64) -> f64> = match upper.as_str() {
-                    "SIN" => Some(|x: f64| x.to_radians().sin()),
-                    "COS" => Some(|x: f64| x.to_radians().cos()),
-                    "TAN" => Some(|x: f64| x.to_radians().tan()),
-                    "SQRT" => Some(f64::sqrt),
-                    "ABS" => Some(f64::abs),
-                    "ATAN" => Some(|x: f64| x.atan().to_degrees()),
-                    "ROUND" => Some(f64::round),
-                    "TRUNC" | "FIX" => Some(f64::trunc),
-                    _ => None,
-                };
+                let function = function(&upper);
                 if let Some(f) = function
                     && matches!(self.peek(), Some('(' | '['))
                 {
@@ -353,6 +343,26 @@ impl Parser<'_> {
             Some(c) => Err(format!("unexpected `{c}` in expression")),
         }
     }
+}
+
+/// The function `name` (upper case) names, if any.
+fn function(name: &str) -> Option<fn(f64) -> f64> {
+    match name {
+        "SIN" => Some(|x: f64| x.to_radians().sin()),
+        "COS" => Some(|x: f64| x.to_radians().cos()),
+        "TAN" => Some(|x: f64| x.to_radians().tan()),
+        "SQRT" => Some(f64::sqrt),
+        "ABS" => Some(f64::abs),
+        "ATAN" => Some(|x: f64| x.atan().to_degrees()),
+        "ROUND" => Some(f64::round),
+        "TRUNC" | "FIX" => Some(f64::trunc),
+        _ => None,
+    }
+}
+
+/// Whether `name` (any case) is a function an expression may call (`SIN[30.]`).
+pub fn is_function(name: &str) -> bool {
+    function(&name.to_ascii_uppercase()).is_some()
 }
 
 /// A parameter number from an expression value: a whole number 1…99999.

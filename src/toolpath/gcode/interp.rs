@@ -453,6 +453,26 @@ impl<'a> Interpreter<'a> {
                         ),
                     ));
                 }
+                Item::Unknown { text, call: false }
+                    if self.spec.spaces == Spaces::Separate
+                        && text.len() > 1
+                        && text.chars().all(|c| c.is_ascii_alphabetic() || c == '_') =>
+                {
+                    // Sinumerik: a bare name is a command or a subprogram call, either of which
+                    // may change the motion (`TRAOOF` for TRAFOOF leaves TRAORI on).
+                    let like = nearest_keyword(self.spec, &text)
+                        .map(|k| format!(" (did the post mean `{k}`?)"))
+                        .unwrap_or_default();
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{text}`: not a {name} command feedopt knows{like}; a bare name \
+                             switches a function or calls a subprogram, which may change the \
+                             motion, so it is not skipped: correct it, remove it, or define \
+                             PROC {text} … RET in this file"
+                        ),
+                    ));
+                }
                 Item::Unknown { text, call: false } => {
                     self.warn(
                         line,
@@ -1083,7 +1103,7 @@ impl<'a> Interpreter<'a> {
             if modal_call {
                 // The call's errors and notes depend on its arguments only: said once, where
                 // the program calls it, not at every position after it.
-                let (steps, notes) = cycles::sinumerik_steps(number, &args)
+                let (steps, notes) = cycles::sinumerik_steps(number, &args, self.rpm)
                     .map_err(|e| self.error(line, format!("MCALL {text}: {e}")))?;
                 for n in notes {
                     self.warn(line, format!("MCALL {text}: {n}"));
@@ -1168,10 +1188,11 @@ impl<'a> Interpreter<'a> {
     }
 
     /// The modal feed at a move of line `line` (not under G93): G94's F, or under G95 F × S,
-    /// the spindle speed last programmed; `None` when no F is in force. Under G95 a move
+    /// the spindle speed last programmed; an error naming the line when no F is in force.
+    /// Under G95 a move
     /// with an F and no spindle speed (none programmed, S0, or G96's cutting speed) is an
     /// error naming the line.
-    fn modal_feed(&self, line: usize) -> Result<Option<ModalFeed>> {
+    fn modal_feed(&self, line: usize) -> Result<ModalFeed> {
         let Some(f) = self.feed else {
             // Every control refuses it (LinuxCNC: "Cannot do G1 with zero feed rate"; Fanuc:
             // alarm PS0011; Sinumerik: alarm 10860; grbl: error 22): it is not a rapid.
@@ -1182,7 +1203,7 @@ impl<'a> Interpreter<'a> {
             ));
         };
         if self.feed_mode != FeedMode::PerRevolution {
-            return Ok(Some(f));
+            return Ok(f);
         }
         let why = match self.rpm {
             _ if self.surface_speed => {
@@ -1194,10 +1215,10 @@ impl<'a> Interpreter<'a> {
                 "the spindle speed is S0: program S<rpm> before the move"
             }
             Some(rpm) => {
-                return Ok(Some(ModalFeed {
+                return Ok(ModalFeed {
                     mm_per_min: f.mm_per_min * rpm,
                     raw: f.raw * rpm,
-                }));
+                });
             }
         };
         Err(self.error(
@@ -2007,14 +2028,11 @@ impl<'a> Interpreter<'a> {
                 }
                 Step::Feed(z, f) => {
                     q[2] = z;
-                    let modal = match f {
-                        Some(_) => None,
-                        None => self.modal_feed(line)?.map(|f| f.mm_per_min),
+                    let mm_per_min = match f {
+                        Some(f) => f,
+                        None => self.modal_feed(line)?.mm_per_min,
                     };
-                    match f.or(modal) {
-                        Some(mm_per_min) => Feed::Programmed(mm_per_min / 60.0),
-                        None => Feed::Unspecified,
-                    }
+                    Feed::Programmed(mm_per_min / 60.0)
                 }
                 Step::ShiftX(dx) => {
                     q[0] += dx;
@@ -2098,10 +2116,20 @@ impl<'a> Interpreter<'a> {
     fn sinumerik_cycle_units(&self, number: u32, args: Vec<Option<f64>>) -> Vec<Option<f64>> {
         let length = self.units.mm_per_unit();
         let feed = self.feed_units.mm_per_unit();
+        let ptab = args.get(13).copied().flatten().map_or(0, |v| v as i64);
         args.into_iter()
             .enumerate()
             .map(|(k, a)| {
                 a.map(|v| {
+                    // CYCLE84's PIT in the unit _PTAB names (0: the program's).
+                    if number == 84 && k == 8 {
+                        return match ptab {
+                            1 => v,
+                            2 if v != 0.0 => MM_PER_INCH / v,
+                            3 => v * MM_PER_INCH,
+                            _ => v * length,
+                        };
+                    }
                     let is_length = k <= 4 || (number == 83 && (5..=7).contains(&k));
                     let is_feed = number == 85 && (6..=7).contains(&k);
                     if is_length {
@@ -2124,7 +2152,7 @@ impl<'a> Interpreter<'a> {
         args: &[Option<f64>],
     ) -> Result<()> {
         self.cycle_plane(line, text)?;
-        let (steps, notes) = cycles::sinumerik_steps(number, args)
+        let (steps, notes) = cycles::sinumerik_steps(number, args, self.rpm)
             .map_err(|e| self.error(line, format!("{text}: {e}")))?;
         for n in notes {
             self.warn(line, format!("{text}: {n}"));
@@ -2409,7 +2437,7 @@ impl<'a> Interpreter<'a> {
     }
 
     fn linear_feed(
-        &self,
+        &mut self,
         line: usize,
         motion: Motion,
         block: &Block,
@@ -2422,14 +2450,33 @@ impl<'a> Interpreter<'a> {
         if self.feed_mode == FeedMode::InverseTime {
             return Ok(Feed::BlockTime(self.inverse_time(line, block)?));
         }
-        let Some(feed) = self.modal_feed(line)? else {
-            return Ok(Feed::Unspecified);
-        };
+        let feed = self.modal_feed(line)?;
         let moves_xyz = (0..3).any(|i| (end[i] - start[i]).abs() > XYZ_MOVE_THRESHOLD_MM);
         let rotary = (3..6)
             .map(|i| (end[i] - start[i]).powi(2))
             .sum::<f64>()
             .sqrt();
+        if rotary > 0.0 && self.spec.rotary_feed == RotaryFeed::Combined && self.tcp == Tcp::Off {
+            // Fanuc: F over the combined distance, linear axes in F's unit (mm or inch),
+            // rotary axes in degrees: a degree counts as one unit of length.
+            let unit = self.feed_units.mm_per_unit();
+            let linear = (0..3)
+                .map(|i| ((end[i] - start[i]) / unit).powi(2))
+                .sum::<f64>();
+            let distance = (linear + rotary * rotary).sqrt();
+            if moves_xyz {
+                // The time differs from other controls' by the whole rotary share: said, so a
+                // user of a control that converts degrees otherwise (Haas) knows.
+                self.warn(
+                    line,
+                    "a block that turns a rotary axis while X, Y or Z move: F is taken over the \
+                     combined distance, a degree counting as one unit of length, as a Fanuc \
+                     control feeds it (a Haas control turns degrees into length through its \
+                     rotary diameter settings 34/79 instead, which feedopt does not read)",
+                );
+            }
+            return Ok(Feed::BlockTime(distance / (feed.raw / 60.0)));
+        }
         Ok(if !moves_xyz && rotary > 0.0 {
             Feed::BlockTime(rotary / (feed.raw / 60.0))
         } else {
@@ -2642,10 +2689,7 @@ impl<'a> Interpreter<'a> {
                 }
             }
             FeedMode::PerMinute | FeedMode::PerRevolution => {
-                let feed = match self.modal_feed(line)? {
-                    Some(f) => Feed::Programmed(f.mm_per_min / 60.0),
-                    None => Feed::Unspecified,
-                };
+                let feed = Feed::Programmed(self.modal_feed(line)?.mm_per_min / 60.0);
                 for q in &qs {
                     self.push(line, q, feed);
                 }
@@ -2654,6 +2698,31 @@ impl<'a> Interpreter<'a> {
         self.tangent = Some((arc_plane, tangent, self.points.len()));
         Ok(())
     }
+}
+
+/// The dialect's keyword closest to `word` (an edit or two away: a post's typo), if any.
+fn nearest_keyword(spec: &DialectSpec, word: &str) -> Option<&'static str> {
+    fn distance(a: &str, b: &str) -> usize {
+        let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+        let mut row: Vec<usize> = (0..=b.len()).collect();
+        for (i, ca) in a.iter().enumerate() {
+            let mut prev = row[0];
+            row[0] = i + 1;
+            for (j, cb) in b.iter().enumerate() {
+                let here = row[j + 1];
+                row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(here + 1);
+                prev = here;
+            }
+        }
+        row[b.len()]
+    }
+    let upper = word.to_ascii_uppercase();
+    spec.keywords
+        .iter()
+        .map(|&(k, _)| (distance(&upper, k), k))
+        .filter(|&(d, k)| d <= 2 && d < k.len() / 2)
+        .min()
+        .map(|(_, k)| k)
 }
 
 /// The warning for a program's contour tolerance (`G64 P0.02`, `CYCL DEF 32.1 T0.075`, of

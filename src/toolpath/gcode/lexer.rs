@@ -1,7 +1,7 @@
 //! Lexing: comments, blocks and words, resolved through a dialect table; variables and
 //! expressions ([`super::expr`]) are evaluated here, left to right, as the block is read.
 
-use super::dialect::{Action, Address, DialectSpec, Semicolon, Spaces};
+use super::dialect::{Action, Address, DialectSpec, Semicolon, Spaces, Subprograms};
 use super::expr::{self, Variables};
 
 /// Removes comments and splits a line into block texts (more than one only where `;` ends a
@@ -133,11 +133,23 @@ fn letter_address(spec: &DialectSpec, letter: char) -> Option<Address> {
 
 /// The end of a value starting at `i`: a sign, then a number, a `#` parameter or a `[ … ]`
 /// group, then (for parameters and groups) more operators and operands up to the next
-/// letter outside brackets.
-fn scan_value(chars: &[char], mut i: usize) -> usize {
+/// letter outside brackets. `assignment`: the right side of `#n=`, an expression from its
+/// start (Fanuc macro B: `#4=63./2.`, `#5=SIN[30.]*2.`), whose functions are read with it.
+fn scan_value(chars: &[char], mut i: usize, assignment: bool) -> usize {
     let mut depth = 0usize;
-    let mut expression = false;
+    let mut expression = assignment;
     while i < chars.len() {
+        if assignment && depth == 0 && chars[i].is_ascii_alphabetic() {
+            // A function name followed by `[`: part of the expression.
+            let end = (i..chars.len())
+                .find(|&k| !chars[k].is_ascii_alphabetic())
+                .unwrap_or(chars.len());
+            let name: String = chars[i..end].iter().collect();
+            if chars.get(end) == Some(&'[') && expr::is_function(&name) {
+                i = end;
+                continue;
+            }
+        }
         let c = chars[i];
         match c {
             '[' => {
@@ -145,6 +157,13 @@ fn scan_value(chars: &[char], mut i: usize) -> usize {
                 expression = true;
             }
             ']' => depth = depth.saturating_sub(1),
+            // `N10#1=…`: a `#` right after a number starts the next word (an assignment).
+            '#' if depth == 0
+                && i > 0
+                && (chars[i - 1].is_ascii_digit() || chars[i - 1] == '.') =>
+            {
+                break;
+            }
             '#' => expression = true,
             '<' if expression => {
                 // LinuxCNC #<name>
@@ -226,7 +245,7 @@ fn lex_letters(
                     "`{name}` without `=`: a parameter must be assigned"
                 ));
             }
-            let end = scan_value(&chars, name_end + 1);
+            let end = scan_value(&chars, name_end + 1, true);
             let text: String = chars[name_end + 1..end].iter().collect();
             let v = expr::eval(&text, vars).map_err(|e| format!("`{name}=`: {e}"))?;
             vars.set(&key, v);
@@ -242,8 +261,19 @@ fn lex_letters(
         }
         let letter = c.to_ascii_uppercase();
         let address = letter_address(spec, letter);
-        let end = scan_value(&chars, i + 1);
+        let end = scan_value(&chars, i + 1, false);
         let text_value: String = chars[i + 1..end].iter().collect();
+        if letter == 'O' && text_value.is_empty() {
+            return Err(match spec.subprograms {
+                Subprograms::OWordSub => "`O` without a number or name: an O-word is written \
+                                          `o100 …` or `o<name> …` (a post's placeholder such \
+                                          as `O ENTER …` needs the program number filled in)"
+                    .to_string(),
+                _ => "`O` without a program number: a program is headed `O1234` (a post's \
+                      placeholder such as `O ENTER …` needs the program number filled in)"
+                    .to_string(),
+            });
+        }
         if let Some(Address::Unsupported(message)) = address {
             return Err(format!("`{letter}{text_value}`: {message}"));
         }
@@ -328,8 +358,9 @@ pub(super) fn split_words(text: &str) -> Vec<String> {
 /// Words split at blanks that Siemens allows inside a statement, joined again: after an
 /// address letter (`X 100` is `X100`), around `=` (`R1 = 100`, `X= 10`) and between the terms
 /// of a value (`R1 = R2 + 3`: a word that starts with an operator, or follows one, continues
-/// the value before it). A lone letter followed by a number, an `=` word, and operators are
-/// never words of their own, so nothing that was read before reads differently.
+/// the value before it), and between a name and its argument list (`CYCLE81 (10,0,2,-5)`). A
+/// lone letter followed by a number, an `=` word, operators and a `( … )` are never words of
+/// their own, so nothing that was read before reads differently.
 fn join_blanks(words: Vec<String>) -> Vec<String> {
     let op = |c: char| matches!(c, '+' | '-' | '*' | '/');
     let mut out: Vec<String> = Vec::with_capacity(words.len());
@@ -354,6 +385,11 @@ fn join_blanks(words: Vec<String>) -> Vec<String> {
                         c.is_ascii_digit() || matches!(c, '.' | '-' | '+')
                     }) =>
             {
+                last.push_str(&w);
+                true
+            }
+            // `CYCLE81` `(10,0,2,-5)`: a name and its argument list (NX's Huron post).
+            Some(last) if w.starts_with('(') && is_identifier(last) => {
                 last.push_str(&w);
                 true
             }

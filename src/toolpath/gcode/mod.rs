@@ -67,10 +67,20 @@
 //!   mm/min (under G20, F × 25.4); a G1/G2/G3 block whose X, Y or Z moves by more than
 //!   [`XYZ_MOVE_THRESHOLD_MM`] gets [`Feed::Programmed`] (F/60 mm/s). When only rotary axes move,
 //!   LinuxCNC's length rule makes F degrees per minute over the A B C distance, so the block gets
-//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). A feed move
-//!   before any F, after `F0`, or after a mode change forgot F is an error naming its line:
-//!   every control stops there (LinuxCNC "Cannot do G1 with zero feed rate", Fanuc alarm
-//!   PS0011, Sinumerik alarm 10860); it is not a move at the machine's maximum feed. Under `G93` (inverse time) every G1/G2/G3
+//!   [`Feed::BlockTime`] = distance / (F/60) s (F as written, not inch-scaled). That is the
+//!   rule of LinuxCNC, Sinumerik (F applies to the geometry axes, the default FGROUP) and
+//!   Klartext ([`RotaryFeed::Xyz`]). A Fanuc control feeds a block that turns a rotary axis,
+//!   with or without linear axes, along the combined distance ([`RotaryFeed::Combined`]):
+//!   outside tool-tip mode such a block gets [`Feed::BlockTime`] = √(ΔX²+ΔY²+ΔZ²+ΔA²+ΔB²+ΔC²)
+//!   / (F/60) s, X Y Z in F's unit (mm, or inch under G20) and A B C in degrees, so
+//!   `G91 G1 X20 C40 F300` takes √(20²+40²)/300 min = 8.94 s (Fanuc operator's manual,
+//!   "Linear interpolation (G01)"); a pure rotary block is the same |ΔA B C|/F as above. A
+//!   Haas control, read in this dialect, instead turns degrees into a length through the
+//!   rotary axis' diameter (settings 34/79), which feedopt does not read. Arcs keep F along
+//!   the chords in every dialect. A feed move before any F, after `F0`, or after a mode change
+//!   forgot F is an error naming its line: every control stops there (LinuxCNC "Cannot do G1
+//!   with zero feed rate", Fanuc alarm PS0011, Sinumerik alarm 10860); it is not a move at the
+//!   machine's maximum feed. Under `G93` (inverse time) every G1/G2/G3
 //!   block must carry its own F (an error naming the line otherwise) and gets
 //!   [`Feed::BlockTime`] = 60/F s; on an arc that time is split over the chords in proportion to
 //!   their length. Leaving G93 forgets F (LinuxCNC: every `G94` sets F to 0), so a feed move must
@@ -137,6 +147,11 @@
 //!   program makes at most [`crate::toolpath::MAX_POINTS`] CL points: an arc, a cycle (with
 //!   its repeats) or a block that would take it past that is an error naming its line, before
 //!   its points are made, however the program got there (repeats, calls, jumps).
+//! * **Fanuc macro control flow**: `WHILE [#1 LT 3.] DO1` … `END1`, `IF [cond] GOTO n`,
+//!   `GOTO n`, `IF [cond] THEN #1=5.` with `EQ NE GT GE LT LE` and `AND OR XOR` (module
+//!   `macro_b`); every block a loop runs counts against the bound on blocks a program may run
+//!   ([`subprograms::MAX_EXPANDED_BLOCKS`]), and a jump back with no macro variable changed
+//!   since it was last taken is an error at once, so no program hangs.
 //! * **Subprograms in the file**: see [`subprograms`] (Fanuc/Haas `M98 P L` with `O<n> … M99`,
 //!   Sinumerik `PROC NAME … RET` and `L123`, LinuxCNC `o100 sub` / `o100 call`): expanded
 //!   where called, nesting and expansion bounded; a call of one not in the file is an error.
@@ -161,8 +176,12 @@
 //! # What is rejected
 //!
 //! * A G code the dialect does not know is an **error** naming it (a G code may move the tool).
-//!   Any other unknown word (letter, M code, named word or keyword) is skipped with a
-//!   [`Warning`] naming the word and its line, never silently.
+//!   So is a Sinumerik name the table does not know, written alone (`TRAOOF`: letters only, no
+//!   value, no `=`): on an 840D a bare name is a command or a subprogram call, either of which
+//!   may change the motion (a post's typo `TRAOOF` for `TRAFOOF` left TRAORI on); the message
+//!   names the keyword one or two letters away, if there is one. Any other unknown word
+//!   (letter, M code, named word) is skipped with a [`Warning`] naming the word and its line,
+//!   never silently.
 //! * Errors ([`crate::error::Error::Parse`] naming the file and line): a malformed number (`X1.2.3`, `Y-`,
 //!   `F`), an unclosed `(` comment, a parameter read before it is set, Sinumerik `IC(..)`,
 //!   LinuxCNC O-word control flow (`if`, `while`, …), the same word twice in a block, two motion codes in one
@@ -179,6 +198,7 @@ pub mod frames;
 mod interp;
 pub mod klartext;
 mod lexer;
+mod macro_b;
 pub mod offsets;
 pub mod subprograms;
 

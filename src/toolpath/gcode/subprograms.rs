@@ -61,6 +61,7 @@ use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
 use super::lexer::{lex, split_blocks};
+use super::macro_b::{self, Statement};
 use crate::error::{Error, Result};
 
 /// Deepest nesting of subprogram calls (the main program is depth 0).
@@ -135,6 +136,92 @@ impl Loop {
                 .map(|f| (f.section, f.pos, f.block, f.start, f.runs))
                 .collect(),
         }
+    }
+}
+
+/// Where Fanuc macro loops end and start and where numbered blocks are, per section, found
+/// once by a scan of the section's blocks.
+#[derive(Default)]
+struct MacroPlaces {
+    /// (section, line, block) of a `DO m` → (line, block) of its `END m`, and back.
+    ends: HashMap<(usize, usize, usize), Option<(usize, usize)>>,
+    starts: HashMap<(usize, usize, usize), Option<(usize, usize)>>,
+    /// (section, n) → the first block numbered `N n`.
+    numbers: HashMap<(usize, u64), Option<(usize, usize)>>,
+}
+
+impl MacroPlaces {
+    /// The section's blocks from (line, block) on, forwards or backwards, with their places.
+    fn blocks<'a>(
+        program: &'a Program,
+        section: usize,
+    ) -> impl DoubleEndedIterator<Item = ((usize, usize), &'a str)> + 'a {
+        program.sections[section]
+            .lines
+            .iter()
+            .enumerate()
+            .flat_map(move |(pos, &index)| {
+                let blocks: &[String] = match &program.lines[index].blocks {
+                    Ok(b) => b,
+                    Err(_) => &[],
+                };
+                blocks
+                    .iter()
+                    .enumerate()
+                    .map(move |(b, text)| ((pos, b), text.as_str()))
+            })
+    }
+
+    /// The `END id` that closes the loop opened at (pos, block): the first after it.
+    fn loop_end(
+        &mut self,
+        program: &Program,
+        section: usize,
+        pos: usize,
+        block: usize,
+        id: u32,
+    ) -> Option<(usize, usize)> {
+        *self.ends.entry((section, pos, block)).or_insert_with(|| {
+            Self::blocks(program, section)
+                .filter(|(at, _)| *at > (pos, block))
+                .find(|(_, text)| {
+                    matches!(macro_b::statement(text), Some(Ok(Statement::End { id: e })) if e == id)
+                })
+                .map(|(at, _)| at)
+        })
+    }
+
+    /// The `WHILE … DO id` or `DO id` that the `END id` at (pos, block) closes: the last
+    /// before it.
+    fn loop_start(
+        &mut self,
+        program: &Program,
+        section: usize,
+        pos: usize,
+        block: usize,
+        id: u32,
+    ) -> Option<(usize, usize)> {
+        *self.starts.entry((section, pos, block)).or_insert_with(|| {
+            Self::blocks(program, section)
+                .rev()
+                .filter(|(at, _)| *at < (pos, block))
+                .find(|(_, text)| {
+                    matches!(
+                        macro_b::statement(text),
+                        Some(Ok(Statement::While { id: d, .. } | Statement::Do { id: d })) if d == id
+                    )
+                })
+                .map(|(at, _)| at)
+        })
+    }
+
+    /// The first block numbered `N n` in the section.
+    fn numbered(&mut self, program: &Program, section: usize, n: u64) -> Option<(usize, usize)> {
+        *self.numbers.entry((section, n)).or_insert_with(|| {
+            Self::blocks(program, section)
+                .find(|(_, text)| macro_b::sequence_number(text) == Some(n))
+                .map(|(at, _)| at)
+        })
     }
 }
 
@@ -552,6 +639,10 @@ impl Program {
         let mut jumps = 0usize;
         // Klartext jumps taken: the line's index → the state then (see `Loop`).
         let mut taken: HashMap<usize, Loop> = HashMap::new();
+        // Fanuc macro jumps taken: (line index, block) → the state then; and where each
+        // loop's other end and each block number is, found once.
+        let mut macro_taken: HashMap<(usize, usize), Loop> = HashMap::new();
+        let mut macro_places = MacroPlaces::default();
         while let Some(&Frame {
             section,
             pos,
@@ -724,6 +815,98 @@ impl Program {
                 }
                 continue;
             }
+            let mut then_text = String::new();
+            let text = match self.style {
+                Subprograms::OPrograms => match macro_b::statement(text) {
+                    None => text,
+                    Some(statement) => {
+                        let located =
+                            |m: String| self.located(Error::parse(source, number, m), &stack);
+                        let statement = statement.map_err(located)?;
+                        let holds = |condition: &str| {
+                            macro_b::condition(condition, &interp.vars).map_err(located)
+                        };
+                        // Where the program goes on: (line in the section, block).
+                        let jump = match &statement {
+                            Statement::While { condition, id } => {
+                                if holds(condition)? {
+                                    None
+                                } else {
+                                    let end = macro_places
+                                        .loop_end(self, section, pos, block, *id)
+                                        .ok_or_else(|| {
+                                            located(format!(
+                                                "WHILE … DO{id} has no END{id} after it in                                                  this program"
+                                            ))
+                                        })?;
+                                    // After the END: its next block.
+                                    Some((end.0, end.1 + 1, false))
+                                }
+                            }
+                            Statement::Do { .. } => None,
+                            Statement::End { id } => {
+                                let start = macro_places
+                                    .loop_start(self, section, pos, block, *id)
+                                    .ok_or_else(|| {
+                                        located(format!(
+                                            "END{id} has no DO{id} before it in this program"
+                                        ))
+                                    })?;
+                                Some((start.0, start.1, true))
+                            }
+                            Statement::IfGoto { condition, target } if holds(condition)? => {
+                                let n = macro_b::target(target, &interp.vars).map_err(located)?;
+                                let at =
+                                    macro_places.numbered(self, section, n).ok_or_else(|| {
+                                        located(format!("GOTO {n}: no block N{n} in this program"))
+                                    })?;
+                                Some((at.0, at.1, true))
+                            }
+                            Statement::IfGoto { .. } => None,
+                            Statement::Goto { target } => {
+                                let n = macro_b::target(target, &interp.vars).map_err(located)?;
+                                let at =
+                                    macro_places.numbered(self, section, n).ok_or_else(|| {
+                                        located(format!("GOTO {n}: no block N{n} in this program"))
+                                    })?;
+                                Some((at.0, at.1, true))
+                            }
+                            Statement::IfThen { condition, then } => {
+                                if !holds(condition)? {
+                                    continue;
+                                }
+                                then_text = then.clone();
+                                None
+                            }
+                        };
+                        if let Statement::IfThen { .. } = statement {
+                            then_text.as_str()
+                        } else {
+                            if let Some((to_pos, to_block, back)) = jump {
+                                if back {
+                                    // The same jump in the same state: the same pass for ever.
+                                    let now = Loop::now(&stack, interp.vars.changes());
+                                    if macro_taken.get(&(index, block)) == Some(&now) {
+                                        return Err(located(format!(
+                                            "`{}` jumps to line {} for ever: no macro                                              variable has changed since it last jumped, so                                              every pass runs the same way; make the loop                                              change what its condition reads (a counter)",
+                                            text,
+                                            self.lines[self.sections[section].lines[to_pos]].number
+                                        )));
+                                    }
+                                    macro_taken.insert((index, block), now);
+                                }
+                                jumps += 1;
+                                if let Some(top) = stack.last_mut() {
+                                    top.pos = to_pos;
+                                    top.block = to_block;
+                                }
+                            }
+                            continue;
+                        }
+                    }
+                },
+                _ => text,
+            };
             if self.style == Subprograms::Procs
                 && (matches!(first_word(text).as_str(), "PROC" | "EXTERN")
                     || sinumerik_header(text).is_some())
