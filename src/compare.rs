@@ -507,7 +507,7 @@ fn dynamics(ctx: &Context, c: &Candidate) -> Result<Dynamics> {
         let jets_at = |u: f64| kin.axis_jets(&span.eval(u));
         // A corner passed at speed: the velocity jump as one period's acceleration.
         if let Some(before) = qd_end {
-            let start = &p.jets[0];
+            let start = p.jets.view(0);
             let r = b[0].max(0.0).sqrt();
             let mut pulse = [0.0; MAX_AXES];
             let mut jump = false;
@@ -551,7 +551,7 @@ fn dynamics(ctx: &Context, c: &Candidate) -> Result<Dynamics> {
         let r = b[n].max(0.0).sqrt();
         let mut end = [0.0; MAX_AXES];
         for j in 0..na {
-            end[j] = p.jets[n].dq[j] * r;
+            end[j] = p.jets.dq(n)[j] * r;
         }
         qd_end = Some(end);
         t0 = ta;

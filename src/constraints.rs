@@ -86,6 +86,134 @@ impl Chord {
     }
 }
 
+/// Axis positions q and their u-derivatives q', q'' at every station of a span, for the
+/// machine's axes only: station after station, `n_axes` values each (an [`AxisJets`] holds
+/// [`crate::base::MAX_AXES`] of each, 192 bytes; a 3-axis machine's stations need 72).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StationJets {
+    n_axes: usize,
+    q: Vec<f64>,
+    dq: Vec<f64>,
+    ddq: Vec<f64>,
+}
+
+impl StationJets {
+    /// No stations yet, room for `n`, `n_axes` axes each.
+    pub fn with_capacity(n_axes: usize, n: usize) -> Self {
+        StationJets {
+            n_axes,
+            q: Vec::with_capacity(n_axes * n),
+            dq: Vec::with_capacity(n_axes * n),
+            ddq: Vec::with_capacity(n_axes * n),
+        }
+    }
+
+    /// `jets` at every station, `n_axes` axes each.
+    pub fn from_jets(n_axes: usize, jets: &[AxisJets]) -> Self {
+        let mut s = Self::with_capacity(n_axes, jets.len());
+        for j in jets {
+            s.push(j);
+        }
+        s
+    }
+
+    /// Number of stations.
+    pub fn len(&self) -> usize {
+        self.q.len().checked_div(self.n_axes).unwrap_or(0)
+    }
+
+    /// No station.
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+
+    /// Appends a station's jets (its first `n_axes` axes).
+    pub fn push(&mut self, j: &AxisJets) {
+        let n = self.n_axes;
+        self.q.extend_from_slice(&j.q[..n]);
+        self.dq.extend_from_slice(&j.dq[..n]);
+        self.ddq.extend_from_slice(&j.ddq[..n]);
+    }
+
+    /// Appends station `i` of `from`.
+    pub fn copy_from(&mut self, from: &StationJets, i: usize) {
+        let r = from.at(i);
+        self.q.extend_from_slice(&from.q[r.clone()]);
+        self.dq.extend_from_slice(&from.dq[r.clone()]);
+        self.ddq.extend_from_slice(&from.ddq[r]);
+    }
+
+    /// Stations `a..=b`.
+    pub fn range(&self, a: usize, b: usize) -> StationJets {
+        let r = self.at(a).start..self.at(b).end;
+        StationJets {
+            n_axes: self.n_axes,
+            q: self.q[r.clone()].to_vec(),
+            dq: self.dq[r.clone()].to_vec(),
+            ddq: self.ddq[r].to_vec(),
+        }
+    }
+
+    fn at(&self, i: usize) -> std::ops::Range<usize> {
+        i * self.n_axes..(i + 1) * self.n_axes
+    }
+
+    /// q at station `i`, per axis.
+    pub fn q(&self, i: usize) -> &[f64] {
+        &self.q[self.at(i)]
+    }
+
+    /// q' at station `i`, per axis.
+    pub fn dq(&self, i: usize) -> &[f64] {
+        &self.dq[self.at(i)]
+    }
+
+    /// q'' at station `i`, per axis.
+    pub fn ddq(&self, i: usize) -> &[f64] {
+        &self.ddq[self.at(i)]
+    }
+
+    /// Station `i`'s q, q', q'' (the machine's axes), borrowed.
+    pub fn view(&self, i: usize) -> JetRef<'_> {
+        JetRef {
+            q: self.q(i),
+            dq: self.dq(i),
+            ddq: self.ddq(i),
+        }
+    }
+
+    /// Station `i` as an [`AxisJets`] (zero past `n_axes`).
+    pub fn get(&self, i: usize) -> AxisJets {
+        let mut j = AxisJets::default();
+        let n = self.n_axes;
+        j.q[..n].copy_from_slice(self.q(i));
+        j.dq[..n].copy_from_slice(self.dq(i));
+        j.ddq[..n].copy_from_slice(self.ddq(i));
+        j
+    }
+}
+
+/// One station's q, q', q'' per axis, borrowed from a [`StationJets`] or an [`AxisJets`].
+#[derive(Debug, Clone, Copy)]
+pub struct JetRef<'a> {
+    /// Axis positions, mm or degrees.
+    pub q: &'a [f64],
+    /// dq/du.
+    pub dq: &'a [f64],
+    /// d²q/du².
+    pub ddq: &'a [f64],
+}
+
+impl<'a> From<&'a AxisJets> for JetRef<'a> {
+    fn from(j: &'a AxisJets) -> Self {
+        JetRef {
+            q: &j.q,
+            dq: &j.dq,
+            ddq: &j.ddq,
+        }
+    }
+}
+
 /// The discretised problem of one span, ready for a solver.
 #[derive(Debug, Clone)]
 pub struct SpanProblem {
@@ -97,8 +225,9 @@ pub struct SpanProblem {
     pub b_max_by: Vec<Bound>,
     /// |P'(u)| at each station (0 on a reorientation span).
     pub tip_speed: Vec<f64>,
-    /// Axis positions and u-derivatives at each station.
-    pub jets: Vec<AxisJets>,
+    /// Axis positions and u-derivatives at each station ([`StationJets`]: the machine's axes
+    /// only).
+    pub jets: StationJets,
     /// Acceleration limit of each axis.
     pub acceleration: Vec<Limit>,
     /// Acceleration rows that shape the feasible set at each station (bit 2j: axis j's
@@ -125,7 +254,7 @@ impl SpanProblem {
             b_max: Vec::with_capacity(u.len()),
             b_max_by: Vec::with_capacity(u.len()),
             tip_speed: Vec::with_capacity(u.len()),
-            jets: Vec::with_capacity(u.len()),
+            jets: StationJets::with_capacity(acceleration.len(), u.len()),
             acceleration,
             essential: Vec::with_capacity(u.len()),
             b_start: 0.0,
@@ -155,7 +284,7 @@ impl SpanProblem {
         self.b_max.push(pb.b_max);
         self.b_max_by.push(pb.by);
         self.tip_speed.push(pb.tip_speed);
-        self.jets.push(jet);
+        self.jets.push(&jet);
         self.essential.push(pb.essential);
     }
 
@@ -206,7 +335,7 @@ impl SpanProblem {
             b_max: Vec::with_capacity(n),
             b_max_by: Vec::with_capacity(n),
             tip_speed: Vec::with_capacity(n),
-            jets: Vec::with_capacity(n),
+            jets: StationJets::with_capacity(self.n_axes(), n),
             acceleration: self.acceleration.clone(),
             essential: Vec::with_capacity(n),
             b_start: self.b_start,
@@ -219,7 +348,7 @@ impl SpanProblem {
         self.b_max.push(from.b_max[i]);
         self.b_max_by.push(from.b_max_by[i]);
         self.tip_speed.push(from.tip_speed[i]);
-        self.jets.push(from.jets[i]);
+        self.jets.copy_from(&from.jets, i);
         self.essential.push(from.essential[i]);
     }
 
@@ -246,7 +375,7 @@ impl SpanProblem {
             b_max: self.b_max[a..=b].to_vec(),
             b_max_by: self.b_max_by[a..=b].to_vec(),
             tip_speed: self.tip_speed[a..=b].to_vec(),
-            jets: self.jets[a..=b].to_vec(),
+            jets: self.jets.range(a, b),
             acceleration: self.acceleration.clone(),
             essential: self.essential[a..=b].to_vec(),
             b_start,
@@ -273,9 +402,9 @@ impl SpanProblem {
     /// (`q'' b + q' ü` within its limits, solved for ü).
     pub fn udd_range(&self, i: usize, b: f64) -> (f64, f64) {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        let jet = &self.jets[i];
+        let (dq, ddq) = (self.jets.dq(i), self.jets.ddq(i));
         for (j, lim) in self.acceleration.iter().enumerate() {
-            let (d, dd) = (jet.dq[j], jet.ddq[j]);
+            let (d, dd) = (dq[j], ddq[j]);
             if d != 0.0 {
                 let (x, y) = ((lim.max - dd * b) / d, (lim.min - dd * b) / d);
                 lo = lo.max(x.min(y));
@@ -293,7 +422,7 @@ impl SpanProblem {
     /// Acceleration q̈ = q'' b + q' ü of axis `j` at station `i`, with interval `k`'s ü
     /// (`k` is `i − 1` or `i`).
     pub fn axis_acceleration(&self, b: &[f64], k: usize, i: usize, j: usize) -> f64 {
-        self.jets[i].ddq[j] * b[i] + self.jets[i].dq[j] * self.path_acceleration(b, k)
+        self.jets.ddq(i)[j] * b[i] + self.jets.dq(i)[j] * self.path_acceleration(b, k)
     }
 }
 

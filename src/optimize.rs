@@ -712,7 +712,7 @@ impl Plan<'_> {
             };
             let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
             if let Some(i) =
-                (0..p.u.len()).find(|&i| !(lo - tol..=hi + tol).contains(&p.jets[i].q[j]))
+                (0..p.u.len()).find(|&i| !(lo - tol..=hi + tol).contains(&p.jets.q(i)[j]))
             {
                 return Err(Error::Infeasible(format!(
                     "span {si}, u = {:.6}, nearest CL line {}: axis {} would be at {:.4}, outside \
@@ -720,7 +720,7 @@ impl Plan<'_> {
                     p.u[i],
                     self.path.spans[si].nearest_line(p.u[i]),
                     axis.name,
-                    p.jets[i].q[j]
+                    p.jets.q(i)[j]
                 )));
             }
         }

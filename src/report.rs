@@ -58,7 +58,7 @@ pub fn interval_binding(
 /// Axis `j`'s q̈ at station `e` (an end of interval k) under the profile's law.
 fn axis_acceleration(p: &SpanProblem, sol: &SpanSolution, k: usize, e: usize, j: usize) -> f64 {
     match &sol.a {
-        Some(a) => p.jets[e].ddq[j] * sol.b[e] + p.jets[e].dq[j] * a[e],
+        Some(a) => p.jets.ddq(e)[j] * sol.b[e] + p.jets.dq(e)[j] * a[e],
         None => p.axis_acceleration(&sol.b, k, e, j),
     }
 }
@@ -93,7 +93,7 @@ pub fn jerk_ratios(
             }
             let w = span.spline.eval_in(seg, u);
             let d3 = kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, u));
-            let jets = &p.jets[e];
+            let jets = p.jets.view(e);
             for (j, axis) in machine.axes.iter().enumerate().take(kin.n_axes()) {
                 let Some(lim) = axis.jerk else { continue };
                 let q3 = st.jerk(jets.dq[j], jets.ddq[j], d3[j]);
@@ -260,7 +260,7 @@ impl Summary {
             let jerk = jerk_ratios(machine, span, &sol.kinematics, p, s);
             for i in 0..p.u.len() {
                 for (j, axis) in machine.axes.iter().enumerate() {
-                    let qd = p.jets[i].dq[j] * b[i].sqrt();
+                    let qd = p.jets.dq(i)[j] * b[i].sqrt();
                     vel[j] = vel[j].max(axis.velocity.ratio(qd));
                 }
             }

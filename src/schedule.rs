@@ -12,11 +12,11 @@
 use crate::constraints::SpanProblem;
 use crate::error::{Error, Result};
 use crate::geometry::Span;
-use crate::kinematics::MAX_AXES;
 use crate::motion::Interval;
 use crate::solver::{SpanSolution, interval_times};
 
-/// One station of the schedule.
+/// One station of the schedule (its axes' motion: [`Schedule::q`], [`Schedule::qd`],
+/// [`Schedule::qdd`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Station {
     /// Index of the span (rest-to-rest piece) the station belongs to.
@@ -33,23 +33,25 @@ pub struct Station {
     /// Tangential acceleration A = dV/dt, mm/s² (of the interval that starts here; joint-space
     /// path: d²s/dt²).
     pub a: f64,
-    /// Axis positions (mm or degrees).
-    pub q: [f64; MAX_AXES],
-    /// Axis velocities q̇ = q' u̇.
-    pub qd: [f64; MAX_AXES],
-    /// Axis accelerations q̈ = q'' b + q' ü (of the interval that starts here).
-    pub qdd: [f64; MAX_AXES],
 }
 
 /// The time-optimal motion along the whole path.
+///
+/// The axes' positions, velocities and accelerations are kept per station for the machine's
+/// axes only (a station of a 3-axis machine takes 48 + 72 bytes, where arrays of every
+/// possible axis took 240).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Schedule {
-    /// Names of the axes, in the order of `Station::q`.
+    /// Names of the axes, in the order of [`Schedule::q`].
     pub axes: Vec<String>,
     /// Every station of every span, in path order.
     pub stations: Vec<Station>,
     /// Total time, s.
     pub cycle_time: f64,
+    /// Per station, per axis: q, q̇ = q' u̇ and q̈ = q'' b + q' ü.
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
 }
 
 /// ü at station `i` (on the interval that starts there; the last station: the one ending
@@ -70,7 +72,13 @@ impl Schedule {
         solutions: &[SpanSolution],
     ) -> Result<Schedule> {
         let na = axes.len();
-        let mut stations = Vec::with_capacity(problems.iter().map(|p| p.u.len()).sum());
+        let total: usize = problems.iter().map(|p| p.u.len()).sum();
+        let mut stations = Vec::with_capacity(total);
+        let (mut q, mut qd, mut qdd) = (
+            Vec::with_capacity(na * total),
+            Vec::with_capacity(na * total),
+            Vec::with_capacity(na * total),
+        );
         let (mut t0, mut s0) = (0.0, 0.0);
         for (si, ((span, p), sol)) in spans.iter().zip(problems).zip(solutions).enumerate() {
             let b = &sol.b;
@@ -80,7 +88,7 @@ impl Schedule {
             for i in 0..=n {
                 let udd = station_udd(p, sol, i);
                 let ud = b[i].sqrt();
-                let jet = &p.jets[i];
+                let jet = p.jets.view(i);
                 let w = span.eval(p.u[i]);
                 let speed = p.tip_speed[i];
                 let along = if speed > 0.0 {
@@ -89,7 +97,7 @@ impl Schedule {
                     0.0
                 };
                 let joint = span.kind == crate::geometry::SpanKind::Joint;
-                let mut st = Station {
+                let st = Station {
                     span: si,
                     u: p.u[i],
                     s,
@@ -100,14 +108,11 @@ impl Schedule {
                     } else {
                         along * b[i] + speed * udd
                     },
-                    q: [0.0; MAX_AXES],
-                    qd: [0.0; MAX_AXES],
-                    qdd: [0.0; MAX_AXES],
                 };
                 for j in 0..na {
-                    st.q[j] = jet.q[j];
-                    st.qd[j] = jet.dq[j] * ud;
-                    st.qdd[j] = jet.ddq[j] * b[i] + jet.dq[j] * udd;
+                    q.push(jet.q[j]);
+                    qd.push(jet.dq[j] * ud);
+                    qdd.push(jet.ddq[j] * b[i] + jet.dq[j] * udd);
                 }
                 stations.push(st);
                 if i < n {
@@ -130,7 +135,30 @@ impl Schedule {
             axes: axes.to_vec(),
             stations,
             cycle_time: t0,
+            q,
+            qd,
+            qdd,
         })
+    }
+
+    fn at(&self, i: usize) -> std::ops::Range<usize> {
+        let na = self.axes.len();
+        i * na..(i + 1) * na
+    }
+
+    /// Axis positions at station `i` (mm or degrees), in the order of [`Schedule::axes`].
+    pub fn q(&self, i: usize) -> &[f64] {
+        &self.q[self.at(i)]
+    }
+
+    /// Axis velocities q̇ = q' u̇ at station `i`.
+    pub fn qd(&self, i: usize) -> &[f64] {
+        &self.qd[self.at(i)]
+    }
+
+    /// Axis accelerations q̈ = q'' b + q' ü at station `i` (of the interval that starts there).
+    pub fn qdd(&self, i: usize) -> &[f64] {
+        &self.qdd[self.at(i)]
     }
 }
 

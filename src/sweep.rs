@@ -388,7 +388,7 @@ fn db_star_dmu(p: &SpanProblem, i: usize, j: usize) -> f64 {
             min: lim[j].min * mu,
             max: lim[j].max * mu,
         };
-        essential_rows(&p.jets[i], &lim, cap).1
+        essential_rows(&p.jets.get(i), &lim, cap).1
     };
     (at(1.0 + EPS) - at(1.0 - EPS)) / (2.0 * EPS)
 }
@@ -763,7 +763,7 @@ mod tests {
             b_max: vec![b_star; 2],
             b_max_by: vec![Bound::AxisAcceleration(0); 2],
             tip_speed: vec![0.0; 2],
-            jets: vec![jet; 2],
+            jets: crate::constraints::StationJets::from_jets(2, &[jet; 2]),
             acceleration,
             essential: vec![u16::MAX; 2],
             b_start: 0.0,

@@ -76,20 +76,17 @@ fn a_groove_is_fitted_by_biarcs_and_b_follows_the_profile_normal() {
     // B (degrees) equals the normal angle of the true groove along the way: 0 on the first
     // line, 45 in the arc's middle, 90 on the last line.
     let b_at = |x: f64, z: f64| {
-        let st = fitted
-            .schedule
-            .stations
-            .iter()
-            .min_by(|a, b| {
-                let d = |s: &&feedopt::schedule::Station| {
-                    // X and Z are the B axis's position; the tip is 10 mm back along the normal.
-                    let th = s.q[2].to_radians();
-                    (s.q[0] - 10.0 * th.sin() - x).hypot(s.q[1] - 10.0 * th.cos() - z)
-                };
-                d(a).total_cmp(&d(b))
-            })
+        let sch = &fitted.schedule;
+        let d = |k: usize| {
+            // X and Z are the B axis's position; the tip is 10 mm back along the normal.
+            let q = sch.q(k);
+            let th = q[2].to_radians();
+            (q[0] - 10.0 * th.sin() - x).hypot(q[1] - 10.0 * th.cos() - z)
+        };
+        let k = (0..sch.stations.len())
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)))
             .unwrap();
-        st.q[2]
+        sch.q(k)[2]
     };
     assert!(b_at(-5.0, 0.0).abs() < 0.1);
     let s45 = 45f64.to_radians();

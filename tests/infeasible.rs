@@ -307,7 +307,7 @@ fn a_joint_path_end_speed_beyond_the_axis_acceleration_names_the_axis() {
     // Control: 1.9 is reachable; the path ends with ṡ = 1.9, so q̇_a = dq_a/ds · ṡ = 1.9.
     for kind in BOTH {
         let ok = optimize_joint(&m, &path, &options(0.0, 1.9, kind)).expect("feasible");
-        let qd = ok.schedule.stations.last().unwrap().qd[0];
+        let qd = ok.schedule.qd(ok.schedule.stations.len() - 1)[0];
         assert!((qd - 1.9).abs() < 1e-6, "{kind:?}: end q̇_a {qd}");
     }
     for kind in BOTH {

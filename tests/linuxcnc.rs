@@ -28,10 +28,10 @@ fn the_linuxcnc_programs_parse_map_within_travel_and_solve() {
         let sol = optimize(&m, &t, &options).unwrap();
         assert!(sol.verification.verified, "{name}");
         // Every axis position at every station is within the machine's travel.
-        for st in &sol.schedule.stations {
+        for k in 0..sol.schedule.stations.len() {
             for (j, axis) in m.axes.iter().enumerate() {
                 if let Some((lo, hi)) = axis.travel {
-                    let q = st.q[j];
+                    let q = sol.schedule.q(k)[j];
                     assert!(
                         q >= lo - 1e-6 && q <= hi + 1e-6,
                         "{name}: {} = {q}",

@@ -298,11 +298,10 @@ fn slot_feed(process: ProcessLimits) -> (f64, Bound, f64) {
     let sol = optimize(&machine(XYZ), &tp, &options).unwrap();
     assert!(sol.verification.verified);
     // The slot is span 1 (the plunge span 0); its middle, x = 50.
-    let st = sol
-        .schedule
-        .stations
-        .iter()
-        .find(|s| s.span == 1 && (s.q[0] - 50.0).abs() < 0.5)
+    let sch = &sol.schedule;
+    let st = (0..sch.stations.len())
+        .find(|&k| sch.stations[k].span == 1 && (sch.q(k)[0] - 50.0).abs() < 0.5)
+        .map(|k| &sch.stations[k])
         .unwrap();
     let p = &sol.problems[1];
     let i = p.u.iter().position(|&u| (u - st.u).abs() < 1e-12).unwrap();
@@ -481,11 +480,10 @@ fn a_repeated_pass_runs_at_the_air_feed() {
     let sol = optimize(&machine(XYZ), &tp, &options).unwrap();
     assert!(sol.verification.verified);
     let at = |span: usize| {
-        let st = sol
-            .schedule
-            .stations
-            .iter()
-            .find(|s| s.span == span && (s.q[0] - 50.0).abs() < 0.5)
+        let sch = &sol.schedule;
+        let st = (0..sch.stations.len())
+            .find(|&k| sch.stations[k].span == span && (sch.q(k)[0] - 50.0).abs() < 0.5)
+            .map(|k| &sch.stations[k])
             .unwrap();
         let p = &sol.problems[span];
         let i = p.u.iter().position(|&u| u == st.u).unwrap();

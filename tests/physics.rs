@@ -304,8 +304,8 @@ fn a_blended_corner_runs_through_at_its_curvatures_speed() {
     let fit = 1e-3;
     let corner = Vector3::new(100.0, 0.0, 0.0);
     let (mut closest, mut vmin) = (f64::INFINITY, f64::INFINITY);
-    for st in &sol.schedule.stations {
-        let (x, y) = (st.q[0], st.q[1]);
+    for (k, st) in sol.schedule.stations.iter().enumerate() {
+        let (x, y) = (sol.schedule.q(k)[0], sol.schedule.q(k)[1]);
         // Distance to the programmed polyline (two axis-aligned lines).
         let off = if x <= 100.0 - y {
             y.abs()

@@ -73,8 +73,9 @@ fn a_near_vertical_pass_slows_as_the_rotary_limits_require_and_nothing_is_nan() 
         let close = optimize(&m, &near_vertical_pass(0.5), &Options::default()).unwrap();
         for sol in [&wide, &close] {
             assert!(sol.verification.verified, "{name}");
-            for st in &sol.schedule.stations {
-                let all = st.q.iter().chain(&st.qd).chain(&st.qdd);
+            for (k, st) in sol.schedule.stations.iter().enumerate() {
+                let sch = &sol.schedule;
+                let all = sch.q(k).iter().chain(sch.qd(k)).chain(sch.qdd(k));
                 assert!(
                     all.copied().chain([st.t, st.v, st.a]).all(f64::is_finite),
                     "{name}"
@@ -84,7 +85,7 @@ fn a_near_vertical_pass_slows_as_the_rotary_limits_require_and_nothing_is_nan() 
         // C swings through ~180° either way, faster the closer the pass: the closer pass is
         // held down by C and takes longer.
         let c_range = |s: &feedopt::optimize::Solution| {
-            let c = s.schedule.stations.iter().map(|st| st.q[c_axis]);
+            let c = (0..s.schedule.stations.len()).map(|k| s.schedule.q(k)[c_axis]);
             c.clone().fold(f64::MIN, f64::max) - c.fold(f64::MAX, f64::min)
         };
         assert!(
@@ -205,7 +206,7 @@ fn an_a_b_program_solves_on_an_a_b_trunnion() {
     // doc's inverse (r = 0, D = (0, 20, 10), L = 0, σ = +1) at P = (30, 10, 5):
     // R_z(90°)P − D = (−10, 10, −5); R_x(30°) of it = (−10, 10 cos30° + 5 sin30°,
     // 10 sin30° − 5 cos30°); + D.
-    let last = sol.schedule.stations.last().unwrap();
+    let last_q = sol.schedule.q(sol.schedule.stations.len() - 1);
     let (s30, c30) = 30f64.to_radians().sin_cos();
     let want = [
         -10.0,
@@ -216,9 +217,9 @@ fn an_a_b_program_solves_on_an_a_b_trunnion() {
     ];
     for (i, w) in want.iter().enumerate() {
         assert!(
-            (last.q[i] - w).abs() < 1e-6,
+            (last_q[i] - w).abs() < 1e-6,
             "axis {i}: {} vs {w}",
-            last.q[i]
+            last_q[i]
         );
     }
     // B turned through 90° at most 90 °/s: at least a second.

@@ -305,12 +305,13 @@ fn check_schedule(case: &Case, sol: &Solution, what: &str) -> Result<(), String>
     let tol = 1e-6;
     let st = &sol.schedule.stations;
     let mut t_prev = -1.0;
+    let sch = &sol.schedule;
     for (i, s) in st.iter().enumerate() {
         let finite = [s.t, s.v, s.a, s.u, s.s]
             .into_iter()
-            .chain(s.q[..na].iter().copied())
-            .chain(s.qd[..na].iter().copied())
-            .chain(s.qdd[..na].iter().copied())
+            .chain(sch.q(i)[..na].iter().copied())
+            .chain(sch.qd(i)[..na].iter().copied())
+            .chain(sch.qdd(i)[..na].iter().copied())
             .all(f64::is_finite);
         if !finite {
             return Err(format!("{what}: station {i} not finite: {s:?}"));
@@ -332,8 +333,8 @@ fn check_schedule(case: &Case, sol: &Solution, what: &str) -> Result<(), String>
         }
         for (j, axis) in m.axes.iter().enumerate() {
             let (rv, ra) = (
-                axis.velocity.ratio(s.qd[j]),
-                axis.acceleration.ratio(s.qdd[j]),
+                axis.velocity.ratio(sch.qd(i)[j]),
+                axis.acceleration.ratio(sch.qdd(i)[j]),
             );
             if rv > 1.0 + tol || ra > 1.0 + tol {
                 return Err(format!(

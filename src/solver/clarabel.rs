@@ -294,7 +294,7 @@ fn linear_rows(p: &SpanProblem, scale: f64) -> Vec<LinearRow> {
         let inv2du = 1.0 / (2.0 * p.du(k));
         for e in [k, k + 1] {
             for (j, lim) in p.acceleration.iter().enumerate() {
-                let (dq, ddq) = (p.jets[e].dq[j], p.jets[e].ddq[j]);
+                let (dq, ddq) = (p.jets.dq(e)[j], p.jets.ddq(e)[j]);
                 let which = p.essential[e] >> (2 * j);
                 if (dq == 0.0 && ddq == 0.0) || which & 3 == 0 {
                     continue;

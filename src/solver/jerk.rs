@@ -452,7 +452,7 @@ pub fn rest_bounds(
 pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Option<f64> {
     let n = p.intervals();
     let i = if end { n } else { 0 };
-    let jet = &p.jets[i];
+    let jet = p.jets.view(i);
     let mut jerk = f64::INFINITY;
     for (j, axis) in machine.axes.iter().take(p.n_axes()).enumerate() {
         let (Some(lim), d) = (axis.jerk, jet.dq[j].abs()) else {
@@ -1242,7 +1242,7 @@ struct Site<'a> {
     slope: Lin,
     /// At a collocation point: the chord (1 − θ) x_k + θ x_{k+1} of its interval.
     chord: Lin,
-    jets: &'a AxisJets,
+    jets: crate::constraints::JetRef<'a>,
     /// q''' there (jerk rows), on the interval's side of a knot.
     d3: Option<&'a [f64; MAX_AXES]>,
     /// Acceleration rows to state ([`crate::constraints::essential_rows`] mask).
@@ -1410,7 +1410,7 @@ impl<'a> Program<'a> {
                 ya: y(i),
                 slope: Lin::default(),
                 chord: Lin::default(),
-                jets: &p.jets[i],
+                jets: p.jets.view(i),
                 d3: None,
                 essential: p.essential[i],
                 b_max: f64::INFINITY,
@@ -1425,7 +1425,7 @@ impl<'a> Program<'a> {
                     ya: y(e),
                     slope: sv(k, end),
                     chord: Lin::default(),
-                    jets: &p.jets[e],
+                    jets: p.jets.view(e),
                     d3: Some(d3),
                     essential: 0,
                     b_max: f64::INFINITY,
@@ -1450,7 +1450,7 @@ impl<'a> Program<'a> {
                     } else {
                         Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th)
                     },
-                    jets: &m.jets,
+                    jets: (&m.jets).into(),
                     d3: (!m.velocity_only).then_some(&m.d3),
                     essential: if m.velocity_only { 0 } else { m.essential },
                     b_max: m.b_max,

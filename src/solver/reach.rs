@@ -86,7 +86,7 @@ impl IntervalRows {
         });
         let inv = 1.0 / (2.0 * p.du(k));
         for (e, at_end) in [(k, false), (k + 1, true)] {
-            let jet = &p.jets[e];
+            let jet = p.jets.view(e);
             for (j, lim) in p.acceleration.iter().enumerate() {
                 let rows = p.essential[e] >> (2 * j) & 3;
                 if rows == 0 {
@@ -271,7 +271,7 @@ pub fn lattice_violations(p: &SpanProblem, b: &[f64], tol: f64) -> Vec<usize> {
         let inv = 1.0 / (2.0 * p.du(k));
         let udd = (b[k + 1] - b[k]) * inv;
         let broken = [(k, false), (k + 1, true)].into_iter().any(|(e, at_end)| {
-            let jet = &p.jets[e];
+            let jet = p.jets.view(e);
             p.acceleration.iter().enumerate().any(|(j, lim)| {
                 let rows = p.essential[e] >> (2 * j) & 3;
                 let (dq, ddq) = (jet.dq[j], jet.ddq[j]);

@@ -199,9 +199,11 @@ pub fn schedule_json(schedule: &Schedule) -> Result<Vec<u8>> {
     let stations: Vec<Value> = schedule
         .stations
         .iter()
-        .map(|s| {
+        .enumerate()
+        .map(|(i, s)| {
             json!({"span": s.span, "u": s.u, "s": s.s, "t": s.t, "v": s.v, "a": s.a,
-                   "q": per_axis(&s.q), "qd": per_axis(&s.qd), "qdd": per_axis(&s.qdd)})
+                   "q": per_axis(schedule.q(i)), "qd": per_axis(schedule.qd(i)),
+                   "qdd": per_axis(schedule.qdd(i))})
         })
         .collect();
     let doc = json!({
@@ -224,9 +226,9 @@ pub fn schedule_csv(schedule: &Schedule) -> String {
         }
     }
     out.push('\n');
-    for s in &schedule.stations {
+    for (i, s) in schedule.stations.iter().enumerate() {
         let _ = write!(out, "{},{},{},{},{},{}", s.span, s.u, s.s, s.t, s.v, s.a);
-        for x in [&s.q, &s.qd, &s.qdd] {
+        for x in [schedule.q(i), schedule.qd(i), schedule.qdd(i)] {
             for v in &x[..na] {
                 let _ = write!(out, ",{v}");
             }

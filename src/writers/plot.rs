@@ -192,7 +192,7 @@ fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
             }
             d.mvc.push((s, scale(i) * p.b_max[i].sqrt()));
             for j in 0..na {
-                let dq = p.jets[i].dq[j];
+                let dq = p.jets.dq(i)[j];
                 let axis = &machine.axes[j];
                 let v = if dq >= 0.0 {
                     axis.velocity.max
@@ -497,7 +497,9 @@ fn axis_ratios(
             for j in 0..na {
                 vel[j].push((
                     st[offset + i].t,
-                    machine.axes[j].velocity.ratio(st[offset + i].qd[j]),
+                    machine.axes[j]
+                        .velocity
+                        .ratio(solution.schedule.qd(offset + i)[j]),
                 ));
             }
         }
