@@ -166,13 +166,15 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     false
 }
 
-/// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`).
+/// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`), streamed
+/// to the file: the working set does not grow with the schedule (a 1.08 M-station schedule's
+/// JSON document took 7.6 GB built in memory).
 pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
-    let bytes = match output_format(path, SCHEDULE)? {
-        Format::Json => schedule_json(schedule)?,
-        _ => schedule_csv(schedule).into_bytes(),
-    };
-    write_atomically(path, &bytes)
+    let format = output_format(path, SCHEDULE)?;
+    write_atomically_with(path, |w| match format {
+        Format::Json => write_schedule_json(schedule, w),
+        _ => write_schedule_csv(schedule, w),
+    })
 }
 
 fn parent_dir(path: &Path) -> &Path {
@@ -182,64 +184,99 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// The schedule as JSON: `{"axes": [...], "cycle_time_s": …, "stations": [{span, u, s, t, v,
-/// a, q: {X: …}, qd: {…}, qdd: {…}}, …]}`.
+/// The schedule as JSON: `{"units": {…}, "axes": [...], "cycle_time_s": …, "stations":
+/// [{span, u, s, t, v, a, q: {X: …}, qd: {…}, qdd: {…}}, …]}`, one station a line.
 pub fn schedule_json(schedule: &Schedule) -> Result<Vec<u8>> {
-    use serde_json::{Map, Value, json};
-    let na = schedule.axes.len();
-    let per_axis = |x: &[f64]| -> Value {
-        let m: Map<String, Value> = schedule
-            .axes
-            .iter()
-            .zip(&x[..na])
-            .map(|(n, v)| (n.clone(), json!(v)))
-            .collect();
-        Value::Object(m)
+    let mut out = Vec::new();
+    write_schedule_json(schedule, &mut out)
+        .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+    Ok(out)
+}
+
+/// [`schedule_json`], written to `w` station by station.
+pub fn write_schedule_json(schedule: &Schedule, w: &mut dyn Write) -> std::io::Result<()> {
+    let num = |w: &mut dyn Write, x: f64| -> std::io::Result<()> {
+        serde_json::to_writer(&mut *w, &x).map_err(std::io::Error::other)
     };
-    let stations: Vec<Value> = schedule
-        .stations
+    let names: Vec<String> = schedule
+        .axes
         .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            json!({"span": s.span, "u": s.u, "s": s.s, "t": s.t, "v": s.v, "a": s.a,
-                   "q": per_axis(schedule.q(i)), "qd": per_axis(schedule.qd(i)),
-                   "qdd": per_axis(schedule.qdd(i))})
-        })
-        .collect();
-    let doc = json!({
-        "units": {"length": "mm", "angle": "deg", "time": "s"},
-        "axes": schedule.axes,
-        "cycle_time_s": schedule.cycle_time,
-        "stations": stations,
-    });
-    serde_json::to_vec_pretty(&doc).map_err(|e| Error::Solver(format!("JSON encoding: {e}")))
+        .map(|n| serde_json::to_string(n).map_err(std::io::Error::other))
+        .collect::<std::io::Result<_>>()?;
+    write!(
+        w,
+        "{{\n  \"units\": {{\"length\": \"mm\", \"angle\": \"deg\", \"time\": \"s\"}},\n  \"axes\": [{}],\n  \"cycle_time_s\": ",
+        names.join(", ")
+    )?;
+    num(w, schedule.cycle_time)?;
+    write!(w, ",\n  \"stations\": [")?;
+    for (i, s) in schedule.stations.iter().enumerate() {
+        write!(
+            w,
+            "{}\n    {{\"span\": {}",
+            if i > 0 { "," } else { "" },
+            s.span
+        )?;
+        for (key, x) in [("u", s.u), ("s", s.s), ("t", s.t), ("v", s.v), ("a", s.a)] {
+            write!(w, ", \"{key}\": ")?;
+            num(w, x)?;
+        }
+        for (key, x) in [
+            ("q", schedule.q(i)),
+            ("qd", schedule.qd(i)),
+            ("qdd", schedule.qdd(i)),
+        ] {
+            write!(w, ", \"{key}\": {{")?;
+            for (j, (name, v)) in names.iter().zip(x).enumerate() {
+                write!(w, "{}{name}: ", if j > 0 { ", " } else { "" })?;
+                num(w, *v)?;
+            }
+            write!(w, "}}")?;
+        }
+        write!(w, "}}")?;
+    }
+    writeln!(w, "\n  ]\n}}")
 }
 
 /// The schedule as CSV, one row per station: `span,u,s,t,v,a,q_X,…,qd_X,…,qdd_X,…`.
 pub fn schedule_csv(schedule: &Schedule) -> String {
-    use std::fmt::Write as _;
-    let na = schedule.axes.len();
-    let mut out = String::from("span,u,s,t,v,a");
+    let mut out = Vec::new();
+    // (Writing to a Vec cannot fail, and every byte written is UTF-8.)
+    let _ = write_schedule_csv(schedule, &mut out);
+    String::from_utf8(out).unwrap_or_default()
+}
+
+/// [`schedule_csv`], written to `w` station by station.
+pub fn write_schedule_csv(schedule: &Schedule, w: &mut dyn Write) -> std::io::Result<()> {
+    write!(w, "span,u,s,t,v,a")?;
     for prefix in ["q", "qd", "qdd"] {
         for n in &schedule.axes {
-            let _ = write!(out, ",{prefix}_{n}");
+            write!(w, ",{prefix}_{n}")?;
         }
     }
-    out.push('\n');
+    writeln!(w)?;
     for (i, s) in schedule.stations.iter().enumerate() {
-        let _ = write!(out, "{},{},{},{},{},{}", s.span, s.u, s.s, s.t, s.v, s.a);
+        write!(w, "{},{},{},{},{},{}", s.span, s.u, s.s, s.t, s.v, s.a)?;
         for x in [schedule.q(i), schedule.qd(i), schedule.qdd(i)] {
-            for v in &x[..na] {
-                let _ = write!(out, ",{v}");
+            for v in x {
+                write!(w, ",{v}")?;
             }
         }
-        out.push('\n');
+        writeln!(w)?;
     }
-    out
+    Ok(())
 }
 
 /// Writes `bytes` to a temporary file next to `path`, then renames it over `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomically_with(path, |w| w.write_all(bytes))
+}
+
+/// [`write_atomically`] with the content written by `write` to a buffered temporary file.
+pub fn write_atomically_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
     // The temporary file's own name stays out of messages: they name the target.
     let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
     // A temporary file is private (0600); the output gets the mode any new file would get
@@ -251,7 +288,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     let mut tmp = builder.tempfile_in(parent_dir(path)).map_err(plain)?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    {
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
+        write(&mut w).map_err(|e| Error::io(path, e))?;
+        w.flush().map_err(|e| Error::io(path, e))?;
+    }
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| plain(e.error))?;
     Ok(())
