@@ -40,7 +40,7 @@ pub struct Station {
 /// The axes' positions, velocities and accelerations are kept per station for the machine's
 /// axes only (a station of a 3-axis machine takes 48 + 72 bytes, where arrays of every
 /// possible axis took 240).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct Schedule {
     /// Names of the axes, in the order of [`Schedule::q`].
     pub axes: Vec<String>,
