@@ -1010,12 +1010,12 @@ pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
     writers::output_format(&args.output, writers::setpoints::SETPOINTS)?;
     writers::check_output("-o", &args.output, &args.plan.inputs())?;
     let (machine, _, _, solution) = plan(&args.plan.solve_args(args.dialect, None, args.period))?;
-    let sp = crate::interpolate::sample(&machine, &solution, args.period)?;
-    writers::setpoints::write_setpoints(&args.output, &sp)?;
+    // Straight to the file, one setpoint at a time: hours of motion at 1 ms in bounded memory.
+    let sp = writers::setpoints::write_sampled(&args.output, &machine, &solution, args.period)?;
     Ok(format!(
         "wrote {}: {} setpoints every {} s over {:.4} s, axes {}\n",
         args.output.display(),
-        sp.samples.len(),
+        sp.count,
         args.period,
         solution.schedule.cycle_time,
         sp.axes.join(" ")

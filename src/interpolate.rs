@@ -63,20 +63,73 @@ pub struct Setpoints {
     pub samples: Vec<Sample>,
 }
 
-/// The most setpoints [`sample`] takes (216 bytes each in memory, about 1 GB; 66 minutes of
-/// motion at 1 ms), checked before sampling.
-pub const MAX_SAMPLES: usize = 4_000_000;
+/// The most setpoints [`sample`] or [`for_each`] takes, checked before sampling: 11 hours of
+/// motion at 1 ms. [`for_each`] keeps one setpoint at a time (`feedopt interpolate` writes
+/// them as they come: a binary file of 8 (3 + n) bytes a setpoint, 2.6 GB for 5 axes at the
+/// limit); [`sample`] keeps them all (216 bytes each).
+pub const MAX_SAMPLES: usize = 40_000_000;
 
-/// Samples the solution's motion at period `period` (s): see the module doc.
+/// What the setpoints of [`for_each`] are: their axes and how many there are.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetpointsHeader {
+    /// Axis names in the order of [`Sample::q`].
+    pub axes: Vec<String>,
+    /// Unit of each axis: linear (mm) or rotary (degrees).
+    pub kinds: Vec<AxisKind>,
+    /// A joint-space path: s and feed are in the path's own units.
+    pub joint: bool,
+    /// Interpolation period T, s.
+    pub period: f64,
+    /// How many setpoints there are.
+    pub count: usize,
+}
+
+/// Samples the solution's motion at period `period` (s), all setpoints at once: see the module
+/// doc and [`for_each`].
 pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Setpoints> {
+    let samples = std::cell::RefCell::new(Vec::new());
+    let h = for_each(
+        machine,
+        solution,
+        period,
+        |head| {
+            samples.borrow_mut().reserve_exact(head.count);
+            Ok(())
+        },
+        |s| {
+            samples.borrow_mut().push(*s);
+            Ok(())
+        },
+    )?;
+    Ok(Setpoints {
+        axes: h.axes,
+        kinds: h.kinds,
+        joint: h.joint,
+        period,
+        samples: samples.into_inner(),
+    })
+}
+
+/// Samples the solution's motion at period `period` (s) one setpoint at a time: `start` gets
+/// the header (the count known before the first setpoint), then `each` every setpoint in time
+/// order. A setpoint that is not finite stops it with an error (whatever `each` did with the
+/// ones before is the caller's to undo). Errors: a bad period, more than [`MAX_SAMPLES`]
+/// setpoints, and what `start` and `each` return.
+pub fn for_each(
+    machine: &Machine,
+    solution: &Solution,
+    period: f64,
+    start: impl FnOnce(&SetpointsHeader) -> Result<()>,
+    mut each: impl FnMut(&Sample) -> Result<()>,
+) -> Result<SetpointsHeader> {
     crate::validate::period("period", period)?;
     let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
     let cycle = timeline.cycle_time;
-    let count = (cycle / period).ceil();
-    if !(count.is_finite() && count < MAX_SAMPLES as f64) {
+    let estimate = (cycle / period).ceil();
+    if !(estimate.is_finite() && estimate < MAX_SAMPLES as f64) {
         return Err(Error::Usage(format!(
             "the schedule takes {} s: at a period of {} s that is more than {MAX_SAMPLES} \
-             setpoints (about 1 GB): give a period of at least {} s",
+             setpoints: give a period of at least {} s",
             crate::error::number(cycle),
             crate::error::number(period),
             crate::error::number(cycle / MAX_SAMPLES as f64)
@@ -85,39 +138,34 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
     let kin = &solution.kinematics;
     let na = kin.n_axes().min(machine.axes.len());
     let spans = &solution.path.spans;
-    let mut samples = Vec::with_capacity(count as usize + 2);
-    let mut k: u64 = 0;
-    for (span, tl) in spans.iter().zip(&timeline.spans) {
-        for i in 0..tl.u.len() - 1 {
-            let iv = tl.interval(i);
-            let t_end = tl.t[i + 1];
-            let dur = t_end - tl.t[i];
-            loop {
-                let t = k as f64 * period;
-                if t >= t_end {
-                    break;
+    // The instants, as the sampling loop below takes them: the count first.
+    let instants = |visit: &mut Visit| {
+        let mut k: u64 = 0;
+        for (span, tl) in spans.iter().zip(&timeline.spans) {
+            for i in 0..tl.u.len() - 1 {
+                let t_end = tl.t[i + 1];
+                loop {
+                    let t = k as f64 * period;
+                    if t >= t_end {
+                        break;
+                    }
+                    visit(span, tl, i, t, t_end)?;
+                    k += 1;
                 }
-                samples.push(point(span, kin, na, tl, i, iv.at(t - tl.t[i], dur), t));
-                k += 1;
             }
         }
+        Ok::<(), Error>(())
+    };
+    let mut count = 0usize;
+    instants(&mut |_, _, _, _, _| {
+        count += 1;
+        Ok(())
+    })?;
+    let last = spans.last().zip(timeline.spans.last());
+    if last.is_some() {
+        count += 1;
     }
-    // The final instant: the end of the last span.
-    if let (Some(span), Some(tl)) = (spans.last(), timeline.spans.last()) {
-        let i = tl.u.len() - 2;
-        let st = tl.interval(i).ends().1;
-        samples.push(point(span, kin, na, tl, i, st, cycle));
-    }
-    if let Some(bad) = samples.iter().find(|s| {
-        !(s.t.is_finite() && s.s.is_finite() && s.feed.is_finite())
-            || s.q[..na].iter().any(|x| !x.is_finite())
-    }) {
-        return Err(Error::Solver(format!(
-            "the setpoint at t = {} s is not finite",
-            bad.t
-        )));
-    }
-    Ok(Setpoints {
+    let header = SetpointsHeader {
         axes: machine
             .axes
             .iter()
@@ -127,9 +175,37 @@ pub fn sample(machine: &Machine, solution: &Solution, period: f64) -> Result<Set
         kinds: machine.axes.iter().take(na).map(|a| a.kind).collect(),
         joint: spans.iter().any(|s| s.kind == SpanKind::Joint),
         period,
-        samples,
-    })
+        count,
+    };
+    start(&header)?;
+    let mut emit = |s: Sample| -> Result<()> {
+        if !(s.t.is_finite() && s.s.is_finite() && s.feed.is_finite())
+            || s.q[..na].iter().any(|x| !x.is_finite())
+        {
+            return Err(Error::Solver(format!(
+                "the setpoint at t = {} s is not finite",
+                s.t
+            )));
+        }
+        each(&s)
+    };
+    instants(&mut |span, tl, i, t, t_end| {
+        let dur = t_end - tl.t[i];
+        let iv = tl.interval(i);
+        emit(point(span, kin, na, tl, i, iv.at(t - tl.t[i], dur), t))
+    })?;
+    // The final instant: the end of the last span.
+    if let Some((span, tl)) = last {
+        let i = tl.u.len() - 2;
+        let st = tl.interval(i).ends().1;
+        emit(point(span, kin, na, tl, i, st, cycle))?;
+    }
+    Ok(header)
 }
+
+/// What [`for_each`] does at one sampling instant: span, its timeline, interval, t and the
+/// interval's end time.
+type Visit<'a> = dyn FnMut(&Span, &SpanTimeline, usize, f64, f64) -> Result<()> + 'a;
 
 /// The setpoint at state `st` within interval `i` of a span.
 fn point(

@@ -240,7 +240,7 @@ fn too_many_setpoints_are_refused_before_sampling() {
     let t = common::toolpath(
         &[
             (Vector3::new(0.0, 0.0, 0.0), common::UP),
-            (Vector3::new(100.0, 0.0, 0.0), common::UP),
+            (Vector3::new(1000.0, 0.0, 0.0), common::UP),
         ],
         None,
     );
@@ -250,14 +250,39 @@ fn too_many_setpoints_are_refused_before_sampling() {
         ..Options::default()
     };
     let sol = optimize(&m, &t, &options).unwrap();
-    // 10.1 s: 10,100 setpoints at 1 ms, 10.1 million at 1 µs.
+    // 100.1 s: 100,100 setpoints at 1 ms, 100.1 million at 1 µs.
     assert!(sample(&m, &sol, 1e-3).is_ok());
     let t0 = std::time::Instant::now();
     let e = sample(&m, &sol, 1e-6).expect_err("too many setpoints");
     assert!(t0.elapsed().as_secs_f64() < 0.5, "{:?}", t0.elapsed());
     let text = e.to_string();
     assert!(
-        text.contains("4000000 setpoints") && text.contains("at least 2.5"),
+        text.contains("40000000 setpoints") && text.contains("at least 2.5"),
         "{text}"
     );
+}
+
+/// `feedopt interpolate` writes the setpoints as they are sampled
+/// ([`feedopt::writers::setpoints::write_sampled`]): the same bytes as the file of all the
+/// setpoints sampled first ([`sample`]), in both formats, with the count it announces.
+#[test]
+fn streamed_setpoints_are_the_collected_ones() {
+    let m = Machine::from_file(&root().join("problems/seed_head_head/machine.json")).unwrap();
+    let t = toolpath::read(&root().join("problems/seed_head_head/impeller_blade.cls")).unwrap();
+    let sol = optimize(&m, &t, &Options::default()).unwrap();
+    let sp = sample(&m, &sol, 1e-3).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for (name, all) in [
+        ("s.csv", setpoints_csv(&sp).into_bytes()),
+        ("s.bin", setpoints_bin(&sp).unwrap()),
+    ] {
+        let path = dir.path().join(name);
+        let h = feedopt::writers::setpoints::write_sampled(&path, &m, &sol, 1e-3).unwrap();
+        assert_eq!(h.count, sp.samples.len(), "{name}");
+        assert_eq!(h.axes, sp.axes, "{name}");
+        assert!(
+            std::fs::read(&path).unwrap() == all,
+            "{name}: the files differ"
+        );
+    }
 }

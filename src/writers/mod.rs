@@ -277,6 +277,15 @@ pub fn write_atomically_with(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
+    write_atomically_try(path, |w| write(w).map_err(|e| Error::io(path, e)))
+}
+
+/// [`write_atomically_with`] for content whose writing may fail otherwise than by I/O (its
+/// error is returned as it is, and nothing is left behind).
+pub fn write_atomically_try(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> Result<()>,
+) -> Result<()> {
     // The temporary file's own name stays out of messages: they name the target.
     let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
     // A temporary file is private (0600); the output gets the mode any new file would get
@@ -290,7 +299,7 @@ pub fn write_atomically_with(
     let mut tmp = builder.tempfile_in(parent_dir(path)).map_err(plain)?;
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
-        write(&mut w).map_err(|e| Error::io(path, e))?;
+        write(&mut w)?;
         w.flush().map_err(|e| Error::io(path, e))?;
     }
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;

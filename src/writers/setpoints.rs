@@ -21,9 +21,13 @@ use std::path::Path;
 
 use super::Format;
 use crate::error::{Error, Result};
-use crate::interpolate::{Sample, Setpoints};
+use std::io::Write;
+
+use crate::interpolate::{Sample, Setpoints, SetpointsHeader};
 use crate::kinematics::MAX_AXES;
 use crate::machine::AxisKind;
+use crate::machine::Machine;
+use crate::optimize::Solution;
 
 /// The formats setpoints are written in: `.csv` ([`setpoints_csv`]) or `.bin`
 /// ([`setpoints_bin`]).
@@ -38,26 +42,43 @@ fn unit_name(kind: AxisKind) -> &'static str {
 
 /// The setpoints as CSV: header `t_s,s_mm,feed_mm_s,<axis>_<unit>…`, one row per sample.
 pub fn setpoints_csv(sp: &Setpoints) -> String {
-    use std::fmt::Write as _;
-    let na = sp.axes.len();
-    let mut out = String::with_capacity(sp.samples.len() * (24 * (3 + na)));
-    out.push_str(if sp.joint {
-        "t_s,s,feed"
-    } else {
-        "t_s,s_mm,feed_mm_s"
-    });
-    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
-        let _ = write!(out, ",{name}_{}", unit_name(*kind));
-    }
-    out.push('\n');
+    let mut out = Vec::with_capacity(sp.samples.len() * (24 * (3 + sp.axes.len())));
+    // (Writing to a Vec cannot fail, and every byte written is UTF-8.)
+    let _ = csv_header(&mut out, &header_of(sp));
     for s in &sp.samples {
-        let _ = write!(out, "{},{},{}", s.t, s.s, s.feed);
-        for q in &s.q[..na] {
-            let _ = write!(out, ",{q}");
-        }
-        out.push('\n');
+        let _ = csv_row(&mut out, s, sp.axes.len());
     }
-    out
+    String::from_utf8(out).unwrap_or_default()
+}
+
+fn header_of(sp: &Setpoints) -> SetpointsHeader {
+    SetpointsHeader {
+        axes: sp.axes.clone(),
+        kinds: sp.kinds.clone(),
+        joint: sp.joint,
+        period: sp.period,
+        count: sp.samples.len(),
+    }
+}
+
+fn csv_header(w: &mut dyn Write, h: &SetpointsHeader) -> std::io::Result<()> {
+    w.write_all(if h.joint {
+        b"t_s,s,feed"
+    } else {
+        b"t_s,s_mm,feed_mm_s"
+    })?;
+    for (name, kind) in h.axes.iter().zip(&h.kinds) {
+        write!(w, ",{name}_{}", unit_name(*kind))?;
+    }
+    writeln!(w)
+}
+
+fn csv_row(w: &mut dyn Write, s: &Sample, na: usize) -> std::io::Result<()> {
+    write!(w, "{},{},{}", s.t, s.s, s.feed)?;
+    for q in &s.q[..na] {
+        write!(w, ",{q}")?;
+    }
+    writeln!(w)
 }
 
 /// Magic bytes of the binary setpoint file.
@@ -69,25 +90,35 @@ pub const VERSION: u32 = 1;
 pub fn setpoints_bin(sp: &Setpoints) -> Result<Vec<u8>> {
     let na = sp.axes.len();
     let mut out = Vec::with_capacity(64 + sp.samples.len() * 8 * (3 + na));
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&u32::from(sp.joint).to_le_bytes());
-    out.extend_from_slice(&(na as u32).to_le_bytes());
-    out.extend_from_slice(&sp.period.to_le_bytes());
-    out.extend_from_slice(&(sp.samples.len() as u64).to_le_bytes());
-    for (name, kind) in sp.axes.iter().zip(&sp.kinds) {
-        let len = u8::try_from(name.len())
-            .map_err(|_| Error::Usage(format!("axis name `{name}` is too long")))?;
-        out.push(len);
-        out.extend_from_slice(name.as_bytes());
-        out.push(u8::from(*kind == AxisKind::Rotary));
-    }
+    bin_header(&mut out, &header_of(sp)).map_err(|e| Error::Usage(e.to_string()))?;
     for s in &sp.samples {
-        for x in [s.t, s.s, s.feed].iter().chain(&s.q[..na]) {
-            out.extend_from_slice(&x.to_le_bytes());
-        }
+        let _ = bin_record(&mut out, s, na);
     }
     Ok(out)
+}
+
+fn bin_header(w: &mut dyn Write, h: &SetpointsHeader) -> std::io::Result<()> {
+    w.write_all(MAGIC)?;
+    w.write_all(&VERSION.to_le_bytes())?;
+    w.write_all(&u32::from(h.joint).to_le_bytes())?;
+    w.write_all(&(h.axes.len() as u32).to_le_bytes())?;
+    w.write_all(&h.period.to_le_bytes())?;
+    w.write_all(&(h.count as u64).to_le_bytes())?;
+    for (name, kind) in h.axes.iter().zip(&h.kinds) {
+        let len = u8::try_from(name.len())
+            .map_err(|_| std::io::Error::other(format!("axis name `{name}` is too long")))?;
+        w.write_all(&[len])?;
+        w.write_all(name.as_bytes())?;
+        w.write_all(&[u8::from(*kind == AxisKind::Rotary)])?;
+    }
+    Ok(())
+}
+
+fn bin_record(w: &mut dyn Write, s: &Sample, na: usize) -> std::io::Result<()> {
+    for x in [s.t, s.s, s.feed].iter().chain(&s.q[..na]) {
+        w.write_all(&x.to_le_bytes())?;
+    }
+    Ok(())
 }
 
 /// Reads the binary layout back (positions only: [`Sample::qd`], [`Sample::qdd`] are 0).
@@ -178,4 +209,49 @@ pub fn write_setpoints(path: &Path, sp: &Setpoints) -> Result<()> {
         _ => setpoints_csv(sp).into_bytes(),
     };
     super::write_atomically(path, &bytes)
+}
+
+/// Samples `solution` at `period` ([`crate::interpolate::for_each`]) straight into `path`
+/// (format by extension), one setpoint at a time: memory does not grow with the motion's
+/// length. Atomic as every writer: an error on the way leaves no file. Returns what was
+/// written.
+pub fn write_sampled(
+    path: &Path,
+    machine: &Machine,
+    solution: &Solution,
+    period: f64,
+) -> Result<SetpointsHeader> {
+    let bin = super::output_format(path, SETPOINTS)? == Format::Bin;
+    let na = solution.kinematics.n_axes().min(machine.axes.len());
+    let io = |e: std::io::Error| Error::io(path, e);
+    let mut header = None;
+    super::write_atomically_try(path, |w| {
+        let w = std::cell::RefCell::new(w);
+        let h = crate::interpolate::for_each(
+            machine,
+            solution,
+            period,
+            |h| {
+                let w = &mut **w.borrow_mut();
+                if bin {
+                    bin_header(w, h)
+                } else {
+                    csv_header(w, h)
+                }
+                .map_err(io)
+            },
+            |s| {
+                let w = &mut **w.borrow_mut();
+                if bin {
+                    bin_record(w, s, na)
+                } else {
+                    csv_row(w, s, na)
+                }
+                .map_err(io)
+            },
+        )?;
+        header = Some(h);
+        Ok(())
+    })?;
+    header.ok_or_else(|| Error::Solver("no setpoints were written".into()))
 }
