@@ -243,6 +243,10 @@ G90\n\
 M99\n\
 %\n",
     "O0001\nG90 G54 G0 X1000 Y2000 Z3000\nG1 X5000 Y-2000 F100.\nG2 X7000 Y0 R2000\nM30\n",
+    // Macro B control flow, and a rotary axis turning with X (the combined-distance feed).
+    "O0002 (MACRO B)\nG21 G90 G94 G17\n#1=0.\n#4=63./2.\nG0 X0. Y0. Z5. C0.\n\
+WHILE [#1 LT 3.] DO1\nG1 X[#1*10.] Y#4 F500.\nIF [#1 EQ 1.] THEN #2=5.\n\
+IF [#1 GT 5.] GOTO 20\n#1=#1+1.\nEND1\nG1 X30. C45. F300.\nN20 G0 Z50.\nM30\n",
 ];
 
 const FANUC_WORDS: &[&str] = &[
@@ -264,11 +268,41 @@ const FANUC_WORDS: &[&str] = &[
     "G30 P3 Z0.",
     "(COMMENT)",
     "%",
+    "WHILE [#1 LT 3.] DO1",
+    "END1",
+    "IF [#1 GT 2.] GOTO 20",
+    "GOTO 20",
+    "N20",
+    "IF [#1 EQ 1.] THEN #2=3.",
+    "#1=#1+1.",
+    "G1 X5. C30. F200.",
 ];
 
 /// Heidenhain Klartext: lines, arcs, Q parameters, TCPM, datum shift, tilted plane, cycles,
 /// patterns, labels and jumps.
-const HEIDENHAIN_PROGRAMS: &[&str] = &[include_str!("../common/everything.h")];
+const HEIDENHAIN_PROGRAMS: &[&str] = &[
+    include_str!("../common/everything.h"),
+    // The cycles added on 2026-11-26: reaming, boring, tapping with chip breaking, single-lip
+    // deep-hole drilling, thread milling.
+    "0 BEGIN PGM CYC MM\n1 TOOL CALL 5 Z S3000\n2 L X+30 Y+40 Z+50 R0 FMAX\n\
+3 CYCL DEF 201 REAMING ~\n Q200=2 ;SET-UP CLEARANCE ~\n Q201=-15 ;DEPTH ~\n\
+ Q206=100 ;FEED RATE FOR PLNGNG ~\n Q211=0.5 ;DWELL TIME AT DEPTH ~\n\
+ Q208=250 ;RETRACTION FEED RATE ~\n Q203=+0 ;SURFACE COORDINATE ~\n\
+ Q204=50 ;2ND SET-UP CLEARANCE\n4 L X+30 Y+40 R0 FMAX M99\n\
+5 CYCL DEF 202 BORING ~\n Q200=2 ~\n Q201=-15 ~\n Q206=100 ~\n Q211=0 ~\n Q208=250 ~\n\
+ Q203=+0 ~\n Q204=50 ~\n Q214=1 ;DISENGAGING DIRECTN ~\n Q336=0 ;ANGLE OF SPINDLE\n\
+6 L X+50 R0 FMAX M99\n\
+7 CYCL DEF 209 TAPPING W/ CHIP BRKG ~\n Q200=2 ~\n Q201=-12 ~\n Q239=+1.5 ;PITCH ~\n\
+ Q203=+0 ~\n Q204=50 ~\n Q257=4 ;DEPTH FOR CHIP BRKNG ~\n Q256=1 ;DIST FOR CHIP BRKNG ~\n\
+ Q336=0 ~\n Q403=1.5 ;RPM FACTOR\n8 L X+70 R0 FMAX M99\n\
+9 CYCL DEF 241 SINGLE-LIP D.H.DRLNG ~\n Q200=2 ~\n Q201=-40 ~\n Q206=150 ~\n Q211=0 ~\n\
+ Q203=+0 ~\n Q204=50 ~\n Q379=7.5 ;STARTING POINT ~\n Q253=750 ;F PRE-POSITIONING ~\n\
+ Q208=1000 ~\n Q426=3 ;DIR. OF SPINDLE ROT. ~\n Q427=0 ~\n Q428=0 ~\n Q429=0 ~\n\
+ Q430=0 ;COOLANT OFF\n10 L X+90 R0 FMAX M99\n\
+11 CYCL DEF 262 THREAD MILLING ~\n Q335=10 ~\n Q239=+1.5 ~\n Q201=-9 ~\n Q355=1 ~\n\
+ Q253=300 ~\n Q351=+1 ~\n Q200=2 ~\n Q203=+0 ~\n Q204=20 ~\n Q207=600\n\
+12 L X+110 R0 FMAX M99\n13 END PGM CYC MM\n",
+];
 
 /// Klartext words and blocks for structure-aware mutations.
 const HEIDENHAIN_WORDS: &[&str] = &[
@@ -329,6 +363,9 @@ N50 ROT Z45\nN60 G1 X5 Y5\nN70 ROT\nN80 M30\n",
 ];
 
 const SINUMERIK_WORDS: &[&str] = &[
+    "CYCLE84 (10, 0, 2, -20, , 0, 3, 10, 1.5, 0, 800, 800)",
+    "CYCLE81 (10, 0, 2, -5)",
+    "TRAOOF",
     "DEF REAL _A=5",
     "DEF REAL _B, _C",
     "R2=R1*R1+1",
