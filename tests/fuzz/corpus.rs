@@ -268,10 +268,8 @@ const FANUC_WORDS: &[&str] = &[
     "G30 P3 Z0.",
     "(COMMENT)",
     "%",
-    "WHILE [#1 LT 3.] DO1",
-    "END1",
-    "IF [#1 GT 2.] GOTO 20",
-    "GOTO 20",
+    // (Loop and jump words inserted alone mostly end a program in an error — a DO without
+    // END, a GOTO to a missing N — and the seed program has them.)
     "N20",
     "IF [#1 EQ 1.] THEN #2=3.",
     "#1=#1+1.",
