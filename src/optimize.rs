@@ -1534,7 +1534,24 @@ impl Plan<'_> {
             let warm = previous
                 .and_then(|(op, os)| Warm::resample(op, os, p))
                 .map(|w| Warm { local, ..w });
-            return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk);
+            return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
+                .map_err(|e| match e {
+                    // Where, and what to try: a bare solver status named neither.
+                    Error::Solver(why) => {
+                        let span = &self.path.spans[si];
+                        let (a, b) = (
+                            span.nearest_line(p.u[0]),
+                            span.nearest_line(p.u[p.intervals()]),
+                        );
+                        Error::Solver(format!(
+                            "span {si} (CL lines {a}–{b}): the jerk-limited solve failed ({why}); \
+                             its subproblems are ill-conditioned on very short or tightly curved \
+                             features next to long ones: drop the jerk limits with --no-jerk, or \
+                             report the program"
+                        ))
+                    }
+                    other => other,
+                });
         }
         Ok(match options.solver_kind {
             SolverKind::Reach => greedy,

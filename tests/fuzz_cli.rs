@@ -432,3 +432,50 @@ fn fuzz_case_a_2_km_excursion_ends_within_10_s() {
     );
     assert!(r.is_ok(), "{r:?} after {:?}", t0.elapsed());
 }
+
+/// The hand-made APT seed on its B-head/C-table machine (jerk limits on Z) is the one seed the
+/// `solve` target cannot solve: a jerk-limited subproblem on one of its tiny features stops
+/// Clarabel (InsufficientProgress) whatever the SCP's fallbacks. Whatever the solver does with
+/// it, the user gets either a verified schedule or one line that says where (span, CL lines)
+/// and what to try (`--no-jerk`, which solves it). (`feedopt` as a child process: a solve in
+/// this process would add to the CPU clock `cpu_time_counts_the_process_and_its_children`
+/// reads.)
+#[test]
+fn a_failed_jerk_limited_solve_says_where_and_what_to_try() {
+    let seed = corpus::apt(false)
+        .into_iter()
+        .find(|s| s.name == "hand-made apt 1")
+        .expect("the hand-made APT seed");
+    let dir = fuzz::scratch_dir();
+    let (program, machine) = (dir.path().join("p.cls"), dir.path().join("m.json"));
+    std::fs::write(&program, &seed.text).unwrap();
+    std::fs::write(&machine, &seed.machine).unwrap();
+    let solve = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+            .arg("solve")
+            .arg("--machine")
+            .arg(&machine)
+            .arg(&program)
+            .args(extra)
+            .output()
+            .expect("feedopt runs")
+    };
+    let out = solve(&[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        assert!(String::from_utf8_lossy(&out.stdout).contains("verified      yes"));
+    } else {
+        let line = err.lines().last().unwrap_or_default();
+        assert!(
+            line.contains("span ") && line.contains("CL lines") && line.contains("--no-jerk"),
+            "{err}"
+        );
+        let out = solve(&["--no-jerk"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("verified      yes"));
+    }
+}
