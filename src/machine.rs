@@ -111,6 +111,15 @@ impl Axis {
     pub fn within_travel(&self, x: f64) -> bool {
         self.travel.is_none_or(|(lo, hi)| x >= lo && x <= hi)
     }
+
+    /// The travel `(min, max)` that position `x` leaves by more than rounding (1e-9 of the
+    /// travel's larger end, plus 1e-9), if it does: what the solve checks at CL points and
+    /// stations.
+    pub fn travel_exceeded(&self, x: f64) -> Option<(f64, f64)> {
+        let (lo, hi) = self.travel?;
+        let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
+        (!(lo - tol..=hi + tol).contains(&x)).then_some((lo, hi))
+    }
 }
 
 /// Which table tilts in a trunnion ("table-rotary-tilting") machine, and the platter's letter.

@@ -722,12 +722,11 @@ impl Plan<'_> {
     /// Every axis within its travel at every station, or an error naming where.
     fn check_travel(&self, si: usize, p: &SpanProblem) -> Result<()> {
         for (j, axis) in self.machine.axes.iter().enumerate() {
-            let Some((lo, hi)) = axis.travel else {
+            if axis.travel.is_none() {
                 continue;
-            };
-            let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
-            if let Some(i) =
-                (0..p.u.len()).find(|&i| !(lo - tol..=hi + tol).contains(&p.jets.q(i)[j]))
+            }
+            if let Some((i, (lo, hi))) =
+                (0..p.u.len()).find_map(|i| axis.travel_exceeded(p.jets.q(i)[j]).map(|t| (i, t)))
             {
                 return Err(Error::Infeasible(format!(
                     "span {si}, u = {:.6}, nearest CL line {}: axis {} would be at {:.4}, outside \

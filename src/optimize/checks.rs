@@ -108,11 +108,7 @@ pub fn travel(
         let mut q = [0.0; MAX_AXES];
         kin.axis_positions(w, &mut q);
         for (j, axis) in machine.axes.iter().enumerate() {
-            let Some((lo, hi)) = axis.travel else {
-                continue;
-            };
-            let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
-            if !(lo - tol..=hi + tol).contains(&q[j]) {
+            if let Some((lo, hi)) = axis.travel_exceeded(q[j]) {
                 return Err(Error::Infeasible(format!(
                     "{}:{}: axis {} would be at {:.4} here, outside its travel [{lo}, {hi}]; \
                      check the program's work offset and units, or the travel in the machine \
