@@ -32,7 +32,11 @@
 //! the kinematics' `work-offset` (trunnion tables) or, for every other kinematics, the program
 //! coordinates themselves. X, Y and Z may give Heidenhain's **M92 datum**, `"m92": 180.0`
 //! (machine coordinates, mm), the machine builder's: an `M92` block's coordinates are relative
-//! to it (machine zero, with a warning, where the file gives none).
+//! to it (machine zero, with a warning, where the file gives none). A rotary axis may give the
+//! **diameter its feed is taken at**, `"feed_diameter": 50.0` (mm; Haas settings 34 and 79, the
+//! "4th/5th axis diameter"): a Fanuc-family program's G94 feed then counts a degree of that axis
+//! as π·D/360 mm of the block's distance instead of one unit of length (only the readers use it,
+//! as [`References::feed_diameter`]).
 //!
 //! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
 //!
@@ -316,6 +320,10 @@ pub struct References {
     /// `"decimal_point_input"`: how the control reads a number written without a decimal
     /// point (Fanuc parameter 3401#0, DPI); `None`: the file does not say.
     pub decimal_point_input: Option<DecimalPointInput>,
+    /// The rotary axes that give `"feed_diameter"` (mm): name and diameter D, at which a
+    /// Fanuc-family control (Haas settings 34/79) turns a G94 feed into degrees, a degree
+    /// counting as π·D/360 mm.
+    pub feed_diameter: Vec<(String, f64)>,
 }
 
 /// How a Fanuc control reads an axis word written without a decimal point (`X100`):
@@ -390,7 +398,32 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
     };
     let mut axes = Vec::new();
     let mut m92 = Vec::new();
+    let mut feed_diameter = Vec::new();
     for axis in &machine.axes {
+        let field = format!("axes.{}.feed_diameter", axis.name);
+        if let Some(v) = value
+            .get("axes")
+            .and_then(|a| a.get(&axis.name))
+            .and_then(|a| a.get("feed_diameter"))
+        {
+            if axis.kind != AxisKind::Rotary {
+                return Err(parser.err(
+                    &field,
+                    "only a rotary axis (A, B, C) has a feed diameter: leave it out",
+                ));
+            }
+            let d = parser.number(Some(v), &field)?;
+            if !(d > 0.0 && d <= MAX_LENGTH) {
+                return Err(parser.err(
+                    &field,
+                    format!(
+                        "must be a diameter in mm, above 0 and at most {MAX_LENGTH:e}, found {}",
+                        crate::error::number(d)
+                    ),
+                ));
+            }
+            feed_diameter.push((axis.name.clone(), d));
+        }
         let field = format!("axes.{}.m92", axis.name);
         if let Some(v) = value
             .get("axes")
@@ -467,6 +500,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         m92,
         program_units,
         decimal_point_input,
+        feed_diameter,
     })
 }
 
@@ -923,6 +957,7 @@ impl Parser {
                         "max",
                         "reference",
                         "m92",
+                        "feed_diameter",
                     ],
                 )?;
                 let kind = if *kin == KinematicsSpec::Joint {

@@ -126,7 +126,103 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         m92: [None; 3],
         program_units: None,
         decimal_point_input: None,
+        feed_diameter: [None; 3],
     }
+}
+
+/// A Fanuc-family G94 block that turns a rotary axis with a feed diameter D in the machine
+/// file (Haas settings 34/79): a degree counts as π·D/360 mm of the combined distance, with
+/// X Y Z or alone, in mm or inch; D = 360/π mm gives the Fanuc rule (a degree as one mm) back.
+/// Other dialects, and tool-tip mode, read F without it and say so once.
+#[test]
+fn a_rotary_feed_diameter_turns_degrees_into_length() {
+    use std::f64::consts::PI;
+    let with = |d: f64| MachineContext {
+        feed_diameter: [None, None, Some(d)],
+        ..context("XYZAC", Default::default(), [0.0; 3])
+    };
+    let read = |dialect: Dialect, d: f64, text: &str| {
+        parse_for(Path::new("t.nc"), text, dialect.spec(), Some(&with(d))).unwrap()
+    };
+    let time = |tp: &Toolpath, k: usize| match tp.points[k].feed {
+        Feed::BlockTime(t) => t,
+        f => panic!("point {k}: {f:?}"),
+    };
+    let fanuc = |d: f64, text: &str| read(Dialect::Fanuc, d, text);
+    // X 20 mm and C 40° at D = 50 mm: C's 40° are 50π·40/360 = 17.45 mm along the part.
+    let tp = fanuc(
+        50.0,
+        "G21 G90 G94 G0 X0. Y0. Z0. C0.
+G91 G1 X20. C40. F300.
+",
+    );
+    let arc = PI * 50.0 * 40.0 / 360.0;
+    let want = (20f64 * 20.0 + arc * arc).sqrt() / 300.0 * 60.0;
+    assert!(
+        (time(&tp, 1) - want).abs() < 1e-9,
+        "{} {want}",
+        time(&tp, 1)
+    );
+    assert!(
+        tp.warnings.iter().all(|w| !w.message.contains("combined")),
+        "{:?}",
+        tp.warnings
+    );
+    // C alone, 90° at F100 mm/min on D = 50 mm: 39.27 mm, 23.56 s (not 90°/100 °/min = 54 s).
+    let tp = fanuc(
+        50.0,
+        "G21 G90 G94 G0 X0. Y0. Z0. C0.
+G1 C90. F100.
+",
+    );
+    assert!((time(&tp, 1) - PI * 50.0 / 4.0 / 100.0 * 60.0).abs() < 1e-9);
+    // Under G20: F in inch/min, the 39.27 mm in inch.
+    let tp = fanuc(
+        50.0,
+        "G20 G90 G94 G0 X0. Y0. Z0. C0.
+G1 C90. F10.
+",
+    );
+    assert!((time(&tp, 1) - PI * 50.0 / 4.0 / 25.4 / 10.0 * 60.0).abs() < 1e-9);
+    // D = 360/π: a degree is a mm again, the Fanuc manual's √(20² + 40²)/300 min.
+    let tp = fanuc(
+        360.0 / PI,
+        "G21 G90 G0 X0. Y0. Z0. C0.
+G91 G1 X20. C40. F300.
+",
+    );
+    assert!((time(&tp, 1) - (2000f64).sqrt() / 300.0 * 60.0).abs() < 1e-9);
+    // A turns too and has no diameter: it counts a degree as a mm, and the block says so.
+    let tp = fanuc(
+        50.0,
+        "G21 G90 G0 X0. Y0. Z0. A0. C0.
+G1 X20. A10. C40. F300.
+",
+    );
+    let want = (400.0 + 100.0 + arc * arc).sqrt() / 300.0 * 60.0;
+    assert!((time(&tp, 1) - want).abs() < 1e-9);
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 2 && w.message.contains("feed_diameter"))
+    );
+    // LinuxCNC's rule has no diameter: F along X Y Z, and one warning that D is not used.
+    let tp = read(
+        Dialect::LinuxCnc,
+        50.0,
+        "G21 G90 G0 X0 Y0 Z0 C0
+G1 X20 C40 F300
+G1 X0 C0
+",
+    );
+    assert_eq!(tp.points[1].feed, Feed::Programmed(5.0));
+    let said: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("feed_diameter"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(said[0].line, 2);
 }
 
 #[test]

@@ -1064,6 +1064,51 @@ fn a_file_that_never_ends_is_refused() {
     }
 }
 
+/// `feed_diameter` (mm) on a rotary axis: read for the toolpath readers; on a linear axis, at
+/// or below 0, or not a number, an error naming the field.
+#[test]
+fn a_rotary_axis_may_give_its_feed_diameter() {
+    use feedopt::machine::references_from_json;
+    let with = |axis: &str, d: &str| {
+        let mut axes: Vec<String> = ["X", "Y", "Z", "A", "C"]
+            .iter()
+            .map(|n| format!(r#""{n}": {{"velocity": 100, "acceleration": 1000"#))
+            .collect();
+        for (n, a) in ["X", "Y", "Z", "A", "C"].iter().zip(&mut axes) {
+            if *n == axis {
+                a.push_str(&format!(r#", "feed_diameter": {d}"#));
+            }
+            a.push('}');
+        }
+        format!(
+            r#"{{"name": "trt", "kinematics": {{"type": "table_table_ac", "x-rot-point": 0,
+                "y-rot-point": 0, "z-rot-point": 0, "y-offset": 0, "z-offset": 0}},
+                "axes": {{{}}}}}"#,
+            axes.join(", ")
+        )
+    };
+    let text = with("C", "50");
+    let m = ok(&text);
+    let r = references_from_json(Path::new("m.json"), &text, &m).unwrap();
+    assert_eq!(r.feed_diameter, vec![("C".to_string(), 50.0)]);
+    for (axis, d, says) in [
+        ("X", "50", "only a rotary axis"),
+        ("C", "0", "above 0"),
+        ("A", "-3", "above 0"),
+        ("C", "\"50\"", "feed_diameter"),
+    ] {
+        let text = with(axis, d);
+        let m = ok(&text);
+        let e = references_from_json(Path::new("m.json"), &text, &m)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("axes.{axis}.feed_diameter")) && e.contains(says),
+            "{axis} {d}: {e}"
+        );
+    }
+}
+
 /// `program_units`: "mm" or "inch", the unit the control reads a program that selects none in
 /// (for the toolpath readers); anything else is an error naming the field.
 #[test]

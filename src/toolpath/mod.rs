@@ -322,6 +322,9 @@ pub struct MachineContext {
     /// How the control reads a Fanuc number without a decimal point (`decimal_point_input`),
     /// where the machine file gives it.
     pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
+    /// The diameter (mm) at which the control turns a G94 feed into degrees, per rotary axis
+    /// A B C, where the machine file gives it (`axes.C.feed_diameter`; Haas settings 34/79).
+    pub feed_diameter: [Option<f64>; 3],
 }
 
 impl MachineContext {
@@ -369,6 +372,13 @@ impl MachineContext {
             }),
             program_units: references.program_units,
             decimal_point_input: references.decimal_point_input,
+            feed_diameter: std::array::from_fn(|i| {
+                references
+                    .feed_diameter
+                    .iter()
+                    .find(|(n, _)| n == NAMES[3 + i])
+                    .map(|(_, d)| *d)
+            }),
         }
     }
 

@@ -114,7 +114,8 @@ pub enum RotaryFeed {
     /// axes in the program's unit and rotary axes in degrees (a degree counts as a mm, or an
     /// inch under G20). `G91 G1 X20 C40 F300` takes √(20²+40²)/300 = 0.149 min (Fanuc
     /// operator's manuals, "Linear interpolation (G01)"). Not in tool-tip mode (G43.4/G43.5),
-    /// where F is the tool tip's speed.
+    /// where F is the tool tip's speed. A rotary axis with a `feed_diameter` D in the machine
+    /// file (Haas settings 34/79) counts a degree as π·D/360 mm instead.
     Combined,
 }
 

@@ -172,6 +172,8 @@ pub(super) struct Interpreter<'a> {
     /// coordinates: `None` until the program sets them (at the start they are the control's).
     g92_params: Option<[f64; 6]>,
     unknown_warned: [bool; 3],
+    /// The machine file's feed diameters were said not to apply to this dialect's feed.
+    feed_diameter_warned: bool,
     vector: Vector3<f64>,
     saw_rotary: bool,
     /// A warning about motion outside TCP mode was given for the current stretch.
@@ -271,6 +273,7 @@ impl<'a> Interpreter<'a> {
             known: [false; 3],
             g92_params: None,
             unknown_warned: [false; 3],
+            feed_diameter_warned: false,
             vector: Vector3::new(0.0, 0.0, 1.0),
             saw_rotary: false,
             non_tcp_warned: false,
@@ -2456,15 +2459,23 @@ impl<'a> Interpreter<'a> {
             .map(|i| (end[i] - start[i]).powi(2))
             .sum::<f64>()
             .sqrt();
+        let diameters = self.machine.map_or([None; 3], |m| m.feed_diameter);
         if rotary > 0.0 && self.spec.rotary_feed == RotaryFeed::Combined && self.tcp == Tcp::Off {
             // Fanuc: F over the combined distance, linear axes in F's unit (mm or inch),
-            // rotary axes in degrees: a degree counts as one unit of length.
+            // rotary axes in degrees: a degree counts as one unit of length, or as π·D/360 mm
+            // where the machine file gives the axis' feed diameter D (Haas settings 34/79).
             let unit = self.feed_units.mm_per_unit();
-            let linear = (0..3)
-                .map(|i| ((end[i] - start[i]) / unit).powi(2))
-                .sum::<f64>();
-            let distance = (linear + rotary * rotary).sqrt();
-            if moves_xyz {
+            let length = |i: usize| {
+                let d = end[i] - start[i];
+                match i.checked_sub(3).and_then(|r| diameters[r]) {
+                    Some(dia) => d * std::f64::consts::PI * dia / 360.0 / unit,
+                    None if i >= 3 => d,
+                    None => d / unit,
+                }
+            };
+            let distance = (0..6).map(|i| length(i).powi(2)).sum::<f64>().sqrt();
+            let undiametered = (3..6).any(|i| end[i] != start[i] && diameters[i - 3].is_none());
+            if moves_xyz && undiametered {
                 // The time differs from other controls' by the whole rotary share: said, so a
                 // user of a control that converts degrees otherwise (Haas) knows.
                 self.warn(
@@ -2472,10 +2483,21 @@ impl<'a> Interpreter<'a> {
                     "a block that turns a rotary axis while X, Y or Z move: F is taken over the \
                      combined distance, a degree counting as one unit of length, as a Fanuc \
                      control feeds it (a Haas control turns degrees into length through its \
-                     rotary diameter settings 34/79 instead, which feedopt does not read)",
+                     rotary diameter settings 34/79 instead: give them as the axis' \
+                     feed_diameter in the machine file)",
                 );
             }
             return Ok(Feed::BlockTime(distance / (feed.raw / 60.0)));
+        }
+        if rotary > 0.0 && diameters.iter().any(Option::is_some) && !self.feed_diameter_warned {
+            // Another dialect's rule, or tool-tip mode: the diameters do not enter.
+            self.feed_diameter_warned = true;
+            self.warn(
+                line,
+                "the machine file gives a rotary axis a feed_diameter, which only a \
+                 Fanuc-family control's G94 feed outside tool-tip mode uses (Haas settings \
+                 34/79): F is read here, and after, without it",
+            );
         }
         Ok(if !moves_xyz && rotary > 0.0 {
             Feed::BlockTime(rotary / (feed.raw / 60.0))

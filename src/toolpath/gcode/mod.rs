@@ -76,7 +76,9 @@
 //!   `G91 G1 X20 C40 F300` takes √(20²+40²)/300 min = 8.94 s (Fanuc operator's manual,
 //!   "Linear interpolation (G01)"); a pure rotary block is the same |ΔA B C|/F as above. A
 //!   Haas control, read in this dialect, instead turns degrees into a length through the
-//!   rotary axis' diameter (settings 34/79), which feedopt does not read. Arcs keep F along
+//!   rotary axis' diameter (settings 34/79): where the machine file gives it as the axis'
+//!   `feed_diameter` D (mm), a degree of that axis counts as π·D/360 mm in the combined
+//!   distance, with or without X Y Z; without it each such block warns. Arcs keep F along
 //!   the chords in every dialect. A feed move before any F, after `F0`, or after a mode change
 //!   forgot F is an error naming its line: every control stops there (LinuxCNC "Cannot do G1
 //!   with zero feed rate", Fanuc alarm PS0011, Sinumerik alarm 10860); it is not a move at the
