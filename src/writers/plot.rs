@@ -94,22 +94,130 @@ fn draw_err(path: &Path) -> impl Fn(String) -> Error + '_ {
 /// Thins a series to the first, minimum, maximum and last point of each of `BINS` bins of
 /// x (in order), so its envelope is kept. Short series are returned as they are.
 pub fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    if points.len() <= 2 * BINS {
-        return points.to_vec();
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return Vec::new();
+    };
+    let mut t = Thinner::new(first.0, last.0);
+    for &p in points {
+        t.push(p);
     }
-    let (x0, x1) = (points[0].0, points[points.len() - 1].0);
-    let width = (x1 - x0).max(f64::MIN_POSITIVE);
-    let bin = |x: f64| (((x - x0) / width * BINS as f64) as usize).min(BINS - 1);
-    let mut out = Vec::with_capacity(4 * BINS);
-    let mut i = 0;
-    while i < points.len() {
-        let (b, start) = (bin(points[i].0), i);
-        while i < points.len() && bin(points[i].0) == b {
-            i += 1;
+    t.finish()
+}
+
+/// A series thinned as it is built ([`thin`]'s points, without holding every point of a long
+/// series): the points themselves while there are at most 2·`BINS`, else, per bin of x over a
+/// range given up front, the bin's first, lowest, highest and last point, in order.
+struct Thinner {
+    x0: f64,
+    width: f64,
+    /// The points so far, while there are at most 2·`BINS`.
+    raw: Vec<(f64, f64)>,
+    count: usize,
+    /// The bins closed so far, thinned.
+    out: Vec<(f64, f64)>,
+    bin: Option<Bin>,
+    /// The largest finite y pushed.
+    peak: f64,
+}
+
+impl Thinner {
+    /// For a series whose x run from `x0` to `x1`.
+    fn new(x0: f64, x1: f64) -> Thinner {
+        Thinner {
+            x0,
+            width: (x1 - x0).max(f64::MIN_POSITIVE),
+            raw: Vec::new(),
+            count: 0,
+            out: Vec::new(),
+            bin: None,
+            peak: f64::NEG_INFINITY,
         }
-        out.extend(thin_bin(&points[start..i]));
     }
-    out
+
+    fn bin_of(&self, x: f64) -> usize {
+        (((x - self.x0) / self.width * BINS as f64) as usize).min(BINS - 1)
+    }
+
+    fn push(&mut self, p: (f64, f64)) {
+        self.count += 1;
+        if self.count <= 2 * BINS {
+            self.raw.push(p);
+        } else if self.count == 2 * BINS + 1 {
+            self.raw = Vec::new();
+        }
+        if p.1.is_finite() {
+            self.peak = self.peak.max(p.1);
+        }
+        let b = self.bin_of(p.0);
+        match &mut self.bin {
+            Some(bin) if bin.index == b => bin.add(p),
+            _ => {
+                if let Some(done) = self.bin.replace(Bin::new(b, p)) {
+                    done.thinned(&mut self.out);
+                }
+            }
+        }
+    }
+
+    /// The thinned series.
+    fn finish(mut self) -> Vec<(f64, f64)> {
+        if self.count <= 2 * BINS {
+            return self.raw;
+        }
+        if let Some(done) = self.bin.take() {
+            done.thinned(&mut self.out);
+        }
+        self.out
+    }
+}
+
+/// One bin of a [`Thinner`]: its first, lowest, highest and last point, each with its place.
+#[derive(Debug, Clone, Copy)]
+struct Bin {
+    index: usize,
+    n: usize,
+    first: (usize, (f64, f64)),
+    lo: (usize, (f64, f64)),
+    hi: (usize, (f64, f64)),
+    last: (usize, (f64, f64)),
+}
+
+impl Bin {
+    fn new(index: usize, p: (f64, f64)) -> Bin {
+        Bin {
+            index,
+            n: 1,
+            first: (0, p),
+            lo: (0, p),
+            hi: (0, p),
+            last: (0, p),
+        }
+    }
+
+    fn add(&mut self, p: (f64, f64)) {
+        let k = self.n;
+        self.n += 1;
+        if p.1 < self.lo.1.1 {
+            self.lo = (k, p);
+        }
+        if p.1 > self.hi.1.1 {
+            self.hi = (k, p);
+        }
+        self.last = (k, p);
+    }
+
+    /// Appends the bin's points, in order, each once.
+    fn thinned(&self, out: &mut Vec<(f64, f64)>) {
+        let mut keep = [self.first, self.lo, self.hi, self.last];
+        keep.sort_unstable_by_key(|k| k.0);
+        let mut last = usize::MAX;
+        for (k, p) in keep {
+            if k != last {
+                out.push(p);
+                last = k;
+            }
+        }
+    }
 }
 
 /// Splits a series into runs of finite points at most `y_max` (a bound that leaves the chart
@@ -154,27 +262,24 @@ pub fn write_solution_plot(
     super::write_atomically(path, svg.as_bytes())
 }
 
-/// (s, V) at an interval's two ends, and the limit binding on it.
-type BoundInterval = ((f64, f64), (f64, f64), Bound);
-
-/// Per-interval feed data of panel 1.
+/// Panel 1's series, each thinned as it is built.
 struct FeedData {
-    /// (s, V) per interval end pair, and the interval's binding limit.
-    intervals: Vec<BoundInterval>,
+    /// The feed as polylines of one binding limit each ([`ColouredRuns`]).
+    runs: Vec<(Bound, Vec<(f64, f64)>)>,
     mvc: Vec<(f64, f64)>,
     cap: Vec<(f64, f64)>,
+    /// The largest finite feed cap.
+    cap_peak: f64,
     axis_bounds: Vec<Vec<(f64, f64)>>,
 }
 
-fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
+fn feed_data(machine: &Machine, solution: &Solution, s_max: f64) -> FeedData {
     let na = solution.kinematics.n_axes().min(machine.axes.len());
     let st = &solution.schedule.stations;
-    let mut d = FeedData {
-        intervals: Vec::new(),
-        mvc: Vec::new(),
-        cap: Vec::new(),
-        axis_bounds: vec![Vec::new(); na],
-    };
+    let mut runs = ColouredRuns::new(s_max);
+    let mut mvc = Thinner::new(0.0, s_max);
+    let mut cap = Thinner::new(0.0, s_max);
+    let mut axis_bounds: Vec<Thinner> = (0..na).map(|_| Thinner::new(0.0, s_max)).collect();
     let mut offset = 0;
     for ((p, sol), span) in solution
         .problems
@@ -190,8 +295,8 @@ fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
             if span.kind == SpanKind::Reorientation {
                 continue;
             }
-            d.mvc.push((s, scale(i) * p.b_max[i].sqrt()));
-            for j in 0..na {
+            mvc.push((s, scale(i) * p.b_max[i].sqrt()));
+            for (j, bounds) in axis_bounds.iter_mut().enumerate() {
                 let dq = p.jets.dq(i)[j];
                 let axis = &machine.axes[j];
                 let v = if dq >= 0.0 {
@@ -199,26 +304,32 @@ fn feed_data(machine: &Machine, solution: &Solution) -> FeedData {
                 } else {
                     -axis.velocity.min
                 };
-                d.axis_bounds[j].push((s, scale(i) * v / dq.abs()));
+                bounds.push((s, scale(i) * v / dq.abs()));
             }
         }
         let jerk = crate::report::jerk_ratios(machine, span, &solution.kinematics, p, sol);
         for k in 0..p.intervals() {
             let (a, z) = (&st[offset + k], &st[offset + k + 1]);
-            d.intervals.push((
+            runs.push(
                 (a.s, a.v),
                 (z.s, z.v),
                 interval_binding(p, sol, k, jerk.as_deref()),
-            ));
+            );
             if !joint && span.kind == SpanKind::Moving {
-                let cap = span.feed_caps[span.spline.segment(0.5 * (p.u[k] + p.u[k + 1]))];
-                d.cap.push((a.s, cap));
-                d.cap.push((z.s, cap));
+                let c = span.feed_caps[span.spline.segment(0.5 * (p.u[k] + p.u[k + 1]))];
+                cap.push((a.s, c));
+                cap.push((z.s, c));
             }
         }
         offset += p.u.len();
     }
-    d
+    FeedData {
+        runs: runs.finish(),
+        mvc: mvc.finish(),
+        cap_peak: cap.peak.max(0.0),
+        cap: cap.finish(),
+        axis_bounds: axis_bounds.into_iter().map(Thinner::finish).collect(),
+    }
 }
 
 fn draw_solution(
@@ -235,16 +346,11 @@ fn draw_solution(
         .iter()
         .any(|s| s.kind == SpanKind::Joint);
     let (s_label, v_label) = path_labels(joint);
-    let data = feed_data(machine, solution);
     let st = &solution.schedule.stations;
     let s_max = st.last().map_or(1.0, |s| s.s).max(1e-9);
+    let data = feed_data(machine, solution, s_max);
     let v_peak = st.iter().map(|s| s.v).fold(0.0, f64::max);
-    let cap_peak = data
-        .cap
-        .iter()
-        .map(|c| c.1)
-        .filter(|c| c.is_finite())
-        .fold(0.0, f64::max);
+    let cap_peak = data.cap_peak;
     // Headroom above the feed for the legend and the limits the feed runs up against.
     let y_max = (1.7 * v_peak)
         .max(1.1 * cap_peak.min(2.0 * v_peak))
@@ -281,7 +387,7 @@ fn draw_solution(
     for (j, pts) in data.axis_bounds.iter().enumerate() {
         let style = axis_colour(j).mix(0.55).stroke_width(1);
         let mut first = true;
-        for run in runs_below(&thin(pts), y_max) {
+        for run in runs_below(pts, y_max) {
             let s = chart
                 .draw_series(LineSeries::new(run, style))
                 .map_err(|x| e(&x))?;
@@ -294,7 +400,7 @@ fn draw_solution(
     }
     let mvc_style = RGBColor(200, 200, 200).stroke_width(9);
     let mut first = true;
-    for run in runs_below(&thin(&data.mvc), y_max) {
+    for run in runs_below(&data.mvc, y_max) {
         let s = chart
             .draw_series(LineSeries::new(run, mvc_style))
             .map_err(|x| e(&x))?;
@@ -308,7 +414,7 @@ fn draw_solution(
     // per bin of s on long schedules: each bin drawn in the colour of the limit that binds
     // over most of its length).
     let mut labelled: Vec<Bound> = Vec::new();
-    for (bound, pts) in coloured_runs(&data.intervals, s_max) {
+    for (bound, pts) in data.runs {
         let style = bound_colour(bound).stroke_width(3);
         let s = chart
             .draw_series(LineSeries::new(pts, style))
@@ -327,7 +433,7 @@ fn draw_solution(
     // The feed cap on top of the feed (dashed), so both stay visible where the feed runs at it.
     let cap_style = BLACK.stroke_width(1);
     let mut first = true;
-    for run in runs_below(&thin(&data.cap), y_max) {
+    for run in runs_below(&data.cap, y_max) {
         let s = chart
             .draw_series(DashedLineSeries::new(run, 6, 4, cap_style))
             .map_err(|x| e(&x))?;
@@ -385,7 +491,7 @@ fn draw_solution(
             .map_err(|x| e(&x))?;
         for (j, pts) in series.iter().enumerate() {
             let style = axis_colour(j).stroke_width(2);
-            for run in runs_below(&thin(pts), top_y) {
+            for run in runs_below(pts, top_y) {
                 chart
                     .draw_series(LineSeries::new(run, style))
                     .map_err(|x| e(&x))?;
@@ -414,74 +520,89 @@ fn draw_solution(
     Ok(())
 }
 
-/// The feed as polylines of one binding limit each. Short schedules: runs of consecutive
-/// intervals with the same limit. Long ones: per bin of s, the limit binding over most of the
-/// bin's length, and the bin's thinned points.
-fn coloured_runs(intervals: &[BoundInterval], s_max: f64) -> Vec<(Bound, Vec<(f64, f64)>)> {
-    let mut runs: Vec<(Bound, Vec<(f64, f64)>)> = Vec::new();
-    if intervals.len() <= 2 * BINS {
-        for &(a, z, b) in intervals {
-            match runs.last_mut() {
-                Some((rb, pts)) if *rb == b => pts.push(z),
-                _ => runs.push((b, vec![a, z])),
-            }
+/// The feed as polylines of one binding limit each, built interval by interval. Short
+/// schedules (at most 2·`BINS` intervals): runs of consecutive intervals with the same limit.
+/// Long ones: per bin of s, the limit binding over most of the bin's length, and the bin's
+/// thinned points.
+struct ColouredRuns {
+    s_max: f64,
+    /// The short schedule's runs, while there are at most 2·`BINS` intervals.
+    raw: Vec<(Bound, Vec<(f64, f64)>)>,
+    count: usize,
+    /// The long schedule's runs, of the bins closed so far.
+    runs: Vec<(Bound, Vec<(f64, f64)>)>,
+    /// The open bin: each limit's length in it, and its points.
+    bin: Option<(Vec<(Bound, f64)>, Bin)>,
+}
+
+impl ColouredRuns {
+    fn new(s_max: f64) -> ColouredRuns {
+        ColouredRuns {
+            s_max,
+            raw: Vec::new(),
+            count: 0,
+            runs: Vec::new(),
+            bin: None,
         }
-        return runs;
     }
-    let bin = |s: f64| ((s / s_max * BINS as f64) as usize).min(BINS - 1);
-    let mut i = 0;
-    while i < intervals.len() {
-        let b0 = bin(intervals[i].0.0);
-        let mut share: Vec<(Bound, f64)> = Vec::new();
-        let mut pts = vec![intervals[i].0];
-        while i < intervals.len() && bin(intervals[i].0.0) == b0 {
-            let (a, z, b) = intervals[i];
-            match share.iter_mut().find(|x| x.0 == b) {
-                Some(x) => x.1 += z.0 - a.0,
-                None => share.push((b, z.0 - a.0)),
+
+    /// The interval from (s, V) `a` to `z`, held down by `bound`.
+    fn push(&mut self, a: (f64, f64), z: (f64, f64), bound: Bound) {
+        self.count += 1;
+        if self.count <= 2 * BINS {
+            match self.raw.last_mut() {
+                Some((rb, pts)) if *rb == bound => pts.push(z),
+                _ => self.raw.push((bound, vec![a, z])),
             }
-            pts.push(z);
-            i += 1;
+        } else if self.count == 2 * BINS + 1 {
+            self.raw = Vec::new();
         }
+        let index = ((a.0 / self.s_max * BINS as f64) as usize).min(BINS - 1);
+        match &mut self.bin {
+            Some((share, pts)) if pts.index == index => {
+                match share.iter_mut().find(|x| x.0 == bound) {
+                    Some(x) => x.1 += z.0 - a.0,
+                    None => share.push((bound, z.0 - a.0)),
+                }
+                pts.add(z);
+            }
+            _ => {
+                self.close();
+                let mut pts = Bin::new(index, a);
+                pts.add(z);
+                self.bin = Some((vec![(bound, z.0 - a.0)], pts));
+            }
+        }
+    }
+
+    /// Closes the open bin: its points, in the colour of its dominant limit.
+    fn close(&mut self) {
+        let Some((share, bin)) = self.bin.take() else {
+            return;
+        };
         let dominant = share
             .iter()
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .map_or(Bound::None, |x| x.0);
-        let pts = thin_bin(&pts);
-        match runs.last_mut() {
+        let mut pts = Vec::with_capacity(4);
+        bin.thinned(&mut pts);
+        match self.runs.last_mut() {
             Some((rb, run)) if *rb == dominant => run.extend(pts.into_iter().skip(1)),
-            _ => runs.push((dominant, pts)),
+            _ => self.runs.push((dominant, pts)),
         }
     }
-    runs
-}
 
-/// First, minimum, maximum and last point of one bin, in order.
-fn thin_bin(pts: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let (mut lo, mut hi) = (0, 0);
-    for (k, p) in pts.iter().enumerate() {
-        if p.1 < pts[lo].1 {
-            lo = k;
+    fn finish(mut self) -> Vec<(Bound, Vec<(f64, f64)>)> {
+        if self.count <= 2 * BINS {
+            return self.raw;
         }
-        if p.1 > pts[hi].1 {
-            hi = k;
-        }
+        self.close();
+        self.runs
     }
-    let mut keep = [0, lo, hi, pts.len() - 1];
-    keep.sort_unstable();
-    let mut out = Vec::with_capacity(4);
-    let mut last = usize::MAX;
-    for k in keep {
-        if k != last {
-            out.push(pts[k]);
-            last = k;
-        }
-    }
-    out
 }
 
 /// Per axis, (t, |q̇|/v) at every station and (t, |q̈|/a) at both ends of every interval with
-/// its ü.
+/// its ü, each thinned as it is built.
 #[allow(clippy::type_complexity)]
 fn axis_ratios(
     machine: &Machine,
@@ -489,13 +610,14 @@ fn axis_ratios(
 ) -> (Vec<Vec<(f64, f64)>>, Vec<Vec<(f64, f64)>>) {
     let na = solution.kinematics.n_axes().min(machine.axes.len());
     let st = &solution.schedule.stations;
-    let mut vel = vec![Vec::with_capacity(st.len()); na];
-    let mut acc = vec![Vec::with_capacity(2 * st.len()); na];
+    let t_end = st.last().map_or(1.0, |s| s.t);
+    let series = || -> Vec<Thinner> { (0..na).map(|_| Thinner::new(0.0, t_end)).collect() };
+    let (mut vel, mut acc) = (series(), series());
     let mut offset = 0;
     for (p, sol) in solution.problems.iter().zip(&solution.solutions) {
         for i in 0..p.u.len() {
-            for j in 0..na {
-                vel[j].push((
+            for (j, v) in vel.iter_mut().enumerate() {
+                v.push((
                     st[offset + i].t,
                     machine.axes[j]
                         .velocity
@@ -505,15 +627,16 @@ fn axis_ratios(
         }
         for k in 0..p.intervals() {
             for e in [k, k + 1] {
-                for j in 0..na {
+                for (j, series) in acc.iter_mut().enumerate() {
                     let a = p.axis_acceleration(&sol.b, k, e, j);
-                    acc[j].push((st[offset + e].t, machine.axes[j].acceleration.ratio(a)));
+                    series.push((st[offset + e].t, machine.axes[j].acceleration.ratio(a)));
                 }
             }
         }
         offset += p.u.len();
     }
-    (vel, acc)
+    let done = |v: Vec<Thinner>| v.into_iter().map(Thinner::finish).collect();
+    (done(vel), done(acc))
 }
 
 /// One feed profile of [`write_profiles_plot`].
@@ -725,4 +848,99 @@ fn pad_range(values: &[f64]) -> (f64, f64) {
         0.05 * lo.abs().max(1e-12)
     };
     (lo - pad, hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// (s, V) at an interval's two ends, and the limit binding on it.
+    type BoundInterval = ((f64, f64), (f64, f64), Bound);
+
+    /// The feed's coloured runs of a whole schedule at once, as the plot drew them before they
+    /// were built interval by interval: the reference for [`ColouredRuns`].
+    fn batch_runs(intervals: &[BoundInterval], s_max: f64) -> Vec<(Bound, Vec<(f64, f64)>)> {
+        let mut runs: Vec<(Bound, Vec<(f64, f64)>)> = Vec::new();
+        if intervals.len() <= 2 * BINS {
+            for &(a, z, b) in intervals {
+                match runs.last_mut() {
+                    Some((rb, pts)) if *rb == b => pts.push(z),
+                    _ => runs.push((b, vec![a, z])),
+                }
+            }
+            return runs;
+        }
+        let bin = |s: f64| ((s / s_max * BINS as f64) as usize).min(BINS - 1);
+        let mut i = 0;
+        while i < intervals.len() {
+            let b0 = bin(intervals[i].0.0);
+            let mut share: Vec<(Bound, f64)> = Vec::new();
+            let mut pts = vec![intervals[i].0];
+            while i < intervals.len() && bin(intervals[i].0.0) == b0 {
+                let (a, z, b) = intervals[i];
+                match share.iter_mut().find(|x| x.0 == b) {
+                    Some(x) => x.1 += z.0 - a.0,
+                    None => share.push((b, z.0 - a.0)),
+                }
+                pts.push(z);
+                i += 1;
+            }
+            let dominant = share
+                .iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(Bound::None, |x| x.0);
+            // First, lowest, highest and last point, in order, each once.
+            let (mut lo, mut hi) = (0, 0);
+            for (k, p) in pts.iter().enumerate() {
+                if p.1 < pts[lo].1 {
+                    lo = k;
+                }
+                if p.1 > pts[hi].1 {
+                    hi = k;
+                }
+            }
+            let mut keep = vec![0, lo, hi, pts.len() - 1];
+            keep.sort_unstable();
+            keep.dedup();
+            let pts: Vec<(f64, f64)> = keep.into_iter().map(|k| pts[k]).collect();
+            match runs.last_mut() {
+                Some((rb, run)) if *rb == dominant => run.extend(pts.into_iter().skip(1)),
+                _ => runs.push((dominant, pts)),
+            }
+        }
+        runs
+    }
+
+    /// Short and long schedules of uneven intervals, their limits changing in runs: built
+    /// interval by interval, the runs are the batch reference's.
+    #[test]
+    fn coloured_runs_built_interval_by_interval_are_the_batch_ones() {
+        let mut seed = 5u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for n in [10, 2 * BINS, 2 * BINS + 1, 50_000] {
+            let mut intervals = Vec::with_capacity(n);
+            let (mut s, mut v) = (0.0, 0.0);
+            let mut bound = Bound::None;
+            for _ in 0..n {
+                if rnd() < 0.02 {
+                    bound = [Bound::None, Bound::Feed, Bound::AxisVelocity(1)]
+                        [(3.0 * rnd()) as usize % 3];
+                }
+                let a = (s, v);
+                s += 0.1 + rnd();
+                v = (v + rnd() - 0.5).abs();
+                intervals.push((a, (s, v), bound));
+            }
+            let mut built = ColouredRuns::new(s);
+            for &(a, z, b) in &intervals {
+                built.push(a, z, b);
+            }
+            assert_eq!(built.finish(), batch_runs(&intervals, s), "{n} intervals");
+        }
+    }
 }
