@@ -449,16 +449,24 @@ pub fn rest_bounds(
 /// half the span is used (`J t³ ≤ L/2`). V is taken as the lowest velocity bound on the near
 /// half of the span, so the estimate errs short: a constant-jerk interval that ends before
 /// the switch is exact, one that ends after it is not.
+///
+/// An axis whose q' is rounding ([`STILL_AXIS`] of the largest |q'|) does not move along the
+/// path there and bounds no path jerk: its 1e-16 would make J 1e20 and the phase 1e-35 long,
+/// a first interval no solver can scale (the fuzz corpus's hand-made APT program on a B-head
+/// machine with jerk limits on Z only: every subproblem of that span stopped Clarabel).
 pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Option<f64> {
     let n = p.intervals();
     let i = if end { n } else { 0 };
     let jet = p.jets.view(i);
+    let moving = jet.dq[..p.n_axes()]
+        .iter()
+        .fold(0.0f64, |m, d| m.max(d.abs()));
     let mut jerk = f64::INFINITY;
     for (j, axis) in machine.axes.iter().take(p.n_axes()).enumerate() {
         let (Some(lim), d) = (axis.jerk, jet.dq[j].abs()) else {
             continue;
         };
-        if d > 0.0 {
+        if d > STILL_AXIS * moving {
             jerk = jerk.min(lim.max.min(-lim.min) / d);
         }
     }
@@ -476,6 +484,10 @@ pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Optio
     let at = jerk * t * t * t / 6.0;
     (at.is_finite() && at > 0.0 && at < 0.5 * len).then_some(at)
 }
+
+/// An axis whose |q'| is at most this share of the largest axis's does not move along the path
+/// ([`rest_phase_length`]).
+const STILL_AXIS: f64 = 1e-9;
 
 /// The largest b at the inner station of a constant-jerk interval from rest at `u_rest` to
 /// `u_in` (mirrored when `end`): with s = t/τ ∈ [0, 1], `u − u_rest = ±Δu s³`, `u̇ = 3Δu s²/τ`,
