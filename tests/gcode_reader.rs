@@ -1035,6 +1035,57 @@ fn fanuc_only_words_tell_the_dialect() {
     assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
 }
 
+/// Fanuc's ISO code writes the program number with a colon, `:1234` for `O1234` (Fanuc
+/// operator's manuals, "Program number"; Fanuc 0 controls send `:` themselves, and NX's Fadal
+/// and Fanuc 0M posts write `:1234 (PROGRAM)`). Such a program was an error at its first block
+/// ("unexpected character `:`"); it now reads as the same program headed `O1234`, point for
+/// point and line for line (also with CRLF line ends), and is detected as Fanuc.
+#[test]
+fn a_colon_program_number_heads_a_fanuc_program_as_o_does() {
+    use feedopt::toolpath::gcode::detect_dialect;
+    let body = "G21 G90\nG0 X0. Y0. Z5.\nG1 Z-1. F100.\nM98 P2000 L2\nG0 Z5.\nM30\n\
+                O2000\nG91 G1 X5.\nG90\nM99\n%\n";
+    for eol in ["\n", "\r\n"] {
+        let with_o = format!("%\n(PART 7)\nO1234 (FLANGE)\n{body}").replace('\n', eol);
+        let with_colon = with_o.replace("O1234", ":1234");
+        assert_eq!(
+            detect_dialect(&with_colon.to_uppercase()),
+            Some(Dialect::Fanuc)
+        );
+        let a = ok_in(Dialect::Fanuc, &with_o);
+        let b = ok_in(Dialect::Fanuc, &with_colon);
+        // Two calls of O2000 (X +5 each) after the plunge: the subprogram is found, so the
+        // header split main and subprogram as `O1234` does.
+        let xs: Vec<f64> = b.points.iter().map(|p| p.p.x).collect();
+        assert_eq!(xs, vec![0.0, 0.0, 5.0, 10.0, 10.0]);
+        assert_eq!(a.points.len(), b.points.len());
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert_eq!(p.p, q.p);
+            assert_eq!(p.line, q.line);
+        }
+    }
+}
+
+/// A `:` word further down is not a program number (an `O` there would start a subprogram and
+/// end the main program silently): NX's Mori SH8000 post writes `:0110 T01 M06` at a tool
+/// change. It is an error naming the word and what to write; an Okuma OSP file (`$NAME.MIN%`
+/// first) is an error saying that OSP is not read, not "unexpected character `$`".
+#[test]
+fn a_colon_inside_a_program_and_an_okuma_header_are_named() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO0001\nG0 X0. Y0. Z5.\n:0110 T01 M06\nG0 X1.\nM30\n",
+        4,
+        &["`:0110`", "N0110", "program number"],
+    );
+    for header in ["$FLANGE.MIN%", "$OKUMA.SSB%"] {
+        let text = format!("{header}\n(OKUMA)\nG0 G90 X0 Y0\nVC1=2\nM02\n");
+        for dialect in [Dialect::Fanuc, Dialect::LinuxCnc] {
+            err_in(dialect, &text, 1, &["Okuma OSP", header]);
+        }
+    }
+}
+
 /// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
 /// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
 /// with a call the subroutine was "defined twice". An O number followed by an O-word keyword
