@@ -1086,6 +1086,20 @@ fn a_colon_inside_a_program_and_an_okuma_header_are_named() {
     }
 }
 
+/// A lone `G71` or `G70` in a mill program's header (`G00G21G17G90G40G49G80` / `G71G91.1`, as
+/// hobby posts write it; NX's Fryer post `G40 G17 G90 G70`) means mm or inch on the control
+/// it was posted for. On LinuxCNC and Fanuc these are lathe cycles, and feedopt said "this
+/// canned cycle is not supported: post the toolpath as G0/G1/G2/G3", which tells the user
+/// nothing. The error now says what such a word means and what to write.
+#[test]
+fn g70_and_g71_as_units_are_named_with_what_to_write() {
+    let text = "G00G21G17G90G40G49G80\nG71G91.1\nG0 X0 Y0 Z5\nG1 Z-1 F100\nM30\n";
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        err_in(dialect, text, 2, &["G71", "lathe", "G20/G21"]);
+        err_in(dialect, &text.replace("G71", "G70"), 2, &["G70", "G20/G21"]);
+    }
+}
+
 /// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
 /// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
 /// with a call the subroutine was "defined twice". An O number followed by an O-word keyword
