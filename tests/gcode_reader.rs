@@ -1100,6 +1100,38 @@ fn g70_and_g71_as_units_are_named_with_what_to_write() {
     }
 }
 
+/// A shop's Haas program tests a tool-life timer, `IF [#5405 GE 6000] THEN #3000=15`: the
+/// control holds #5405, the program never sets it. feedopt said only "read before it is set";
+/// it now says that the variable is the control's and what to do. A user parameter (`#100`)
+/// keeps the short message.
+#[test]
+fn a_system_variable_read_before_it_is_set_is_named_as_the_controls() {
+    let text = "O1\nG0 G90 X0. Y0. Z5.\nIF [#5405 GE 6000] THEN #3000=15\nM30\n";
+    err_in(
+        Dialect::Fanuc,
+        text,
+        3,
+        &["#5405", "system variable", "machine's"],
+    );
+    let text = "O1\nG0 G90 X#2001 Y0. Z5.\nM30\n";
+    err_in(
+        Dialect::Fanuc,
+        text,
+        2,
+        &["#2001", "Fanuc and Haas", "system variable"],
+    );
+    match parse(Path::new("u.nc"), "O1\nG0 X#100\n", Dialect::Fanuc) {
+        Err(Error::Parse { message, .. }) => {
+            assert!(
+                message.contains("`#100` is read before it is set"),
+                "{message}"
+            );
+            assert!(!message.contains("system"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
 /// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
 /// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
 /// with a call the subroutine was "defined twice". An O number followed by an O-word keyword
