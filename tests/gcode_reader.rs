@@ -1069,15 +1069,27 @@ fn a_colon_program_number_heads_a_fanuc_program_as_o_does() {
 /// A `:` word further down is not a program number (an `O` there would start a subprogram and
 /// end the main program silently): NX's Mori SH8000 post writes `:0110 T01 M06` at a tool
 /// change. It is an error naming the word and what to write; an Okuma OSP file (`$NAME.MIN%`
-/// first) is an error saying that OSP is not read, not "unexpected character `$`".
+/// first) is an error saying that OSP is not read, not "unexpected character `$`", and a
+/// Heidenhain DIN/ISO program (`%123 G71 *`, NX's Mikron post) one naming Klartext, not "axis
+/// words without a motion mode" at its first `G90 Z-25. M91`.
 #[test]
-fn a_colon_inside_a_program_and_an_okuma_header_are_named() {
+fn a_colon_inside_a_program_and_okuma_and_din_iso_headers_are_named() {
     err_in(
         Dialect::Fanuc,
         "%\nO0001\nG0 X0. Y0. Z5.\n:0110 T01 M06\nG0 X1.\nM30\n",
         4,
         &["`:0110`", "N0110", "program number"],
     );
+    // A Heidenhain DIN/ISO program: its header says so, where its words would be misread.
+    for header in ["%123 G71 *", "% PART7 G70"] {
+        let text = format!("{header}\nN10 G30 G17 X+0 Y+0 Z-40 *\nN20 G90 Z-25. M91\n");
+        err_in(
+            Dialect::LinuxCnc,
+            &text,
+            1,
+            &["Heidenhain DIN/ISO", "Klartext"],
+        );
+    }
     for header in ["$FLANGE.MIN%", "$OKUMA.SSB%"] {
         let text = format!("{header}\n(OKUMA)\nG0 G90 X0 Y0\nVC1=2\nM02\n");
         for dialect in [Dialect::Fanuc, Dialect::LinuxCnc] {

@@ -393,6 +393,11 @@ fn starts_with_colon_number(line: &str) -> bool {
 ///   length, so every line keeps its number). A `:` word further down is not taken for a
 ///   program number (an `O` there starts a subprogram, which would end the main program
 ///   silently): the lexer names it as an error.
+/// * **Heidenhain DIN/ISO.** A TNC's ISO program starts `%NAME G71 *` (G70: inch), as NX's
+///   Mikron WF21D post writes it: the TNC's ISO dialect, not Fanuc's or LinuxCNC's (G70/G71
+///   are its units, G30/G31 the blank form, M91/M92 machine positions). That first line is an
+///   error saying so and naming Klartext, which feedopt reads, instead of an error further
+///   down about a word whose meaning differs.
 /// * **Okuma OSP.** An Okuma program file starts with `$NAME.MIN%` (`.SSB`, `.SDF`, `.LIB`
 ///   likewise): OSP's own language (`VC` variables, `CALL O…`, labels `N…` as jump targets,
 ///   `G15 H` work offsets), which feedopt does not read. That first line is an error saying so,
@@ -402,6 +407,28 @@ fn program_header<'t>(
     source: &Path,
     text: &'t str,
 ) -> Result<std::borrow::Cow<'t, str>> {
+    if let Some((index, line)) = text.lines().enumerate().find(|(_, l)| !l.trim().is_empty())
+        && let Some(rest) = line.trim().strip_prefix('%')
+    {
+        let words: Vec<&str> = rest.split_whitespace().filter(|w| *w != "*").collect();
+        if let [name, unit] = words[..]
+            && matches!(
+                unit.to_ascii_uppercase().trim_end_matches('*'),
+                "G70" | "G71"
+            )
+        {
+            return Err(crate::error::Error::parse(
+                source,
+                index + 1,
+                format!(
+                    "`%{name} {unit}` heads a Heidenhain DIN/ISO program, which feedopt does \
+                     not read (its G codes differ from Fanuc's and LinuxCNC's: G70/G71 \
+                     units, G30/G31 blank form, M91 machine positions): post the program \
+                     in Klartext (`BEGIN PGM {name} MM`)"
+                ),
+            ));
+        }
+    }
     let Some((index, line)) = first_code_line(text) else {
         return Ok(text.into());
     };
