@@ -1144,6 +1144,29 @@ fn a_system_variable_read_before_it_is_set_is_named_as_the_controls() {
     }
 }
 
+/// A MillMaster Pro program comments with `//`; a Haas shop program mills a circle with
+/// `G12 I0.75 F10. Z-1.2 D01`. Both were errors that did not say what to do ("unexpected
+/// character `/`", "not a Fanuc G code feedopt knows"); they now say it. A single leading `/`
+/// is still block delete, read as before.
+#[test]
+fn double_slash_comments_and_haas_g12_say_what_to_do() {
+    err(
+        "G21 G90\n// rest position -1, 0, 0.5\nG0 X0 Y0 Z1\n",
+        2,
+        &["`//` does not start a comment", "( … )"],
+    );
+    let tp = ok("G21 G90\nG0 X0 Y0 Z1\n/G0 X5\nG0 Y5\n");
+    assert_eq!(tp.points.len(), 3);
+    for g in ["G12", "G13"] {
+        err_in(
+            Dialect::Fanuc,
+            &format!("O1\nG0 G90 X0. Y0. Z1.\n{g} I0.75 F10. Z-1.2 D01\nM30\n"),
+            3,
+            &[g, "Haas circular pocket", "G2/G3"],
+        );
+    }
+}
+
 /// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
 /// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
 /// with a call the subroutine was "defined twice". An O number followed by an O-word keyword

@@ -752,6 +752,16 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("9", Action::Ignored),
         ("10", Action::SetOffset(OffsetNumbering::Fanuc)),
         ("11", Action::Ignored),
+        // Haas circular pocket milling (G12 clockwise, G13 counter-clockwise: I, K, Q, L, Z,
+        // D): a cycle whose lead-in and passes feedopt does not expand. Haas programs are read
+        // in this dialect, so the error names it rather than "not a Fanuc G code".
+        (
+            "12..13",
+            Unsup(
+                "Haas circular pocket milling (G12/G13) is not expanded: post the pocket as \
+                 G2/G3 moves",
+            ),
+        ),
         ("15", Action::Ignored),
         ("16", Unsup(TRANSFORM)),
         ("17", Action::Plane(Plane::Xy)),
