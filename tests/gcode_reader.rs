@@ -1035,6 +1035,138 @@ fn fanuc_only_words_tell_the_dialect() {
     assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
 }
 
+/// Fanuc's ISO code writes the program number with a colon, `:1234` for `O1234` (Fanuc
+/// operator's manuals, "Program number"; Fanuc 0 controls send `:` themselves, and NX's Fadal
+/// and Fanuc 0M posts write `:1234 (PROGRAM)`). Such a program was an error at its first block
+/// ("unexpected character `:`"); it now reads as the same program headed `O1234`, point for
+/// point and line for line (also with CRLF line ends), and is detected as Fanuc.
+#[test]
+fn a_colon_program_number_heads_a_fanuc_program_as_o_does() {
+    use feedopt::toolpath::gcode::detect_dialect;
+    let body = "G21 G90\nG0 X0. Y0. Z5.\nG1 Z-1. F100.\nM98 P2000 L2\nG0 Z5.\nM30\n\
+                O2000\nG91 G1 X5.\nG90\nM99\n%\n";
+    for eol in ["\n", "\r\n"] {
+        let with_o = format!("%\n(PART 7)\nO1234 (FLANGE)\n{body}").replace('\n', eol);
+        let with_colon = with_o.replace("O1234", ":1234");
+        assert_eq!(
+            detect_dialect(&with_colon.to_uppercase()),
+            Some(Dialect::Fanuc)
+        );
+        let a = ok_in(Dialect::Fanuc, &with_o);
+        let b = ok_in(Dialect::Fanuc, &with_colon);
+        // Two calls of O2000 (X +5 each) after the plunge: the subprogram is found, so the
+        // header split main and subprogram as `O1234` does.
+        let xs: Vec<f64> = b.points.iter().map(|p| p.p.x).collect();
+        assert_eq!(xs, vec![0.0, 0.0, 5.0, 10.0, 10.0]);
+        assert_eq!(a.points.len(), b.points.len());
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert_eq!(p.p, q.p);
+            assert_eq!(p.line, q.line);
+        }
+    }
+}
+
+/// A `:` word further down is not a program number (an `O` there would start a subprogram and
+/// end the main program silently): NX's Mori SH8000 post writes `:0110 T01 M06` at a tool
+/// change. It is an error naming the word and what to write; an Okuma OSP file (`$NAME.MIN%`
+/// first) is an error saying that OSP is not read, not "unexpected character `$`", and a
+/// Heidenhain DIN/ISO program (`%123 G71 *`, NX's Mikron post) one naming Klartext, not "axis
+/// words without a motion mode" at its first `G90 Z-25. M91`.
+#[test]
+fn a_colon_inside_a_program_and_okuma_and_din_iso_headers_are_named() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO0001\nG0 X0. Y0. Z5.\n:0110 T01 M06\nG0 X1.\nM30\n",
+        4,
+        &["`:0110`", "N0110", "program number"],
+    );
+    // A Heidenhain DIN/ISO program: its header says so, where its words would be misread.
+    for header in ["%123 G71 *", "% PART7 G70"] {
+        let text = format!("{header}\nN10 G30 G17 X+0 Y+0 Z-40 *\nN20 G90 Z-25. M91\n");
+        err_in(
+            Dialect::LinuxCnc,
+            &text,
+            1,
+            &["Heidenhain DIN/ISO", "Klartext"],
+        );
+    }
+    for header in ["$FLANGE.MIN%", "$OKUMA.SSB%"] {
+        let text = format!("{header}\n(OKUMA)\nG0 G90 X0 Y0\nVC1=2\nM02\n");
+        for dialect in [Dialect::Fanuc, Dialect::LinuxCnc] {
+            err_in(dialect, &text, 1, &["Okuma OSP", header]);
+        }
+    }
+}
+
+/// A lone `G71` or `G70` in a mill program's header (`G00G21G17G90G40G49G80` / `G71G91.1`, as
+/// hobby posts write it; NX's Fryer post `G40 G17 G90 G70`) means mm or inch on the control
+/// it was posted for. On LinuxCNC and Fanuc these are lathe cycles, and feedopt said "this
+/// canned cycle is not supported: post the toolpath as G0/G1/G2/G3", which tells the user
+/// nothing. The error now says what such a word means and what to write.
+#[test]
+fn g70_and_g71_as_units_are_named_with_what_to_write() {
+    let text = "G00G21G17G90G40G49G80\nG71G91.1\nG0 X0 Y0 Z5\nG1 Z-1 F100\nM30\n";
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        err_in(dialect, text, 2, &["G71", "lathe", "G20/G21"]);
+        err_in(dialect, &text.replace("G71", "G70"), 2, &["G70", "G20/G21"]);
+    }
+}
+
+/// A shop's Haas program tests a tool-life timer, `IF [#5405 GE 6000] THEN #3000=15`: the
+/// control holds #5405, the program never sets it. feedopt said only "read before it is set";
+/// it now says that the variable is the control's and what to do. A user parameter (`#100`)
+/// keeps the short message.
+#[test]
+fn a_system_variable_read_before_it_is_set_is_named_as_the_controls() {
+    let text = "O1\nG0 G90 X0. Y0. Z5.\nIF [#5405 GE 6000] THEN #3000=15\nM30\n";
+    err_in(
+        Dialect::Fanuc,
+        text,
+        3,
+        &["#5405", "system variable", "machine's"],
+    );
+    let text = "O1\nG0 G90 X#2001 Y0. Z5.\nM30\n";
+    err_in(
+        Dialect::Fanuc,
+        text,
+        2,
+        &["#2001", "Fanuc and Haas", "system variable"],
+    );
+    match parse(Path::new("u.nc"), "O1\nG0 X#100\n", Dialect::Fanuc) {
+        Err(Error::Parse { message, .. }) => {
+            assert!(
+                message.contains("`#100` is read before it is set"),
+                "{message}"
+            );
+            assert!(!message.contains("system"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A MillMaster Pro program comments with `//`; a Haas shop program mills a circle with
+/// `G12 I0.75 F10. Z-1.2 D01`. Both were errors that did not say what to do ("unexpected
+/// character `/`", "not a Fanuc G code feedopt knows"); they now say it. A single leading `/`
+/// is still block delete, read as before.
+#[test]
+fn double_slash_comments_and_haas_g12_say_what_to_do() {
+    err(
+        "G21 G90\n// rest position -1, 0, 0.5\nG0 X0 Y0 Z1\n",
+        2,
+        &["`//` does not start a comment", "( … )"],
+    );
+    let tp = ok("G21 G90\nG0 X0 Y0 Z1\n/G0 X5\nG0 Y5\n");
+    assert_eq!(tp.points.len(), 3);
+    for g in ["G12", "G13"] {
+        err_in(
+            Dialect::Fanuc,
+            &format!("O1\nG0 G90 X0. Y0. Z1.\n{g} I0.75 F10. Z-1.2 D01\nM30\n"),
+            3,
+            &[g, "Haas circular pocket", "G2/G3"],
+        );
+    }
+}
+
 /// A LinuxCNC file that defines its numbered subroutines first (`o100 sub` on line 1, the
 /// usual layout) was taken for Fanuc by its `O` number: `S` of `sub` then had no number, and
 /// with a call the subroutine was "defined twice". An O number followed by an O-word keyword

@@ -500,6 +500,14 @@ use Action::{
 use Address::{ArcCentre, Axis};
 
 const CANNED: &str = "this canned cycle is not supported: post the toolpath as G0/G1/G2/G3";
+/// G70/G71 on LinuxCNC (and Fanuc lathes) are turning cycles; on Siemens, Fagor, Heidenhain
+/// ISO and Beckhoff controls, and Fanuc lathes in G-code system B/C, they select inch/mm.
+/// Hobby and NX posts write a lone `G71` (Vectric-style `G71G91.1` headers, NX's Fryer post
+/// `G70`) in that second sense, which a LinuxCNC or Fanuc mill would refuse too.
+const G70_71: &str = "not a unit on this control: G70/G71 are lathe cycles here (finishing, \
+                      roughing), which feedopt does not expand. A post that writes G70/G71 for \
+                      inch/mm (as Siemens, Fagor and Heidenhain ISO controls read them) means \
+                      G20/G21: write those instead (a Siemens program: --dialect sinumerik)";
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution is not supported";
@@ -628,7 +636,8 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("61", Action::Ignored),
         ("61.1", Action::Ignored),
         ("64", Action::ContourTolerance),
-        ("70..72", Unsup(CANNED)),
+        ("70..71", Unsup(G70_71)),
+        ("72", Unsup(CANNED)),
         ("73", Action::Cycle(73)),
         ("74", Action::Cycle(74)),
         (
@@ -744,6 +753,16 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("9", Action::Ignored),
         ("10", Action::SetOffset(OffsetNumbering::Fanuc)),
         ("11", Action::Ignored),
+        // Haas circular pocket milling (G12 clockwise, G13 counter-clockwise: I, K, Q, L, Z,
+        // D): a cycle whose lead-in and passes feedopt does not expand. Haas programs are read
+        // in this dialect, so the error names it rather than "not a Fanuc G code".
+        (
+            "12..13",
+            Unsup(
+                "Haas circular pocket milling (G12/G13) is not expanded: post the pocket as \
+                 G2/G3 moves",
+            ),
+        ),
         ("15", Action::Ignored),
         ("16", Unsup(TRANSFORM)),
         ("17", Action::Plane(Plane::Xy)),
@@ -795,6 +814,7 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("68", Unsup(TRANSFORM)),
         ("68.2", Action::TiltedPlane),
         ("69", Action::TiltedPlaneCancel),
+        ("70..71", Unsup(G70_71)),
         ("73", Action::Cycle(73)),
         ("74", Action::Cycle(74)),
         ("75", Unsup(CANNED)),

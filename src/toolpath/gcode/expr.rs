@@ -14,7 +14,8 @@
 //! brackets (Fanuc, LinuxCNC), and the functions `SIN COS TAN` (degrees), `SQRT ABS ATAN`
 //! (`ATAN[y]/[x]` as Fanuc writes it is not read: an error), `ROUND TRUNC`. A variable read
 //! before it has a value (Fanuc `#100` never assigned, a name never declared) is an error
-//! naming it; so is a result that is not a finite number. Expressions are at most
+//! naming it (a system variable, `#1000` and up, with a word on what it is: the control's
+//! value, which a program cannot be followed without); so is a result that is not a finite number. Expressions are at most
 //! [`MAX_EXPRESSION_LEN`] characters and nest at most [`MAX_DEPTH`] deep, so evaluation is
 //! bounded.
 
@@ -135,12 +136,34 @@ impl Variables {
         if is_r_parameter(&name) {
             return Ok(0.0); // Sinumerik R parameters start at 0
         }
-        Err(if name.starts_with('#') || is_q_parameter(&name) {
+        Err(if let Some(n) = system_variable(&name) {
+            let which = if n >= 5000 {
+                "one of the control's system variables (#1000 and up on Fanuc and Haas, #5000 \
+                 and up on LinuxCNC: positions, offsets, tool data)"
+            } else {
+                "on Fanuc and Haas controls one of the system variables (#1000 and up: tool \
+                 data, alarms, modal states, positions)"
+            };
+            format!(
+                "parameter `{name}` is read before it is set: #{n} is {which}, whose value is \
+                 the machine's, not the program's. Set it earlier in the program, or remove \
+                 the test or move that reads it"
+            )
+        } else if name.starts_with('#') || is_q_parameter(&name) {
             format!("parameter `{name}` is read before it is set")
         } else {
             format!("`{name}` is not a number nor a variable the program defines (DEF)")
         })
     }
+}
+
+/// The number of a Fanuc/LinuxCNC numbered parameter `#n` with n ≥ 1000: a system variable,
+/// which the control sets (Fanuc: #1000– interface signals, #2000– tool offsets, #3000 alarm,
+/// #4000– modal information, #5000– positions; Haas: #5401– tool timers and the like;
+/// LinuxCNC: #5061– probe results, #5161– G28 home, #5221– work offsets).
+fn system_variable(name: &str) -> Option<u64> {
+    let n: u64 = name.strip_prefix('#')?.parse().ok()?;
+    (n >= 1000).then_some(n)
 }
 
 /// `R` followed by 1–3 digits (Sinumerik R parameters).

@@ -256,6 +256,28 @@ fn lex_letters(
         if !c.is_ascii_alphabetic() {
             return Err(match c {
                 '[' | ']' => "an expression `[ … ]` must follow a letter or `=`".to_string(),
+                // Block delete `/` is read at the start of a block (`super::interp`); a second
+                // one or one further in is not G-code (MillMaster Pro programs comment with
+                // `//`).
+                '/' => "`/` inside a block: block delete `/` (or `/1` … `/9`) is read only at \
+                        the start of a block, and `//` does not start a comment in G-code: \
+                        write comments in `( … )` or after `;`"
+                    .to_string(),
+                // ISO code's program number (`:1234` for `O1234`) is read where it heads a
+                // Fanuc program (`super::program_header`); anywhere else it is not taken for
+                // one, since a program number there would start a subprogram.
+                ':' => {
+                    let digits: String = chars[i + 1..]
+                        .iter()
+                        .take_while(|c| c.is_ascii_digit())
+                        .collect();
+                    format!(
+                        "`:{digits}`: a `:` word inside the program; feedopt reads `:` only as \
+                         the program number heading a Fanuc program (ISO code's `:1234` for \
+                         `O1234`). If it numbers this block (a post's mark at a tool change), \
+                         write `N{digits}`"
+                    )
+                }
                 _ => format!("unexpected character `{c}`"),
             });
         }

@@ -354,7 +354,8 @@ pub fn parse_configured(
     settings: &Settings,
 ) -> Result<(Toolpath, Assumed)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let program = Program::scan(spec, source, text)?;
+    let text = program_header(spec, source, text)?;
+    let program = Program::scan(spec, source, &text)?;
     let mut interp = Interpreter::new(spec, source, machine);
     interp.procs = program.proc_names();
     interp.cycle_aliases = settings.cycle_aliases.clone();
@@ -369,11 +370,104 @@ pub fn parse_configured(
         .map(|toolpath| (toolpath, assumed))
 }
 
+/// The first line of a program that holds code: not blank, not a `%` line, not a `( … )`
+/// comment line. Returns its 0-based index and its text.
+fn first_code_line(text: &str) -> Option<(usize, &str)> {
+    text.lines().enumerate().find(|(_, l)| {
+        let l = l.trim();
+        !l.is_empty() && !l.starts_with('%') && !l.starts_with('(')
+    })
+}
+
+/// Whether a (trimmed) line starts with ISO code's program number `:1234`.
+fn starts_with_colon_number(line: &str) -> bool {
+    line.strip_prefix(':')
+        .is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit()))
+}
+
+/// What the head of a program says before its blocks are read.
+///
+/// * **ISO code's program number.** Fanuc's program number is `O1234`, and "in ISO code, the
+///   colon (`:`) can be used instead of O" (Fanuc operator's manuals, "Program number";
+///   older Fanuc 0 and 6 controls punch and send `:` on their own, and NX's posts for Fadal and
+///   Fanuc 0M write `:1234 (PROGRAM)`). In a dialect whose programs are headed `O1234`
+///   ([`Subprograms::OPrograms`]), a first code line `:1234` is read as `O1234` (the same
+///   length, so every line keeps its number). A `:` word further down is not taken for a
+///   program number (an `O` there starts a subprogram, which would end the main program
+///   silently): the lexer names it as an error.
+/// * **Heidenhain DIN/ISO.** A TNC's ISO program starts `%NAME G71 *` (G70: inch), as NX's
+///   Mikron WF21D post writes it: the TNC's ISO dialect, not Fanuc's or LinuxCNC's (G70/G71
+///   are its units, G30/G31 the blank form, M91/M92 machine positions). That first line is an
+///   error saying so and naming Klartext, which feedopt reads, instead of an error further
+///   down about a word whose meaning differs.
+/// * **Okuma OSP.** An Okuma program file starts with `$NAME.MIN%` (`.SSB`, `.SDF`, `.LIB`
+///   likewise): OSP's own language (`VC` variables, `CALL O…`, labels `N…` as jump targets,
+///   `G15 H` work offsets), which feedopt does not read. That first line is an error saying so,
+///   not "unexpected character `$`".
+fn program_header<'t>(
+    spec: &DialectSpec,
+    source: &Path,
+    text: &'t str,
+) -> Result<std::borrow::Cow<'t, str>> {
+    if let Some((index, line)) = text.lines().enumerate().find(|(_, l)| !l.trim().is_empty())
+        && let Some(rest) = line.trim().strip_prefix('%')
+    {
+        let words: Vec<&str> = rest.split_whitespace().filter(|w| *w != "*").collect();
+        if let [name, unit] = words[..]
+            && matches!(
+                unit.to_ascii_uppercase().trim_end_matches('*'),
+                "G70" | "G71"
+            )
+        {
+            return Err(crate::error::Error::parse(
+                source,
+                index + 1,
+                format!(
+                    "`%{name} {unit}` heads a Heidenhain DIN/ISO program, which feedopt does \
+                     not read (its G codes differ from Fanuc's and LinuxCNC's: G70/G71 \
+                     units, G30/G31 blank form, M91 machine positions): post the program \
+                     in Klartext (`BEGIN PGM {name} MM`)"
+                ),
+            ));
+        }
+    }
+    let Some((index, line)) = first_code_line(text) else {
+        return Ok(text.into());
+    };
+    let trimmed = line.trim();
+    if let Some(name) = trimmed.strip_prefix('$')
+        && let Some((name, _)) = name.split_once('%')
+        && name.contains('.')
+        && !name.contains(char::is_whitespace)
+    {
+        return Err(crate::error::Error::parse(
+            source,
+            index + 1,
+            format!(
+                "`${name}%` heads an Okuma OSP program file; OSP's language (VC variables, \
+                 CALL, G15 H work offsets) is not read by feedopt: post the toolpath for a \
+                 Fanuc, LinuxCNC, Sinumerik or Heidenhain control"
+            ),
+        ));
+    }
+    if spec.subprograms == Subprograms::OPrograms && starts_with_colon_number(trimmed) {
+        // The line's start in the text (`lines()` drops `\n` and `\r\n` line ends).
+        let start: usize = text.split_inclusive('\n').take(index).map(str::len).sum();
+        let colon = start + (line.len() - line.trim_start().len());
+        let mut owned = String::with_capacity(text.len());
+        owned.push_str(&text[..colon]);
+        owned.push('O');
+        owned.push_str(&text[colon + 1..]);
+        return Ok(owned.into());
+    }
+    Ok(text.into())
+}
+
 /// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
 /// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
 /// `G05.1`, `M98`, look-ahead `G08 P…`, macro calls `G65 P…`, Haas `G187`, a first block
-/// `O1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
+/// `O1234` or ISO code's `:1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
 /// by an O-word keyword: `o100 sub`, `o100 call`, `o101 if`, …, which is not a Fanuc program
 /// number).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
@@ -399,9 +493,10 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
             })
             .is_some_and(|l| {
                 let l = l.trim();
-                l.starts_with('O')
+                (l.starts_with('O')
                     && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
-                    && !is_oword_control(l)
+                    && !is_oword_control(l))
+                    || starts_with_colon_number(l)
             });
     let linuxcnc = ["M428", "M429", "M430", "O<"].iter().any(|w| has(w))
         || upper.lines().any(is_oword_control);
