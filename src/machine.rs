@@ -43,6 +43,7 @@
 //! | `type` | axes | parameters |
 //! |---|---|---|
 //! | `xyz` | X Y Z | – |
+//! | `xyza`, `xyzb`, `xyzc` | X Y Z and A, B or C | – (programmed in machine coordinates: X Y Z and the angle are the axes' positions, [`KinematicsSpec::FourthAxis`]) |
 //! | `head_head` | X Y Z C A | `tool_length` (> 0) |
 //! | `table_table_ac` | X Y Z A C | LinuxCNC xyzac-trt: `x-rot-point`, `y-rot-point`, `z-rot-point`, `y-offset`, `z-offset` (required); `tool-offset` (0), `conventional-directions` (false), `work-offset` ([0, 0, 0]) |
 //! | `table_table_bc` | X Y Z B C | LinuxCNC xyzbc-trt: the same with `x-offset` instead of `y-offset` |
@@ -123,6 +124,37 @@ impl Axis {
         let (lo, hi) = self.travel?;
         let tol = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
         (!(lo - tol..=hi + tol).contains(&x)).then_some((lo, hi))
+    }
+}
+
+/// The rotary axis of a four-axis machine ([`KinematicsSpec::FourthAxis`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FourthAxis {
+    /// A, about X (a rotary table or indexer on a mill's or router's table).
+    A,
+    /// B, about Y (a horizontal machining centre's table).
+    B,
+    /// C, about Z.
+    C,
+}
+
+impl FourthAxis {
+    /// The axis letter.
+    pub fn letter(self) -> &'static str {
+        match self {
+            FourthAxis::A => "A",
+            FourthAxis::B => "B",
+            FourthAxis::C => "C",
+        }
+    }
+
+    /// Its index in a program's `[A, B, C]` rotary words.
+    pub fn index(self) -> usize {
+        match self {
+            FourthAxis::A => 0,
+            FourthAxis::B => 1,
+            FourthAxis::C => 2,
+        }
     }
 }
 
@@ -212,6 +244,11 @@ pub enum KinematicsSpec {
     /// A joint-space path (CSV of axis positions along a parameter s): any axes, named as in
     /// the CSV's `q_<axis>` columns, in the file's order; no feed limit applies.
     Joint,
+    /// Three linear axes and a fourth, rotary one (`xyza`, `xyzb`, `xyzc`: a rotary table or
+    /// indexer), programmed in machine coordinates: a program's X Y Z and angle are the axes'
+    /// positions, each block a straight move of all four (no tool-tip mode). The path is the
+    /// axes' own, so the feed cap applies to X Y Z's speed and the rotary axis follows.
+    FourthAxis(FourthAxis),
 }
 
 impl KinematicsSpec {
@@ -228,6 +265,9 @@ impl KinematicsSpec {
             },
             KinematicsSpec::HeadTable { .. } => &["X", "Y", "Z", "B", "C"],
             KinematicsSpec::Dresser { .. } => &["X", "Z", "B"],
+            KinematicsSpec::FourthAxis(FourthAxis::A) => &["X", "Y", "Z", "A"],
+            KinematicsSpec::FourthAxis(FourthAxis::B) => &["X", "Y", "Z", "B"],
+            KinematicsSpec::FourthAxis(FourthAxis::C) => &["X", "Y", "Z", "C"],
             KinematicsSpec::Joint => &[],
         }
     }
@@ -768,6 +808,14 @@ impl Parser {
                 self.only_known(obj, "kinematics", &["type"])?;
                 Ok(KinematicsSpec::Joint)
             }
+            Some(t @ ("xyza" | "xyzb" | "xyzc")) => {
+                self.only_known(obj, "kinematics", &["type"])?;
+                Ok(KinematicsSpec::FourthAxis(match t {
+                    "xyza" => FourthAxis::A,
+                    "xyzb" => FourthAxis::B,
+                    _ => FourthAxis::C,
+                }))
+            }
             Some("head_head") => {
                 self.only_known(obj, "kinematics", &["type", "tool_length"])?;
                 let tool_length =
@@ -795,9 +843,9 @@ impl Parser {
             _ => Err(self.err(
                 "kinematics.type",
                 format!(
-                    "unknown kinematics {ty} (expected \"xyz\", \"head_head\", \
-                     \"table_table_ac\", \"table_table_bc\", \"table_table_ab\", \
-                     \"head_table\", \"dresser\" or \"joint\")"
+                    "unknown kinematics {ty} (expected \"xyz\", \"xyza\", \"xyzb\", \"xyzc\", \
+                     \"head_head\", \"table_table_ac\", \"table_table_bc\", \
+                     \"table_table_ab\", \"head_table\", \"dresser\" or \"joint\")"
                 ),
             )),
         }
@@ -1069,7 +1117,7 @@ impl Machine {
         let length = |field: &str, x: f64| plausible_length(x).map_err(|r| bad(field, r));
         let kin = &self.kinematics;
         match kin {
-            KinematicsSpec::Xyz | KinematicsSpec::Joint => {}
+            KinematicsSpec::Xyz | KinematicsSpec::Joint | KinematicsSpec::FourthAxis(_) => {}
             KinematicsSpec::HeadHead { tool_length } => {
                 length("kinematics.tool_length", *tool_length)?;
                 if *tool_length <= 0.0 {

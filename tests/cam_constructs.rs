@@ -127,6 +127,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         program_units: None,
         decimal_point_input: None,
         feed_diameter: [None; 3],
+        machine_coordinates: false,
     }
 }
 

@@ -97,6 +97,9 @@ pub enum Kinematics {
         /// Number of axes.
         n: usize,
     },
+    /// X Y Z and a rotary axis, in machine coordinates ([`KinematicsSpec::FourthAxis`]): the
+    /// path is (X, Y, Z, θ) itself, θ the rotary axis's position; the tool axis is +z there.
+    FourthAxis(crate::machine::FourthAxis),
 }
 
 impl Kinematics {
@@ -117,6 +120,7 @@ impl Kinematics {
             KinematicsSpec::Joint => Kinematics::Joint {
                 n: machine.axes.len(),
             },
+            KinematicsSpec::FourthAxis(r) => Kinematics::FourthAxis(r),
         }
     }
 
@@ -124,6 +128,7 @@ impl Kinematics {
     pub fn n_axes(&self) -> usize {
         match self {
             Kinematics::Xyz | Kinematics::Dresser(_) => 3,
+            Kinematics::FourthAxis(_) => 4,
             Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_) => 5,
             Kinematics::Joint { n } => *n,
         }
@@ -142,13 +147,14 @@ impl Kinematics {
                 [Some(3), Some(4)]
             }
             Kinematics::Dresser(_) => [Some(2), None],
+            Kinematics::FourthAxis(_) => [Some(3), None],
         }
     }
 
     /// The path angles (radians) of rotary axis positions `[A, B, C]` in degrees as a program
     /// gives them (never reduced modulo 360°): (C, A) for head_head, (A, C) for
     /// table_table_ac, (B, C) for table_table_bc and head_table, (A, B) for table_table_ab,
-    /// (B, 0) for the dresser, zero for xyz and joint.
+    /// (B, 0) for the dresser, (its angle, 0) for a fourth axis, zero for xyz and joint.
     pub fn angles_from_rotary(&self, rotary: [f64; 3]) -> [f64; 2] {
         let [a, b, c] = rotary.map(f64::to_radians);
         match self {
@@ -161,15 +167,16 @@ impl Kinematics {
             },
             Kinematics::HeadTable(_) => [b, c],
             Kinematics::Dresser(_) => [b, 0.0],
+            Kinematics::FourthAxis(r) => [[a, b, c][r.index()], 0.0],
         }
     }
 
-    /// The unit tool axis in program coordinates for path angles in radians (+z for xyz and
-    /// joint).
+    /// The unit tool axis in program coordinates for path angles in radians (+z for xyz, joint
+    /// and a fourth axis, whose program coordinates are the machine's).
     pub fn tool_axis(&self, angles: [f64; 2]) -> Vector3<f64> {
         let [a0, a1] = angles;
         match self {
-            Kinematics::Xyz | Kinematics::Joint { .. } => Vector3::z(),
+            Kinematics::Xyz | Kinematics::Joint { .. } | Kinematics::FourthAxis(_) => Vector3::z(),
             Kinematics::HeadHead { .. } => head_head::orientation(a0, a1),
             Kinematics::TableTable(t) => t.tool_axis(a0, a1),
             Kinematics::HeadTable(h) => h.tool_axis(a0, a1),
@@ -191,6 +198,11 @@ impl Kinematics {
             Kinematics::TableTable(t) => t.forward(q),
             Kinematics::HeadTable(h) => h.forward(q),
             Kinematics::Dresser(d) => d.forward(q),
+            Kinematics::FourthAxis(_) => ToolPose {
+                p: Vector3::new(q[0], q[1], q[2]),
+                k: Vector3::z(),
+                angles: [q[3].to_radians(), 0.0],
+            },
             Kinematics::Joint { .. } => return None,
         })
     }
@@ -219,6 +231,7 @@ impl Kinematics {
         let names = match self {
             Kinematics::Xyz | Kinematics::Joint { .. } => return Ok(vec![[0.0; 2]; points.len()]),
             Kinematics::Dresser(d) => return dresser_angles(d, points, travel[0]),
+            Kinematics::FourthAxis(r) => return fourth_axis_angles(*r, points, travel[0]),
             Kinematics::HeadHead { .. } => {
                 return self.follow(points, &lines, head_head::layout(travel));
             }
@@ -269,6 +282,12 @@ impl Kinematics {
             Kinematics::TableTable(t) => t.axis_positions(w, out),
             Kinematics::HeadTable(h) => h.axis_positions(w, out),
             Kinematics::Dresser(d) => d.axis_positions(w, out),
+            Kinematics::FourthAxis(_) => {
+                out[0] = w[0];
+                out[1] = w[1];
+                out[2] = w[2];
+                out[3] = w[3].scale(rad_to_deg());
+            }
             Kinematics::Joint { n } => out[..*n].copy_from_slice(&w[..*n]),
         }
     }
@@ -356,6 +375,47 @@ impl Effective {
         }
         Some(e)
     }
+}
+
+/// A fourth axis's angle at every CL point: its programmed position (0 where the program never
+/// turns it), which must lie within its travel; a tool vector other than +z is an error (such a
+/// machine's program coordinates are its own, the tool always along +z).
+fn fourth_axis_angles(
+    r: crate::machine::FourthAxis,
+    points: &[ClPoint],
+    travel: Option<(f64, f64)>,
+) -> Result<Vec<[f64; 2]>> {
+    points
+        .iter()
+        .map(|p| {
+            let line = p.line;
+            if (p.o - Vector3::z()).norm() > 1e-9 {
+                return Err(Error::Infeasible(format!(
+                    "CL point at line {line}: a tool vector ({}, {}, {}) on a machine of type \
+                     xyz{}, whose tool stays along +Z (its programs give the {} axis's \
+                     position instead)",
+                    p.o.x,
+                    p.o.y,
+                    p.o.z,
+                    r.letter().to_ascii_lowercase(),
+                    r.letter()
+                )));
+            }
+            let theta = p.rotary.map_or(0.0, |q| q[r.index()].to_radians());
+            if !branch::within(theta, travel) {
+                let (lo, hi) = travel.unwrap_or_default();
+                return Err(Error::Infeasible(format!(
+                    "CL point at line {line}: programmed {} = {}° is outside its travel \
+                     [{}, {}]°",
+                    r.letter(),
+                    theta.to_degrees(),
+                    lo.to_degrees(),
+                    hi.to_degrees()
+                )));
+            }
+            Ok([theta, 0.0])
+        })
+        .collect()
 }
 
 /// The dresser's B along the path: programmed, or the profile normal's angle unwrapped nearest

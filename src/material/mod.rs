@@ -242,6 +242,22 @@ pub fn tool_axes<'a>(
     machine: &crate::machine::Machine,
 ) -> Result<std::borrow::Cow<'a, Toolpath>> {
     use crate::kinematics::Kinematics;
+    if let crate::machine::KinematicsSpec::FourthAxis(r) = machine.kinematics
+        && let Some(p) = tp
+            .points
+            .iter()
+            .find(|p| p.rotary.is_some_and(|q| q[r.index()] != 0.0))
+    {
+        // The part turns with the axis: its coordinates are not the program's (machine) ones.
+        return Err(Error::Usage(format!(
+            "{}: line {} turns the {} axis, and with it the part; the material model cuts in the \
+             part's coordinates, which a four-axis program (in machine coordinates) does not \
+             give: leave out the stock",
+            tp.source.display(),
+            p.line,
+            r.letter()
+        )));
+    }
     if machine.kinematics == crate::machine::KinematicsSpec::Joint
         || !tp.points.iter().any(|p| p.rotary.is_some())
     {

@@ -325,6 +325,10 @@ pub struct MachineContext {
     /// The diameter (mm) at which the control turns a G94 feed into degrees, per rotary axis
     /// A B C, where the machine file gives it (`axes.C.feed_diameter`; Haas settings 34/79).
     pub feed_diameter: [Option<f64>; 3],
+    /// The machine is programmed in machine coordinates (a four-axis machine,
+    /// [`KinematicsSpec::FourthAxis`]): X Y Z and the angle are the axes' positions, not a tool
+    /// tip, and it has no tool-tip mode.
+    pub machine_coordinates: bool,
 }
 
 impl MachineContext {
@@ -372,6 +376,7 @@ impl MachineContext {
             }),
             program_units: references.program_units,
             decimal_point_input: references.decimal_point_input,
+            machine_coordinates: matches!(machine.kinematics, KinematicsSpec::FourthAxis(_)),
             feed_diameter: std::array::from_fn(|i| {
                 references
                     .feed_diameter

@@ -45,7 +45,8 @@
 //! | fanuc | `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
 //! | sinumerik | `G710 G90 G17` | `TRAORI` / `TRAFOOF` | `; …` | `M30` |
 //!
-//! TCP is switched on only on machines with rotary axes; X Y Z are then the tool tip and the
+//! TCP is switched on only on machines with rotary axes, and not on a four-axis machine
+//! (`xyza`, `xyzb`, `xyzc`), whose programs are in machine coordinates; X Y Z are then the tool tip and the
 //! rotary words (named as the machine's axes: C and A on the head_head, A/B and C on trunnions,
 //! B on the dresser) the machine's rotary positions in degrees, unwrapped as the schedule
 //! follows them. Coordinates carry 6 decimals (1 nm, 1 µ°), always with a decimal point (a
@@ -496,7 +497,13 @@ pub fn program(
     for h in w.header {
         let _ = writeln!(text, "{h}");
     }
-    if !rotary.is_empty() {
+    // A four-axis machine is programmed in machine coordinates: no tool-tip mode.
+    let tcp = !rotary.is_empty()
+        && !matches!(
+            machine.kinematics,
+            crate::machine::KinematicsSpec::FourthAxis(_)
+        );
+    if tcp {
         let _ = writeln!(text, "{}", w.tcp_on);
     }
     let first = &nodes[keep[0]];
@@ -543,7 +550,7 @@ pub fn program(
     if inverse_mode {
         let _ = writeln!(text, "G94");
     }
-    if !rotary.is_empty() {
+    if tcp {
         let _ = writeln!(text, "{}", w.tcp_off);
     }
     for f in w.footer {

@@ -364,6 +364,23 @@ impl<'a> Interpreter<'a> {
         );
     }
 
+    /// Tool-tip mode on a machine programmed in machine coordinates (a four-axis machine) is
+    /// an error: its X Y Z are read as the axes' positions, which a tool-tip program's are not.
+    pub(super) fn no_tcp_on_machine_coordinates(&self, line: usize) -> Result<()> {
+        match self.machine {
+            Some(m) if m.machine_coordinates => Err(self.error(
+                line,
+                format!(
+                    "tool-tip mode (TCP) on a four-axis machine, whose programs feedopt reads \
+                     in machine coordinates (X Y Z and the angle as the axes' positions): give \
+                     a five-axis kinematics in {} for a tool-tip program",
+                    m.file.display()
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+
     fn error(&self, line: usize, message: impl Into<String>) -> Error {
         Error::parse(self.source, line, message)
     }
@@ -863,6 +880,9 @@ impl<'a> Interpreter<'a> {
                 Action::Distance(d) => self.distance = d,
                 Action::ArcDistance(d) => self.arc_distance = d,
                 Action::Tcp(t) => {
+                    if t == Tcp::On {
+                        self.no_tcp_on_machine_coordinates(line)?;
+                    }
                     if t != self.tcp {
                         self.non_tcp_warned = false;
                     }
@@ -2313,6 +2333,7 @@ impl<'a> Interpreter<'a> {
 
         if self.tcp == Tcp::Off
             && !self.non_tcp_warned
+            && !self.machine.is_some_and(|m| m.machine_coordinates)
             && !block.plane_rotary.iter().any(|&q| q)
             && (end[3..] != [0.0; 3]
                 || block.axes[3..].iter().any(Option::is_some)
@@ -2322,7 +2343,8 @@ impl<'a> Interpreter<'a> {
             self.warn(
                 line,
                 "motion with rotary axes or a tool vector outside tool-tip (TCP) mode: X Y Z \
-                 taken as the tool tip",
+                 taken as the tool tip (a four-axis machine's program, in machine \
+                 coordinates, needs kinematics xyza, xyzb or xyzc)",
             );
         }
 

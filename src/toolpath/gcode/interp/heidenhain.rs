@@ -813,6 +813,7 @@ impl Interpreter<'_> {
                  rotary axes interpolate it (PATHCTRL AXIS)",
             );
         }
+        self.no_tcp_on_machine_coordinates(line)?;
         if self.tcp != Tcp::On {
             self.non_tcp_warned = false;
         }

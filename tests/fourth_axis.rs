@@ -1,0 +1,209 @@
+//! Four-axis machines (`xyza`, `xyzb`, `xyzc`): programs in machine coordinates, X Y Z and the
+//! angle the axes' own positions, each block a straight move of all four.
+
+use std::path::Path;
+
+use feedopt::machine::{Machine, references_from_json};
+use feedopt::optimize::{Options, Solution, optimize};
+use feedopt::toolpath::gcode::{Dialect, parse_for};
+use feedopt::toolpath::{MachineContext, Toolpath};
+
+/// A VMC with a rotary table on `letter` (A 100 °/s, 500 °/s²).
+fn machine_json(letter: char) -> String {
+    format!(
+        r#"{{"name": "4-axis", "kinematics": {{"type": "xyz{}"}},
+            "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
+                     "Y": {{"velocity": 500, "acceleration": 3000}},
+                     "Z": {{"velocity": 500, "acceleration": 3000}},
+                     "{letter}": {{"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}},
+            "feed": {{"max": 500}}}}"#,
+        letter.to_ascii_lowercase()
+    )
+}
+
+fn setup(letter: char) -> (Machine, MachineContext) {
+    let text = machine_json(letter);
+    let m = Machine::from_json(Path::new("m.json"), &text).unwrap();
+    let refs = references_from_json(Path::new("m.json"), &text, &m).unwrap();
+    let ctx = MachineContext::new(&m, &refs);
+    (m, ctx)
+}
+
+fn read(ctx: &MachineContext, dialect: Dialect, program: &str) -> feedopt::error::Result<Toolpath> {
+    parse_for(Path::new("p.nc"), program, dialect.spec(), Some(ctx))
+}
+
+fn solve(m: &Machine, tp: &Toolpath) -> Solution {
+    let s = optimize(m, tp, &Options::default()).unwrap();
+    assert!(s.verification.verified, "{:?}", s.verification);
+    s
+}
+
+/// A rapid turn of the table alone, rest to rest: the axis's trapezoidal profile in closed
+/// form, v/a + d/v = 0.2 + 0.9 s for 90° at 100 °/s and 500 °/s²; on every letter.
+#[test]
+fn a_table_turn_alone_takes_the_axis_own_closed_form_time() {
+    for (letter, k) in [('A', 3), ('B', 3), ('C', 3)] {
+        let (m, ctx) = setup(letter);
+        let tp = read(
+            &ctx,
+            Dialect::LinuxCnc,
+            &format!("G21 G90 G94\nG0 X0 Y0 Z0 {letter}0\nG0 {letter}90\nM2\n"),
+        )
+        .unwrap();
+        let s = solve(&m, &tp);
+        let want = 100.0 / 500.0 + 90.0 / 100.0;
+        assert!(
+            (s.schedule.cycle_time - want).abs() < 1e-6 * want,
+            "{letter}: {} s, want {want} s",
+            s.schedule.cycle_time
+        );
+        let last = s.schedule.stations.len() - 1;
+        assert!((s.schedule.q(last)[k] - 90.0).abs() < 1e-9);
+        assert!(
+            tp.warnings.iter().all(|w| !w.message.contains("tool tip")),
+            "{:?}",
+            tp.warnings
+        );
+    }
+}
+
+/// X and A in one block move together, linearly in each other (the control interpolates the
+/// axes, not a tool tip on the turning part), while Y and Z stay where the program left them;
+/// F (LinuxCNC: along X Y Z) holds the block to at least 50 mm / 10 mm/s.
+#[test]
+fn a_block_moves_the_axes_straight_and_leaves_the_others() {
+    let (m, ctx) = setup('A');
+    let tp = read(
+        &ctx,
+        Dialect::LinuxCnc,
+        "G21 G90 G94\nG0 X0 Y5 Z10 A0\nG1 X50 A180 F600\nM2\n",
+    )
+    .unwrap();
+    let s = solve(&m, &tp);
+    assert!(s.schedule.cycle_time > 5.0, "{}", s.schedule.cycle_time);
+    let mut moved = 0;
+    for i in 0..s.schedule.stations.len() {
+        let q = s.schedule.q(i);
+        assert!(
+            (q[1] - 5.0).abs() < 1e-6 && (q[2] - 10.0).abs() < 1e-6,
+            "station {i}: {q:?}"
+        );
+        if q[0] > 1e-9 {
+            moved += 1;
+            assert!(
+                (q[3] / 180.0 - q[0] / 50.0).abs() < 1e-6,
+                "station {i}: {q:?}"
+            );
+        }
+    }
+    assert!(moved > 10);
+}
+
+/// Tool-tip mode, a tool vector or a stock on a turning part cannot be read in machine
+/// coordinates: each is an error naming where.
+#[test]
+fn tool_tip_mode_tool_vectors_and_a_turning_stock_are_refused() {
+    let (m, ctx) = setup('A');
+    let e = read(
+        &ctx,
+        Dialect::Fanuc,
+        "G21 G90 G94\nG0 X0. Y0. Z0. A0.\nG43.4 H1\nG1 X10. A20. F600.\nM30\n",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("p.nc:3") && e.contains("tool-tip mode"), "{e}");
+    let e = read(
+        &ctx,
+        Dialect::LinuxCnc,
+        "G21 G90 G94\nG0 X0 Y0 Z0 A0\nM428\nG1 X10 A20 F600\nM2\n",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("p.nc:3") && e.contains("tool-tip mode"), "{e}");
+    // An APT program's tool vectors: the tool of a four-axis machine stays along +Z.
+    let apt = feedopt::toolpath::apt::parse(
+        Path::new("p.cls"),
+        "MULTAX/ON\nFEDRAT/MMPM,600\nGOTO/0,0,10,0,0,1\nGOTO/10,0,10,0,0.6,0.8\nFINI\n",
+    )
+    .unwrap();
+    let e = optimize(&m, &apt, &Options::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 4") && e.contains("tool vector"), "{e}");
+    // The material model: a program that turns A turns the part.
+    let tp = read(
+        &ctx,
+        Dialect::LinuxCnc,
+        "G21 G90 G94\nG0 X0 Y0 Z0 A0\nG1 X10 A20 F600\nM2\n",
+    )
+    .unwrap();
+    let e = feedopt::material::tool_axes(&tp, &m)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 3") && e.contains("A axis"), "{e}");
+    // One that never turns it is in the part's coordinates: read as it is.
+    let tp = read(
+        &ctx,
+        Dialect::LinuxCnc,
+        "G21 G90 G94\nG0 X0 Y0 Z0\nG1 X10 F600\nM2\n",
+    )
+    .unwrap();
+    assert!(feedopt::material::tool_axes(&tp, &m).is_ok());
+}
+
+/// The machine file: `xyza`, `xyzb`, `xyzc` take X Y Z and that axis, no other.
+#[test]
+fn four_axis_machine_files_name_their_axes() {
+    for letter in ['A', 'B', 'C'] {
+        let m = Machine::from_json(Path::new("m.json"), &machine_json(letter)).unwrap();
+        let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+        assert_eq!(names, vec!["X", "Y", "Z", &letter.to_string()[..]]);
+    }
+    let wrong = machine_json('A').replace(r#""type": "xyza""#, r#""type": "xyzb""#);
+    let e = Machine::from_json(Path::new("m.json"), &wrong)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("axes"), "{e}");
+}
+
+/// `feedopt gcode` writes a four-axis program back in machine coordinates: the optimised feed
+/// per block, without a tool-tip mode switch, and it reads back on the same machine.
+#[test]
+fn the_written_program_stays_in_machine_coordinates() {
+    use feedopt::writers::gcode::{GcodeOptions, program};
+    let (m, ctx) = setup('A');
+    let tp = read(
+        &ctx,
+        Dialect::LinuxCnc,
+        "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 X50 A180 F600\nG1 X0 A0\nM2\n",
+    )
+    .unwrap();
+    let options = Options::default();
+    let s = solve(&m, &tp);
+    let written = program(
+        &m,
+        &tp,
+        &s,
+        &options.geometry,
+        &GcodeOptions {
+            dialect: Dialect::LinuxCnc,
+            max_rotation_deg: None,
+        },
+    )
+    .unwrap();
+    assert!(
+        !written.text.contains("M428") && !written.text.contains("M429"),
+        "{}",
+        written.text
+    );
+    let back = read(&ctx, Dialect::LinuxCnc, &written.text).unwrap();
+    assert!(
+        back.warnings
+            .iter()
+            .all(|w| !w.message.contains("tool tip"))
+    );
+    let again = solve(&m, &back);
+    // Each block now runs in the block time it was given: no faster than the schedule.
+    assert!(again.schedule.cycle_time >= s.schedule.cycle_time * (1.0 - 1e-9));
+}
