@@ -440,12 +440,15 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
     let mut m92 = Vec::new();
     let mut feed_diameter = Vec::new();
     for axis in &machine.axes {
+        // The axis object's field `name`, if given.
+        let given = |name: &str| {
+            value
+                .get("axes")
+                .and_then(|a| a.get(&axis.name))
+                .and_then(|a| a.get(name))
+        };
         let field = format!("axes.{}.feed_diameter", axis.name);
-        if let Some(v) = value
-            .get("axes")
-            .and_then(|a| a.get(&axis.name))
-            .and_then(|a| a.get("feed_diameter"))
-        {
+        if let Some(v) = given("feed_diameter") {
             if axis.kind != AxisKind::Rotary {
                 return Err(parser.err(
                     &field,
@@ -465,11 +468,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             feed_diameter.push((axis.name.clone(), d));
         }
         let field = format!("axes.{}.m92", axis.name);
-        if let Some(v) = value
-            .get("axes")
-            .and_then(|a| a.get(&axis.name))
-            .and_then(|a| a.get("m92"))
-        {
+        if let Some(v) = given("m92") {
             if !matches!(axis.name.as_str(), "X" | "Y" | "Z") {
                 return Err(parser.err(&field, "only X, Y and Z have an M92 datum"));
             }
@@ -486,11 +485,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             m92.push((axis.name.clone(), d));
         }
         let field = format!("axes.{}.reference", axis.name);
-        let given = value
-            .get("axes")
-            .and_then(|a| a.get(&axis.name))
-            .and_then(|a| a.get("reference"));
-        let list = match given {
+        let list = match given("reference") {
             None => Vec::new(),
             Some(Value::Array(items)) if !items.is_empty() => items
                 .iter()
