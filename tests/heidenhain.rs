@@ -866,6 +866,10 @@ fn cycle_parameters_spaced_about_equals_and_errors_at_their_own_line() {
     assert!(e.contains("t.h:9:") && e.contains("`Q206 =FOO`"), "{e}");
     let e = fails(&spaced_drill("+120", "BAR "));
     assert!(e.contains("t.h:13:") && e.contains("`BAR`"), "{e}");
+    // A `~` inside a line continues nothing: a word like `BAR`, on its own line (the fuzz
+    // campaign's `Q206=100 ~ M14` was counted as a line break and named the line after).
+    let e = fails(&spaced_drill("+120", "~ M14 "));
+    assert!(e.contains("t.h:13:") && e.contains("`~`"), "{e}");
     let e = fails(&spaced_drill("", ""));
     assert!(e.contains("t.h:9:") && e.contains("no value"), "{e}");
 }

@@ -192,8 +192,11 @@ pub(super) fn feed_word(text: &str) -> Option<&'static str> {
 }
 
 /// The mark that stands, in a `CYCL DEF` block joined from several lines, where a line ended
-/// (`~`): so that a parameter's line can be named.
-const LINE_MARK: &str = "~";
+/// (`~`): so that a parameter's line can be named. A line break, which no line of the program
+/// holds, so a `~` the program writes inside a line is not taken for it (the fuzz campaign's
+/// `Q206=100 ~ M14` named a line past the file's end); [`split_words`] makes it a word of its
+/// own.
+const LINE_MARK: &str = "\n";
 
 /// A block continued on the next line (this one ended in `~`): `first` and `next` as one
 /// block. A `CYCL DEF` keeps a mark [`LINE_MARK`] where each line ended, read by
@@ -235,23 +238,29 @@ pub(super) fn cycle_arguments(
 ) -> Result<(Vec<String>, Vec<CycleParameter>), (usize, String)> {
     let mut words = Vec::new();
     let mut params: Vec<CycleParameter> = Vec::new();
+    // Every word with the line it is on.
     let mut line = 0;
-    let all = split_words(args);
-    let mut i = 0;
-    while i < all.len() {
-        let w = &all[i];
-        i += 1;
+    let mut all: Vec<(usize, String)> = Vec::new();
+    for w in split_words(args) {
         if w == LINE_MARK {
             line += 1;
-            continue;
+        } else {
+            all.push((line, w));
         }
+    }
+    let mut i = 0;
+    while i < all.len() {
+        let (line, w) = (all[i].0, &all[i].1);
+        i += 1;
         // `Q200=+5`, `Q208=` `MAX`, `Q208` `=MAX`, `Q208` `=` `MAX`.
         let (name, after) = match w.split_once('=') {
             Some((name, after)) => (name, Some(after)),
             None => (w.as_str(), None),
         };
-        let next_is =
-            |k: usize, f: &dyn Fn(&str) -> bool| all.get(k).is_some_and(|n| n != LINE_MARK && f(n));
+        // The word at `k` is on this line and `f` holds for it.
+        let next_is = |k: usize, f: &dyn Fn(&str) -> bool| {
+            all.get(k).is_some_and(|(l, n)| *l == line && f(n))
+        };
         let is_param = expr::is_q_parameter(name)
             && (after.is_some() || next_is(i, &|n: &str| n.starts_with('=')));
         if !is_param {
@@ -273,7 +282,7 @@ pub(super) fn cycle_arguments(
         let mut value = match after {
             Some(a) => a.to_string(),
             None => {
-                let eq = &all[i];
+                let eq = &all[i].1;
                 i += 1;
                 written.push(' ');
                 written.push_str(eq);
@@ -281,7 +290,7 @@ pub(super) fn cycle_arguments(
             }
         };
         if value.is_empty() && next_is(i, &|_| true) {
-            value = all[i].clone();
+            value = all[i].1.clone();
             written.push(' ');
             written.push_str(&value);
             i += 1;

@@ -350,13 +350,24 @@ fn scan_name(chars: &[char], mut i: usize) -> usize {
     i
 }
 
-/// Splits a Sinumerik-style (or Klartext) block at spaces outside `( )` and quotes.
+/// Splits a Sinumerik-style (or Klartext) block at spaces outside `( )` and quotes; a line
+/// break (only a joined Klartext cycle definition holds one) is a word `"\n"` of its own.
 pub(super) fn split_words(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut current = String::new();
     let mut depth = 0usize;
     let mut quoted = false;
     for c in text.chars() {
+        if c == '\n' {
+            // A line break joined into a block (a Klartext `CYCL DEF` continued on `~` lines,
+            // `super::klartext::join_continued`): a word of its own, and a new line's start.
+            if !current.is_empty() {
+                words.push(std::mem::take(&mut current));
+            }
+            words.push("\n".to_string());
+            (depth, quoted) = (0, false);
+            continue;
+        }
         match c {
             '"' => quoted = !quoted,
             '(' if !quoted => depth += 1,
