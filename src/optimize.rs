@@ -211,6 +211,7 @@ pub fn optimize_observed(
         machine.feed_max,
         kin.uses_orientation(),
         matches!(kin, Kinematics::Dresser(_)),
+        matches!(kin, Kinematics::FourthAxis(_)),
         &options.geometry,
     )?;
     if path.spans.is_empty() {

@@ -199,12 +199,17 @@ impl Path {
     /// tangent-continuous lines and arcs within `tolerance_mm` ([`biarc::fit`]) and the rotary
     /// angle follows the fitted profile's normal, on the side the program points the tool
     /// (with a zero tolerance the points are interpolated exactly, as everywhere).
+    ///
+    /// `angles_on_chords` (a four-axis machine, programmed in machine coordinates): on a moving
+    /// span the rotary angle is held to its programmed chords as the tip is (within
+    /// `tolerance_deg`), since the control moves every axis straight from block to block.
     pub fn build(
         toolpath: &Toolpath,
         angles: &[[f64; 2]],
         feed_max: Option<f64>,
         orientation_moves_axes: bool,
         profile_normal: bool,
+        angles_on_chords: bool,
         options: &GeometryOptions,
     ) -> Result<Path> {
         let pts = &toolpath.points;
@@ -281,7 +286,9 @@ impl Path {
             // deviation is measured and reported. On a reorientation (the tip stands, u is the
             // angles' travel) the angles are what is held: three points 0.1 and 2.2 rad apart
             // swung B 32° past the programmed positions on boat-xyzbc.
-            let bound = if moving {
+            let bound = if moving && angles_on_chords {
+                (tol_mm + CHORD_SLACK_MM, tol_rad + CHORD_SLACK_RAD)
+            } else if moving {
                 (tol_mm + CHORD_SLACK_MM, f64::INFINITY)
             } else {
                 (f64::INFINITY, tol_rad + CHORD_SLACK_RAD)
