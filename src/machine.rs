@@ -272,6 +272,13 @@ impl KinematicsSpec {
         }
     }
 
+    /// Whether the machine is programmed in machine coordinates (a four-axis machine): a
+    /// program's X Y Z and angles are the axes' positions, not a tool tip, and it has no
+    /// tool-tip mode.
+    pub fn machine_coordinates(&self) -> bool {
+        matches!(self, KinematicsSpec::FourthAxis(_))
+    }
+
     /// Whether an axis of this name is rotary (A, B, C: degrees) or linear (mm) in a machine
     /// with kinematics (a joint-space machine's axes are all treated as linear).
     pub fn axis_kind(name: &str) -> AxisKind {

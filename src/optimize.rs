@@ -211,7 +211,7 @@ pub fn optimize_observed(
         machine.feed_max,
         kin.uses_orientation(),
         matches!(kin, Kinematics::Dresser(_)),
-        matches!(kin, Kinematics::FourthAxis(_)),
+        machine.kinematics.machine_coordinates(),
         &options.geometry,
     )?;
     if path.spans.is_empty() {
@@ -1544,10 +1544,8 @@ impl Plan<'_> {
                             span.nearest_line(p.u[p.intervals()]),
                         );
                         Error::Solver(format!(
-                            "span {si} (CL lines {a}–{b}): the jerk-limited solve failed ({why}); \
-                             its subproblems are ill-conditioned on very short or tightly curved \
-                             features next to long ones: drop the jerk limits with --no-jerk, or \
-                             report the program"
+                            "span {si} (CL lines {a}–{b}): the jerk-limited solve failed ({why}): \
+                             drop the jerk limits with --no-jerk, or report the program"
                         ))
                     }
                     other => other,

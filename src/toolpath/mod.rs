@@ -376,7 +376,7 @@ impl MachineContext {
             }),
             program_units: references.program_units,
             decimal_point_input: references.decimal_point_input,
-            machine_coordinates: matches!(machine.kinematics, KinematicsSpec::FourthAxis(_)),
+            machine_coordinates: machine.kinematics.machine_coordinates(),
             feed_diameter: std::array::from_fn(|i| {
                 references
                     .feed_diameter

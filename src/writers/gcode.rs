@@ -45,8 +45,8 @@
 //! | fanuc | `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
 //! | sinumerik | `G710 G90 G17` | `TRAORI` / `TRAFOOF` | `; …` | `M30` |
 //!
-//! TCP is switched on only on machines with rotary axes, and not on a four-axis machine
-//! (`xyza`, `xyzb`, `xyzc`), whose programs are in machine coordinates; X Y Z are then the tool tip and the
+//! TCP is switched on only on machines with rotary axes (not on a four-axis machine, `xyza`,
+//! `xyzb`, `xyzc`, whose programs are in machine coordinates); X Y Z are then the tool tip and the
 //! rotary words (named as the machine's axes: C and A on the head_head, A/B and C on trunnions,
 //! B on the dresser) the machine's rotary positions in degrees, unwrapped as the schedule
 //! follows them. Coordinates carry 6 decimals (1 nm, 1 µ°), always with a decimal point (a
@@ -497,12 +497,8 @@ pub fn program(
     for h in w.header {
         let _ = writeln!(text, "{h}");
     }
-    // A four-axis machine is programmed in machine coordinates: no tool-tip mode.
-    let tcp = !rotary.is_empty()
-        && !matches!(
-            machine.kinematics,
-            crate::machine::KinematicsSpec::FourthAxis(_)
-        );
+    // A machine programmed in machine coordinates has no tool-tip mode.
+    let tcp = !rotary.is_empty() && !machine.kinematics.machine_coordinates();
     if tcp {
         let _ = writeln!(text, "{}", w.tcp_on);
     }

@@ -2487,15 +2487,15 @@ impl<'a> Interpreter<'a> {
             // rotary axes in degrees: a degree counts as one unit of length, or as π·D/360 mm
             // where the machine file gives the axis' feed diameter D (Haas settings 34/79).
             let unit = self.feed_units.mm_per_unit();
-            let length = |i: usize| {
-                let d = end[i] - start[i];
-                match i.checked_sub(3).and_then(|r| diameters[r]) {
-                    Some(dia) => d * std::f64::consts::PI * dia / 360.0 / unit,
-                    None if i >= 3 => d,
-                    None => d / unit,
-                }
+            // F's units of length per mm (X Y Z) or per degree (A B C).
+            let scale = |i: usize| match i {
+                0..3 => 1.0 / unit,
+                _ => diameters[i - 3].map_or(1.0, |d| std::f64::consts::PI * d / 360.0 / unit),
             };
-            let distance = (0..6).map(|i| length(i).powi(2)).sum::<f64>().sqrt();
+            let distance = (0..6)
+                .map(|i| ((end[i] - start[i]) * scale(i)).powi(2))
+                .sum::<f64>()
+                .sqrt();
             let undiametered = (3..6).any(|i| end[i] != start[i] && diameters[i - 3].is_none());
             if moves_xyz && undiametered {
                 // The time differs from other controls' by the whole rotary share: said, so a

@@ -238,29 +238,23 @@ pub(super) fn cycle_arguments(
 ) -> Result<(Vec<String>, Vec<CycleParameter>), (usize, String)> {
     let mut words = Vec::new();
     let mut params: Vec<CycleParameter> = Vec::new();
-    // Every word with the line it is on.
     let mut line = 0;
-    let mut all: Vec<(usize, String)> = Vec::new();
-    for w in split_words(args) {
-        if w == LINE_MARK {
-            line += 1;
-        } else {
-            all.push((line, w));
-        }
-    }
+    let all = split_words(args);
     let mut i = 0;
     while i < all.len() {
-        let (line, w) = (all[i].0, &all[i].1);
+        let w = &all[i];
         i += 1;
+        if w == LINE_MARK {
+            line += 1;
+            continue;
+        }
         // `Q200=+5`, `Q208=` `MAX`, `Q208` `=MAX`, `Q208` `=` `MAX`.
         let (name, after) = match w.split_once('=') {
             Some((name, after)) => (name, Some(after)),
             None => (w.as_str(), None),
         };
-        // The word at `k` is on this line and `f` holds for it.
-        let next_is = |k: usize, f: &dyn Fn(&str) -> bool| {
-            all.get(k).is_some_and(|(l, n)| *l == line && f(n))
-        };
+        let next_is =
+            |k: usize, f: &dyn Fn(&str) -> bool| all.get(k).is_some_and(|n| n != LINE_MARK && f(n));
         let is_param = expr::is_q_parameter(name)
             && (after.is_some() || next_is(i, &|n: &str| n.starts_with('=')));
         if !is_param {
@@ -282,7 +276,7 @@ pub(super) fn cycle_arguments(
         let mut value = match after {
             Some(a) => a.to_string(),
             None => {
-                let eq = &all[i].1;
+                let eq = &all[i];
                 i += 1;
                 written.push(' ');
                 written.push_str(eq);
@@ -290,7 +284,7 @@ pub(super) fn cycle_arguments(
             }
         };
         if value.is_empty() && next_is(i, &|_| true) {
-            value = all[i].1.clone();
+            value = all[i].clone();
             written.push(' ');
             written.push_str(&value);
             i += 1;
