@@ -62,7 +62,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::dexel::{Dexel, Dexels, TILE};
-use super::tool::{Pose, Tool};
+use super::tool::{NO_HIT, Pose, Tool};
 use crate::toolpath::{Feed, Toolpath};
 
 /// What the tool engaged over one sample step.
@@ -378,7 +378,7 @@ pub(crate) struct SharedPose {
     rows: Vec<SharedRow>,
 }
 
-/// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, [`MISS`] where the
+/// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, [`NO_HIT`] where the
 /// tool does not cross.
 #[derive(Debug, Clone, Default)]
 struct SharedRow {
@@ -386,9 +386,6 @@ struct SharedRow {
     start: usize,
     hits: Vec<[f64; 2]>,
 }
-
-/// A crossing that is none.
-const MISS: [f64; 2] = [f64::INFINITY, f64::NEG_INFINITY];
 
 impl SharedPose {
     /// For a grid of `rows` rows.
@@ -441,14 +438,15 @@ pub(crate) fn cut_step(
             let (x0, y0, hx, hy) = (dexels.x0, dexels.y0, dexels.hx, dexels.hy);
             let pose_list = &pose_list;
             let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
-            // Per task, per row: the run of consecutive poses crossing each cell (`last`: the
-            // latest such pose) and the runs a miss ended (cell, interval), reused from row to
-            // row.
+            // Per task, per row: every pose's crossings with the row's cells (pose-major), the
+            // run of consecutive poses crossing each cell and how many runs it has, and the runs
+            // a miss ended (the pose that ended it, cell, interval), reused from row to row.
             let scratch = || {
                 (
                     Vec::<[f64; 2]>::new(),
-                    Vec::<usize>::new(),
-                    Vec::<(usize, [f64; 2])>::new(),
+                    Vec::<[f64; 2]>::new(),
+                    Vec::<f64>::new(),
+                    Vec::<(usize, usize, [f64; 2])>::new(),
                     Vec::<Option<(usize, usize)>>::new(),
                 )
             };
@@ -461,7 +459,7 @@ pub(crate) fn cut_step(
                 .zip(shared_rows.par_chunks_mut(TILE))
                 .map_init(
                     scratch,
-                    |(run, last, ended, ranges), (mut band, shared_rows)| {
+                    |(hits, run, starts, ended, ranges), (mut band, shared_rows)| {
                         let mut acc = Acc::ZERO;
                         let rows = band.rows();
                         for (j, row_shared) in rows.zip(shared_rows) {
@@ -514,68 +512,107 @@ pub(crate) fn cut_step(
                                 continue;
                             }
                             let width = ub - ua + 1;
-                            run.clear();
-                            run.resize(width, MISS);
-                            last.clear();
-                            last.resize(width, usize::MAX);
-                            ended.clear();
+                            hits.clear();
+                            hits.resize(poses * width, NO_HIT);
                             for k in 0..poses {
                                 let Some((ia, ib)) = ranges[k] else {
                                     continue;
                                 };
                                 let pose = &pose_list[k].0;
-                                let from_shared = k == 0 && reuse && row_shared.step == prev;
-                                let known = if from_shared {
-                                    let s0 = row_shared.start;
-                                    s0..s0 + row_shared.hits.len()
+                                let row = &mut hits[k * width + ia - ua..=k * width + ib - ua];
+                                // k = 0 reads the shared row where it has the cells, k = poses − 1
+                                // ≥ 1 writes it.
+                                let s0 = row_shared.start;
+                                let known = if k == 0 && reuse && row_shared.step == prev {
+                                    s0.max(ia)..(s0 + row_shared.hits.len()).min(ib + 1)
                                 } else {
                                     0..0
                                 };
-                                let to_shared = k == poses - 1;
-                                if to_shared {
+                                if known.is_empty() {
+                                    pose.hits_row(y, x0, hx, ia, row);
+                                } else {
+                                    let (before, rest) = row.split_at_mut(known.start - ia);
+                                    let (mid, after) = rest.split_at_mut(known.len());
+                                    pose.hits_row(y, x0, hx, ia, before);
+                                    mid.copy_from_slice(
+                                        &row_shared.hits[known.start - s0..known.end - s0],
+                                    );
+                                    pose.hits_row(y, x0, hx, known.end, after);
+                                }
+                                if k == poses - 1 {
                                     row_shared.step = this;
                                     row_shared.start = ia;
                                     row_shared.hits.clear();
-                                }
-                                for i in ia..=ib {
-                                    // (k = 0 reads the shared row, k = poses − 1 ≥ 1 writes it.)
-                                    let h = if known.contains(&i) {
-                                        row_shared.hits[i - known.start]
-                                    } else {
-                                        pose.hit(cx(i), y).unwrap_or(MISS)
-                                    };
-                                    if to_shared {
-                                        row_shared.hits.push(h);
-                                    }
-                                    if h[0] > h[1] {
-                                        continue;
-                                    }
-                                    let c = i - ua;
-                                    if last[c] != usize::MAX && last[c] + 1 == k {
-                                        run[c] = [run[c][0].min(h[0]), run[c][1].max(h[1])];
-                                    } else {
-                                        if last[c] != usize::MAX {
-                                            ended.push((i, run[c]));
-                                        }
-                                        run[c] = h;
-                                    }
-                                    last[c] = k;
+                                    row_shared.hits.extend_from_slice(row);
                                 }
                             }
-                            for &(i, [lo, hi]) in ended.iter() {
+                            // The runs of consecutive poses that cross each cell, each joined
+                            // into [min lo, max hi]. First, without branches, every cell's
+                            // crossings joined and its runs counted (`starts`: the poses that
+                            // cross it after one that does not); a miss between two crossings
+                            // (at least three poses) leaves several runs, taken apart cell by
+                            // cell below, the ones a miss ended kept aside. (A miss is
+                            // [∞, −∞], which min and max leave out exactly.)
+                            run.clear();
+                            run.extend_from_slice(&hits[..width]);
+                            starts.clear();
+                            starts.extend(run.iter().map(|h| f64::from(u8::from(h[0] <= h[1]))));
+                            for k in 1..poses {
+                                let (before, row) =
+                                    hits[(k - 1) * width..(k + 1) * width].split_at(width);
+                                for (((run, n), p), h) in
+                                    run.iter_mut().zip(starts.iter_mut()).zip(before).zip(row)
+                                {
+                                    let start = h[0] <= h[1] && p[0] > p[1];
+                                    *n += f64::from(u8::from(start));
+                                    *run = [run[0].min(h[0]), run[1].max(h[1])];
+                                }
+                            }
+                            ended.clear();
+                            for (c, run) in run.iter_mut().enumerate() {
+                                if starts[c] < 2.0 {
+                                    continue;
+                                }
+                                *run = NO_HIT;
+                                let mut open = false;
+                                for k in 0..poses {
+                                    let h = hits[k * width + c];
+                                    if h[0] > h[1] {
+                                        open = false;
+                                        continue;
+                                    }
+                                    if open {
+                                        *run = [run[0].min(h[0]), run[1].max(h[1])];
+                                    } else {
+                                        if run[0] <= run[1] {
+                                            ended.push((k, ua + c, *run));
+                                        }
+                                        *run = h;
+                                    }
+                                    open = true;
+                                }
+                            }
+                            // In the order the poses ended them (the sums then add up in one
+                            // order whatever the grid).
+                            ended.sort_unstable_by_key(|&(k, i, _)| (k, i));
+                            for &(_, i, [lo, hi]) in ended.iter() {
                                 note(cx(i), band.dexel(i, j).remove(lo, hi));
                             }
                             band.each(j, ua, ub, |i, cell| {
-                                let c = i - ua;
-                                if last[c] != usize::MAX {
-                                    note(cx(i), cell.remove(run[c][0], run[c][1]));
+                                let [lo, hi] = run[i - ua];
+                                if lo <= hi {
+                                    note(cx(i), cell.remove(lo, hi));
                                 }
                             });
                         }
                         acc
                     },
                 )
-                .reduce(|| Acc::ZERO, Acc::join)
+                // Band by band in grid order, whatever thread cut which: the sums are then
+                // the same on any number of threads.
+                .collect::<Vec<Acc>>()
+                .into_iter()
+                .fold(Acc::ZERO, Acc::join)
         }
     };
     let cell_area = dexels.hx * dexels.hy;

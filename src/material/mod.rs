@@ -357,31 +357,38 @@ pub fn simulate(tp: &Toolpath, m: &Material) -> Result<Simulation> {
     let cell = m.cell();
     let mut dexels = Dexels::new(&m.stock, cell);
     let initial_volume = dexels.volume();
-    let mut samples = Vec::new();
-    let mut shared = cut::SharedPose::new(dexels.ny);
-    let mut current = m.tool_index(1.min(tp.points.len()));
-    for k in 1..tp.points.len() {
-        let which = m.tool_index(k);
-        if which != current {
-            // Another tool: the last pose's crossings were the old tool's.
-            shared = cut::SharedPose::new(dexels.ny);
-            current = which;
+    // The steps run one after the other, each spreading its rows over the thread pool: from
+    // one of the pool's own threads (`rayon::scope`), so that a step hands its rows to the
+    // others directly rather than waking the pool from outside and sleeping until it is done
+    // (9,344 steps on the LinuxCNC impeller: 14 % of the time went to that).
+    let samples = rayon::scope(|_| {
+        let mut samples = Vec::new();
+        let mut shared = cut::SharedPose::new(dexels.ny);
+        let mut current = m.tool_index(1.min(tp.points.len()));
+        for k in 1..tp.points.len() {
+            let which = m.tool_index(k);
+            if which != current {
+                // Another tool: the last pose's crossings were the old tool's.
+                shared = cut::SharedPose::new(dexels.ny);
+                current = which;
+            }
+            let tool = &m.tools[which].tool;
+            let delta = cut::pose_spacing(tool, dexels.hx.min(dexels.hy));
+            let n = cut::steps_of_move(tp, k, tool, m.step_for(tool));
+            let (feed, rapid) = cut::move_feed(tp, k);
+            for s in 0..n {
+                let st = cut::step_of_move(tp, k, s, n);
+                let mut sample = cut::cut_step(&mut dexels, tool, &st, delta, &mut shared);
+                sample.point = k;
+                sample.t = [s as f64 / n as f64, (s + 1) as f64 / n as f64];
+                sample.line = tp.points[k].line;
+                sample.rapid = rapid;
+                sample.programmed_feed = feed;
+                samples.push(sample);
+            }
         }
-        let tool = &m.tools[which].tool;
-        let delta = cut::pose_spacing(tool, dexels.hx.min(dexels.hy));
-        let n = cut::steps_of_move(tp, k, tool, m.step_for(tool));
-        let (feed, rapid) = cut::move_feed(tp, k);
-        for s in 0..n {
-            let st = cut::step_of_move(tp, k, s, n);
-            let mut sample = cut::cut_step(&mut dexels, tool, &st, delta, &mut shared);
-            sample.point = k;
-            sample.t = [s as f64 / n as f64, (s + 1) as f64 / n as f64];
-            sample.line = tp.points[k].line;
-            sample.rapid = rapid;
-            sample.programmed_feed = feed;
-            samples.push(sample);
-        }
-    }
+        samples
+    });
     let final_volume = dexels.volume();
     let removed_volume = samples.iter().map(|s| s.removed).sum();
     Ok(Simulation {

@@ -14,6 +14,7 @@
 //! `f(d) = 0` for d ≤ R − r_c and `r_c − √(r_c² − (d − R + r_c)²)` up to R: convex and
 //! non-decreasing in d.
 
+use multiversion::multiversion;
 use nalgebra::Vector3;
 
 /// The largest tool diameter (mm) feedopt accepts: 1 m.
@@ -249,7 +250,81 @@ impl<'a> Pose<'a> {
         hit.filter(|h| h.0.is_finite() && h.1.is_finite())
             .map(|(lo, hi)| [p.z + lo, p.z + hi])
     }
+
+    /// [`Pose::hit`] on a run of dexel lines of one grid row: `out[k]` for the line through
+    /// x = `x0` + (i0 + k + ½)·`hx` and `y`, [`NO_HIT`] where the tool does not cross it.
+    ///
+    /// The same arithmetic as [`Pose::hit`], so the same crossings bit for bit (a test keeps
+    /// them so); for a flat or ball-nose tool on a pose neither vertical nor horizontal it is
+    /// written without branches (every candidate interval computed, the answer selected), which
+    /// the compiler turns into vector instructions: the crossings are most of a tilted cut's
+    /// work. Other tools and poses take [`Pose::hit`] line by line.
+    pub fn hits_row(&self, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 2]]) {
+        let tool = self.tool;
+        let (r, rc) = (tool.radius(), tool.corner_radius);
+        let ball = rc >= r;
+        if !(ball || rc == 0.0) || self.inv_a.is_infinite() || self.inv_oz.is_infinite() {
+            for (k, h) in out.iter_mut().enumerate() {
+                *h = self
+                    .hit(x0 + ((i0 + k) as f64 + 0.5) * hx, y)
+                    .unwrap_or(NO_HIT);
+            }
+            return;
+        }
+        crossings_row(self, ball, y, x0, hx, i0, out);
+    }
 }
+
+/// [`Pose::hits_row`]'s branch-free loop (a flat or ball-nose tool on a pose neither vertical nor
+/// horizontal), compiled also for the vector instructions of newer processors and chosen by
+/// what the processor running it has (`multiversion`): the same operations in the same order
+/// on every path, so the same crossings bit for bit (Rust never fuses a product and a sum).
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn crossings_row(
+    pose: &Pose,
+    ball: bool,
+    y: f64,
+    x0: f64,
+    hx: f64,
+    i0: usize,
+    out: &mut [[f64; 2]],
+) {
+    let tool = pose.tool;
+    let (r, rc, lf) = (tool.radius(), tool.corner_radius, tool.flute_length);
+    let (p, o, a, inv_a, inv_oz) = (pose.p, pose.o, pose.a, pose.inv_a, pose.inv_oz);
+    let dy = y - p.y;
+    for (k, h) in out.iter_mut().enumerate() {
+        let dx = x0 + ((i0 + k) as f64 + 0.5) * hx - p.x;
+        let c = dx * o.x + dy * o.y;
+        let q0 = dx * dx + dy * dy - c * c;
+        // The cylinder h ∈ [r_c, L_f], ρ ≤ R: the slab, the disc, their meet.
+        let (t0, t1) = ((rc - c) * inv_oz, (lf - c) * inv_oz);
+        let bh = -c * o.z;
+        let disc = bh * bh - a * (q0 - r * r);
+        let sq = disc.max(0.0).sqrt();
+        let (w0, w1) = ((-bh - sq) * inv_a, (-bh + sq) * inv_a);
+        let (c0, c1) = (t0.min(t1).max(w0), t0.max(t1).min(w1));
+        let cylinder = disc >= 0.0 && c0 <= c1;
+        // The ball about P + R O (flat end mill: none).
+        let (ex, ey, ez) = (dx - r * o.x, dy - r * o.y, -r * o.z);
+        let d2 = r * r - ex * ex - ey * ey;
+        let sq2 = d2.max(0.0).sqrt();
+        let (b0, b1) = (-ez - sq2, -ez + sq2);
+        let sphere = ball && d2 >= 0.0;
+        let (lo, hi) = if cylinder && sphere {
+            (c0.min(b0), c1.max(b1))
+        } else if cylinder {
+            (c0, c1)
+        } else {
+            (b0, b1)
+        };
+        let any = (cylinder || sphere) && lo.is_finite() && hi.is_finite();
+        *h = if any { [p.z + lo, p.z + hi] } else { NO_HIT };
+    }
+}
+
+/// A crossing that is none: `[∞, −∞]` (its lower end above its upper).
+pub const NO_HIT: [f64; 2] = [f64::INFINITY, f64::NEG_INFINITY];
 
 /// The interval of [s0, s1] where the convex function f ≤ 0, to within `tol`: golden-section
 /// search for the minimum, then bisection for both ends.
@@ -305,6 +380,57 @@ mod tests {
         let h = d.dot(o);
         let rho = (d - h * o).norm();
         (0.0..=t.flute_length).contains(&h) && rho <= t.radius_at(h)
+    }
+
+    /// A row of crossings is the crossings line by line, bit for bit: for every shape, on
+    /// vertical, horizontal and tilted poses, over rows that pass through, beside and far from
+    /// the tool (whichever vector instructions this processor runs the row with).
+    #[test]
+    fn a_row_of_crossings_is_the_crossings_line_by_line() {
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (x0, hx) = (-20.0, 0.1);
+        let mut out = vec![[0.0; 2]; 400];
+        let (mut crossed, mut missed) = (0, 0);
+        for tool in [
+            Tool::new(10.0, 0.0, 20.0, 3).unwrap(),
+            Tool::new(10.0, 5.0, 20.0, 2).unwrap(),
+            Tool::new(10.0, 2.0, 20.0, 4).unwrap(),
+        ] {
+            for case in 0..120 {
+                let o = match case % 6 {
+                    0 => Vector3::z(),
+                    1 => Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.0).normalize(),
+                    2 => Vector3::new(rnd() - 0.5, rnd() - 0.5, -0.2 - rnd()).normalize(),
+                    _ => Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.1 + rnd()).normalize(),
+                };
+                let p = Vector3::new(10.0 * (rnd() - 0.5), 10.0 * (rnd() - 0.5), rnd());
+                let pose = Pose::new(&tool, &p, &o);
+                let y = p.y + 30.0 * (rnd() - 0.5);
+                let i0 = (rnd() * 20.0) as usize;
+                pose.hits_row(y, x0, hx, i0, &mut out);
+                for (k, h) in out.iter().enumerate() {
+                    let one = pose.hit(x0 + ((i0 + k) as f64 + 0.5) * hx, y);
+                    assert_eq!(
+                        h.map(f64::to_bits),
+                        one.unwrap_or(NO_HIT).map(f64::to_bits),
+                        "{tool:?} tip {p:?} axis {o:?} line {}",
+                        i0 + k
+                    );
+                    if one.is_some() {
+                        crossed += 1;
+                    } else {
+                        missed += 1;
+                    }
+                }
+            }
+        }
+        assert!(crossed > 10_000 && missed > 10_000, "{crossed} crossed, {missed} missed");
     }
 
     /// The line hit agrees with point membership for every shape and many tilted poses.
