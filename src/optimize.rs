@@ -986,11 +986,11 @@ impl Plan<'_> {
             options,
             tol,
             |si| {
-                let p = self.final_grid(
-                    si,
-                    self.uniform_problem(si, options.initial_stations, options)?,
-                    options,
-                );
+                let p = self.uniform_problem(si, options.initial_stations, options)?;
+                if let Some(round) = self.straight_round(si, options, &p)? {
+                    return Ok(round);
+                }
+                let p = self.final_grid(si, p, options);
                 // G's SCP stops at COARSE_SCP: its profile only starts F's SCP (which
                 // converges as every other), and its times enter only round 0's ε.
                 let mut coarse_options = options.clone();
@@ -1157,6 +1157,49 @@ impl Plan<'_> {
                 }
             }
         }
+    }
+
+    /// A straight span from rest to rest with the same limits everywhere (`p`: its problem on
+    /// any grid): the double-S profile in closed form ([`solver::double_s`]) as a finished
+    /// round. Its stations carry the profile under the motion laws within that module's
+    /// tolerances (time within 1e-7, jerk within 5e-4), so its intervals carry no error for
+    /// the refinement to mark; the re-simulation checks it as every other. `None`: not such a
+    /// span (or the option is off), the programme takes it.
+    fn straight_round(
+        &self,
+        si: usize,
+        options: &Options,
+        p: &SpanProblem,
+    ) -> Result<Option<JerkRound>> {
+        use solver::double_s::{DoubleS, PathLimits, profile_stations};
+        if !options.jerk.closed_form {
+            return Ok(None);
+        }
+        let Some(limits) = PathLimits::of_straight(p, self.machine) else {
+            return Ok(None);
+        };
+        let n = p.intervals();
+        let profile = DoubleS::new(p.u[n] - p.u[0], limits);
+        let Some((u, solution)) = profile_stations(&profile, p.u[0]) else {
+            return Ok(None);
+        };
+        let span = &self.path.spans[si];
+        let mut fine = SpanProblem::at_stations(span, &self.kin, self.machine, u);
+        if let Some(c) = &options.verify.chord {
+            fine.apply_chord(span, c);
+        }
+        self.check_travel(si, &fine)?;
+        let times = self.times(si, &fine, &solution)?;
+        let k = times.len();
+        Ok(Some(JerkRound {
+            fine,
+            fine_solution: solution,
+            coarse_times: times.clone(),
+            split: vec![1; k],
+            time: times.iter().sum(),
+            fine_times: times,
+            eps: vec![0.0; k],
+        }))
     }
 
     /// The next jerk-limited round of span `si`: its next G is F with the parts of the

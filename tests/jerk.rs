@@ -95,6 +95,96 @@ fn straight_line_with_only_jerk_binding_matches_the_closed_form() {
     assert_verified_with_jerk(&sol, "line");
 }
 
+/// The textbook double-S time from rest to rest over L under u̇ ≤ V, |ü| ≤ A, |u⃛| ≤ J (here
+/// V·J ≥ A²): with a cruise L/V + V/A + A/J; without, but reaching A, A/J + √((A/J)² + 4L/A);
+/// reaching neither, 4 (L/2J)^{1/3}.
+fn double_s_time(len: f64, v: f64, a: f64, j: f64) -> f64 {
+    assert!(v * j >= a * a);
+    if len >= v * (v / a + a / j) {
+        len / v + v / a + a / j
+    } else if len >= 2.0 * a * a * a / (j * j) {
+        a / j + ((a / j).powi(2) + 4.0 * len / a).sqrt()
+    } else {
+        4.0 * (len / (2.0 * j)).cbrt()
+    }
+}
+
+/// A straight move from rest to rest takes the double-S time of its path limits, in closed
+/// form (`solver::double_s`), in each of its three cases; the re-simulation verifies it with
+/// every limit, and a few dozen stations carry it. The X and Y limits differ, so the diagonal
+/// move's path limits are the tighter axis's over its share of the move.
+#[test]
+fn a_straight_move_takes_the_double_s_time() {
+    let m = common::machine(
+        r#"{"kinematics": {"type": "xyz"}, "axes": {
+        "X": {"velocity": 100, "acceleration": 1000, "jerk": 20000},
+        "Y": {"velocity": 80, "acceleration": 1500, "jerk": 30000},
+        "Z": {"velocity": 100, "acceleration": 1000, "jerk": 20000}}}"#,
+    );
+    for (len, case) in [(60.0, "cruise"), (6.0, "A, no cruise"), (0.4, "neither")] {
+        // Along X alone, and along the diagonal (3, 4, 0)/5, where X bounds acceleration and
+        // jerk (1000/0.6 < 1500/0.8) and Y the speed (80/0.8 < 100/0.6).
+        for (dir, (v, a, j)) in [
+            (Vector3::x(), (100.0, 1000.0, 20000.0)),
+            (
+                Vector3::new(0.6, 0.8, 0.0),
+                (80.0 / 0.8, 1000.0 / 0.6, 20000.0 / 0.6),
+            ),
+        ] {
+            let pts = [(Vector3::zeros(), UP), (dir * len, UP)];
+            let sol =
+                optimize(&m, &common::toolpath(&pts, None), &Options::default()).expect("solve");
+            let exact = double_s_time(len, v, a, j);
+            let t = sol.schedule.cycle_time;
+            eprintln!("{case}, {dir:?}: {t:.9} s vs {exact:.9} s");
+            assert!((t - exact).abs() <= 1e-6 * exact, "{case}: {t} vs {exact}");
+            assert!(
+                sol.schedule.stations.len() <= 80,
+                "{case}: {} stations",
+                sol.schedule.stations.len()
+            );
+            assert_verified_with_jerk(&sol, case);
+        }
+    }
+}
+
+/// The closed form and the sequential convex programme agree on straight moves: the
+/// programme's adaptive answer (the closed form switched off) within its own tolerance of the
+/// closed form's, on a zig-zag of exact stops (each move a span from rest to rest).
+#[test]
+fn the_double_s_agrees_with_the_programme() {
+    let m = common::machine(
+        r#"{"kinematics": {"type": "xyz"}, "axes": {
+        "X": {"velocity": 200, "acceleration": 2000, "jerk": 20000},
+        "Y": {"velocity": 200, "acceleration": 2000, "jerk": 20000},
+        "Z": {"velocity": 200, "acceleration": 2000, "jerk": 20000}}}"#,
+    );
+    let pts: Vec<_> = (0..6)
+        .map(|k| {
+            let x = if k % 2 == 0 {
+                0.0
+            } else {
+                5.0 + 20.0 * k as f64
+            };
+            (Vector3::new(x, 3.0 * k as f64, 0.0), UP)
+        })
+        .collect();
+    let tp = common::toolpath(&pts, None);
+    let closed = optimize(&m, &tp, &Options::default()).expect("closed form");
+    let mut o = Options::default();
+    o.jerk.closed_form = false;
+    let programme = optimize(&m, &tp, &o).expect("programme");
+    let (a, b) = (closed.schedule.cycle_time, programme.schedule.cycle_time);
+    eprintln!(
+        "closed form {a:.6} s on {} stations, programme {b:.6} s on {}",
+        closed.schedule.stations.len(),
+        programme.schedule.stations.len()
+    );
+    assert!((a - b).abs() <= 1e-3 * a, "{a} vs {b}");
+    assert!(closed.schedule.stations.len() < programme.schedule.stations.len());
+    assert_verified_with_jerk(&closed, "zig-zag");
+}
+
 /// The bundled 5-axis problem with its jerk-limited machine: slower than acceleration-limited,
 /// every limit (jerk too) kept; with the jerk limits scaled up the time comes down to the
 /// acceleration-limited one.

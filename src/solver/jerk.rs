@@ -93,6 +93,10 @@ pub struct JerkOptions {
     /// Stations per window: a longer span is cut into windows of about this many stations,
     /// solved independently and in parallel (see [`solve`]); `usize::MAX`: one piece.
     pub window: usize,
+    /// A straight span from rest to rest with the same limits everywhere takes the double-S
+    /// profile in closed form ([`super::double_s`]) instead of the programme (an adaptive
+    /// refinement only; a grid the user fixes is always solved by the programme).
+    pub closed_form: bool,
 }
 
 /// The objective of each convex subproblem.
@@ -118,6 +122,7 @@ impl Default for JerkOptions {
             max_iterations: 30,
             objective: Objective::default(),
             window: 150,
+            closed_form: true,
         }
     }
 }

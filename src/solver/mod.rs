@@ -7,6 +7,7 @@
 //! cross-check, and the source of precise infeasibility errors.
 
 pub mod clarabel;
+pub mod double_s;
 // Being edited on the jerk-limited refinement's branch: documented once that lands.
 #[allow(missing_docs)]
 pub mod jerk;
