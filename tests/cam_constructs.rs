@@ -1564,3 +1564,33 @@ fn an_o_without_a_number_says_so() {
         "{e}"
     );
 }
+
+/// Sinumerik `FGROUP()` (HAMUEL's blade-milling posts end every operation with it) restores
+/// the default feed group, F along X Y Z, which is how feedopt reads F: the program reads as
+/// without it; a group with a rotary axis changes what F means and is refused, naming it.
+#[test]
+fn the_default_sinumerik_feed_group_is_read_and_another_is_named() {
+    let plain = "G0 X0 Y0 Z0\nG1 X10 F600\nY10\n";
+    let with = "FGROUP()\nG0 X0 Y0 Z0\nFGROUP(Z, Y,X)\nG1 X10 F600\nY10\nFGROUP()\n";
+    let a = gcode(Dialect::Sinumerik, plain);
+    let b = gcode(Dialect::Sinumerik, with);
+    assert_eq!(a.points.len(), b.points.len());
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert_close(p.p, q.p, 0.0);
+        assert_eq!(format!("{:?}", p.feed), format!("{:?}", q.feed));
+    }
+    assert!((feed_time(&b) - 2.0).abs() < 1e-12, "{}", feed_time(&b));
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G0 X0 Y0 Z0\nFGROUP(X,Y,Z,A)\nG1 X10 A5 F600\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(
+        e.contains("t.mpf:2") && e.contains("`FGROUP(X,Y,Z,A)`") && e.contains("default"),
+        "{e}"
+    );
+}
+

@@ -1012,6 +1012,27 @@ impl<'a> Interpreter<'a> {
                     }
                     spindle_limit = true;
                 }
+                Action::FeedGroup => {
+                    let given = args.as_deref().unwrap_or("");
+                    let mut axes: Vec<String> = given
+                        .split(',')
+                        .map(|a| a.trim().to_ascii_uppercase())
+                        .filter(|a| !a.is_empty())
+                        .collect();
+                    axes.sort();
+                    let default = axes.is_empty() || axes == ["X", "Y", "Z"];
+                    if !default {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}({given})`: F would be the speed along the combined \
+                                 path of these axes; feedopt reads a Sinumerik F along X Y Z, \
+                                 the default feed group (`FGROUP()` or `FGROUP(X,Y,Z)`). Post \
+                                 the program with the default feed group"
+                            ),
+                        ));
+                    }
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
