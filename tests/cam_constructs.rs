@@ -1594,3 +1594,52 @@ fn the_default_sinumerik_feed_group_is_read_and_another_is_named() {
     );
 }
 
+/// A Sinumerik frame on a rotary axis (`TRANS A=R25` in HAMUEL's posts) is refused, naming the
+/// axis and what to do (it said "TRANS with A/B/C: not supported").
+#[test]
+fn a_frame_on_a_rotary_axis_names_the_axis_and_what_to_do() {
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G0 X0 Y0 Z0\nTRANS  A=10\nG0 X1\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(
+        e.contains("t.mpf:2")
+            && e.contains("`TRANS` with A")
+            && e.contains("Remove it where the shift is 0"),
+        "{e}"
+    );
+}
+
+/// The older Siemens languages' `@` codes (`@430 K1 K1 K0 K1525`) are named as such, with what
+/// feedopt reads instead (it said "unexpected character `@`").
+#[test]
+fn an_old_siemens_at_code_is_named() {
+    for dialect in [Dialect::Sinumerik, Dialect::LinuxCnc, Dialect::Fanuc] {
+        let e = message(
+            parse(
+                Path::new("t.nc"),
+                "G0 X0 Y0 Z0\n@430 K1 K1 K0 K1525\n",
+                dialect,
+            )
+            .unwrap_err(),
+        );
+        assert!(
+            e.contains("t.nc:2") && e.contains("`@430`") && e.contains("840D"),
+            "{e}"
+        );
+    }
+}
+
+/// A lathe program's `G92 S4000` (Fusion's Fanuc turning post) is named a turning program,
+/// not a G92 missing its axis words.
+#[test]
+fn a_lathe_spindle_limit_names_a_turning_program() {
+    let e = fanuc_error("%\nO1001\nG90 G94 G18\nG21\nG92 S4000\nG28 U0.\n");
+    assert!(e.contains("t.nc:5") && e.contains("turning program"), "{e}");
+    let e = fanuc_error("G90 G0 X0. Y0. Z0.\nG92\n");
+    assert!(e.contains("t.nc:2") && e.contains("name the axes"), "{e}");
+}
