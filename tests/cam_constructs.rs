@@ -1564,3 +1564,82 @@ fn an_o_without_a_number_says_so() {
         "{e}"
     );
 }
+
+/// Sinumerik `FGROUP()` (HAMUEL's blade-milling posts end every operation with it) restores
+/// the default feed group, F along X Y Z, which is how feedopt reads F: the program reads as
+/// without it; a group with a rotary axis changes what F means and is refused, naming it.
+#[test]
+fn the_default_sinumerik_feed_group_is_read_and_another_is_named() {
+    let plain = "G0 X0 Y0 Z0\nG1 X10 F600\nY10\n";
+    let with = "FGROUP()\nG0 X0 Y0 Z0\nFGROUP(Z, Y,X)\nG1 X10 F600\nY10\nFGROUP()\n";
+    let a = gcode(Dialect::Sinumerik, plain);
+    let b = gcode(Dialect::Sinumerik, with);
+    assert_eq!(a.points.len(), b.points.len());
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert_close(p.p, q.p, 0.0);
+        assert_eq!(format!("{:?}", p.feed), format!("{:?}", q.feed));
+    }
+    assert!((feed_time(&b) - 2.0).abs() < 1e-12, "{}", feed_time(&b));
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G0 X0 Y0 Z0\nFGROUP(X,Y,Z,A)\nG1 X10 A5 F600\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(
+        e.contains("t.mpf:2") && e.contains("`FGROUP(X,Y,Z,A)`") && e.contains("default"),
+        "{e}"
+    );
+}
+
+/// A Sinumerik frame on a rotary axis (`TRANS A=R25` in HAMUEL's posts) is refused, naming the
+/// axis and what to do (it said "TRANS with A/B/C: not supported").
+#[test]
+fn a_frame_on_a_rotary_axis_names_the_axis_and_what_to_do() {
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G0 X0 Y0 Z0\nTRANS  A=10\nG0 X1\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(
+        e.contains("t.mpf:2")
+            && e.contains("`TRANS` with A")
+            && e.contains("Remove it where the shift is 0"),
+        "{e}"
+    );
+}
+
+/// The older Siemens languages' `@` codes (`@430 K1 K1 K0 K1525`) are named as such, with what
+/// feedopt reads instead (it said "unexpected character `@`").
+#[test]
+fn an_old_siemens_at_code_is_named() {
+    for dialect in [Dialect::Sinumerik, Dialect::LinuxCnc, Dialect::Fanuc] {
+        let e = message(
+            parse(
+                Path::new("t.nc"),
+                "G0 X0 Y0 Z0\n@430 K1 K1 K0 K1525\n",
+                dialect,
+            )
+            .unwrap_err(),
+        );
+        assert!(
+            e.contains("t.nc:2") && e.contains("`@430`") && e.contains("840D"),
+            "{e}"
+        );
+    }
+}
+
+/// A lathe program's `G92 S4000` (Fusion's Fanuc turning post) is named a turning program,
+/// not a G92 missing its axis words.
+#[test]
+fn a_lathe_spindle_limit_names_a_turning_program() {
+    let e = fanuc_error("%\nO1001\nG90 G94 G18\nG21\nG92 S4000\nG28 U0.\n");
+    assert!(e.contains("t.nc:5") && e.contains("turning program"), "{e}");
+    let e = fanuc_error("G90 G0 X0. Y0. Z0.\nG92\n");
+    assert!(e.contains("t.nc:2") && e.contains("name the axes"), "{e}");
+}

@@ -353,6 +353,12 @@ pub enum Action {
     /// Sinumerik `G92 S…`: the spindle speed limit under G96; moves nothing, and its S is no
     /// spindle speed. Axis words with it are an error.
     SpindleLimit,
+    /// Sinumerik `FGROUP(…)`: the axes the path feed F applies to. Siemens' programming
+    /// manual (Fundamentals, "Feedrate for positioning axes … FGROUP"): `FGROUP()` without
+    /// axes restores the default of the machine data, F along the geometry axes X Y Z, which
+    /// is how feedopt reads every Sinumerik F; so do `FGROUP(X,Y,Z)` in any order. A group with
+    /// other axes makes F the speed along their combined path: an error naming the word.
+    FeedGroup,
     /// Accepted, no effect on motion.
     Ignored,
     /// Accepted with this warning.
@@ -1065,6 +1071,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("CYCLE88", Action::SinumerikCycle(88)),
         ("CYCLE89", Action::SinumerikCycle(89)),
         ("MCALL", Action::ModalCall),
+        ("FGROUP", Action::FeedGroup),
         ("FNORM", Action::Ignored),
         (
             "CALL",

@@ -1012,6 +1012,27 @@ impl<'a> Interpreter<'a> {
                     }
                     spindle_limit = true;
                 }
+                Action::FeedGroup => {
+                    let given = args.as_deref().unwrap_or("");
+                    let mut axes: Vec<String> = given
+                        .split(',')
+                        .map(|a| a.trim().to_ascii_uppercase())
+                        .filter(|a| !a.is_empty())
+                        .collect();
+                    axes.sort();
+                    let default = axes.is_empty() || axes == ["X", "Y", "Z"];
+                    if !default {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}({given})`: F would be the speed along the combined \
+                                 path of these axes; feedopt reads a Sinumerik F along X Y Z, \
+                                 the default feed group (`FGROUP()` or `FGROUP(X,Y,Z)`). Post \
+                                 the program with the default feed group"
+                            ),
+                        ));
+                    }
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -1318,7 +1339,30 @@ impl<'a> Interpreter<'a> {
     /// Sinumerik `TRANS`/`ATRANS`/`ROT`/`AROT` with the block's X Y Z (none: cancel).
     fn frame(&mut self, line: usize, text: &str, op: FrameOp, block: &Block) -> Result<()> {
         if block.axes[3..].iter().any(Option::is_some) {
-            return Err(self.error(line, format!("{text} with A/B/C: not supported")));
+            let rotary: Vec<&str> = ["A", "B", "C"]
+                .into_iter()
+                .zip(&block.axes[3..])
+                .filter(|(_, a)| a.is_some())
+                .map(|(n, _)| n)
+                .collect();
+            let rotary = rotary.join(", ");
+            // Siemens (Programming Manual Fundamentals, "TRANS, ATRANS"): the offset may name
+            // any axis, a rotary one included, whose zero it shifts. feedopt's frames move X Y
+            // Z only; a rotary axis' shift changes where its programmed angles are, and on a
+            // 5-axis machine where the tool is, so it is an error, not a skipped word.
+            let what = match op {
+                FrameOp::Trans | FrameOp::ATrans => format!(
+                    "`{text}` with {rotary}: a shift of the zero of rotary axis {rotary}, which \
+                     feedopt does not model (the programmed angles, and on a 5-axis machine the \
+                     tool's position, depend on it). Remove it where the shift is 0, or add the \
+                     shift to the program's {rotary} words"
+                ),
+                FrameOp::Rot | FrameOp::ARot => format!(
+                    "`{text}` with {rotary}: feedopt rotates frames about X, Y and Z only \
+                     (`{text} X… Y… Z…`, angles in degrees)"
+                ),
+            };
+            return Err(self.error(line, what));
         }
         let given = block.axes[..3].iter().any(Option::is_some);
         let v: [f64; 3] = std::array::from_fn(|i| match (block.axes[i], op) {
@@ -1617,6 +1661,20 @@ impl<'a> Interpreter<'a> {
     /// cancels `G52` there is the control's matter).
     fn g92(&mut self, line: usize, numbering: OffsetNumbering, block: &Block) -> Result<()> {
         if block.axes.iter().all(Option::is_none) {
+            // A lathe's G92 S (Fanuc T series, G-code systems B and C; G50 S in system A)
+            // limits the spindle speed under G96: a turning program, whose X is a diameter.
+            if let Some(s) = block.letter('S') {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "`G92 S{}` without axis words: a lathe's spindle speed limit (Fanuc T \
+                         series, G-code systems B and C), so this is a turning program (X a \
+                         diameter, U/W incremental axes), which feedopt does not read: it reads \
+                         milling programs. On a mill, G92 X… Y… Z… sets the current position",
+                        s.value
+                    ),
+                ));
+            }
             return Err(self.error(
                 line,
                 "G92 without axis words: name the axes whose current position it sets (G92 X0 \

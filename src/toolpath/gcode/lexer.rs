@@ -278,6 +278,22 @@ fn lex_letters(
                          write `N{digits}`"
                     )
                 }
+                // Siemens' older controls (Sinumerik 3, 8, 810/820 M, 850/880) program their
+                // macro functions, jumps and parameter arithmetic as `@` codes with `K`/`R`
+                // operands (`@430 K1 K1 K0 K1525`, `@714`), a language the 840D replaced.
+                '@' => {
+                    let digits: String = chars[i + 1..]
+                        .iter()
+                        .take_while(|c| c.is_ascii_digit())
+                        .collect();
+                    format!(
+                        "`@{digits}`: an `@` code of the older Siemens languages (Sinumerik 3, \
+                         8, 810/820, 850/880: jumps, parameter arithmetic and machine functions), \
+                         which feedopt does not read: it reads the Sinumerik 840D language \
+                         (`--dialect sinumerik`). Post the program for an 840D, or as plain \
+                         G0/G1/G2/G3 moves"
+                    )
+                }
                 _ => format!("unexpected character `{c}`"),
             });
         }
