@@ -430,7 +430,10 @@ mod tests {
                 }
             }
         }
-        assert!(crossed > 10_000 && missed > 10_000, "{crossed} crossed, {missed} missed");
+        assert!(
+            crossed > 10_000 && missed > 10_000,
+            "{crossed} crossed, {missed} missed"
+        );
     }
 
     /// The line hit agrees with point membership for every shape and many tilted poses.
