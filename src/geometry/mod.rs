@@ -280,16 +280,23 @@ impl Path {
             // the tolerance plus [`CHORD_SLACK_MM`] plus the chord's allowance (the sagitta at
             // [`chord_curvature`]) everywhere, or the span has [`max_knots`]; `deviation` says
             // how far it is (the rotary angles' too).
-            // On a moving span only the tip is held to its chords: inserting knots where the
-            // rotary angles leave their linear interpolation in u made jerk-limited
-            // subproblems fail (Clarabel: DualInfeasible on the LinuxCNC boats); their
-            // deviation is measured and reported. On a reorientation (the tip stands, u is the
-            // angles' travel) the angles are what is held: three points 0.1 and 2.2 rad apart
-            // swung B 32° past the programmed positions on boat-xyzbc.
+            // On a moving span the tip is held to its chords, and the rotary angles only
+            // within [`ANGLE_SWING_RAD`] of theirs: inserting knots wherever the angles leave
+            // their linear interpolation in u by the angular tolerance made jerk-limited
+            // subproblems fail (Clarabel: DualInfeasible on the LinuxCNC boats, whose angles
+            // stay within 1.3°), but without any bound a cubic swung them 43° off on a real
+            // TRAORI program (tiny tip moves that turn A far, next to long ones), a motion of
+            // the rotary axes the program does not make. Their deviation is reported. On a
+            // reorientation (the tip stands, u is the angles' travel) the angles are what is
+            // held: three points 0.1 and 2.2 rad apart swung B 32° past the programmed
+            // positions on boat-xyzbc.
             let bound = if moving && angles_on_chords {
                 (tol_mm + CHORD_SLACK_MM, tol_rad + CHORD_SLACK_RAD)
             } else if moving {
-                (tol_mm + CHORD_SLACK_MM, f64::INFINITY)
+                (
+                    tol_mm + CHORD_SLACK_MM,
+                    ANGLE_SWING_RAD.max(tol_rad + CHORD_SLACK_RAD),
+                )
             } else {
                 (f64::INFINITY, tol_rad + CHORD_SLACK_RAD)
             };
@@ -391,6 +398,15 @@ pub const CHORD_SLACK_MM: f64 = 1e-3;
 /// How far beyond the angular tolerance a reorientation's rotary angles may stray from their
 /// linear interpolation between knots, rad (a thousandth of a degree).
 pub const CHORD_SLACK_RAD: f64 = 1e-3 * std::f64::consts::PI / 180.0;
+
+/// How far a five-axis moving span's fitted rotary angles may stray from their linear
+/// interpolation between knots (the programmed chords), rad: 2°. A bound on gross swings, not
+/// a fitting tolerance (the tip's is that): holding the angles to the angular tolerance made
+/// jerk-limited subproblems fail on the LinuxCNC boats, whose fitted angles stay within 1.3°
+/// of their chords (the impeller's within 0.3°), and left those programs' answers as they
+/// were; a real TRAORI program whose angles swung 43° off is held within it (its cycle time
+/// moved by 1 %).
+pub const ANGLE_SWING_RAD: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
 /// The most pieces [`Path::build`]'s chord refinement cuts an interval into at once.
 const MAX_PIECES: usize = 8;
