@@ -1643,3 +1643,33 @@ fn a_lathe_spindle_limit_names_a_turning_program() {
     let e = fanuc_error("G90 G0 X0. Y0. Z0.\nG92\n");
     assert!(e.contains("t.nc:2") && e.contains("name the axes"), "{e}");
 }
+
+/// A Sinumerik R parameter read before the program sets it is taken as 0 (its value after the
+/// control's reset), and the reader says so at the line of its first read, once per parameter:
+/// R parameters keep their values between programs, and this one moves the tool (a post wrote
+/// `TRANS X=R24-243.6` with R24 set elsewhere). One the program sets is not mentioned.
+#[test]
+fn an_unset_r_parameter_is_read_as_0_and_said() {
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "R2=5\nG0 X0 Y0 Z0\nTRANS X=R24-10\nG1 X=R2 Y=R24 F1000\nG1 X=R7+R24\nM30\n",
+    );
+    let said: Vec<&Warning> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("is read before the program sets it"))
+        .collect();
+    assert_eq!(said.len(), 2, "{:?}", tp.warnings);
+    assert!(
+        said[0].message.contains("`R24`") && said[0].line == 3,
+        "{said:?}"
+    );
+    assert!(
+        said[1].message.contains("`R7`") && said[1].line == 5,
+        "{said:?}"
+    );
+    // Both as 0: TRANS X=R24-10 shifts X by −10, and the last point, X = R7 + R24 = 0 in
+    // that frame, lies at X −10.
+    let last = tp.points.last().unwrap().p;
+    assert!((last.x + 10.0).abs() < 1e-9, "{last:?}");
+}

@@ -36,7 +36,17 @@ pub struct Variables {
     declared: HashMap<String, ()>,
     /// Changes so far ([`Variables::changes`]).
     changes: u64,
+    /// The source line being run, set by the reader before each block: where a read of an
+    /// unset R parameter is noted ([`Variables::take_assumed_zero`]).
+    pub line: usize,
+    /// Sinumerik R parameters read before the program set them, each with the line of its
+    /// first such read: taken as 0 (a read does not change the variables, so this notes it
+    /// through a shared reference).
+    assumed_zero: std::cell::RefCell<AssumedZero>,
 }
+
+/// [`Variables`]' unset R parameters read: (name, line) in the order first read, and the names.
+type AssumedZero = (Vec<(String, usize)>, std::collections::HashSet<String>);
 
 impl Variables {
     /// Declares a Sinumerik user variable (value 0).
@@ -47,6 +57,12 @@ impl Variables {
             self.values.insert(name.clone(), 0.0);
         }
         self.declared.insert(name, ());
+    }
+
+    /// The R parameters read before the program set them (taken as 0), each with the line of
+    /// its first such read, in the order they were first read; emptied.
+    pub fn take_assumed_zero(&mut self) -> Vec<(String, usize)> {
+        std::mem::take(&mut self.assumed_zero.get_mut().0)
     }
 
     /// How many times a value has changed so far (a new variable, or a different value
@@ -134,7 +150,13 @@ impl Variables {
             ));
         }
         if is_r_parameter(&name) {
-            return Ok(0.0); // Sinumerik R parameters start at 0
+            // Sinumerik R parameters are 0 after the control's reset, but they keep their
+            // values from one program to the next: noted, for the reader to say.
+            let (order, seen) = &mut *self.assumed_zero.borrow_mut();
+            if seen.insert(name.clone()) {
+                order.push((name, self.line));
+            }
+            return Ok(0.0);
         }
         Err(if let Some(n) = system_variable(&name) {
             let which = if n >= 5000 {

@@ -412,6 +412,23 @@ impl<'a> Interpreter<'a> {
         }
     }
 
+    /// After the program: every Sinumerik R parameter it read before setting it, at the line
+    /// of the first such read. Taken as 0, as after the control's reset; but R parameters keep
+    /// their values between programs (a main program or the operator may have set them), and
+    /// the value can move the tool (`TRANS X=R24-243.6`).
+    pub(super) fn note_assumed_parameters(&mut self) {
+        for (name, line) in self.vars.take_assumed_zero() {
+            self.warn(
+                line,
+                format!(
+                    "`{name}` is read before the program sets it: taken as 0, its value after \
+                     the control's reset (R parameters keep their values between programs: if \
+                     another program or the operator sets it, set it at the start of this one)"
+                ),
+            );
+        }
+    }
+
     pub(super) fn finish(mut self, last_line: usize) -> Result<Toolpath> {
         if self.points.is_empty() {
             return Err(self.error(last_line.max(1), "no motion blocks"));

@@ -364,6 +364,7 @@ pub fn parse_configured(
     interp.set_decimal_point_input(settings.decimal_point_input);
     program.run(spec, &mut interp, source)?;
     interp.note_units();
+    interp.note_assumed_parameters();
     let assumed = interp.assumed;
     interp
         .finish(program.last_line())

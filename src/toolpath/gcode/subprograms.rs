@@ -659,6 +659,7 @@ impl Program {
             };
             let line = &self.lines[index];
             let number = line.number;
+            interp.vars.line = number;
             let blocks = match &line.blocks {
                 Ok(b) => b,
                 Err(m) => {
