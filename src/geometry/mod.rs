@@ -316,13 +316,18 @@ impl Path {
                 let sag: Vec<f64> = (0..kchord.len())
                     .map(|k| (u[k + 1] - u[k]).powi(2) * kchord[k] / 8.0)
                     .collect();
-                // (An interval shorter than twice the bound is not cut: a cubic that swings
-                // that far off so short a chord turns back on itself, which the points do not
-                // ask for, and much shorter intervals leave the solvers badly scaled.)
+                // (An interval shorter than twice the bound is not cut for the tip: a cubic
+                // that swings that far off so short a chord turns back on itself, which the
+                // points do not ask for, and much shorter intervals leave the solvers badly
+                // scaled. A five-axis moving span's bound on the angles' swing holds on every
+                // interval: a short one may turn the tool far, the tip moving 1 µm while C
+                // turns 90°, and a cubic swung C 33° off there.)
                 let far: Vec<usize> = (0..between.len())
                     .filter(|&k| {
                         let short = u[k + 1] - u[k] < 2.0 * if moving { bound.0 } else { bound.1 };
-                        !short && (between[k].0 > bound.0 + sag[k] || between[k].1 > bound.1)
+                        let swing = moving && !angles_on_chords;
+                        (!short && (between[k].0 > bound.0 + sag[k] || between[k].1 > bound.1))
+                            || (swing && between[k].1 > bound.1)
                     })
                     .collect();
                 if far.is_empty()
