@@ -63,17 +63,21 @@ fn assert_verified_with_jerk(sol: &Solution, what: &str) {
     assert!(sol.solutions.iter().all(|s| s.a.is_some()), "{what}");
 }
 
+/// A three-axis mill whose X, Y and Z share velocity `v`, acceleration `a` and jerk `j`
+/// (symmetric limits).
+fn xyz_jerk(v: f64, a: f64, j: f64) -> Machine {
+    let axis = format!(r#"{{"velocity": {v}, "acceleration": {a}, "jerk": {j}}}"#);
+    common::machine(&format!(
+        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{"X": {axis}, "Y": {axis}, "Z": {axis}}}}}"#
+    ))
+}
+
 /// Rest to rest along one axis with only the jerk limit J binding: jerk +J, −J, +J for τ, 2τ,
 /// τ, so L = 2 J τ³ and T = 4 (L / 2J)^{1/3}.
 #[test]
 fn straight_line_with_only_jerk_binding_matches_the_closed_form() {
     let (len, jerk) = (20.0, 5000.0);
-    let m = common::machine(&format!(
-        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{
-        "X": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
-        "Y": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
-        "Z": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}}}}}}"#
-    ));
+    let m = xyz_jerk(1e4, 1e5, jerk);
     let pts: Vec<_> = (0..=4)
         .map(|k| (Vector3::new(len * k as f64 / 4.0, 0.0, 0.0), UP))
         .collect();
@@ -153,12 +157,7 @@ fn a_straight_move_takes_the_double_s_time() {
 /// closed form's, on a zig-zag of exact stops (each move a span from rest to rest).
 #[test]
 fn the_double_s_agrees_with_the_programme() {
-    let m = common::machine(
-        r#"{"kinematics": {"type": "xyz"}, "axes": {
-        "X": {"velocity": 200, "acceleration": 2000, "jerk": 20000},
-        "Y": {"velocity": 200, "acceleration": 2000, "jerk": 20000},
-        "Z": {"velocity": 200, "acceleration": 2000, "jerk": 20000}}}"#,
-    );
+    let m = xyz_jerk(200.0, 2000.0, 20000.0);
     let pts: Vec<_> = (0..6)
         .map(|k| {
             let x = if k % 2 == 0 {
@@ -464,12 +463,7 @@ fn a_linuxcnc_program_with_jerk_limits_solves_without_stalls_or_cycles() {
 /// ramps: jerk +J, −J to the feed in 2√(V/J) each way, so T = L/V + 2√(V/J) = 2.2 s.
 fn jerk_line_with_plateau() -> (Machine, feedopt::toolpath::Toolpath, f64) {
     let (len, v, jerk) = (100.0, 50.0, 5000.0);
-    let m = common::machine(&format!(
-        r#"{{"kinematics": {{"type": "xyz"}}, "axes": {{
-        "X": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
-        "Y": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}},
-        "Z": {{"velocity": 1e4, "acceleration": 1e5, "jerk": {jerk}}}}}}}"#
-    ));
+    let m = xyz_jerk(1e4, 1e5, jerk);
     let pts: Vec<_> = (0..=4)
         .map(|k| (Vector3::new(len * k as f64 / 4.0, 0.0, 0.0), UP))
         .collect();
@@ -645,12 +639,7 @@ fn exact_interpolation_of_the_boats_solves_with_jerk_limits() {
 /// the same path blends and verifies.
 #[test]
 fn a_corner_tolerance_with_jerk_limits_is_refused_with_the_way_out() {
-    let m = common::machine(
-        r#"{"kinematics": {"type": "xyz"}, "axes": {
-        "X": {"velocity": 500, "acceleration": 3000, "jerk": 30000},
-        "Y": {"velocity": 500, "acceleration": 3000, "jerk": 30000},
-        "Z": {"velocity": 500, "acceleration": 3000, "jerk": 30000}}}"#,
-    );
+    let m = xyz_jerk(500.0, 3000.0, 30000.0);
     let pts = [
         (Vector3::new(0.0, 0.0, 0.0), UP),
         (Vector3::new(10.0, 0.0, 0.0), UP),
