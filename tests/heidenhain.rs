@@ -651,7 +651,7 @@ fn m92_moves_relative_to_the_builders_datum_from_the_machine_file() {
             v(20.0, 20.0, 180.5)
         ]
     );
-    let notes: Vec<&str> = tp.warnings.iter().map(|w| w.message.as_str()).collect();
+    let notes: Vec<&str> = tp.warnings.iter().map(|w| &*w.message).collect();
     assert!(notes.iter().any(|w| w.contains("axes.Y.m92")), "{notes:?}");
     assert!(
         !notes

@@ -436,7 +436,7 @@ impl<'a> Reader<'a> {
                 if !known {
                     self.warnings.push(crate::toolpath::Warning {
                         line,
-                        message: format!("unknown APT record `{}`: skipped", major),
+                        message: format!("unknown APT record `{}`: skipped", major).into(),
                     });
                 }
                 // Compensation on (as G41/G42 and Klartext RL/RR say): the CL points may be
@@ -453,7 +453,8 @@ impl<'a> Reader<'a> {
                             "CUTCOM/{}: cutter radius compensation is not applied: the CL \
                              points are taken as the tool path",
                             m.trim()
-                        ),
+                        )
+                        .into(),
                     });
                 }
                 Ok(())

@@ -240,11 +240,14 @@ impl SpindleChange {
     }
 }
 
-/// A reader's warning: a line and what about it.
+/// A reader's warning: a line and what about it. The message is shared (`Arc<str>`): a
+/// reader that says the same thing of many blocks keeps one copy of its text, not one per
+/// block (the Fanuc combined-feed rule's 390 characters on every block of a 51k-line
+/// four-axis program: 20 MB).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Warning {
     pub line: usize,
-    pub message: String,
+    pub message: std::sync::Arc<str>,
 }
 
 /// A reader's warnings with the same message, told once: the first, and how many more.
@@ -265,13 +268,13 @@ impl WarningGroup {
         let mut groups: Vec<WarningGroup> = Vec::new();
         let mut index: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
         for w in warnings {
-            match index.get(w.message.as_str()) {
+            match index.get(&*w.message) {
                 Some(&k) => {
                     groups[k].more += 1;
                     groups[k].last_line = w.line;
                 }
                 None => {
-                    index.insert(&w.message, groups.len());
+                    index.insert(&*w.message, groups.len());
                     groups.push(WarningGroup {
                         first: w.clone(),
                         more: 0,
@@ -286,7 +289,7 @@ impl WarningGroup {
     /// The message, with `(and N more like it, the last at line L)` when there are more.
     pub fn message(&self) -> String {
         match self.more {
-            0 => self.first.message.clone(),
+            0 => self.first.message.to_string(),
             n => format!(
                 "{} (and {n} more like it, the last at line {})",
                 self.first.message, self.last_line

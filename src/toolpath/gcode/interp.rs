@@ -195,6 +195,8 @@ pub(super) struct Interpreter<'a> {
     pub(super) procs: Vec<String>,
     pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
+    /// Every warning text said so far, once ([`Interpreter::warn`]).
+    warning_texts: std::collections::HashSet<std::sync::Arc<str>>,
     dwells: Vec<Dwell>,
     /// The tangent (plane, unit direction in its two axes) at the end of the last straight
     /// line or arc, and the point count right after it (Klartext `CT` must follow directly).
@@ -288,6 +290,7 @@ impl<'a> Interpreter<'a> {
             procs: Vec::new(),
             points: Vec::new(),
             warnings: Vec::new(),
+            warning_texts: std::collections::HashSet::new(),
             dwells: Vec::new(),
             tangent: None,
             shortest_path: false,
@@ -386,9 +389,19 @@ impl<'a> Interpreter<'a> {
     }
 
     pub(super) fn warn(&mut self, line: usize, message: impl Into<String>) {
+        // One copy of each text ([`Warning`]): a message said before shares its first copy.
+        let message: String = message.into();
+        let shared = match self.warning_texts.get(message.as_str()) {
+            Some(text) => text.clone(),
+            None => {
+                let text: std::sync::Arc<str> = message.into();
+                self.warning_texts.insert(text.clone());
+                text
+            }
+        };
         self.warnings.push(Warning {
             line,
-            message: message.into(),
+            message: shared,
         });
     }
 
