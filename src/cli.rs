@@ -450,6 +450,9 @@ fn solve_with_progress(
             solution.error_target.unwrap_or(f64::NAN)
         );
     }
+    if let Some(why) = &solution.slowed_down {
+        eprintln!("feedopt: warning: {why}");
+    }
     Ok(solution)
 }
 

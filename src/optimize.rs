@@ -31,7 +31,7 @@ use crate::solver::jerk::{JerkData, JerkOptions, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
-use crate::verify::{Verification, VerifyOptions, Violation, verify_marked};
+use crate::verify::{Quantity, Verification, VerifyOptions, Violation, verify_marked};
 
 mod checks;
 pub(crate) use checks::inputs as check_inputs;
@@ -65,6 +65,9 @@ pub struct Options {
     /// first converged (or the fixed) grid is returned as it is, with its verification: for
     /// like-for-like comparisons with other solvers on their grid. The CLI always refines.
     pub refine_until_verified: bool,
+    /// Rounds of local refinement before the spans still over a limit are slowed down
+    /// instead ([`Solution::slowed_down`]); default 12.
+    pub local_rounds: usize,
     /// Honour the machine's jerk limits (when it has any; issue 6). When false, the jerk limits
     /// are dropped from the machine for the whole solve (an acceleration-limited schedule).
     pub jerk_limited: bool,
@@ -89,6 +92,7 @@ impl Default for Options {
             max_stations: 4_000_000,
             verify: VerifyOptions::default(),
             refine_until_verified: true,
+            local_rounds: MAX_LOCAL_ROUNDS,
             jerk_limited: true,
             jerk: JerkOptions::default(),
             process: None,
@@ -147,6 +151,11 @@ pub struct Solution {
     /// if it did. The schedule is verified all the same; the estimate says how far its cycle
     /// time may be from the continuous optimum.
     pub unconverged: Option<String>,
+    /// Where the local refinement did not settle within its rounds and the spans still over
+    /// a limit were slowed down instead (each by the least factor that keeps every limit):
+    /// how many, by how much, and the time it cost. The schedule keeps every limit; its time
+    /// is that much above what the stations would give, which the error estimate includes.
+    pub slowed_down: Option<String>,
     /// The re-simulation of the returned schedule at the servo period.
     pub verification: Verification,
     /// Its servo period, s.
@@ -322,7 +331,7 @@ fn optimize_path(
     let mark = LOCAL_MARK * options.verify.tolerance;
     let (mut v, mut marks) = plan.verify_marked(&lv, options, mark)?;
     let mut round = 0;
-    while !v.verified && options.refine_until_verified && round < MAX_LOCAL_ROUNDS {
+    while !v.verified && options.refine_until_verified && round < options.local_rounds {
         tracing::debug!(
             "verify: {} intervals ({} marked), worst {:?}",
             v.violating_intervals,
@@ -351,6 +360,71 @@ fn optimize_path(
     if round > 0 && !v.verified {
         lv.rebuild_schedule(&plan)?;
     }
+    // The local refinement did not settle (each round's re-simulation found the excess in
+    // other intervals): the spans still over a limit run slower instead, each by the least
+    // factor that brings its worst excess within the limit (velocity and feed fall as 1/f,
+    // acceleration and chord error as 1/f², jerk as 1/f³), so that the schedule returned
+    // keeps every limit; the time that costs is added to the error estimate and said.
+    let mut slowed = (0usize, 1.0f64, 0.0f64); // spans, largest factor, time added (s)
+    let mut tries = 0;
+    while !v.verified
+        && options.refine_until_verified
+        && round >= options.local_rounds
+        && tries < SLOW_DOWN_TRIES
+    {
+        let mut factors: Vec<f64> = vec![1.0; lv.solutions.len()];
+        for w in &v.violations {
+            let k = match w.kind {
+                Quantity::Velocity | Quantity::Feed => 1.0,
+                Quantity::Acceleration | Quantity::Chord => 2.0,
+                Quantity::Jerk => 3.0,
+            };
+            let p = &lv.problems[w.span];
+            if !w.ratio.is_finite() || p.b_start != 0.0 || p.b_end != 0.0 {
+                factors.clear();
+                break;
+            }
+            let f = w.ratio.powf(1.0 / k) * (1.0 + SLOW_DOWN_MARGIN);
+            factors[w.span] = factors[w.span].max(f);
+        }
+        if factors.is_empty() {
+            break;
+        }
+        let before = lv.schedule.cycle_time;
+        for (si, &f) in factors.iter().enumerate().filter(|(_, f)| **f > 1.0) {
+            lv.solutions[si].slow_down(f);
+            slowed.0 += 1;
+            slowed.1 = slowed.1.max(f);
+        }
+        lv.rebuild_schedule(&plan)?;
+        slowed.2 += lv.schedule.cycle_time - before;
+        v = plan.verify_marked(&lv, options, mark)?.0;
+        tries += 1;
+    }
+    let mut error_estimate = error_estimate;
+    let mut slowed_down = None;
+    if slowed.0 > 0 && v.verified {
+        let added = slowed.2 / lv.schedule.cycle_time;
+        error_estimate = error_estimate.map(|e| e + added);
+        let why = format!(
+            "the re-simulation still found limits exceeded between stations after \
+             {round} rounds of local refinement: {} span(s) run up to {:.3} % \
+             slower instead, which keeps every limit ({:.4} s, {added:.1e} of the cycle \
+             time{})",
+            slowed.0,
+            (slowed.1 - 1.0) * 100.0,
+            slowed.2,
+            if error_estimate.is_some() {
+                ", added to the error estimate"
+            } else {
+                ""
+            }
+        );
+        if error_target.is_some_and(|t| error_estimate.is_some_and(|e| e > t)) {
+            unconverged = Some(unconverged.map_or(why.clone(), |u| format!("{u}; {why}")));
+        }
+        slowed_down = Some(why);
+    }
     if round > 0 {
         refinement.push(Refinement {
             stations: lv.schedule.stations.len(),
@@ -360,7 +434,7 @@ fn optimize_path(
     if !v.verified && options.refine_until_verified {
         let worst = v.violations.first();
         return Err(Error::Solver(format!(
-            "the schedule still exceeds a limit between stations after {MAX_LOCAL_ROUNDS} rounds \
+            "the schedule still exceeds a limit between stations after {round} rounds \
              of local refinement ({} intervals{}); try a finer --period or report the program",
             v.violating_intervals,
             worst.map_or(String::new(), |w| format!(
@@ -385,6 +459,7 @@ fn optimize_path(
         error_estimate,
         error_target,
         unconverged,
+        slowed_down,
         verification: v,
         verify_period: options.verify.period,
         corners_blended: 0,
@@ -484,6 +559,14 @@ const MAX_LOCAL_SPLIT: usize = 8;
 /// Rounds of local refinement where the re-simulation failed before giving up (each round
 /// divides the excess between stations by four or more).
 const MAX_LOCAL_ROUNDS: usize = 12;
+
+/// Times the spans still over a limit after the local refinement are slowed down (the
+/// violations a re-simulation lists are its worst, so a span it left out may show in the
+/// next).
+const SLOW_DOWN_TRIES: usize = 4;
+
+/// How far below its limit a slowed-down span's worst excess is brought (relative).
+const SLOW_DOWN_MARGIN: f64 = 1e-6;
 
 /// Rounds of the adaptive refinement of one span at most (each halves the intervals marked).
 const MAX_ADAPTIVE_ROUNDS: usize = 60;

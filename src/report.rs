@@ -194,6 +194,9 @@ pub struct Summary {
     /// Why the refinement stopped with `error_estimate` above `error_target` (`null`: it did
     /// not): see [`Solution::unconverged`].
     pub unconverged: Option<String>,
+    /// Where spans were slowed down after the local refinement did not settle (`null`: none
+    /// were): see [`Solution::slowed_down`].
+    pub slowed_down: Option<String>,
     /// The re-simulation at the servo period found every limit kept (within its tolerance).
     pub verified: bool,
     /// Servo period of the re-simulation, s.
@@ -333,6 +336,7 @@ impl Summary {
             error_estimate: sol.error_estimate,
             error_target: sol.error_target,
             unconverged: sol.unconverged.clone(),
+            slowed_down: sol.slowed_down.clone(),
             verified: sol.verification.verified,
             verify_period_s: sol.verify_period,
             worst_ratio: sol

@@ -334,6 +334,7 @@ impl Study<'_> {
             error_estimate: None,
             error_target: None,
             unconverged: None,
+            slowed_down: None,
             verification,
             verify_period: self.options.verify.period,
             corners_blended: self.base.corners_blended,

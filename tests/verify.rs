@@ -404,3 +404,53 @@ fn the_result_does_not_depend_on_the_threads() {
     assert_eq!(one, on(3));
     assert_eq!(one, on(0));
 }
+
+/// Where the local refinement has not settled within its rounds, the spans still over a limit
+/// are slowed down instead, each by the least factor that keeps its limits (velocity as 1/f,
+/// acceleration as 1/f², jerk as 1/f³): the schedule returned verifies and says so in
+/// `slowed_down`. Here with no rounds at all, on the coarse circle of the tests above, whose
+/// grid exceeds the acceleration limits between stations; slowing a span down by f
+/// multiplies each of its intervals' times by f exactly.
+#[test]
+fn spans_the_refinement_has_not_settled_are_slowed_down_until_they_verify() {
+    let m = machine(XYZ_2000);
+    let tp = toolpath(&circle(10.0, 3, 37), None);
+    let coarse = Options {
+        stations: Some(20),
+        local_rounds: 0,
+        ..Options::default()
+    };
+    let sol = solve(&m, &tp, &coarse);
+    assert!(
+        sol.verification.verified,
+        "{:?}",
+        sol.verification.violations.first()
+    );
+    let why = sol.slowed_down.as_deref().expect("spans were slowed down");
+    assert!(why.contains("slower instead"), "{why}");
+    // Against the refined answer: slower, by the excess the coarse grid had between stations.
+    let refined = solve(
+        &m,
+        &tp,
+        &Options {
+            stations: Some(20),
+            ..Options::default()
+        },
+    );
+    assert!(refined.slowed_down.is_none());
+    let (t, r) = (sol.schedule.cycle_time, refined.schedule.cycle_time);
+    eprintln!("{why}: {t} s against {r} s refined");
+    assert!(t >= r && t <= 1.1 * r, "{t} vs {r}");
+    // Slowing down is exact: every interval takes f times as long.
+    let (p, s) = (&refined.problems[0], &refined.solutions[0]);
+    let before = feedopt::solver::interval_times(p, s).unwrap();
+    let mut slow = s.clone();
+    slow.slow_down(1.25);
+    let after = feedopt::solver::interval_times(p, &slow).unwrap();
+    for (a, b) in after.iter().zip(&before) {
+        assert!(
+            (a - 1.25 * b).abs() <= 1e-12 * b.max(1e-9),
+            "{a} vs 1.25 × {b}"
+        );
+    }
+}

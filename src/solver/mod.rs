@@ -175,6 +175,26 @@ pub struct SpanSolution {
     pub scp_iterations: u32,
 }
 
+impl SpanSolution {
+    /// The same motion `factor` (≥ 1) times slower: u̇ → u̇/f, so b, ü and a' = dü/du all
+    /// divide by f². Every motion law is homogeneous in them, so each interval takes f times
+    /// as long, and every axis's velocity, acceleration and jerk along the path divide by f,
+    /// f² and f³ (the path, its stations and the laws unchanged).
+    pub fn slow_down(&mut self, factor: f64) {
+        let k = 1.0 / (factor * factor);
+        self.b.iter_mut().for_each(|x| *x *= k);
+        if let Some(a) = &mut self.a {
+            a.iter_mut().for_each(|x| *x *= k);
+        }
+        if let Some(s) = &mut self.slopes {
+            s.iter_mut().for_each(|x| {
+                x[0] *= k;
+                x[1] *= k;
+            });
+        }
+    }
+}
+
 /// Time taken by each interval of one span's profile: [`crate::motion::interval_times`] at
 /// the problem's stations.
 pub fn interval_times(

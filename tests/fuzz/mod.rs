@@ -541,12 +541,14 @@ fn machine_case(path: PathBuf, bytes: Vec<u8>) -> Outcome {
 }
 
 /// Fields of the summary that are `null` by design: no estimate or target on a fixed grid,
-/// no reason when the refinement converged, no dialect for an APT or CSV input, no reference
-/// or units note when the reader assumed no G28/G30 reference and no program unit.
-const OPTIONAL: [&str; 7] = [
+/// no reason when the refinement converged, none when no span was slowed down, no dialect for
+/// an APT or CSV input, no reference or units note when the reader assumed no G28/G30
+/// reference and no program unit.
+const OPTIONAL: [&str; 8] = [
     "summary.error_estimate",
     "summary.error_target",
     "summary.unconverged",
+    "summary.slowed_down",
     "summary.dialect",
     "summary.dialect_by",
     "summary.reference",
