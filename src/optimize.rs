@@ -365,7 +365,9 @@ fn optimize_path(
     // factor that brings its worst excess within the limit (velocity and feed fall as 1/f,
     // acceleration and chord error as 1/f², jerk as 1/f³), so that the schedule returned
     // keeps every limit; the time that costs is added to the error estimate and said.
-    let mut slowed = (0usize, 1.0f64, 0.0f64); // spans, largest factor, time added (s)
+    // Each span's factor so far (a span a later try slows again multiplies its factors).
+    let mut slowed: Vec<f64> = vec![1.0; lv.solutions.len()];
+    let before_slowing = lv.schedule.cycle_time;
     let mut tries = 0;
     while !v.verified
         && options.refine_until_verified
@@ -390,30 +392,30 @@ fn optimize_path(
         if factors.is_empty() {
             break;
         }
-        let before = lv.schedule.cycle_time;
         for (si, &f) in factors.iter().enumerate().filter(|(_, f)| **f > 1.0) {
             lv.solutions[si].slow_down(f);
-            slowed.0 += 1;
-            slowed.1 = slowed.1.max(f);
+            slowed[si] *= f;
         }
         lv.rebuild_schedule(&plan)?;
-        slowed.2 += lv.schedule.cycle_time - before;
         v = plan.verify_marked(&lv, options, mark)?.0;
         tries += 1;
     }
     let mut error_estimate = error_estimate;
     let mut slowed_down = None;
-    if slowed.0 > 0 && v.verified {
-        let added = slowed.2 / lv.schedule.cycle_time;
+    let spans_slowed = slowed.iter().filter(|&&f| f > 1.0).count();
+    if spans_slowed > 0 && v.verified {
+        let largest = slowed.iter().copied().fold(1.0, f64::max);
+        let cost = lv.schedule.cycle_time - before_slowing;
+        let added = cost / lv.schedule.cycle_time;
         error_estimate = error_estimate.map(|e| e + added);
         let why = format!(
             "the re-simulation still found limits exceeded between stations after \
              {round} rounds of local refinement: {} span(s) run up to {:.3} % \
              slower instead, which keeps every limit ({:.4} s, {added:.1e} of the cycle \
              time{})",
-            slowed.0,
-            (slowed.1 - 1.0) * 100.0,
-            slowed.2,
+            spans_slowed,
+            (largest - 1.0) * 100.0,
+            cost,
             if error_estimate.is_some() {
                 ", added to the error estimate"
             } else {

@@ -322,10 +322,10 @@ impl Path {
                 // scaled. A five-axis moving span's bound on the angles' swing holds on every
                 // interval: a short one may turn the tool far, the tip moving 1 µm while C
                 // turns 90°, and a cubic swung C 33° off there.)
+                let swing = moving && !angles_on_chords;
                 let far: Vec<usize> = (0..between.len())
                     .filter(|&k| {
                         let short = u[k + 1] - u[k] < 2.0 * if moving { bound.0 } else { bound.1 };
-                        let swing = moving && !angles_on_chords;
                         (!short && (between[k].0 > bound.0 + sag[k] || between[k].1 > bound.1))
                             || (swing && between[k].1 > bound.1)
                     })

@@ -296,12 +296,8 @@ pub fn profile_stations(s: &DoubleS, u0: f64) -> Option<(Vec<f64>, SpanSolution)
             if matches!(iv.law, crate::motion::Law::Cubic) {
                 for f in [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 1.0] {
                     let x = f * iv.du;
-                    let slope = iv.s0 + (iv.s1 - iv.s0) * f;
-                    let bx = iv.b0
-                        + 2.0 * iv.a0 * x
-                        + iv.s0 * x * x
-                        + (iv.s1 - iv.s0) * x * x * x / (3.0 * iv.du);
-                    if (slope * bx.max(0.0).sqrt()).abs() > s.jerk * (1.0 + JERK_TOLERANCE) {
+                    let jerk = iv.slope_at_x(x) * iv.at_x(x).0.sqrt();
+                    if jerk.abs() > s.jerk * (1.0 + JERK_TOLERANCE) {
                         jerk_ok = false;
                     }
                 }
