@@ -305,18 +305,8 @@ impl Summary {
             solve_time_s: sol.solve_time,
             path_length_mm: length,
             joint_space: machine.kinematics == crate::machine::KinematicsSpec::Joint,
-            max_deviation_mm: sol
-                .path
-                .spans
-                .iter()
-                .map(|s| s.deviation.0)
-                .fold(0.0, f64::max),
-            max_deviation_deg: sol
-                .path
-                .spans
-                .iter()
-                .map(|s| s.deviation.1.to_degrees())
-                .fold(0.0, f64::max),
+            max_deviation_mm: sol.path.deviation().0,
+            max_deviation_deg: sol.path.deviation().1.to_degrees(),
             axes: names
                 .iter()
                 .enumerate()

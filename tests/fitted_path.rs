@@ -184,12 +184,7 @@ fn a_five_axis_move_keeps_its_rotary_angles_near_their_chords() {
         let tp = parse(Path::new("step.ngc"), program, Dialect::LinuxCnc).expect("reads");
         let sol = optimize_input(&machine, &Input::Cl(tp), &Options::default()).expect("solves");
         assert!(sol.verification.verified);
-        let worst = sol
-            .path
-            .spans
-            .iter()
-            .map(|s| s.deviation.1)
-            .fold(0.0, f64::max);
+        let worst = sol.path.deviation().1;
         assert!(
             worst.to_degrees() <= 2.0 + 1e-9,
             "the rotary angles stray {}° from their chords",

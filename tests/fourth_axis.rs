@@ -222,12 +222,6 @@ fn the_rotary_angle_is_held_to_its_chords() {
     )
     .unwrap();
     let s = solve(&m, &tp);
-    let worst = s
-        .path
-        .spans
-        .iter()
-        .map(|sp| sp.deviation.1)
-        .fold(0.0, f64::max)
-        .to_degrees();
+    let worst = s.path.deviation().1.to_degrees();
     assert!(worst <= 0.0111, "the angle strays {worst}° from its chords");
 }

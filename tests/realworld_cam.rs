@@ -108,13 +108,7 @@ fn the_five_axis_programs_keep_their_angles_near_the_programmed_ones() {
         let (input, _) = read(file, machine).unwrap_or_else(|e| panic!("{e}"));
         let sol = optimize_input(&m, &input, &Options::default()).expect("solves");
         assert!(sol.verification.verified, "{file}");
-        let worst = sol
-            .path
-            .spans
-            .iter()
-            .map(|s| s.deviation.1)
-            .fold(0.0, f64::max)
-            .to_degrees();
+        let worst = sol.path.deviation().1.to_degrees();
         eprintln!(
             "{file}: {:.4} s, angles within {worst:.4}°",
             sol.schedule.cycle_time

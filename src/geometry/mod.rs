@@ -190,6 +190,14 @@ pub struct Path {
 }
 
 impl Path {
+    /// How far the fitted curve strays from the programmed path over every span: the largest
+    /// tool-tip distance (mm) and rotary-angle difference (rad) of [`Span::deviation`].
+    pub fn deviation(&self) -> (f64, f64) {
+        self.spans.iter().fold((0.0, 0.0), |(mm, rad), s| {
+            (mm.max(s.deviation.0), rad.max(s.deviation.1))
+        })
+    }
+
     /// Builds the spans of `toolpath`. `angles[k]` are the rotary angles (radians) of CL point
     /// k on one continuous branch; `feed_max` caps every feed, rapids run at it;
     /// `orientation_moves_axes` is false for machines that ignore orientation (a pure
