@@ -41,6 +41,21 @@ pub enum Bound {
     None,
 }
 
+impl Bound {
+    /// Two words that tell every bound apart (for [`SpanProblem::fingerprint`]).
+    fn words(self) -> [u64; 2] {
+        match self {
+            Bound::AxisVelocity(j) => [0, j as u64],
+            Bound::AxisAcceleration(j) => [1, j as u64],
+            Bound::AxisJerk(j) => [2, j as u64],
+            Bound::Feed => [3, 0],
+            Bound::Chord => [4, 0],
+            Bound::Process(l) => [5, l as u64],
+            Bound::None => [6, 0],
+        }
+    }
+}
+
 /// The chord-error bound of data-sampling interpolation (seed 004): a controller moves on
 /// straight chords between setpoints one period T apart; on a tool-tip path of curvature κ at
 /// feed V a chord of length V T strays from the curve by about κ (V T)²/8. Keeping that below δ
@@ -240,6 +255,49 @@ pub struct SpanProblem {
 }
 
 impl SpanProblem {
+    /// Appends to `out` the exact bits of everything a solver reads of this problem, so that
+    /// two problems with equal fingerprints have the same solution (a drilling cycle's plunge
+    /// at every hole; [`crate::optimize`] solves such spans once). The axis positions q are
+    /// left out: no solver reads them, only their derivatives and the bounds (which is what
+    /// makes the same move at another place the same problem).
+    pub fn fingerprint(&self, out: &mut Vec<u64>) {
+        // Every field named, so that a new one cannot be missed here.
+        let SpanProblem {
+            u,
+            b_max,
+            b_max_by,
+            tip_speed,
+            jets,
+            acceleration,
+            essential,
+            b_start,
+            b_end,
+        } = self;
+        let StationJets {
+            n_axes,
+            q: _,
+            dq,
+            ddq,
+        } = jets;
+        out.extend([
+            u.len() as u64,
+            *n_axes as u64,
+            b_start.to_bits(),
+            b_end.to_bits(),
+        ]);
+        for v in [u, b_max, tip_speed, dq, ddq] {
+            out.push(v.len() as u64);
+            out.extend(v.iter().map(|x| x.to_bits()));
+        }
+        out.extend(b_max_by.iter().flat_map(|b| b.words()));
+        out.extend(
+            acceleration
+                .iter()
+                .flat_map(|l| [l.min.to_bits(), l.max.to_bits()]),
+        );
+        out.extend(essential.iter().map(|&e| u64::from(e)));
+    }
+
     /// Discretises `span` at the stations of [`stations`].
     pub fn build(span: &Span, kin: &Kinematics, machine: &Machine, grid: Grid) -> Self {
         Self::at_stations(span, kin, machine, stations(span, grid))

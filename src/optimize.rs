@@ -34,6 +34,7 @@ use crate::toolpath::{Input, Toolpath};
 use crate::verify::{Quantity, Verification, VerifyOptions, Violation, verify_marked};
 
 mod checks;
+mod reuse;
 pub(crate) use checks::inputs as check_inputs;
 
 /// Options of a solve.
@@ -76,6 +77,10 @@ pub struct Options {
     /// Process feed caps from the material stage ([`crate::material::FeedLimits`], computed
     /// on the same toolpath): attached to the spans before the constraints are built.
     pub process: Option<std::sync::Arc<crate::material::FeedLimits>>,
+    /// Solve each distinct span problem once and give its answer to every span that poses
+    /// the same one (a drilling cycle's moves at every hole): the same schedule, bit for bit,
+    /// as solving each (see `reuse`). Default on.
+    pub reuse_spans: bool,
 }
 
 impl Default for Options {
@@ -96,6 +101,7 @@ impl Default for Options {
             jerk_limited: true,
             jerk: JerkOptions::default(),
             process: None,
+            reuse_spans: true,
         }
     }
 }
@@ -162,6 +168,9 @@ pub struct Solution {
     pub verify_period: f64,
     /// Corners blended within [`GeometryOptions::corner_tolerance_mm`] instead of stopped at.
     pub corners_blended: usize,
+    /// Span solves answered by an earlier solve of the same problem ([`Options::reuse_spans`]),
+    /// over every round of the refinement.
+    pub reused_solves: usize,
 }
 
 impl Solution {
@@ -300,6 +309,7 @@ fn optimize_path(
         kin: Kinematics::new(machine),
         path,
         progress,
+        reuse: reuse::Reuse::new(options.reuse_spans),
     };
     let (mut unconverged, mut error_target) = (None, None);
     let (mut lv, mut refinement, error_estimate) = match options.stations {
@@ -465,6 +475,7 @@ fn optimize_path(
         verification: v,
         verify_period: options.verify.period,
         corners_blended: 0,
+        reused_solves: plan.reuse.hits(),
     })
 }
 
@@ -802,6 +813,8 @@ struct Plan<'a> {
     /// Each span's share of the stations.
     weights: Vec<f64>,
     progress: &'a dyn Progress,
+    /// The answers of the span problems solved so far.
+    reuse: reuse::Reuse,
 }
 
 impl Plan<'_> {
@@ -1662,7 +1675,18 @@ impl Plan<'_> {
             let warm = previous
                 .and_then(|(op, os)| Warm::resample(op, os, p))
                 .map(|w| Warm { local, ..w });
-            return solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
+            let key = self.reuse.key(
+                p,
+                &options.solver,
+                Some(&options.jerk),
+                &greedy,
+                warm.as_ref(),
+                |out| jd.fingerprint(out),
+            );
+            if let Some(sol) = key.as_deref().and_then(|k| self.reuse.get(k)) {
+                return Ok(sol);
+            }
+            let sol = solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
                 .map_err(|e| match e {
                     // Where, and what to try: a bare solver status named neither.
                     Error::Solver(why) => {
@@ -1677,12 +1701,26 @@ impl Plan<'_> {
                         ))
                     }
                     other => other,
-                });
+                })?;
+            if let Some(k) = key {
+                self.reuse.put(k, &sol);
+            }
+            return Ok(sol);
         }
-        Ok(match options.solver_kind {
-            SolverKind::Reach => greedy,
-            SolverKind::Clarabel => solver::optimal(p, &greedy, &options.solver)?,
-        })
+        if options.solver_kind == SolverKind::Reach {
+            return Ok(greedy);
+        }
+        let key = self
+            .reuse
+            .key(p, &options.solver, None, &greedy, None, |_| ());
+        if let Some(sol) = key.as_deref().and_then(|k| self.reuse.get(k)) {
+            return Ok(sol);
+        }
+        let sol = solver::optimal(p, &greedy, &options.solver)?;
+        if let Some(k) = key {
+            self.reuse.put(k, &sol);
+        }
+        Ok(sol)
     }
 
     /// Turns the reach pass's finding into an error naming span, station, u, CL line and axes.

@@ -197,6 +197,9 @@ pub struct Summary {
     /// Where spans were slowed down after the local refinement did not settle (`null`: none
     /// were): see [`Solution::slowed_down`].
     pub slowed_down: Option<String>,
+    /// Span solves answered by an earlier solve of the same problem (a drilling cycle's
+    /// moves at every hole): see [`Solution::reused_solves`].
+    pub reused_solves: usize,
     /// The re-simulation at the servo period found every limit kept (within its tolerance).
     pub verified: bool,
     /// Servo period of the re-simulation, s.
@@ -327,6 +330,7 @@ impl Summary {
             error_target: sol.error_target,
             unconverged: sol.unconverged.clone(),
             slowed_down: sol.slowed_down.clone(),
+            reused_solves: sol.reused_solves,
             verified: sol.verification.verified,
             verify_period_s: sol.verify_period,
             worst_ratio: sol

@@ -338,6 +338,7 @@ impl Study<'_> {
             verification,
             verify_period: self.options.verify.period,
             corners_blended: self.base.corners_blended,
+            reused_solves: 0,
         };
         let summary = Summary::new(&machine, &self.toolpath, &sol);
         Ok(Eval {

@@ -146,6 +146,55 @@ pub struct JerkData {
     pub mid_start: Vec<usize>,
 }
 
+impl JerkData {
+    /// Appends to `out` the exact bits of everything the programme reads of this data beyond
+    /// its [`SpanProblem`] (see [`SpanProblem::fingerprint`]; the axis positions q at the
+    /// collocation points are left out as there).
+    pub fn fingerprint(&self, out: &mut Vec<u64>) {
+        let JerkData {
+            right,
+            left,
+            limits,
+            rest_bound,
+            mid,
+            mid_start,
+        } = self;
+        for side in [right, left] {
+            out.push(side.len() as u64);
+            out.extend(side.iter().flatten().map(|x| x.to_bits()));
+        }
+        out.extend(limits.iter().flat_map(|l| match l {
+            Some(l) => [1, l.min.to_bits(), l.max.to_bits()],
+            None => [0, 0, 0],
+        }));
+        out.extend([
+            rest_bound.0.to_bits(),
+            rest_bound.1.to_bits(),
+            mid.len() as u64,
+        ]);
+        for m in mid {
+            let Midpoint {
+                theta,
+                jets,
+                d3,
+                b_max,
+                essential,
+                velocity_only,
+            } = m;
+            out.extend([theta.to_bits(), b_max.to_bits(), u64::from(*essential)]);
+            out.push(u64::from(*velocity_only));
+            out.extend(
+                jets.dq
+                    .iter()
+                    .chain(&jets.ddq)
+                    .chain(d3)
+                    .map(|x| x.to_bits()),
+            );
+        }
+        out.extend(mid_start.iter().map(|&k| k as u64));
+    }
+}
+
 /// Where inside each interval velocity, acceleration and jerk are also bounded (as fractions
 /// of the interval): b is cubic between stations and may bulge above both ends, and the
 /// geometry's curvature varies in between. At [`VELOCITY_ONLY`] only the velocity bound.
