@@ -1683,7 +1683,7 @@ impl Plan<'_> {
                 warm.as_ref(),
                 |out| jd.fingerprint(out),
             );
-            if let Some(sol) = key.as_deref().and_then(|k| self.reuse.get(k)) {
+            if let Some(sol) = key.as_ref().and_then(|k| self.reuse.get(k)) {
                 return Ok(sol);
             }
             let sol = solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
@@ -1713,7 +1713,7 @@ impl Plan<'_> {
         let key = self
             .reuse
             .key(p, &options.solver, None, &greedy, None, |_| ());
-        if let Some(sol) = key.as_deref().and_then(|k| self.reuse.get(k)) {
+        if let Some(sol) = key.as_ref().and_then(|k| self.reuse.get(k)) {
             return Ok(sol);
         }
         let sol = solver::optimal(p, &greedy, &options.solver)?;
