@@ -39,9 +39,6 @@ pub struct PathLimits {
     pub j: f64,
 }
 
-/// An axis whose |q'| is at most this share of the largest axis's does not move.
-const STILL: f64 = 1e-9;
-
 /// How far (relative) q' may vary, q'' stray from 0 (times the span's length) and the bounds
 /// differ between stations or between the two signs for a span to count as straight with
 /// constant, symmetric limits.
@@ -80,23 +77,7 @@ impl PathLimits {
         if !(a.is_finite() && a > 0.0) || (hi + lo).abs() > SAME * a {
             return None;
         }
-        let (mut up, mut down) = (f64::INFINITY, f64::INFINITY);
-        for (j, axis) in machine.axes.iter().take(na).enumerate() {
-            let (Some(lim), d) = (axis.jerk, d0[j]) else {
-                continue;
-            };
-            if d.abs() <= STILL * big {
-                continue;
-            }
-            // u⃛ > 0 moves axis j by d·u⃛: its jerk's positive side bounds it where d > 0.
-            let (plus, minus) = if d > 0.0 {
-                (lim.max / d, -lim.min / d)
-            } else {
-                (-lim.min / -d, lim.max / -d)
-            };
-            up = up.min(plus);
-            down = down.min(minus);
-        }
+        let (up, down) = super::jerk::path_jerk_bounds(machine, d0);
         let j = up.min(down);
         if !(j.is_finite() && j > 0.0) || (up - down).abs() > SAME * j {
             return None;

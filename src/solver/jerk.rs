@@ -511,19 +511,8 @@ pub fn rest_bounds(
 pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Option<f64> {
     let n = p.intervals();
     let i = if end { n } else { 0 };
-    let jet = p.jets.view(i);
-    let moving = jet.dq[..p.n_axes()]
-        .iter()
-        .fold(0.0f64, |m, d| m.max(d.abs()));
-    let mut jerk = f64::INFINITY;
-    for (j, axis) in machine.axes.iter().take(p.n_axes()).enumerate() {
-        let (Some(lim), d) = (axis.jerk, jet.dq[j].abs()) else {
-            continue;
-        };
-        if d > STILL_AXIS * moving {
-            jerk = jerk.min(lim.max.min(-lim.min) / d);
-        }
-    }
+    let (up, down) = path_jerk_bounds(machine, &p.jets.dq(i)[..p.n_axes()]);
+    let jerk = up.min(down);
     let (lo, hi) = p.udd_range(i, 0.0);
     let acc = if end { -lo } else { hi };
     let half = if end { n / 2..n + 1 } else { 0..n / 2 + 1 };
@@ -540,8 +529,32 @@ pub fn rest_phase_length(p: &SpanProblem, machine: &Machine, end: bool) -> Optio
 }
 
 /// An axis whose |q'| is at most this share of the largest axis's does not move along the path
-/// ([`rest_phase_length`]).
+/// ([`path_jerk_bounds`]).
 const STILL_AXIS: f64 = 1e-9;
+
+/// The jerk bounds on the path that the axes' jerk limits give along the direction `dq` (q'
+/// per axis) where the path is straight (q'' = 0, so q⃛ = q' u⃛): the largest u⃛ ≥ 0 and the
+/// largest −u⃛ (each infinite where no moving axis has a jerk limit). An axis with |q'| at most
+/// [`STILL_AXIS`] of the largest does not move and bounds nothing.
+pub(crate) fn path_jerk_bounds(machine: &Machine, dq: &[f64]) -> (f64, f64) {
+    let moving = dq.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let (mut up, mut down) = (f64::INFINITY, f64::INFINITY);
+    for (axis, &d) in machine.axes.iter().zip(dq) {
+        let Some(lim) = axis.jerk else { continue };
+        if d.abs() <= STILL_AXIS * moving {
+            continue;
+        }
+        // u⃛ > 0 moves axis j by q'·u⃛: its jerk's positive side bounds it where q' > 0.
+        let (plus, minus) = if d > 0.0 {
+            (lim.max / d, -lim.min / d)
+        } else {
+            (-lim.min / -d, lim.max / -d)
+        };
+        up = up.min(plus);
+        down = down.min(minus);
+    }
+    (up, down)
+}
 
 /// The largest b at the inner station of a constant-jerk interval from rest at `u_rest` to
 /// `u_in` (mirrored when `end`): with s = t/τ ∈ [0, 1], `u − u_rest = ±Δu s³`, `u̇ = 3Δu s²/τ`,
