@@ -24,8 +24,10 @@ use crate::constraints::SpanProblem;
 use crate::solver::jerk::{JerkOptions, Warm};
 use crate::solver::{SolverSettings, SpanSolution, Status};
 
-/// Spans longer than this (stations) are solved without keeping their answer.
-pub const MAX_STATIONS: usize = 20_000;
+/// Spans longer than this (stations) are solved without keeping their answer: long spans
+/// seldom repeat, and a jerk-limited key carries some 160 words per interval (every
+/// collocation point's derivatives), 6 MB at this length.
+pub const MAX_STATIONS: usize = 5_000;
 
 /// Keys and profiles kept, 8-byte words, at most.
 pub const MAX_WORDS: usize = 1 << 23;
