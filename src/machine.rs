@@ -48,7 +48,7 @@
 //! | `table_table_ac` | X Y Z A C | LinuxCNC xyzac-trt: `x-rot-point`, `y-rot-point`, `z-rot-point`, `y-offset`, `z-offset` (required); `tool-offset` (0), `conventional-directions` (false), `work-offset` ([0, 0, 0]) |
 //! | `table_table_bc` | X Y Z B C | LinuxCNC xyzbc-trt: the same with `x-offset` instead of `y-offset` |
 //! | `table_table_ab` | X Y Z A B | a Haas TR-series A/B trunnion: A tilts about X, B turns the platter (machine +Z at A = 0); `table_table_ac`'s parameters, the rot-point being B's centre |
-//! | `head_table` | X Y Z B C | `pivot_length` (≥ 0) |
+//! | `head_table` | X Y Z B C, or X Y Z A B with `"table": "A"` | `pivot_length` (≥ 0); `table` (`"C"`, the default: a rotary table about Z; `"A"`: a rotary axis about X, as on a blade mill's A axis between centres) |
 //! | `dresser` | X Z B | `tool_length` (≥ 0) |
 //! | `joint` | as the file names them | – |
 
@@ -158,6 +158,16 @@ impl FourthAxis {
     }
 }
 
+/// The rotary axis that carries the workpiece on a head–table machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RotaryTable {
+    /// A rotary table C about Z.
+    #[default]
+    C,
+    /// A rotary axis A about X (a blade mill's workpiece between centres).
+    A,
+}
+
 /// Which table tilts in a trunnion ("table-rotary-tilting") machine, and the platter's letter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TrunnionTilt {
@@ -229,11 +239,14 @@ pub enum KinematicsSpec {
         /// The LinuxCNC parameters.
         params: TrunnionParams,
     },
-    /// A tilting head B (about Y) on a fixed bed with a rotary table C; `pivot_length` (mm)
-    /// from the B pivot to the tool tip. Axes X Y Z B C.
+    /// A tilting head B (about Y) with a rotary table C (about Z; axes X Y Z B C) or a rotary
+    /// axis A (about X, a blade mill's workpiece between centres; axes X Y Z A B);
+    /// `pivot_length` (mm) from the B pivot to the tool tip.
     HeadTable {
         /// B pivot to tool tip, mm.
         pivot_length: f64,
+        /// The rotary axis that carries the workpiece.
+        table: RotaryTable,
     },
     /// Seed 001's dresser: planar X–Z slides and a rotary axis B that keeps the dressing tool
     /// on the profile normal; `tool_length` (mm) from the B axis to the tool tip. Axes X Z B.
@@ -263,7 +276,14 @@ impl KinematicsSpec {
                 TrunnionTilt::B => &["X", "Y", "Z", "B", "C"],
                 TrunnionTilt::AB => &["X", "Y", "Z", "A", "B"],
             },
-            KinematicsSpec::HeadTable { .. } => &["X", "Y", "Z", "B", "C"],
+            KinematicsSpec::HeadTable {
+                table: RotaryTable::C,
+                ..
+            } => &["X", "Y", "Z", "B", "C"],
+            KinematicsSpec::HeadTable {
+                table: RotaryTable::A,
+                ..
+            } => &["X", "Y", "Z", "A", "B"],
             KinematicsSpec::Dresser { .. } => &["X", "Z", "B"],
             KinematicsSpec::FourthAxis(FourthAxis::A) => &["X", "Y", "Z", "A"],
             KinematicsSpec::FourthAxis(FourthAxis::B) => &["X", "Y", "Z", "B"],
@@ -829,11 +849,30 @@ impl Parser {
             Some("table_table_bc") => self.trunnion(obj, TrunnionTilt::B),
             Some("table_table_ab") => self.trunnion(obj, TrunnionTilt::AB),
             Some("head_table") => {
-                self.only_known(obj, "kinematics", &["type", "pivot_length"])?;
+                self.only_known(obj, "kinematics", &["type", "pivot_length", "table"])?;
                 let pivot_length =
                     self.non_negative(obj.get("pivot_length"), "kinematics.pivot_length")?;
                 self.plausible_length(pivot_length, "kinematics.pivot_length")?;
-                Ok(KinematicsSpec::HeadTable { pivot_length })
+                let table = match obj.get("table") {
+                    None => RotaryTable::C,
+                    Some(v) => match v.as_str() {
+                        Some("C") => RotaryTable::C,
+                        Some("A") => RotaryTable::A,
+                        _ => {
+                            return Err(self.err(
+                                "kinematics.table",
+                                format!(
+                                    "must be \"C\" (a rotary table about Z) or \"A\" (a rotary \
+                                     axis about X), found {v}"
+                                ),
+                            ));
+                        }
+                    },
+                };
+                Ok(KinematicsSpec::HeadTable {
+                    pivot_length,
+                    table,
+                })
             }
             Some("dresser") => {
                 self.only_known(obj, "kinematics", &["type", "tool_length"])?;
@@ -1129,7 +1168,9 @@ impl Machine {
                     ));
                 }
             }
-            KinematicsSpec::HeadTable { pivot_length: x }
+            KinematicsSpec::HeadTable {
+                pivot_length: x, ..
+            }
             | KinematicsSpec::Dresser { tool_length: x } => {
                 let field = match kin {
                     KinematicsSpec::HeadTable { .. } => "kinematics.pivot_length",

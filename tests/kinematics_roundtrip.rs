@@ -20,7 +20,7 @@ use feedopt::kinematics::head_table::HeadTable;
 use feedopt::kinematics::trunnion::Trunnion;
 use feedopt::kinematics::{Kinematics, MAX_AXES, PATH_DIM, PathJet};
 use feedopt::machine::{
-    Axis, AxisKind, KinematicsSpec, Limit, Machine, TrunnionParams, TrunnionTilt,
+    Axis, AxisKind, KinematicsSpec, Limit, Machine, RotaryTable, TrunnionParams, TrunnionTilt,
 };
 use feedopt::toolpath::{ClPoint, Feed};
 use nalgebra::Vector3;
@@ -109,11 +109,29 @@ fn all() -> Vec<(&'static str, Kinematics)> {
             "head_table",
             Kinematics::HeadTable(HeadTable {
                 pivot_length: 150.0,
+                table: RotaryTable::C,
             }),
         ),
         (
             "head_table L=0",
-            Kinematics::HeadTable(HeadTable { pivot_length: 0.0 }),
+            Kinematics::HeadTable(HeadTable {
+                pivot_length: 0.0,
+                table: RotaryTable::C,
+            }),
+        ),
+        (
+            "head_table A",
+            Kinematics::HeadTable(HeadTable {
+                pivot_length: 150.0,
+                table: RotaryTable::A,
+            }),
+        ),
+        (
+            "head_table A L=0",
+            Kinematics::HeadTable(HeadTable {
+                pivot_length: 0.0,
+                table: RotaryTable::A,
+            }),
         ),
         (
             "dresser",
@@ -655,8 +673,18 @@ fn programmed_rotary_words_are_taken_as_they_are() {
         (trunnion(TrunnionTilt::B, false), [b, c]),
         (trunnion(TrunnionTilt::AB, false), [a, b]),
         (
-            Kinematics::HeadTable(HeadTable { pivot_length: 50.0 }),
+            Kinematics::HeadTable(HeadTable {
+                pivot_length: 50.0,
+                table: RotaryTable::C,
+            }),
             [b, c],
+        ),
+        (
+            Kinematics::HeadTable(HeadTable {
+                pivot_length: 50.0,
+                table: RotaryTable::A,
+            }),
+            [b - PI / 2.0, a],
         ),
         (Kinematics::Dresser(Dresser { tool_length: 5.0 }), [b, 0.0]),
         (Kinematics::Xyz, [0.0, 0.0]),
@@ -827,6 +855,7 @@ fn spin_unwraps_past_360_degrees_until_travel_ends() {
     // The tool circles three times about the C axis at 30° tilt on a head–table machine.
     let kin = Kinematics::HeadTable(HeadTable {
         pivot_length: 100.0,
+        table: RotaryTable::C,
     });
     let pts: Vec<ClPoint> = (0..300)
         .map(|k| {
@@ -1088,4 +1117,90 @@ fn a_path_starting_at_the_pole_takes_c_from_its_first_defined_point() {
             );
         }
     }
+}
+
+/// A head–table machine with table A (a blade mill: the workpiece turns about X between
+/// centres, the head swivels B about Y), worked by hand: A = 90°, B = 30°, L = 100 mm, tool
+/// tip at P = (10, 20, 30) in the workpiece. The table turns the workpiece by −A:
+/// m = R_x(−90°)·P = (10, 30, −20); the pivot sits L along k_m = (sin 30°, 0, cos 30°) above
+/// the tip, so X = 10 + 100·sin 30° = 60, Y = 30, Z = −20 + 100·cos 30° − 100 = −33.3975; the
+/// tool relative to the workpiece is R_x(90°)·k_m = (0.5, −cos 30°, 0).
+#[test]
+fn head_table_with_table_a_matches_a_hand_computed_pose() {
+    let kin = Kinematics::HeadTable(HeadTable {
+        pivot_length: 100.0,
+        table: RotaryTable::A,
+    });
+    let angles = kin.angles_from_rotary([90.0, 30.0, 0.0]);
+    let w = path_w(&kin, Vector3::new(10.0, 20.0, 30.0), angles);
+    let q = ik(&kin, w);
+    let want = [
+        60.0,
+        30.0,
+        -20.0 + 100.0 * 30f64.to_radians().cos() - 100.0,
+        90.0,
+        30.0,
+    ];
+    for (j, (&g, &e)) in q.iter().zip(&want).enumerate() {
+        assert!((g - e).abs() < 1e-9, "axis {j}: {g} vs {e} ({q:?})");
+    }
+    let k = Vector3::new(0.5, -30f64.to_radians().cos(), 0.0);
+    assert_vec(kin.tool_axis(angles), k, 1e-12, "tool axis");
+    let pose = kin.forward(&q[..5]).unwrap();
+    assert_vec(pose.p, Vector3::new(10.0, 20.0, 30.0), 1e-9, "tip");
+    assert_vec(pose.k, k, 1e-12, "forward tool axis");
+    // The tool vector alone gives a pose with the same tip and tool axis (A, B or its other
+    // branch, A + 180°, 180° − B).
+    let pts = [cl(Vector3::new(10.0, 20.0, 30.0), k, None, 3)];
+    let a = kin.rotary_angles(&pts, &[]).unwrap()[0];
+    let q2 = ik(&kin, path_w(&kin, Vector3::new(10.0, 20.0, 30.0), a));
+    let pose = kin.forward(&q2[..5]).unwrap();
+    assert_vec(
+        pose.p,
+        Vector3::new(10.0, 20.0, 30.0),
+        1e-9,
+        "tip from the vector",
+    );
+    assert_vec(pose.k, k, 1e-12, "tool axis from the vector");
+    let b = q2[4].rem_euclid(360.0);
+    assert!(
+        (b - 30.0).abs() < 1e-9 || (b - 150.0).abs() < 1e-9,
+        "B = {}",
+        q2[4]
+    );
+}
+
+/// Messages give machine B, not the path angle B − 90°: a programmed B outside travel names
+/// the programmed value and B's travel as the machine file states it.
+#[test]
+fn head_table_with_table_a_names_b_and_its_travel_as_programmed() {
+    let kin = Kinematics::HeadTable(HeadTable {
+        pivot_length: 100.0,
+        table: RotaryTable::A,
+    });
+    let axes = vec![
+        axis("X", None),
+        axis("Y", None),
+        axis("Z", None),
+        axis("A", Some((-36000.0, 36000.0))),
+        axis("B", Some((-100.0, 50.0))),
+    ];
+    let ok = [cl(
+        Vector3::zeros(),
+        Vector3::z(),
+        Some([10.0, 45.0, 0.0]),
+        4,
+    )];
+    assert!(kin.rotary_angles(&ok, &axes).is_ok());
+    let bad = [cl(
+        Vector3::zeros(),
+        Vector3::z(),
+        Some([10.0, 60.0, 0.0]),
+        5,
+    )];
+    let msg = kin.rotary_angles(&bad, &axes).unwrap_err().to_string();
+    assert!(
+        msg.contains("line 5") && msg.contains("B = 60.000000°") && msg.contains("[-100, 50]"),
+        "{msg}"
+    );
 }

@@ -3,7 +3,9 @@
 //! wrong.
 
 use feedopt::error::Error;
-use feedopt::machine::{AxisKind, KinematicsSpec, Limit, Machine, TrunnionParams, TrunnionTilt};
+use feedopt::machine::{
+    AxisKind, KinematicsSpec, Limit, Machine, RotaryTable, TrunnionParams, TrunnionTilt,
+};
 use std::path::Path;
 
 const FILE: &str = "machines/test_machine.json";
@@ -673,11 +675,36 @@ fn valid_head_table_and_dresser() {
     assert_eq!(
         m.kinematics,
         KinematicsSpec::HeadTable {
-            pivot_length: 150.0
+            pivot_length: 150.0,
+            table: RotaryTable::C,
         }
     );
     let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["X", "Y", "Z", "B", "C"]);
+
+    // With table A (a blade mill's rotary axis about X): X Y Z A B.
+    let axes = five_axes("B").replace("\"C\"", "\"A\"");
+    let m = ok(&with_kinematics(
+        r#"{"type": "head_table", "pivot_length": 150, "table": "A"}"#,
+        &axes,
+    ));
+    assert_eq!(
+        m.kinematics,
+        KinematicsSpec::HeadTable {
+            pivot_length: 150.0,
+            table: RotaryTable::A,
+        }
+    );
+    let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["X", "Y", "Z", "A", "B"]);
+    field_err(
+        &with_kinematics(
+            r#"{"type": "head_table", "pivot_length": 150, "table": "B"}"#,
+            &axes,
+        ),
+        "kinematics.table",
+        &["\"C\"", "\"A\"", "about X"],
+    );
 
     // The dresser: X Z B, in that order whatever the file's order; a zero tool length (tip on
     // the B axis) is allowed.

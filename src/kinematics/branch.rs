@@ -2,7 +2,8 @@
 //!
 //! Every two-rotary kinematics here (head_head, table_table_ac/bc/ab, head_table) turns the
 //! tool by a *tilt* angle t and a *spin* angle s about the C axis (table_table_ab's platter
-//! B), and its tool-vector inverse kinematics has exactly two solutions, (t, s) with t ≥ 0 and
+//! B; head_table's A with table A, whose tilt t is then B − 90°, [`super::head_table`]), and
+//! its tool-vector inverse kinematics has exactly two solutions, (t, s) with t ≥ 0 and
 //! (−t, s + π), each defined up to 2π in either angle. Where the tool is parallel to the C
 //! axis (sin t = 0, the singular pose, "the pole") s is free.
 //!
@@ -74,6 +75,10 @@ pub struct Layout {
     pub travel: [Option<(f64, f64)>; 2],
     /// Axis names of path angle 0 and 1.
     pub names: [&'static str; 2],
+    /// The machine axis's position minus path angle 0 and 1, radians (messages give axis
+    /// positions): 0, but 90° for the tilt of a head–table machine with table A
+    /// ([`super::head_table`]).
+    pub offset: [f64; 2],
 }
 
 impl Layout {
@@ -94,8 +99,17 @@ impl Layout {
 
     fn travel_text(&self, i: usize) -> String {
         self.travel[i].map_or("unlimited".to_string(), |(lo, hi)| {
-            format!("[{}, {}]°", lo.to_degrees(), hi.to_degrees())
+            format!("[{}, {}]°", self.degrees(i, lo), self.degrees(i, hi))
         })
+    }
+
+    /// Axis `i`'s position, degrees, at path angle `x` (radians); with an offset, to 1e-9°
+    /// (a travel of −100° reads back as −99.99999999999999° through the offset).
+    fn degrees(&self, i: usize, x: f64) -> f64 {
+        if self.offset[i] == 0.0 {
+            return x.to_degrees();
+        }
+        ((x + self.offset[i]).to_degrees() * 1e9).round() / 1e9
     }
 }
 
@@ -204,11 +218,19 @@ impl Walker<'_> {
     fn no_solution(&self, k: usize, tilt: f64) -> Error {
         let l = self.layout;
         Error::Infeasible(format!(
-            "CL point at line {}: the tool vector needs {} = ±{:.4}° and no solution lies within \
-             travel ({} {}, {} {})",
+            "CL point at line {}: the tool vector needs {} and no solution lies within travel \
+             ({} {}, {} {})",
             self.line(k),
-            l.names[l.tilt],
-            tilt.to_degrees(),
+            if l.offset[l.tilt] == 0.0 {
+                format!("{} = ±{:.4}°", l.names[l.tilt], tilt.to_degrees())
+            } else {
+                format!(
+                    "{} = {:.4}° or {:.4}°",
+                    l.names[l.tilt],
+                    l.degrees(l.tilt, tilt),
+                    l.degrees(l.tilt, -tilt)
+                )
+            },
             l.names[0],
             l.travel_text(0),
             l.names[1],
@@ -254,7 +276,7 @@ impl Walker<'_> {
                         format!(
                             "{} = {:.4}° (travel {})",
                             l.names[i],
-                            free[i].to_degrees(),
+                            l.degrees(i, free[i]),
                             l.travel_text(i)
                         )
                     })
@@ -268,9 +290,9 @@ impl Walker<'_> {
                         self.line(k),
                         out.join(", "),
                         l.names[0],
-                        cand[0].to_degrees(),
+                        l.degrees(0, cand[0]),
                         l.names[1],
-                        cand[1].to_degrees(),
+                        l.degrees(1, cand[1]),
                         d.to_degrees()
                     )),
                 ))
@@ -376,7 +398,7 @@ impl Walker<'_> {
                                      travel {}",
                                     self.line(k),
                                     self.layout.names[i],
-                                    a[i].to_degrees(),
+                                    self.layout.degrees(i, a[i]),
                                     self.layout.travel_text(i)
                                 )),
                             ));
@@ -472,6 +494,7 @@ mod tests {
                 Some((-TAU * 100.0, TAU * 100.0)),
             ],
             names: ["B", "C"],
+            offset: [0.0; 2],
         };
         let targets: Vec<Target> = (0..10)
             .map(|k| target((20.0 + 5.0 * k as f64).to_radians(), 0.3))

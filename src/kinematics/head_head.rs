@@ -80,6 +80,7 @@ pub(crate) fn layout(travel: [Option<(f64, f64)>; 2]) -> Layout {
         tilt: 1,
         travel,
         names: ["C", "A"],
+        offset: [0.0; 2],
     }
 }
 

@@ -43,7 +43,7 @@ pub mod trunnion;
 use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
-use crate::machine::{Axis, KinematicsSpec, Machine, TrunnionTilt};
+use crate::machine::{Axis, KinematicsSpec, Machine, RotaryTable, TrunnionTilt};
 use crate::toolpath::ClPoint;
 use branch::{Layout, Target};
 use dual::{Dual2, Dual3, Real};
@@ -111,9 +111,13 @@ impl Kinematics {
             KinematicsSpec::TableTable { tilt, params } => {
                 Kinematics::TableTable(trunnion::Trunnion { tilt, params })
             }
-            KinematicsSpec::HeadTable { pivot_length } => {
-                Kinematics::HeadTable(head_table::HeadTable { pivot_length })
-            }
+            KinematicsSpec::HeadTable {
+                pivot_length,
+                table,
+            } => Kinematics::HeadTable(head_table::HeadTable {
+                pivot_length,
+                table,
+            }),
             KinematicsSpec::Dresser { tool_length } => {
                 Kinematics::Dresser(dresser::Dresser { tool_length })
             }
@@ -143,6 +147,8 @@ impl Kinematics {
     pub fn rotary_axes(&self) -> [Option<usize>; 2] {
         match self {
             Kinematics::Xyz | Kinematics::Joint { .. } => [None, None],
+            // Table A: path angles (B − 90°, A), axes X Y Z A B.
+            Kinematics::HeadTable(h) if h.table == RotaryTable::A => [Some(4), Some(3)],
             Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_) => {
                 [Some(3), Some(4)]
             }
@@ -151,9 +157,20 @@ impl Kinematics {
         }
     }
 
+    /// Each rotary axis's position minus its path angle, radians ([`Self::rotary_axes`] says
+    /// which axis): zero but for a head–table machine with table A, whose path angle 0 is
+    /// B − 90° ([`head_table`]).
+    pub fn angle_offsets(&self) -> [f64; 2] {
+        match self {
+            Kinematics::HeadTable(h) => [h.tilt_offset(), 0.0],
+            _ => [0.0; 2],
+        }
+    }
+
     /// The path angles (radians) of rotary axis positions `[A, B, C]` in degrees as a program
     /// gives them (never reduced modulo 360°): (C, A) for head_head, (A, C) for
     /// table_table_ac, (B, C) for table_table_bc and head_table, (A, B) for table_table_ab,
+    /// (B − 90°, A) for head_table with table A,
     /// (B, 0) for the dresser, (its angle, 0) for a fourth axis, zero for xyz and joint.
     pub fn angles_from_rotary(&self, rotary: [f64; 3]) -> [f64; 2] {
         let [a, b, c] = rotary.map(f64::to_radians);
@@ -165,7 +182,10 @@ impl Kinematics {
                 TrunnionTilt::B => [b, c],
                 TrunnionTilt::AB => [a, b],
             },
-            Kinematics::HeadTable(_) => [b, c],
+            Kinematics::HeadTable(h) => match h.table {
+                RotaryTable::C => [b, c],
+                RotaryTable::A => [b - h.tilt_offset(), a],
+            },
             Kinematics::Dresser(_) => [b, 0.0],
             Kinematics::FourthAxis(r) => [[a, b, c][r.index()], 0.0],
         }
@@ -236,8 +256,13 @@ impl Kinematics {
                 return self.follow(points, &lines, head_head::layout(travel));
             }
             Kinematics::TableTable(t) => t.tilt.letters(),
-            Kinematics::HeadTable(_) => ["B", "C"],
+            Kinematics::HeadTable(h) => match h.table {
+                RotaryTable::C => ["B", "C"],
+                RotaryTable::A => ["B", "A"],
+            },
         };
+        let offset = self.angle_offsets();
+        let travel = [0, 1].map(|i| travel[i].map(|(lo, hi)| (lo - offset[i], hi - offset[i])));
         self.follow(
             points,
             &lines,
@@ -245,6 +270,7 @@ impl Kinematics {
                 tilt: 0,
                 travel,
                 names,
+                offset,
             },
         )
     }

@@ -429,13 +429,14 @@ pub fn program(
         }
     }
     rotary.sort_by_key(|(n, _)| n.clone());
+    let offsets = kin.angle_offsets();
     let (nodes, split) = nodes(machine, toolpath, solution, geometry, step)?;
     // Written words of each node, and the merge of tiny blocks.
     let written = |n: &Node| -> (Vec<String>, [f64; 3], Vec<f64>) {
         let p = n.p.map(rounded);
         let r: Vec<f64> = rotary
             .iter()
-            .map(|(_, a)| rounded(n.angles[*a].to_degrees()))
+            .map(|(_, a)| rounded((n.angles[*a] + offsets[*a]).to_degrees()))
             .collect();
         let mut w = vec![
             format!("X{}", coord(p[0])),
