@@ -384,3 +384,25 @@ fn blended_corners_are_written_as_the_blends_the_schedule_runs() {
     );
     assert_eq!(back.points.len(), prog.blocks + 1);
 }
+
+/// A head–table machine with table A (a blade mill) writes its A and B words as the axes
+/// stand: its tilt path angle is B − 90° ([`feedopt::kinematics::head_table`]), and a writer
+/// that wrote path angles as they are would put every B 90° off. The seed's blade, given by
+/// tool vectors, goes through the tool-vector inverse, out as G-code and back.
+#[test]
+fn a_head_table_with_table_a_writes_its_b_words_as_the_axis_stands() {
+    let (_, t) = bundled("seed_head_head", "impeller_blade.cls");
+    let m = common::machine(
+        r#"{"kinematics": {"type": "head_table", "pivot_length": 250, "table": "A"},
+            "feed": {"max": 500},
+            "axes": {"X": {"velocity": 500, "acceleration": 3000},
+                     "Y": {"velocity": 500, "acceleration": 3000},
+                     "Z": {"velocity": 500, "acceleration": 3000},
+                     "A": {"velocity": 90, "acceleration": 600},
+                     "B": {"velocity": 60, "acceleration": 600}}}"#,
+    );
+    let options = reach();
+    let sol = optimize(&m, &t, &options).unwrap();
+    let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
+    assert!(prog.inverse_time_blocks > 0);
+}
