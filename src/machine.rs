@@ -36,7 +36,9 @@
 //! **diameter its feed is taken at**, `"feed_diameter": 50.0` (mm; Haas settings 34 and 79, the
 //! "4th/5th axis diameter"): a Fanuc-family program's G94 feed then counts a degree of that axis
 //! as π·D/360 mm of the block's distance instead of one unit of length (only the readers use it,
-//! as [`References::feed_diameter`]).
+//! as [`References::feed_diameter`]). A rotary axis may be a modulo axis that reaches an
+//! absolute position **the shorter way**, `"shortest_way": true` (Sinumerik MD30455 bit 2,
+//! Fanuc 1008 RAB = 0, LinuxCNC `WRAPPED_ROTARY`; [`References::shortest_way`]).
 //!
 //! Kinematics types and their parameters (see [`crate::kinematics`] for the maths):
 //!
@@ -391,6 +393,10 @@ pub struct References {
     /// Fanuc-family control (Haas settings 34/79) turns a G94 feed into degrees, a degree
     /// counting as π·D/360 mm.
     pub feed_diameter: Vec<(String, f64)>,
+    /// The rotary axes that give `"shortest_way": true`: a modulo ("roll-over") rotary axis
+    /// that reaches an absolute position the shorter way, modulo 360° (Sinumerik MD30455 bit
+    /// 2, Fanuc parameter 1008 ROA with RAB = 0, LinuxCNC `WRAPPED_ROTARY`).
+    pub shortest_way: Vec<String>,
 }
 
 /// How a Fanuc control reads an axis word written without a decimal point (`X100`):
@@ -466,6 +472,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
     let mut axes = Vec::new();
     let mut m92 = Vec::new();
     let mut feed_diameter = Vec::new();
+    let mut shortest_way = Vec::new();
     for axis in &machine.axes {
         // The axis object's field `name`, if given.
         let given = |name: &str| {
@@ -493,6 +500,28 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
                 ));
             }
             feed_diameter.push((axis.name.clone(), d));
+        }
+        let field = format!("axes.{}.shortest_way", axis.name);
+        if let Some(v) = given("shortest_way") {
+            if axis.kind != AxisKind::Rotary {
+                return Err(parser.err(
+                    &field,
+                    "only a rotary axis (A, B, C) turns the shorter way: leave it out",
+                ));
+            }
+            match v.as_bool() {
+                Some(true) => shortest_way.push(axis.name.clone()),
+                Some(false) => {}
+                None => {
+                    return Err(parser.err(
+                        &field,
+                        format!(
+                            "must be true (an absolute position is reached the shorter way, \
+                             modulo 360°) or false (by the sign of the difference), found {v}"
+                        ),
+                    ));
+                }
+            }
         }
         let field = format!("axes.{}.m92", axis.name);
         if let Some(v) = given("m92") {
@@ -563,6 +592,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         program_units,
         decimal_point_input,
         feed_diameter,
+        shortest_way,
     })
 }
 
@@ -1047,6 +1077,7 @@ impl Parser {
                         "reference",
                         "m92",
                         "feed_diameter",
+                        "shortest_way",
                     ],
                 )?;
                 let kind = if *kin == KinematicsSpec::Joint {

@@ -127,6 +127,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         program_units: None,
         decimal_point_input: None,
         feed_diameter: [None; 3],
+        shortest_way: [false; 3],
         machine_coordinates: false,
     }
 }
@@ -1672,4 +1673,52 @@ fn an_unset_r_parameter_is_read_as_0_and_said() {
     // that frame, lies at X −10.
     let last = tp.points.last().unwrap().p;
     assert!((last.x + 10.0).abs() < 1e-9, "{last:?}");
+}
+
+/// A modulo rotary axis set to take the shorter way (`"shortest_way": true`; Sinumerik
+/// MD30455 bit 2, Fanuc RAB = 0, LinuxCNC WRAPPED_ROTARY): a blade mill's spiral writes A
+/// 359.499 then A 3.9768, which that A reaches by turning +4.48°, not −355.5°. Without the
+/// setting the program is read as written (the sign of the difference, as a control moves an
+/// axis that is not such a modulo axis), and a warning names the setting, once per axis.
+#[test]
+fn a_modulo_axis_set_to_the_shorter_way_continues_past_360_degrees() {
+    let text = "G90 G1 X0. Y0. Z10. A350. F1000.\nX0.1 A359.499\nX0.2 A3.9768\nX0.3 A10.\nX0.4 A355.\nM30\n";
+    for dialect in [Dialect::Sinumerik, Dialect::Fanuc, Dialect::LinuxCnc] {
+        let a = |tp: &Toolpath| -> Vec<f64> {
+            tp.points.iter().map(|p| p.rotary.unwrap()[0]).collect()
+        };
+        let plain = context("XYZA", Default::default(), [0.0; 3]);
+        let tp = parse_for(Path::new("t.nc"), text, dialect.spec(), Some(&plain)).unwrap();
+        assert_eq!(a(&tp), [350.0, 359.499, 3.9768, 10.0, 355.0], "{dialect}");
+        let said: Vec<&Warning> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("shortest_way"))
+            .collect();
+        // At X0.2 (−355.5°) and X0.4 (+345°), one text.
+        assert_eq!(said.len(), 2, "{dialect}: {:?}", tp.warnings);
+        assert_eq!(said[0].line, 3);
+        assert!(said[0].message.starts_with("A: ") && said[0].message == said[1].message);
+
+        let modulo = MachineContext {
+            shortest_way: [true, false, false],
+            ..plain.clone()
+        };
+        let tp = parse_for(Path::new("t.nc"), text, dialect.spec(), Some(&modulo)).unwrap();
+        let got = a(&tp);
+        // From A 0 (where the axis stands before the program) the shorter way to 350° is −10°;
+        // every later position continues from there the shorter way.
+        let want = [-10.0, -0.501, 3.9768, 10.0, -5.0];
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-9, "{dialect}: {got:?}");
+        }
+        assert!(
+            tp.warnings
+                .iter()
+                .all(|w| !w.message.contains("shortest_way")),
+            "{dialect}: {:?}",
+            tp.warnings
+        );
+    }
 }

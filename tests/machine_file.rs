@@ -1203,3 +1203,32 @@ fn decimal_point_input_is_increment_or_calculator() {
         );
     }
 }
+
+/// `"shortest_way"` on a rotary axis: true or false; on a linear axis, or anything but a
+/// boolean, an error naming the field.
+#[test]
+fn shortest_way_is_a_rotary_axis_boolean() {
+    let with = |axis: &str, v: &str| {
+        let axes = five_axes("A").replace(
+            &format!("\"{axis}\": {{"),
+            &format!("\"{axis}\": {{\"shortest_way\": {v}, "),
+        );
+        with_kinematics(AC_FULL, &axes)
+    };
+    let refs = |text: &str| {
+        let m = ok(text);
+        feedopt::machine::references_from_json(Path::new(FILE), text, &m).map(|r| r.shortest_way)
+    };
+    assert_eq!(refs(&with("A", "true")).unwrap(), ["A"]);
+    assert!(refs(&with("C", "false")).unwrap().is_empty());
+    let e = refs(&with("X", "true")).unwrap_err().to_string();
+    assert!(
+        e.contains("axes.X.shortest_way") && e.contains("rotary"),
+        "{e}"
+    );
+    let e = refs(&with("A", "1")).unwrap_err().to_string();
+    assert!(
+        e.contains("axes.A.shortest_way") && e.contains("true"),
+        "{e}"
+    );
+}

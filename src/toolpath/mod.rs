@@ -328,6 +328,10 @@ pub struct MachineContext {
     /// The diameter (mm) at which the control turns a G94 feed into degrees, per rotary axis
     /// A B C, where the machine file gives it (`axes.C.feed_diameter`; Haas settings 34/79).
     pub feed_diameter: [Option<f64>; 3],
+    /// Per rotary axis A B C: whether it reaches an absolute position the shorter way,
+    /// modulo 360° (`axes.A.shortest_way`: a modulo rotary axis set so), rather than by the
+    /// sign of the difference.
+    pub shortest_way: [bool; 3],
     /// The machine is programmed in machine coordinates (a four-axis machine,
     /// [`KinematicsSpec::FourthAxis`]): X Y Z and the angle are the axes' positions, not a tool
     /// tip, and it has no tool-tip mode.
@@ -386,6 +390,9 @@ impl MachineContext {
                     .iter()
                     .find(|(n, _)| n == NAMES[3 + i])
                     .map(|(_, d)| *d)
+            }),
+            shortest_way: std::array::from_fn(|i| {
+                references.shortest_way.iter().any(|n| n == NAMES[3 + i])
             }),
         }
     }

@@ -2309,6 +2309,9 @@ impl<'a> Interpreter<'a> {
         let start = self.pos;
         let mut end = start;
         let mut machine_xyz = self.to_machine(Vector3::new(start[0], start[1], start[2]));
+        // Whether the rotary axes stand where an earlier block put them (not at the unknown
+        // start).
+        let rotary_known = self.saw_rotary;
         for (i, word) in block.axes.iter().enumerate() {
             let Some(num) = *word else { continue };
             let value = if i < 3 {
@@ -2346,12 +2349,34 @@ impl<'a> Interpreter<'a> {
             } else {
                 value
             };
+            let shortest_way = self
+                .machine
+                .is_some_and(|c| i >= 3 && c.shortest_way[i - 3]);
             end[i] = if incremental {
                 start[i] + value
-            } else if i >= 3 && self.shortest_path {
-                // Klartext M126: the shorter way to the absolute position.
+            } else if i >= 3 && (self.shortest_path || shortest_way) {
+                // Klartext M126, or a modulo axis set so in the machine file: the shorter way
+                // to the absolute position.
                 start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
             } else {
+                if i >= 3 && (value - start[i]).abs() > 180.0 && rotary_known {
+                    // Read as written; a modulo axis set to take the shorter way would turn
+                    // the other way, less than half a turn (a blade mill's A going 359.5° →
+                    // 4° in a spiral).
+                    self.warn(
+                        line,
+                        format!(
+                            "{0}: a rotary position more than 180° from where {0} stands is \
+                             reached by the sign of the difference, the long way round, as a \
+                             control moves an axis that is not a modulo axis set to take the \
+                             shorter way (Sinumerik MD30455 bit 2, Fanuc parameter 1008 RAB = \
+                             0, LinuxCNC WRAPPED_ROTARY); if this machine's {0} takes the \
+                             shorter way, set \"shortest_way\": true for {0} in the machine \
+                             file",
+                            AXIS_NAMES[i]
+                        ),
+                    );
+                }
                 value
             };
             if i < 3 && !incremental {
