@@ -1437,3 +1437,24 @@ fn cycle_262_mills_the_thread_on_a_helix_with_approach_and_departure_arcs() {
         .to_string();
     assert!(e.contains("not narrower"), "{e}");
 }
+
+/// Mastercam's Heidenhain post (MPPOSTABILITY_AVIA_VMC_800_4X, round 8's n091.h) wraps a long
+/// comment with `~`: the next line is the rest of the comment (a file path here), not a block.
+/// A structure comment continued so is comment too; a cycle's parameter lines, whose `~` ends
+/// a parameter's comment, still continue the cycle.
+#[test]
+fn a_comment_block_continued_with_a_tilde_continues_as_comment() {
+    let text = format!(
+        "{HEADER}4 ;MCX FILE  -~\n Z:\\00NZL\\KR\\PART.MCX-9\n5 * - LONG ~\n X+500 Y+500\n\
+         6 L X+10 Y+0 Z+0 F600\n7 L X+20\n8 END PGM T MM\n"
+    );
+    let tp = read(&text);
+    let xs: Vec<f64> = tp.points.iter().map(|q| q.p.x).collect();
+    assert!(xs.iter().all(|x| *x <= 20.0), "{xs:?}");
+    assert!((length(&tp.points) - 10.0).abs() < 1e-9);
+    // The cycle's lines still join (`~` after a parameter's comment).
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 R0 FMAX\n{DRILL_NEW}13 L X+10 Y+10 R0 FMAX M99\n14 END PGM T MM\n"
+    ));
+    assert!(tp.points.iter().any(|q| (q.p.z + 10.0).abs() < 1e-9));
+}

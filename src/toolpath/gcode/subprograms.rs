@@ -431,11 +431,20 @@ impl Program {
         let raw: Vec<&str> = text.lines().collect();
         let mut i = 0;
         while i < self.lines.len() {
+            // A comment block (`4 ;MCX FILE -~`, `* - …~`: nothing but the block number
+            // before the comment) continues as comment: Mastercam's Heidenhain post wraps a
+            // long comment so, and the TNC reads the lines that follow as part of it.
+            let comment_block = matches!(&self.lines[i].blocks, Ok(b)
+                if b.iter().all(|s| klartext::strip_block_number(s).trim().is_empty()));
             let mut j = i;
             while j + 1 < self.lines.len()
                 && raw.get(j).is_some_and(|r| r.trim_end().ends_with('~'))
             {
                 j += 1;
+                if comment_block {
+                    self.lines[j].blocks = Ok(Vec::new());
+                    continue;
+                }
                 let next = std::mem::replace(&mut self.lines[j].blocks, Ok(Vec::new()));
                 let add = match next {
                     Ok(b) => b.join(" "),
