@@ -1242,3 +1242,32 @@ fn a_warning_said_again_shares_its_text() {
         "one text, shared"
     );
 }
+
+/// A Fadal program (round 8: `L900` defines subprogram 9, `L901` calls it, `G3 I-4.5 L14`
+/// repeats the arc 14 times) read as LinuxCNC or Fanuc dropped every such move in silence.
+/// An L word with nothing in its block to read it is an error naming it; G10, canned cycles
+/// (their repeat count), M98 and LinuxCNC's M66 still read theirs.
+#[test]
+fn an_l_word_nothing_reads_is_an_error_naming_it() {
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        err_in(
+            dialect,
+            "G21 G90\nG0 X0. Y0. Z0.\nN3 L901\nG1 X10. F100.\n",
+            3,
+            &["`L901`", "Fadal"],
+        );
+        err_in(
+            dialect,
+            "G21 G90\nG0 X4.5 Y0. Z0.\nG91 G3 I-4.5 Z-0.5 L14 F80.\n",
+            3,
+            &["`L14`"],
+        );
+    }
+    ok(
+        "G21 G90\nG10 L2 P1 X0 Y0 Z0\nG0 X0 Y0 Z5\nG81 X5 Y0 Z-3 R1 L2 F100\nX10\nG80\nM66 P0 L3 Q1\n",
+    );
+    ok_in(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X0. Y0. Z5.\nG81 X5. Z-3. R1. K2 F100.\nX10. L2\nG80\n",
+    );
+}

@@ -1104,6 +1104,34 @@ impl<'a> Interpreter<'a> {
         if fanuc_call {
             self.fanuc_call(line, &block)?;
         }
+        // An L word is read by G10, a canned cycle (repeats), `M98` (repeats) and LinuxCNC's
+        // `M66` (wait mode). Elsewhere it is no word of these dialects, but a Fadal control's
+        // subprogram definition and call (`L900`, `L901`) and arc repeat (`G3 I-4.5 L14`):
+        // moves feedopt would drop in silence (round 8, a Fadal program read as 0.2 s).
+        if matches!(
+            self.spec.subprograms,
+            Subprograms::OWordSub | Subprograms::OPrograms
+        ) && let Some(l) = block.letter('L')
+            && !(fanuc_call
+                || set_offset.is_some()
+                || new_cycle.is_some()
+                || self.cycle.is_some()
+                || block
+                    .actions
+                    .iter()
+                    .any(|(text, _, _)| code_name(text) == "M66"))
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`L{}`: an L word with no G10, canned cycle or M98 in the block to read it; \
+                     on a Fadal control L defines or calls a subprogram (L900, L901) or repeats \
+                     a move (G3 … L14), which feedopt does not read: post the program for a \
+                     Fanuc-style control (M98 P… calls, moves written out)",
+                    l.value
+                ),
+            ));
+        }
         if end && self.call.is_some() {
             return Err(self.error(
                 line,
