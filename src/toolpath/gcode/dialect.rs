@@ -151,8 +151,16 @@ pub enum Address {
     /// A subprogram call by number, the word as written naming it (Sinumerik `L123`; `P`
     /// in the same block is the repeat count).
     Call,
-    /// Klartext: an incremental axis word 0–5 (`IX+5`: this word only, never modal).
+    /// Klartext: an incremental axis word 0–5 (`IX+5`: this word only, never modal); Sinumerik
+    /// `X=IC(5)`. Made by the lexer for Sinumerik, in Klartext's table.
     IncrementalAxis(usize),
+    /// Sinumerik `X=AC(5)`: axis word 0–5 absolute whatever G90/G91 (this word only). Made by
+    /// the lexer, in no dialect's table.
+    AbsoluteAxis(usize),
+    /// Sinumerik rotary axis 3–5 to an absolute position by a way of its own, this word
+    /// only: `C=DC(v)` the shorter way (0), `C=ACP(v)` turning positive (+1), `C=ACN(v)`
+    /// negative (−1). Made by the lexer, in no dialect's table.
+    RotaryTo(usize, i8),
     /// Klartext: the direction of a circular path, `DR+` (counter-clockwise, value +1) or
     /// `DR-` (clockwise, −1).
     ArcDirection,

@@ -39,8 +39,13 @@ struct Block {
     letters: [Option<Num>; 26],
     /// Codes and keywords in the order written, with their text and `( … )` arguments.
     actions: Vec<(String, Action, Option<String>)>,
-    /// Klartext: the axis word is incremental (`IX+5`, this word only).
+    /// Klartext: the axis word is incremental (`IX+5`, this word only); Sinumerik `X=IC(5)`.
     incremental: [bool; 6],
+    /// Sinumerik `X=AC(5)`: the axis word is absolute whatever G90/G91.
+    absolute: [bool; 6],
+    /// Sinumerik `C=DC(v)` (0), `C=ACP(v)` (+1), `C=ACN(v)` (−1): the way a rotary axis
+    /// turns to its absolute position.
+    rotary_way: [Option<i8>; 6],
     /// Klartext `DR±`: +1 counter-clockwise, −1 clockwise.
     direction: Option<f64>,
     /// Klartext `PA`/`IPA` (degrees) and `PR`/`IPR` (mm), `true` when incremental.
@@ -555,10 +560,17 @@ impl<'a> Interpreter<'a> {
             match address {
                 Address::Axis(_)
                 | Address::IncrementalAxis(_)
+                | Address::AbsoluteAxis(_)
+                | Address::RotaryTo(..)
                 | Address::ArcCentre(_)
                 | Address::Radius => {
-                    let degrees =
-                        matches!(address, Address::Axis(3..) | Address::IncrementalAxis(3..));
+                    let degrees = matches!(
+                        address,
+                        Address::Axis(3..)
+                            | Address::IncrementalAxis(3..)
+                            | Address::AbsoluteAxis(3..)
+                            | Address::RotaryTo(..)
+                    );
                     self.note_increments(line, &block, &text, num, degrees);
                 }
                 Address::Ignored if text.starts_with('Q') => {
@@ -577,6 +589,19 @@ impl<'a> Interpreter<'a> {
                     self.check_axis(line, &text, i)?;
                     block.axes[i] = Some(num);
                     block.incremental[i] = true;
+                }
+                Address::AbsoluteAxis(i) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.absolute[i] = true;
+                }
+                Address::RotaryTo(i, way) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.absolute[i] = true;
+                    block.rotary_way[i] = Some(way);
                 }
                 Address::PlaneRotary(i) => {
                     duplicate(block.axes[3 + i].is_some() || block.plane_rotary[i])?;
@@ -2365,8 +2390,9 @@ impl<'a> Interpreter<'a> {
                 self.known[i] = true;
                 continue;
             }
-            let incremental =
-                (self.distance == Distance::Incremental || block.incremental[i]) && !machine;
+            let incremental = (self.distance == Distance::Incremental || block.incremental[i])
+                && !machine
+                && !block.absolute[i];
             // A rotary machine coordinate: the program coordinate that the offsets in force
             // take to it (`push` adds their shift; the X Y Z are converted below).
             let value = if machine {
@@ -2376,6 +2402,13 @@ impl<'a> Interpreter<'a> {
             };
             end[i] = if incremental {
                 start[i] + value
+            } else if let Some(way) = block.rotary_way[i] {
+                // Sinumerik DC / ACP / ACN: to the position modulo 360° the way the word says.
+                match way {
+                    0 => start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0,
+                    1 => start[i] + (value - start[i]).rem_euclid(360.0),
+                    _ => start[i] - (start[i] - value).rem_euclid(360.0),
+                }
             } else if i >= 3 && self.shortest_path {
                 // Klartext M126: the shorter way to the absolute position.
                 start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
