@@ -1271,3 +1271,24 @@ fn an_l_word_nothing_reads_is_an_error_naming_it() {
         "G21 G90\nG0 X0. Y0. Z5.\nG81 X5. Z-3. R1. K2 F100.\nX10. L2\nG80\n",
     );
 }
+
+/// SolidCAM's Mach3 post (round 8) writes `G0 G53 Z123  ; move up to tool_z_level` in a
+/// program headed `O1`, read in the Fanuc dialect, where `;` ends a block: the words after it
+/// were "`M` has no number". The error now says what the `;` is taken for and what to do.
+#[test]
+fn text_after_a_fanuc_end_of_block_semicolon_names_the_semicolon() {
+    err_in(
+        Dialect::Fanuc,
+        "O1 (TEST)\nG21 G90\nG0 G53 Z123  ; move up to tool_z_level\n",
+        3,
+        &[
+            "`M` has no number",
+            "after a `;`",
+            "Fanuc",
+            "--dialect linuxcnc",
+        ],
+    );
+    // A `;` as Fanuc's end of block before another block still reads.
+    let tp = ok_in(Dialect::Fanuc, "G21 G90\nG0 X0. Y0. Z5. ; G1 X10. F100.\n");
+    assert_eq!(tp.points.last().unwrap().p.x, 10.0);
+}

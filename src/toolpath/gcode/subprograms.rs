@@ -56,7 +56,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::dialect::{DialectSpec, Subprograms};
+use super::dialect::{DialectSpec, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
@@ -923,8 +923,23 @@ impl Program {
             {
                 continue;
             }
-            let items = lex(spec, text, &mut interp.vars)
-                .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+            let items = lex(spec, text, &mut interp.vars).map_err(|m| {
+                // Text after a `;`, which ends a block in this dialect (Fanuc's), that is no
+                // block: most likely a comment as Mach3 and LinuxCNC write them (round 8,
+                // SolidCAM's Mach3 post: `G0 G53 Z123 ; move up to tool_z_level`).
+                let m = if block > 0 && spec.semicolon == Semicolon::EndOfBlock {
+                    format!(
+                        "{m}, in `{text}` after a `;`, which ends a block in the {} dialect; \
+                         if the `;` starts a comment (as Mach3 and LinuxCNC read it), remove \
+                         the comment, or read the program in the LinuxCNC dialect \
+                         (--dialect linuxcnc)",
+                        spec.name
+                    )
+                } else {
+                    m
+                };
+                self.located(Error::parse(source, number, m), &stack)
+            })?;
             interp
                 .block(number, items)
                 .and_then(|()| interp.check_room(number, "this block", 0))
