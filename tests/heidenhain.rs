@@ -1458,3 +1458,23 @@ fn a_comment_block_continued_with_a_tilde_continues_as_comment() {
     ));
     assert!(tp.points.iter().any(|q| (q.p.z + 10.0).abs() < 1e-9));
 }
+
+/// A shop's TNC program (round 8, KOLEK-MOC-STR1.H) keeps its probing cycle under `/`: run
+/// with the block-skip switch on. Read with the switch off, the refusal of `TCH PROBE` says
+/// that the block is a block-delete one and that `--block-delete` skips it.
+#[test]
+fn an_error_in_a_block_delete_block_names_block_delete() {
+    let text = format!(
+        "{HEADER}/ 4 TCH PROBE 413 PKT.BAZ.OKRAG ZEWN. ~\n    Q321=+0 ;SRODEK ~\n    \
+         Q322=+0 ;SRODEK\n5 L X+0 Y+0 Z+5 R0 FMAX\n6 END PGM T MM\n"
+    );
+    let e = fails(&text);
+    assert!(
+        e.contains("t.h:5:") && e.contains("TCH PROBE") && e.contains("--block-delete"),
+        "{e}"
+    );
+    let e = fails(&format!(
+        "{HEADER}4 TCH PROBE 413 ~\n    Q321=+0 ;X\n5 END PGM T MM\n"
+    ));
+    assert!(!e.contains("--block-delete"), "{e}");
+}

@@ -698,6 +698,7 @@ impl Program {
                 return Err(self.too_many(source, number, &stack, jumps));
             }
             let run_deleted;
+            let deleted = self.block_delete_mark(text).is_some();
             let text = match self.block_delete_mark(text) {
                 None => text,
                 Some(_) if interp.block_delete => {
@@ -938,12 +939,15 @@ impl Program {
                 } else {
                     m
                 };
-                self.located(Error::parse(source, number, m), &stack)
+                self.located(
+                    delete_hint(Error::parse(source, number, m), deleted),
+                    &stack,
+                )
             })?;
             interp
                 .block(number, items)
                 .and_then(|()| interp.check_room(number, "this block", 0))
-                .map_err(|e| self.located(e, &stack))?;
+                .map_err(|e| self.located(delete_hint(e, deleted), &stack))?;
             if let Some(call) = interp.call.take() {
                 self.enter(&mut stack, call, number, source)?;
             } else if interp.ended {
@@ -1225,5 +1229,26 @@ impl Program {
             },
             other => other,
         }
+    }
+}
+
+/// An error in a block run with the block-delete mark `/` (the control's block-skip switch
+/// off): says that `--block-delete` skips it (round 8: a TNC program's probing cycle under
+/// `/`, which the shop runs with the switch on).
+fn delete_hint(e: Error, deleted: bool) -> Error {
+    match e {
+        Error::Parse {
+            file,
+            line,
+            message,
+        } if deleted => Error::Parse {
+            file,
+            line,
+            message: format!(
+                "{message} (the block starts with `/`, block delete: --block-delete skips \
+                 it, as the control's block-skip switch does)"
+            ),
+        },
+        e => e,
     }
 }
