@@ -1292,3 +1292,15 @@ fn text_after_a_fanuc_end_of_block_semicolon_names_the_semicolon() {
     let tp = ok_in(Dialect::Fanuc, "G21 G90\nG0 X0. Y0. Z5. ; G1 X10. F100.\n");
     assert_eq!(tp.points.last().unwrap().p.x, 10.0);
 }
+
+/// A Fusion lathe post's `G28 U0. W0.` (round 8) read in the Fanuc dialect: the refusal of
+/// the U word says that on a Fanuc lathe U and W are X and Z incremental, a turning program.
+#[test]
+fn a_fanuc_u_word_names_the_lathe_reading() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO2001\nN10 G99 G18\nN11 G21\nN12 G50 S6000\nN13 G28 U0. W0.\n",
+        6,
+        &["`U0.`", "lathe", "turning program"],
+    );
+}

@@ -531,6 +531,13 @@ const G60: &str = "single-direction positioning approaches the end point from on
                    the move goes straight to its end point";
 const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
                    quill); the move would be lost: post the program without it";
+/// Fanuc's U/V/W: as [`UVW`], and on a Fanuc lathe U and W are X and Z incremental (round 8:
+/// a Fusion lathe post's `G28 U0. W0.` was named a parallel axis only).
+const UVW_FANUC: &str = "a U, V or W word moves an axis feedopt does not model (parallel \
+                         axes, a quill); the move would be lost: post the program without it. \
+                         On a Fanuc lathe (T series) U and W are X and Z incremental: then this \
+                         is a turning program, which feedopt does not read (it reads milling \
+                         programs)";
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
 const CSS_ON: Action = Action::SurfaceSpeed {
     on: true,
@@ -750,9 +757,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ('L', Address::Ignored),
         ('P', Address::Ignored),
         ('Q', Address::Ignored),
-        ('U', Address::Unsupported(UVW)),
-        ('V', Address::Unsupported(UVW)),
-        ('W', Address::Unsupported(UVW)),
+        ('U', Address::Unsupported(UVW_FANUC)),
+        ('V', Address::Unsupported(UVW_FANUC)),
+        ('W', Address::Unsupported(UVW_FANUC)),
     ],
     named: &[],
     g_codes: &[
