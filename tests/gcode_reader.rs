@@ -1029,10 +1029,16 @@ fn fanuc_only_words_tell_the_dialect() {
         "%\nG65 P9021 T1000\n",
         "G187\nG0 X0\n",
         "(TOOL LIST)\n(T1 D10)\nO1234\nG0 X0\n",
+        // Round 8: a Fadal program numbers its first block, `N1 O3 ( … )`.
+        "N1 O3 ( ZAMEK-INTERP )\nN2 ( UWAGA )\nN3 L900\n",
     ] {
         assert_eq!(detect_dialect(text), Some(Dialect::Fanuc), "{text}");
     }
     assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
+    assert_eq!(
+        detect_dialect("N10 O100 SUB\nG0 X0\nN20 O100 ENDSUB\n"),
+        Some(Dialect::LinuxCnc)
+    );
 }
 
 /// Fanuc's ISO code writes the program number with a colon, `:1234` for `O1234` (Fanuc
