@@ -1310,3 +1310,22 @@ fn a_fanuc_u_word_names_the_lathe_reading() {
         &["`U0.`", "lathe", "turning program"],
     );
 }
+
+/// A Fanuc macro program run on its own (round 8, Brown-Industries' O9250 starts `IF [#1 EQ
+/// #0] THEN #3000=1`): its arguments #1–#33 are unset. The error says they are a macro call's
+/// arguments and to solve the calling program.
+#[test]
+fn a_macro_argument_read_before_it_is_set_names_the_macro_call() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO9250 (DYNAMIC ROTATION CALC)\nIF [#1 EQ #0] THEN #3000=1 (NEED AXIS)\nM99\n",
+        3,
+        &["`#1`", "macro call's arguments", "G65", "calls it"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X[#100] Y0. Z0.\n",
+        2,
+        &["`#100` is read before it is set"],
+    );
+}
