@@ -1722,3 +1722,89 @@ fn a_modulo_axis_set_to_the_shorter_way_continues_past_360_degrees() {
         );
     }
 }
+
+/// On a modulo axis set to take the shorter way, Sinumerik's `A=AC(…)` still goes by the sign
+/// of the difference (as AC does for a modulo axis), without the warning; `A=DC(…)` the
+/// shorter way, and a plain word as the machine file says.
+#[test]
+fn sinumerik_ac_on_a_modulo_axis_goes_by_the_sign_of_the_difference() {
+    let modulo = MachineContext {
+        shortest_way: [true, false, false],
+        ..context("XYZA", Default::default(), [0.0; 3])
+    };
+    let text = "G90 G1 X0 Y0 Z10 A359.5 F1000\nX1 A=AC(350)\nX2 A=DC(0)\nX3 A4\nM30\n";
+    let tp = parse_for(
+        Path::new("t.mpf"),
+        text,
+        Dialect::Sinumerik.spec(),
+        Some(&modulo),
+    )
+    .unwrap();
+    let a: Vec<f64> = tp.points.iter().map(|p| p.rotary.unwrap()[0]).collect();
+    // From 0 the shorter way to 359.5 is −0.5; AC(350) turns +350.5 by the sign (the shorter
+    // way would be −10.5); DC(0) +10 to 360; the plain A4 +4 to 364, the shorter way.
+    let want = [-0.5, 350.0, 360.0, 364.0];
+    assert_eq!(a.len(), want.len(), "{a:?}");
+    for (g, w) in a.iter().zip(want) {
+        assert!((g - w).abs() < 1e-9, "{a:?}");
+    }
+    assert!(
+        tp.warnings
+            .iter()
+            .all(|w| !w.message.contains("shortest_way"))
+    );
+}
+
+/// NX's SINUMERIK ONE post (round 8, LOMO's G300 A/C trunnion program) writes `C=DC(0.0)`:
+/// the rotary axis to 0° the shorter way. DC, ACP (turning positive) and ACN (negative) go to
+/// the position modulo 360° their way; `X=AC(…)` is absolute under G91 and `X=IC(…)`
+/// incremental under G90, this word only. On a linear axis DC is refused, naming the word.
+#[test]
+fn sinumerik_dc_acp_acn_ac_ic_axis_words() {
+    let c_after = |text: &str| -> Vec<f64> {
+        let tp = gcode(Dialect::Sinumerik, text);
+        tp.points.iter().map(|p| p.rotary.unwrap()[2]).collect()
+    };
+    let head = "G71 G90 G94\nG0 X0 Y0 Z50 A0 C350\n";
+    // From 350°: DC(10) goes +20° (to 370), ACN(10) −340° (to 10), ACP(340) +350° (to 700).
+    assert_eq!(
+        *c_after(&format!("{head}G0 C=DC(10)\n")).last().unwrap(),
+        370.0
+    );
+    assert_eq!(
+        *c_after(&format!("{head}G0 C=ACN(10)\n")).last().unwrap(),
+        10.0
+    );
+    assert_eq!(
+        *c_after(&format!("{head}G0 C=ACP(340)\n")).last().unwrap(),
+        700.0
+    );
+    assert_eq!(
+        *c_after(&format!("{head}G0 C=DC(350.0)\n")).last().unwrap(),
+        350.0
+    );
+    // AC under G91, IC under G90.
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "G71 G90 G94\nG0 X10 Y0 Z50\nG91 G1 X=AC(40) Y5 F1000\nG90 X=IC(5) Y0\n",
+    );
+    let last = tp.points.len() - 1;
+    assert_close(tp.points[last].p, v(45.0, 0.0, 50.0), 1e-9);
+    assert!(
+        tp.points
+            .iter()
+            .any(|p| (p.p - v(40.0, 5.0, 50.0)).norm() < 1e-9)
+    );
+    let e = message(
+        parse(
+            Path::new("t.mpf"),
+            "G71 G90\nG0 X0 Y0 Z50\nG0 X=DC(10)\n",
+            Dialect::Sinumerik,
+        )
+        .unwrap_err(),
+    );
+    assert!(
+        e.contains("t.mpf:3:") && e.contains("X=DC(10)") && e.contains("linear"),
+        "{e}"
+    );
+}

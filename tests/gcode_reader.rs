@@ -1029,10 +1029,16 @@ fn fanuc_only_words_tell_the_dialect() {
         "%\nG65 P9021 T1000\n",
         "G187\nG0 X0\n",
         "(TOOL LIST)\n(T1 D10)\nO1234\nG0 X0\n",
+        // Round 8: a Fadal program numbers its first block, `N1 O3 ( … )`.
+        "N1 O3 ( ZAMEK-INTERP )\nN2 ( UWAGA )\nN3 L900\n",
     ] {
         assert_eq!(detect_dialect(text), Some(Dialect::Fanuc), "{text}");
     }
     assert_eq!(detect_dialect("G21 G90\nG0 X0 Y0\nG1 X1 F100\n"), None);
+    assert_eq!(
+        detect_dialect("N10 O100 SUB\nG0 X0\nN20 O100 ENDSUB\n"),
+        Some(Dialect::LinuxCnc)
+    );
 }
 
 /// Fanuc's ISO code writes the program number with a colon, `:1234` for `O1234` (Fanuc
@@ -1240,5 +1246,86 @@ fn a_warning_said_again_shares_its_text() {
         said.windows(2)
             .all(|w| std::sync::Arc::ptr_eq(&w[0].message, &w[1].message)),
         "one text, shared"
+    );
+}
+
+/// A Fadal program (round 8: `L900` defines subprogram 9, `L901` calls it, `G3 I-4.5 L14`
+/// repeats the arc 14 times) read as LinuxCNC or Fanuc dropped every such move in silence.
+/// An L word with nothing in its block to read it is an error naming it; G10, canned cycles
+/// (their repeat count), M98 and LinuxCNC's M66 still read theirs.
+#[test]
+fn an_l_word_nothing_reads_is_an_error_naming_it() {
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        err_in(
+            dialect,
+            "G21 G90\nG0 X0. Y0. Z0.\nN3 L901\nG1 X10. F100.\n",
+            3,
+            &["`L901`", "Fadal"],
+        );
+        err_in(
+            dialect,
+            "G21 G90\nG0 X4.5 Y0. Z0.\nG91 G3 I-4.5 Z-0.5 L14 F80.\n",
+            3,
+            &["`L14`"],
+        );
+    }
+    ok(
+        "G21 G90\nG10 L2 P1 X0 Y0 Z0\nG0 X0 Y0 Z5\nG81 X5 Y0 Z-3 R1 L2 F100\nX10\nG80\nM66 P0 L3 Q1\n",
+    );
+    ok_in(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X0. Y0. Z5.\nG81 X5. Z-3. R1. K2 F100.\nX10. L2\nG80\n",
+    );
+}
+
+/// SolidCAM's Mach3 post (round 8) writes `G0 G53 Z123  ; move up to tool_z_level` in a
+/// program headed `O1`, read in the Fanuc dialect, where `;` ends a block: the words after it
+/// were "`M` has no number". The error now says what the `;` is taken for and what to do.
+#[test]
+fn text_after_a_fanuc_end_of_block_semicolon_names_the_semicolon() {
+    err_in(
+        Dialect::Fanuc,
+        "O1 (TEST)\nG21 G90\nG0 G53 Z123  ; move up to tool_z_level\n",
+        3,
+        &[
+            "`M` has no number",
+            "after a `;`",
+            "Fanuc",
+            "--dialect linuxcnc",
+        ],
+    );
+    // A `;` as Fanuc's end of block before another block still reads.
+    let tp = ok_in(Dialect::Fanuc, "G21 G90\nG0 X0. Y0. Z5. ; G1 X10. F100.\n");
+    assert_eq!(tp.points.last().unwrap().p.x, 10.0);
+}
+
+/// A Fusion lathe post's `G28 U0. W0.` (round 8) read in the Fanuc dialect: the refusal of
+/// the U word says that on a Fanuc lathe U and W are X and Z incremental, a turning program.
+#[test]
+fn a_fanuc_u_word_names_the_lathe_reading() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO2001\nN10 G99 G18\nN11 G21\nN12 G50 S6000\nN13 G28 U0. W0.\n",
+        6,
+        &["`U0.`", "lathe", "turning program"],
+    );
+}
+
+/// A Fanuc macro program run on its own (round 8, Brown-Industries' O9250 starts `IF [#1 EQ
+/// #0] THEN #3000=1`): its arguments #1–#33 are unset. The error says they are a macro call's
+/// arguments and to solve the calling program.
+#[test]
+fn a_macro_argument_read_before_it_is_set_names_the_macro_call() {
+    err_in(
+        Dialect::Fanuc,
+        "%\nO9250 (DYNAMIC ROTATION CALC)\nIF [#1 EQ #0] THEN #3000=1 (NEED AXIS)\nM99\n",
+        3,
+        &["`#1`", "macro call's arguments", "G65", "calls it"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "G21 G90\nG0 X[#100] Y0. Z0.\n",
+        2,
+        &["`#100` is read before it is set"],
     );
 }

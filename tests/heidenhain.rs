@@ -1437,3 +1437,44 @@ fn cycle_262_mills_the_thread_on_a_helix_with_approach_and_departure_arcs() {
         .to_string();
     assert!(e.contains("not narrower"), "{e}");
 }
+
+/// Mastercam's Heidenhain post (MPPOSTABILITY_AVIA_VMC_800_4X, round 8's n091.h) wraps a long
+/// comment with `~`: the next line is the rest of the comment (a file path here), not a block.
+/// A structure comment continued so is comment too; a cycle's parameter lines, whose `~` ends
+/// a parameter's comment, still continue the cycle.
+#[test]
+fn a_comment_block_continued_with_a_tilde_continues_as_comment() {
+    let text = format!(
+        "{HEADER}4 ;MCX FILE  -~\n Z:\\00NZL\\KR\\PART.MCX-9\n5 * - LONG ~\n X+500 Y+500\n\
+         6 L X+10 Y+0 Z+0 F600\n7 L X+20\n8 END PGM T MM\n"
+    );
+    let tp = read(&text);
+    let xs: Vec<f64> = tp.points.iter().map(|q| q.p.x).collect();
+    assert!(xs.iter().all(|x| *x <= 20.0), "{xs:?}");
+    assert!((length(&tp.points) - 10.0).abs() < 1e-9);
+    // The cycle's lines still join (`~` after a parameter's comment).
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 R0 FMAX\n{DRILL_NEW}13 L X+10 Y+10 R0 FMAX M99\n14 END PGM T MM\n"
+    ));
+    assert!(tp.points.iter().any(|q| (q.p.z + 10.0).abs() < 1e-9));
+}
+
+/// A shop's TNC program (round 8, KOLEK-MOC-STR1.H) keeps its probing cycle under `/`: run
+/// with the block-skip switch on. Read with the switch off, the refusal of `TCH PROBE` says
+/// that the block is a block-delete one and that `--block-delete` skips it.
+#[test]
+fn an_error_in_a_block_delete_block_names_block_delete() {
+    let text = format!(
+        "{HEADER}/ 4 TCH PROBE 413 PKT.BAZ.OKRAG ZEWN. ~\n    Q321=+0 ;SRODEK ~\n    \
+         Q322=+0 ;SRODEK\n5 L X+0 Y+0 Z+5 R0 FMAX\n6 END PGM T MM\n"
+    );
+    let e = fails(&text);
+    assert!(
+        e.contains("t.h:5:") && e.contains("TCH PROBE") && e.contains("--block-delete"),
+        "{e}"
+    );
+    let e = fails(&format!(
+        "{HEADER}4 TCH PROBE 413 ~\n    Q321=+0 ;X\n5 END PGM T MM\n"
+    ));
+    assert!(!e.contains("--block-delete"), "{e}");
+}

@@ -151,8 +151,16 @@ pub enum Address {
     /// A subprogram call by number, the word as written naming it (Sinumerik `L123`; `P`
     /// in the same block is the repeat count).
     Call,
-    /// Klartext: an incremental axis word 0–5 (`IX+5`: this word only, never modal).
+    /// Klartext: an incremental axis word 0–5 (`IX+5`: this word only, never modal); Sinumerik
+    /// `X=IC(5)`. Made by the lexer for Sinumerik, in Klartext's table.
     IncrementalAxis(usize),
+    /// Sinumerik `X=AC(5)`: axis word 0–5 absolute whatever G90/G91 (this word only). Made by
+    /// the lexer, in no dialect's table.
+    AbsoluteAxis(usize),
+    /// Sinumerik rotary axis 3–5 to an absolute position by a way of its own, this word
+    /// only: `C=DC(v)` the shorter way (0), `C=ACP(v)` turning positive (+1), `C=ACN(v)`
+    /// negative (−1). Made by the lexer, in no dialect's table.
+    RotaryTo(usize, i8),
     /// Klartext: the direction of a circular path, `DR+` (counter-clockwise, value +1) or
     /// `DR-` (clockwise, −1).
     ArcDirection,
@@ -523,6 +531,13 @@ const G60: &str = "single-direction positioning approaches the end point from on
                    the move goes straight to its end point";
 const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
                    quill); the move would be lost: post the program without it";
+/// Fanuc's U/V/W: as [`UVW`], and on a Fanuc lathe U and W are X and Z incremental (round 8:
+/// a Fusion lathe post's `G28 U0. W0.` was named a parallel axis only).
+const UVW_FANUC: &str = "a U, V or W word moves an axis feedopt does not model (parallel \
+                         axes, a quill); the move would be lost: post the program without it. \
+                         On a Fanuc lathe (T series) U and W are X and Z incremental: then this \
+                         is a turning program, which feedopt does not read (it reads milling \
+                         programs)";
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
 const CSS_ON: Action = Action::SurfaceSpeed {
     on: true,
@@ -742,9 +757,9 @@ pub static FANUC: DialectSpec = DialectSpec {
         ('L', Address::Ignored),
         ('P', Address::Ignored),
         ('Q', Address::Ignored),
-        ('U', Address::Unsupported(UVW)),
-        ('V', Address::Unsupported(UVW)),
-        ('W', Address::Unsupported(UVW)),
+        ('U', Address::Unsupported(UVW_FANUC)),
+        ('V', Address::Unsupported(UVW_FANUC)),
+        ('W', Address::Unsupported(UVW_FANUC)),
     ],
     named: &[],
     g_codes: &[

@@ -171,6 +171,19 @@ impl Variables {
                  the machine's, not the program's. Set it earlier in the program, or remove \
                  the test or move that reads it"
             )
+        } else if let Some(n) = name
+            .strip_prefix('#')
+            .and_then(|d| d.parse::<u32>().ok())
+            .filter(|n| (1..=33).contains(n))
+        {
+            // Round 8: a Fanuc macro program (Brown-Industries' O9250) tests its arguments
+            // `IF [#1 EQ #0]` first: run on its own, they are unset.
+            format!(
+                "parameter `{name}` is read before it is set: #{n} is a local variable, which \
+                 a macro call's arguments set (Fanuc G65 P… A… B…: A is #1, B #2; LinuxCNC \
+                 `o… call [..]`); a macro program does not run on its own: solve the program \
+                 that calls it, or set #{n} before it is read"
+            )
         } else if name.starts_with('#') || is_q_parameter(&name) {
             format!("parameter `{name}` is read before it is set")
         } else {

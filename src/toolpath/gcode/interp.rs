@@ -39,8 +39,13 @@ struct Block {
     letters: [Option<Num>; 26],
     /// Codes and keywords in the order written, with their text and `( … )` arguments.
     actions: Vec<(String, Action, Option<String>)>,
-    /// Klartext: the axis word is incremental (`IX+5`, this word only).
+    /// Klartext: the axis word is incremental (`IX+5`, this word only); Sinumerik `X=IC(5)`.
     incremental: [bool; 6],
+    /// Sinumerik `X=AC(5)`: the axis word is absolute whatever G90/G91.
+    absolute: [bool; 6],
+    /// Sinumerik `C=DC(v)` (0), `C=ACP(v)` (+1), `C=ACN(v)` (−1): the way a rotary axis
+    /// turns to its absolute position.
+    rotary_way: [Option<i8>; 6],
     /// Klartext `DR±`: +1 counter-clockwise, −1 clockwise.
     direction: Option<f64>,
     /// Klartext `PA`/`IPA` (degrees) and `PR`/`IPR` (mm), `true` when incremental.
@@ -555,10 +560,17 @@ impl<'a> Interpreter<'a> {
             match address {
                 Address::Axis(_)
                 | Address::IncrementalAxis(_)
+                | Address::AbsoluteAxis(_)
+                | Address::RotaryTo(..)
                 | Address::ArcCentre(_)
                 | Address::Radius => {
-                    let degrees =
-                        matches!(address, Address::Axis(3..) | Address::IncrementalAxis(3..));
+                    let degrees = matches!(
+                        address,
+                        Address::Axis(3..)
+                            | Address::IncrementalAxis(3..)
+                            | Address::AbsoluteAxis(3..)
+                            | Address::RotaryTo(..)
+                    );
                     self.note_increments(line, &block, &text, num, degrees);
                 }
                 Address::Ignored if text.starts_with('Q') => {
@@ -577,6 +589,19 @@ impl<'a> Interpreter<'a> {
                     self.check_axis(line, &text, i)?;
                     block.axes[i] = Some(num);
                     block.incremental[i] = true;
+                }
+                Address::AbsoluteAxis(i) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.absolute[i] = true;
+                }
+                Address::RotaryTo(i, way) => {
+                    duplicate(block.axes[i].is_some())?;
+                    self.check_axis(line, &text, i)?;
+                    block.axes[i] = Some(num);
+                    block.absolute[i] = true;
+                    block.rotary_way[i] = Some(way);
                 }
                 Address::PlaneRotary(i) => {
                     duplicate(block.axes[3 + i].is_some() || block.plane_rotary[i])?;
@@ -1103,6 +1128,34 @@ impl<'a> Interpreter<'a> {
         }
         if fanuc_call {
             self.fanuc_call(line, &block)?;
+        }
+        // An L word is read by G10, a canned cycle (repeats), `M98` (repeats) and LinuxCNC's
+        // `M66` (wait mode). Elsewhere it is no word of these dialects, but a Fadal control's
+        // subprogram definition and call (`L900`, `L901`) and arc repeat (`G3 I-4.5 L14`):
+        // moves feedopt would drop in silence (round 8, a Fadal program read as 0.2 s).
+        if matches!(
+            self.spec.subprograms,
+            Subprograms::OWordSub | Subprograms::OPrograms
+        ) && let Some(l) = block.letter('L')
+            && !(fanuc_call
+                || set_offset.is_some()
+                || new_cycle.is_some()
+                || self.cycle.is_some()
+                || block
+                    .actions
+                    .iter()
+                    .any(|(text, _, _)| code_name(text) == "M66"))
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`L{}`: an L word with no G10, canned cycle or M98 in the block to read it; \
+                     on a Fadal control L defines or calls a subprogram (L900, L901) or repeats \
+                     a move (G3 … L14), which feedopt does not read: post the program for a \
+                     Fanuc-style control (M98 P… calls, moves written out)",
+                    l.value
+                ),
+            ));
         }
         if end && self.call.is_some() {
             return Err(self.error(
@@ -2340,8 +2393,9 @@ impl<'a> Interpreter<'a> {
                 self.known[i] = true;
                 continue;
             }
-            let incremental =
-                (self.distance == Distance::Incremental || block.incremental[i]) && !machine;
+            let incremental = (self.distance == Distance::Incremental || block.incremental[i])
+                && !machine
+                && !block.absolute[i];
             // A rotary machine coordinate: the program coordinate that the offsets in force
             // take to it (`push` adds their shift; the X Y Z are converted below).
             let value = if machine {
@@ -2354,12 +2408,21 @@ impl<'a> Interpreter<'a> {
                 .is_some_and(|c| i >= 3 && c.shortest_way[i - 3]);
             end[i] = if incremental {
                 start[i] + value
-            } else if i >= 3 && (self.shortest_path || shortest_way) {
-                // Klartext M126, or a modulo axis set so in the machine file: the shorter way
-                // to the absolute position.
+            } else if let Some(way) = block.rotary_way[i] {
+                // Sinumerik DC / ACP / ACN: to the position modulo 360° the way the word says.
+                match way {
+                    0 => start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0,
+                    1 => start[i] + (value - start[i]).rem_euclid(360.0),
+                    _ => start[i] - (start[i] - value).rem_euclid(360.0),
+                }
+            } else if i >= 3 && (self.shortest_path || (shortest_way && !block.absolute[i])) {
+                // Klartext M126, or a modulo axis set so in the machine file (unless the word
+                // says AC(), by the sign of the difference): the shorter way to the absolute
+                // position.
                 start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
             } else {
-                if i >= 3 && (value - start[i]).abs() > 180.0 && rotary_known {
+                if i >= 3 && (value - start[i]).abs() > 180.0 && rotary_known && !block.absolute[i]
+                {
                     // Read as written; a modulo axis set to take the shorter way would turn
                     // the other way, less than half a turn (a blade mill's A going 359.5° →
                     // 4° in a spiral).

@@ -601,6 +601,45 @@ fn lex_separate_word(
                     });
                     return Ok(());
                 }
+                // `X=AC(…)`, `X=IC(…)`: absolute or incremental for this word; a rotary axis's
+                // `C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`: absolute the shorter way, or turning
+                // positive or negative (NX's 840D posts write `C=DC(0.0)`).
+                if let Address::Axis(i) = address {
+                    let modes: [(&str, Option<i8>); 5] = [
+                        ("AC(", None),
+                        ("IC(", None),
+                        ("DC(", Some(0)),
+                        ("ACP(", Some(1)),
+                        ("ACN(", Some(-1)),
+                    ];
+                    for (prefix, way) in modes {
+                        let Some(inner) =
+                            text.strip_prefix(prefix).and_then(|t| t.strip_suffix(')'))
+                        else {
+                            continue;
+                        };
+                        let num =
+                            value(inner, vars).map_err(|e| format!("`{name}={text}`: {e}"))?;
+                        let address = match (prefix, way) {
+                            ("AC(", _) => Address::AbsoluteAxis(i),
+                            ("IC(", _) => Address::IncrementalAxis(i),
+                            (_, Some(way)) if i >= 3 => Address::RotaryTo(i, way),
+                            _ => {
+                                return Err(format!(
+                                    "`{name}={text}`: {} positions a rotary axis (the shorter \
+                                     way, or turning one way); {name} is a linear axis",
+                                    &prefix[..prefix.len() - 1]
+                                ));
+                            }
+                        };
+                        items.push(Item::Word {
+                            text: format!("{name}={text}"),
+                            address,
+                            num,
+                        });
+                        return Ok(());
+                    }
+                }
                 if text.starts_with("IC(") || text.starts_with("AC(") {
                     return Err(format!(
                         "`{name}={text}`: IC( )/AC( ) (incremental or absolute for one word) is \

@@ -468,7 +468,7 @@ fn program_header<'t>(
 /// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
 /// `G05.1`, `M98`, look-ahead `G08 P…`, macro calls `G65 P…`, Haas `G187`, a first block
-/// `O1234` or ISO code's `:1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
+/// `O1234` (after a block number too: `N1 O3`) or ISO code's `:1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
 /// by an O-word keyword: `o100 sub`, `o100 call`, `o101 if`, …, which is not a Fanuc program
 /// number).
 pub fn detect_dialect(upper: &str) -> Option<Dialect> {
@@ -493,7 +493,8 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
                 !l.is_empty() && !l.starts_with('%') && !l.starts_with('(')
             })
             .is_some_and(|l| {
-                let l = l.trim();
+                // After a block number as Fadal programs write it (round 8: `N1 O3 ( … )`).
+                let l = strip_sequence_number(l.trim());
                 (l.starts_with('O')
                     && l[1..].chars().next().is_some_and(|c| c.is_ascii_digit())
                     && !is_oword_control(l))
@@ -506,6 +507,16 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
         (false, true, _) => Some(Dialect::Fanuc),
         (false, false, true) => Some(Dialect::LinuxCnc),
         _ => None,
+    }
+}
+
+/// A line without its block number `N<digits>` (and the blanks after it).
+fn strip_sequence_number(l: &str) -> &str {
+    match l.strip_prefix('N') {
+        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) => rest
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start(),
+        _ => l,
     }
 }
 
@@ -534,13 +545,7 @@ const OWORD_KEYWORDS: [&str; 15] = [
 /// `N10 O100 CALL [1]`): the number, then a keyword, then the end of the line, a space, `[` or
 /// `(`.
 fn is_oword_control(line: &str) -> bool {
-    let l = line.trim_start();
-    let l = match l.strip_prefix('N') {
-        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) => rest
-            .trim_start_matches(|c: char| c.is_ascii_digit())
-            .trim_start(),
-        _ => l,
-    };
+    let l = strip_sequence_number(line.trim_start());
     let Some(rest) = l.strip_prefix('O') else {
         return false;
     };

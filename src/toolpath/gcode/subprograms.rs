@@ -56,7 +56,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::dialect::{DialectSpec, Subprograms};
+use super::dialect::{DialectSpec, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
@@ -431,11 +431,20 @@ impl Program {
         let raw: Vec<&str> = text.lines().collect();
         let mut i = 0;
         while i < self.lines.len() {
+            // A comment block (`4 ;MCX FILE -~`, `* - …~`: nothing but the block number
+            // before the comment) continues as comment: Mastercam's Heidenhain post wraps a
+            // long comment so, and the TNC reads the lines that follow as part of it.
+            let comment_block = matches!(&self.lines[i].blocks, Ok(b)
+                if b.iter().all(|s| klartext::strip_block_number(s).trim().is_empty()));
             let mut j = i;
             while j + 1 < self.lines.len()
                 && raw.get(j).is_some_and(|r| r.trim_end().ends_with('~'))
             {
                 j += 1;
+                if comment_block {
+                    self.lines[j].blocks = Ok(Vec::new());
+                    continue;
+                }
                 let next = std::mem::replace(&mut self.lines[j].blocks, Ok(Vec::new()));
                 let add = match next {
                     Ok(b) => b.join(" "),
@@ -689,6 +698,7 @@ impl Program {
                 return Err(self.too_many(source, number, &stack, jumps));
             }
             let run_deleted;
+            let deleted = self.block_delete_mark(text).is_some();
             let text = match self.block_delete_mark(text) {
                 None => text,
                 Some(_) if interp.block_delete => {
@@ -914,12 +924,30 @@ impl Program {
             {
                 continue;
             }
-            let items = lex(spec, text, &mut interp.vars)
-                .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+            let items = lex(spec, text, &mut interp.vars).map_err(|m| {
+                // Text after a `;`, which ends a block in this dialect (Fanuc's), that is no
+                // block: most likely a comment as Mach3 and LinuxCNC write them (round 8,
+                // SolidCAM's Mach3 post: `G0 G53 Z123 ; move up to tool_z_level`).
+                let m = if block > 0 && spec.semicolon == Semicolon::EndOfBlock {
+                    format!(
+                        "{m}, in `{text}` after a `;`, which ends a block in the {} dialect; \
+                         if the `;` starts a comment (as Mach3 and LinuxCNC read it), remove \
+                         the comment, or read the program in the LinuxCNC dialect \
+                         (--dialect linuxcnc)",
+                        spec.name
+                    )
+                } else {
+                    m
+                };
+                self.located(
+                    delete_hint(Error::parse(source, number, m), deleted),
+                    &stack,
+                )
+            })?;
             interp
                 .block(number, items)
                 .and_then(|()| interp.check_room(number, "this block", 0))
-                .map_err(|e| self.located(e, &stack))?;
+                .map_err(|e| self.located(delete_hint(e, deleted), &stack))?;
             if let Some(call) = interp.call.take() {
                 self.enter(&mut stack, call, number, source)?;
             } else if interp.ended {
@@ -1201,5 +1229,26 @@ impl Program {
             },
             other => other,
         }
+    }
+}
+
+/// An error in a block run with the block-delete mark `/` (the control's block-skip switch
+/// off): says that `--block-delete` skips it (round 8: a TNC program's probing cycle under
+/// `/`, which the shop runs with the switch on).
+fn delete_hint(e: Error, deleted: bool) -> Error {
+    match e {
+        Error::Parse {
+            file,
+            line,
+            message,
+        } if deleted => Error::Parse {
+            file,
+            line,
+            message: format!(
+                "{message} (the block starts with `/`, block delete: --block-delete skips \
+                 it, as the control's block-skip switch does)"
+            ),
+        },
+        e => e,
     }
 }
