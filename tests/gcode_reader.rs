@@ -26,7 +26,17 @@ fn ok(text: &str) -> Toolpath {
 fn others(tp: &Toolpath) -> Vec<&Warning> {
     tp.warnings
         .iter()
-        .filter(|w| !w.message.contains("selects no unit"))
+        .filter(|w| !w.message.contains("selects no unit") && !w.message.contains("shortest_way"))
+        .collect()
+}
+
+/// The lines where a rotary axis turns more than 180° by the sign of the difference (the
+/// warning that names `shortest_way`), with the axis.
+fn long_way(tp: &Toolpath) -> Vec<(usize, char)> {
+    tp.warnings
+        .iter()
+        .filter(|w| w.message.contains("shortest_way"))
+        .map(|w| (w.line, w.message.chars().next().unwrap_or('?')))
         .collect()
 }
 
@@ -137,6 +147,10 @@ fn modal_g0_g1_and_feeds() {
     assert!(tp.points.iter().all(|p| p.rotary.is_none()));
     assert!(tp.points.iter().all(|p| p.o == v(0.0, 0.0, 1.0)));
     assert!(others(&tp).is_empty(), "{:?}", tp.warnings);
+    // C turns the long way three times, as LinuxCNC does without WRAPPED_ROTARY: the rapids
+    // between operations (C −345.249 → −43.723 at line 3401, and at 4146) and the return to
+    // C 0 at the end (line 4504, from −399.805).
+    assert_eq!(long_way(&tp), [(3401, 'C'), (4146, 'C'), (4504, 'C')]);
 }
 
 #[test]
@@ -909,9 +923,11 @@ fn linuxcnc_boat_xyzac() {
         assert!(tp.points.iter().filter(|p| p.line == line).count() > 10);
     }
     assert!(tp.points.iter().all(|p| p.rotary.is_some()));
-    // The only warning: the first move (`Z5`) comes before any X and Y.
+    // The only warning: the first move (`Z5`) comes before any X and Y; and C's return to 0
+    // at the end turns the long way.
     assert_eq!(others(&tp).len(), 1, "{:?}", tp.warnings);
     assert_eq!(others(&tp)[0].line, 11);
+    assert_eq!(long_way(&tp), [(1878, 'C')]);
 }
 
 #[test]
@@ -935,9 +951,10 @@ fn linuxcnc_boat_xyzbc() {
         .map(|w| w.line)
         .collect();
     assert_eq!(g53, vec![1863, 1864]);
-    // And the first move (line 11) comes before any Z.
+    // And the first move (line 11) comes before any Z; C's return to 0 turns the long way.
     assert_eq!(others(&tp).len(), 3, "{:?}", tp.warnings);
     assert_eq!(others(&tp)[0].line, 11);
+    assert_eq!(long_way(&tp), [(1864, 'C')]);
 }
 
 /// A program that selects one work offset reads its coordinates in that frame, without a
