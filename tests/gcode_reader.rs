@@ -147,10 +147,6 @@ fn modal_g0_g1_and_feeds() {
     assert!(tp.points.iter().all(|p| p.rotary.is_none()));
     assert!(tp.points.iter().all(|p| p.o == v(0.0, 0.0, 1.0)));
     assert!(others(&tp).is_empty(), "{:?}", tp.warnings);
-    // C turns the long way three times, as LinuxCNC does without WRAPPED_ROTARY: the rapids
-    // between operations (C −345.249 → −43.723 at line 3401, and at 4146) and the return to
-    // C 0 at the end (line 4504, from −399.805).
-    assert_eq!(long_way(&tp), [(3401, 'C'), (4146, 'C'), (4504, 'C')]);
 }
 
 #[test]
@@ -898,6 +894,10 @@ fn linuxcnc_impeller() {
     assert!((c_min + 399.805).abs() < 1e-9, "{c_min}");
     assert!(tp.points.iter().all(|p| p.o == v(0.0, 0.0, 1.0)));
     assert!(others(&tp).is_empty(), "{:?}", tp.warnings);
+    // C turns the long way three times, as LinuxCNC does without WRAPPED_ROTARY: the rapids
+    // between operations (C −345.249 → −43.723 at line 3401, and at 4146) and the return to
+    // C 0 at the end (line 4504, from −399.805).
+    assert_eq!(long_way(&tp), [(3401, 'C'), (4146, 'C'), (4504, 'C')]);
 }
 
 #[test]

@@ -2433,9 +2433,9 @@ impl<'a> Interpreter<'a> {
                              reached by the sign of the difference, the long way round, as a \
                              control moves an axis that is not a modulo axis set to take the \
                              shorter way (Sinumerik MD30455 bit 2, Fanuc parameter 1008 RAB = \
-                             0, LinuxCNC WRAPPED_ROTARY); if this machine's {0} takes the \
-                             shorter way, set \"shortest_way\": true for {0} in the machine \
-                             file",
+                             0, LinuxCNC WRAPPED_ROTARY; a Heidenhain program says M126); if \
+                             this machine's {0} takes the shorter way, set \"shortest_way\": \
+                             true for {0} in the machine file",
                             AXIS_NAMES[i]
                         ),
                     );
