@@ -59,10 +59,18 @@ fn round_trip(
         toolpath::Input::Cl(t) => t,
         toolpath::Input::Joint(_) => unreachable!(),
     };
+    // No warning, but where a rotary axis turns more than 180° (the impeller's rapids
+    // between operations): the written block turns it the long way as the input did, which
+    // the reader says a modulo axis set to take the shorter way would not.
+    let said: Vec<_> = back
+        .warnings
+        .iter()
+        .filter(|w| !w.message.contains("shortest_way"))
+        .collect();
     assert!(
-        back.warnings.is_empty(),
+        said.is_empty(),
         "{dialect}: reader warnings {:?}",
-        &back.warnings[..back.warnings.len().min(3)]
+        &said[..said.len().min(3)]
     );
     // Every block after the first carries a time (no rapid, no missing F).
     let time = programmed_time(&back).unwrap();
