@@ -1683,29 +1683,25 @@ impl Plan<'_> {
                 warm.as_ref(),
                 |out| jd.fingerprint(out),
             );
-            if let Some(sol) = key.as_ref().and_then(|k| self.reuse.get(k)) {
-                return Ok(sol);
-            }
-            let sol = solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
-                .map_err(|e| match e {
-                    // Where, and what to try: a bare solver status named neither.
-                    Error::Solver(why) => {
-                        let span = &self.path.spans[si];
-                        let (a, b) = (
-                            span.nearest_line(p.u[0]),
-                            span.nearest_line(p.u[p.intervals()]),
-                        );
-                        Error::Solver(format!(
-                            "span {si} (CL lines {a}–{b}): the jerk-limited solve failed ({why}): \
-                             drop the jerk limits with --no-jerk, or report the program"
-                        ))
-                    }
-                    other => other,
-                })?;
-            if let Some(k) = key {
-                self.reuse.put(k, &sol);
-            }
-            return Ok(sol);
+            // Where, and what to try: a bare solver status named neither.
+            let named = |e: Error| match e {
+                Error::Solver(why) => {
+                    let span = &self.path.spans[si];
+                    let (a, b) = (
+                        span.nearest_line(p.u[0]),
+                        span.nearest_line(p.u[p.intervals()]),
+                    );
+                    Error::Solver(format!(
+                        "span {si} (CL lines {a}–{b}): the jerk-limited solve failed ({why}): \
+                         drop the jerk limits with --no-jerk, or report the program"
+                    ))
+                }
+                other => other,
+            };
+            return self.reuse.answer(key, || {
+                solver::jerk::solve(p, &jd, &greedy, warm, &options.solver, &options.jerk)
+                    .map_err(named)
+            });
         }
         if options.solver_kind == SolverKind::Reach {
             return Ok(greedy);
@@ -1713,14 +1709,8 @@ impl Plan<'_> {
         let key = self
             .reuse
             .key(p, &options.solver, None, &greedy, None, |_| ());
-        if let Some(sol) = key.as_ref().and_then(|k| self.reuse.get(k)) {
-            return Ok(sol);
-        }
-        let sol = solver::optimal(p, &greedy, &options.solver)?;
-        if let Some(k) = key {
-            self.reuse.put(k, &sol);
-        }
-        Ok(sol)
+        self.reuse
+            .answer(key, || solver::optimal(p, &greedy, &options.solver))
     }
 
     /// Turns the reach pass's finding into an error naming span, station, u, CL line and axes.

@@ -124,29 +124,39 @@ impl Reuse {
         Some(Key(key))
     }
 
-    /// The answer kept under `key`, if any, with no solver work counted (its iterations and
-    /// solve time are the first solve's).
-    pub fn get(&self, key: &Key) -> Option<SpanSolution> {
-        let mut inner = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        let mut sol = inner.answers.get(key)?.clone();
-        inner.hits += 1;
-        sol.iterations = 0;
-        sol.solve_time = 0.0;
-        Some(sol)
-    }
-
-    /// Keeps `sol` as the answer under `key`, while the memory bound allows.
-    pub fn put(&self, key: Key, sol: &SpanSolution) {
+    /// The answer kept under `key` (with no solver work counted: its iterations and solve
+    /// time were counted with the first solve), else `solve()`'s, kept under `key` while the
+    /// memory bound allows. Without a key, `solve()`. An error is never kept (its message
+    /// names the span it came from).
+    pub fn answer(
+        &self,
+        key: Option<Key>,
+        solve: impl FnOnce() -> crate::error::Result<SpanSolution>,
+    ) -> crate::error::Result<SpanSolution> {
+        let Some(key) = key else { return solve() };
+        {
+            let mut inner = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(kept) = inner.answers.get(&key) {
+                let mut sol = kept.clone();
+                inner.hits += 1;
+                sol.iterations = 0;
+                sol.solve_time = 0.0;
+                return Ok(sol);
+            }
+        }
+        // Solved outside the lock: spans are solved in parallel (two that pose the same
+        // problem at once are both solved, to the same answer).
+        let sol = solve()?;
         let words = key.0.len()
             + sol.b.len()
             + sol.a.as_ref().map_or(0, Vec::len)
             + 2 * sol.slopes.as_ref().map_or(0, Vec::len);
         let mut inner = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        if inner.words + words > MAX_WORDS || inner.answers.contains_key(&key) {
-            return;
+        if inner.words + words <= MAX_WORDS && !inner.answers.contains_key(&key) {
+            inner.words += words;
+            inner.answers.insert(key, sol.clone());
         }
-        inner.words += words;
-        inner.answers.insert(key, sol.clone());
+        Ok(sol)
     }
 
     /// Solves answered from a kept answer so far.
