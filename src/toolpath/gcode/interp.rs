@@ -2403,23 +2403,25 @@ impl<'a> Interpreter<'a> {
             } else {
                 value
             };
-            let shortest_way = self
+            // The way a rotary axis turns to an absolute position, where not by the sign of
+            // the difference: the word's own (Sinumerik DC 0, ACP +1, ACN −1), else the
+            // shorter way (0) under Klartext M126 or on a modulo axis the machine file sets so
+            // (unless the word says AC(): by the sign, as on a modulo axis).
+            let modulo = self
                 .machine
                 .is_some_and(|c| i >= 3 && c.shortest_way[i - 3]);
+            let way = block.rotary_way[i].or((i >= 3
+                && (self.shortest_path || (modulo && !block.absolute[i])))
+                .then_some(0));
             end[i] = if incremental {
                 start[i] + value
-            } else if let Some(way) = block.rotary_way[i] {
-                // Sinumerik DC / ACP / ACN: to the position modulo 360° the way the word says.
+            } else if let Some(way) = way {
+                // To the position modulo 360° the way chosen.
                 match way {
                     0 => start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0,
                     1 => start[i] + (value - start[i]).rem_euclid(360.0),
                     _ => start[i] - (start[i] - value).rem_euclid(360.0),
                 }
-            } else if i >= 3 && (self.shortest_path || (shortest_way && !block.absolute[i])) {
-                // Klartext M126, or a modulo axis set so in the machine file (unless the word
-                // says AC(), by the sign of the difference): the shorter way to the absolute
-                // position.
-                start[i] + (value - start[i] + 180.0).rem_euclid(360.0) - 180.0
             } else {
                 if i >= 3 && (value - start[i]).abs() > 180.0 && rotary_known && !block.absolute[i]
                 {
