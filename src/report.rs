@@ -285,6 +285,7 @@ impl Summary {
             offset += p.u.len();
         }
         let length = st.last().map_or(0.0, |s| s.s);
+        let deviation = sol.path.deviation();
         let time = sol.schedule.cycle_time;
         let label = |b: Bound| binding_label(b, &names);
         let mut binding: Vec<BindingShare> = by_bound
@@ -308,8 +309,8 @@ impl Summary {
             solve_time_s: sol.solve_time,
             path_length_mm: length,
             joint_space: machine.kinematics == crate::machine::KinematicsSpec::Joint,
-            max_deviation_mm: sol.path.deviation().0,
-            max_deviation_deg: sol.path.deviation().1.to_degrees(),
+            max_deviation_mm: deviation.0,
+            max_deviation_deg: deviation.1.to_degrees(),
             axes: names
                 .iter()
                 .enumerate()
