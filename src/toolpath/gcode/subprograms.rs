@@ -698,8 +698,9 @@ impl Program {
                 return Err(self.too_many(source, number, &stack, jumps));
             }
             let run_deleted;
-            let deleted = self.block_delete_mark(text).is_some();
-            let text = match self.block_delete_mark(text) {
+            let mark = self.block_delete_mark(text);
+            let deleted = mark.is_some();
+            let text = match mark {
                 None => text,
                 Some(_) if interp.block_delete => {
                     interp.warn(
