@@ -643,7 +643,8 @@ fn lex_separate_word(
                 if text.starts_with("IC(") || text.starts_with("AC(") {
                     return Err(format!(
                         "`{name}={text}`: IC( )/AC( ) (incremental or absolute for one word) is \
-                         not supported; program G90/G91"
+                         read on axis words and arc centres, closed by `)`, not here; program \
+                         G90/G91"
                     ));
                 }
                 let num = value(text, vars).map_err(|e| format!("`{name}={text}`: {e}"))?;
