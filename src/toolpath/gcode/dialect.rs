@@ -529,15 +529,21 @@ const COMP: &str = "cutter radius compensation is not applied: the programmed pa
 const G60: &str = "single-direction positioning approaches the end point from one side, past \
                    it by an amount the control's parameters set; that approach is not modelled: \
                    the move goes straight to its end point";
-const UVW: &str = "a U, V or W word moves an axis feedopt does not model (parallel axes, a \
-                   quill); the move would be lost: post the program without it";
+/// The text of [`UVW`], for [`UVW_FANUC`] to extend.
+macro_rules! uvw {
+    () => {
+        "a U, V or W word moves an axis feedopt does not model (parallel axes, a quill); the \
+         move would be lost: post the program without it"
+    };
+}
+const UVW: &str = uvw!();
 /// Fanuc's U/V/W: as [`UVW`], and on a Fanuc lathe U and W are X and Z incremental (round 8:
 /// a Fusion lathe post's `G28 U0. W0.` was named a parallel axis only).
-const UVW_FANUC: &str = "a U, V or W word moves an axis feedopt does not model (parallel \
-                         axes, a quill); the move would be lost: post the program without it. \
-                         On a Fanuc lathe (T series) U and W are X and Z incremental: then this \
-                         is a turning program, which feedopt does not read (it reads milling \
-                         programs)";
+const UVW_FANUC: &str = concat!(
+    uvw!(),
+    ". On a Fanuc lathe (T series) U and W are X and Z incremental: then this is a turning \
+     program, which feedopt does not read (it reads milling programs)"
+);
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
 const CSS_ON: Action = Action::SurfaceSpeed {
     on: true,
