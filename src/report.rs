@@ -487,9 +487,16 @@ impl fmt::Display for Summary {
                 self.solve_time_s
             )?;
         } else {
+            // Jerk limits: the SCP's linear subproblems go to the banded interior-point
+            // method, with Clarabel where it does not answer (`solver::jerk::LpSolver`).
+            let name = if self.jerk_limited {
+                "SCP, banded LP and Clarabel"
+            } else {
+                "Clarabel"
+            };
             writeln!(
                 f,
-                "solver        Clarabel: {status}, {} iterations, {:.3} s",
+                "solver        {name}: {status}, {} iterations, {:.3} s",
                 self.iterations, self.solve_time_s
             )?;
         }

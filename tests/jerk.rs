@@ -6,7 +6,7 @@ use std::path::Path;
 use feedopt::constraints::Chord;
 use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize, optimize_joint};
-use feedopt::solver::jerk::{JerkOptions, Objective};
+use feedopt::solver::jerk::{JerkOptions, LpSolver, Objective};
 use feedopt::toolpath::joint_csv;
 use feedopt::verify::VerifyOptions;
 use nalgebra::Vector3;
@@ -226,6 +226,77 @@ fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
         last <= t_acc * 1.04,
         "jerk ×10 is within 4 % of acceleration-limited: {last} vs {t_acc}"
     );
+}
+
+/// The cycle time and the SCP's LP solves with `lp_solver` on `m`, `tp`'s fixed grid.
+fn fixed_grid_with(
+    m: &Machine,
+    tp: &feedopt::toolpath::Toolpath,
+    o: &Options,
+    lp_solver: LpSolver,
+) -> (f64, bool) {
+    let o = Options {
+        refine_until_verified: false,
+        jerk: JerkOptions {
+            lp_solver,
+            ..o.jerk
+        },
+        ..o.clone()
+    };
+    let sol = optimize(m, tp, &o).expect("solve");
+    (sol.schedule.cycle_time, sol.verification.verified)
+}
+
+/// Two independent LP solvers for the SCP's subproblems — the banded interior-point method
+/// and Clarabel — reach the same schedule (within the SCP's own tolerance, 1e-4) on the
+/// bundled 5-axis problem with its jerk limits, and both verify.
+#[test]
+fn banded_lp_and_clarabel_agree_on_the_bundled_problem() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
+    let m = Machine::from_file(&dir.join("machine_jerk.json")).expect("machine");
+    let tp = feedopt::toolpath::read(&dir.join("impeller_blade.cls")).expect("toolpath");
+    let o = Options {
+        stations: Some(1500),
+        ..Options::default()
+    };
+    let (banded, v1) = fixed_grid_with(&m, &tp, &o, LpSolver::Banded);
+    let (clarabel, v2) = fixed_grid_with(&m, &tp, &o, LpSolver::Clarabel);
+    eprintln!("banded LP {banded:.6} s, Clarabel {clarabel:.6} s");
+    assert!(
+        (banded - clarabel).abs() <= 1e-4 * clarabel,
+        "{banded} vs {clarabel}"
+    );
+    assert!(v1 && v2, "verified: banded {v1}, Clarabel {v2}");
+}
+
+/// The same on two COPP paths (7 axes, jerk limits, 1,000 intervals).
+#[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
+fn banded_lp_and_clarabel_agree_on_copp_paths() {
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
+    for idx in [1, 3] {
+        let (m, path, _) = copp_case(&dir, idx);
+        let solve = |lp_solver| {
+            let o = Options {
+                refine_until_verified: false,
+                jerk: JerkOptions {
+                    lp_solver,
+                    ..JerkOptions::default()
+                },
+                ..copp_options()
+            };
+            optimize_joint(&m, &path, &o)
+                .expect("solve")
+                .schedule
+                .cycle_time
+        };
+        let (banded, clarabel) = (solve(LpSolver::Banded), solve(LpSolver::Clarabel));
+        eprintln!("path {idx}: banded LP {banded:.6} s, Clarabel {clarabel:.6} s");
+        assert!(
+            (banded - clarabel).abs() <= 1e-4 * clarabel,
+            "path {idx}: {banded} vs {clarabel}"
+        );
+    }
 }
 
 /// Two independent subproblem objectives — the linearised time (LP) and the time itself

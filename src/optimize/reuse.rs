@@ -195,6 +195,7 @@ fn jerk_words(j: &JerkOptions, out: &mut Vec<u64>) {
         objective,
         window,
         closed_form,
+        lp_solver,
     } = *j;
     out.extend([
         convergence.to_bits(),
@@ -202,6 +203,7 @@ fn jerk_words(j: &JerkOptions, out: &mut Vec<u64>) {
         objective as u64,
         window as u64,
         u64::from(closed_form),
+        lp_solver as u64,
     ]);
 }
 

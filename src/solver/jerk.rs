@@ -97,6 +97,19 @@ pub struct JerkOptions {
     /// profile in closed form ([`super::double_s`]) instead of the programme (an adaptive
     /// refinement only; a grid the user fixes is always solved by the programme).
     pub closed_form: bool,
+    /// Who solves the linear subproblems ([`Objective::Linearised`]).
+    pub lp_solver: LpSolver,
+}
+
+/// The solver of the SCP's linear subproblems.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LpSolver {
+    /// The banded interior-point method ([`super::banded`]), with Clarabel where it does not
+    /// answer (a subproblem it cannot solve within its iteration cap, e.g. an infeasible one).
+    #[default]
+    Banded,
+    /// Clarabel for every subproblem.
+    Clarabel,
 }
 
 /// The objective of each convex subproblem.
@@ -123,6 +136,7 @@ impl Default for JerkOptions {
             objective: Objective::default(),
             window: 150,
             closed_form: true,
+            lp_solver: LpSolver::default(),
         }
     }
 }
@@ -1067,7 +1081,7 @@ fn solve_piece(
     let mut best: Option<(SpanSolution, f64)> = None;
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
     let mut carried: Vec<bool> = Vec::new();
-    let program = Program::new(p, jd, &bbar, a_ends, options.objective, start.fresh);
+    let program = Program::new(p, jd, &bbar, a_ends, options, start.fresh);
     // Whether (bbar, abar) is an iterate of this SCP (feasible), not the start.
     let mut from_iterate = false;
     let mut subproblems = 0;
@@ -1386,6 +1400,8 @@ struct Program<'a> {
     /// Per site: at or inside an interval next to a fresh station of a warm start (see
     /// [`ACTIVE_NEAR_FRESH`]); `None` from the reach profile.
     hot: Option<Vec<bool>>,
+    /// Who solves a linear subproblem.
+    lp_solver: LpSolver,
 }
 
 impl<'a> Program<'a> {
@@ -1394,13 +1410,13 @@ impl<'a> Program<'a> {
         jd: &'a JerkData,
         bbar: &[f64],
         a_ends: (f64, f64),
-        objective: Objective,
+        options: &JerkOptions,
         fresh: Option<&[bool]>,
     ) -> Self {
         let n = p.intervals();
         let lay = Layout {
             n,
-            lp: objective == Objective::Linearised,
+            lp: options.objective == Objective::Linearised,
         };
         let scale = super::median_scale(bbar);
         let (rest_start, rest_end) = (p.b_start == 0.0, p.b_end == 0.0);
@@ -1629,6 +1645,7 @@ impl<'a> Program<'a> {
             soc,
             n_soc,
             hot,
+            lp_solver: options.lp_solver,
         }
     }
 
@@ -1873,39 +1890,67 @@ impl<'a> Program<'a> {
             }
             all.append(&self.soc);
             let m = all.h.len();
-            let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
-            let pmat = CscMatrix::zeros((nv, nv));
-            let mut cones = Vec::with_capacity(2 + self.n_soc);
-            cones.push(SupportedConeT::ZeroConeT(n_eq));
-            if self.lin.len() + n_rows > 0 {
-                cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
-            }
-            cones.extend(std::iter::repeat_n(
-                SupportedConeT::SecondOrderConeT(3),
-                self.n_soc,
-            ));
-            let s = settings.clarabel(gap)?;
-            let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
-                .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
-            super::run_clarabel(&mut solver);
-            let sol = &solver.solution;
-            iterations += sol.iterations;
-            solve_time += sol.solve_time;
-            let status = match sol.status {
-                SolverStatus::Solved => Status::Optimal,
-                SolverStatus::AlmostSolved => Status::AlmostOptimal,
-                other => {
-                    return Err(Error::Solver(format!(
-                        "jerk-limited subproblem: Clarabel stopped with status {other:?}"
-                    )));
+            // A linear subproblem is banded: the banded interior-point method first; Clarabel
+            // where it does not answer (it then also tells infeasibility apart). Its gap is a
+            // hundredth of Clarabel's: at Clarabel's, ü at stations on a velocity plateau (where
+            // it barely moves the objective) was still 5e-5 of B from its settled value, and on
+            // the bundled problem's rest end the jerk between the LP's sites, which the 1 ms
+            // re-simulation checks, came out 0.2 % over its limit; two or three iterations more
+            // settle it (the COPP paths: the same cycle times to 5e-7).
+            let banded = (self.n_soc == 0 && self.lp_solver == LpSolver::Banded)
+                .then(|| {
+                    let started = std::time::Instant::now();
+                    let r = super::banded::solve(&q, &all, n_eq, settings.tol_feas, 1e-2 * gap);
+                    (r, started.elapsed().as_secs_f64())
+                })
+                .and_then(|(r, secs)| match r {
+                    Ok(sol) => Some((sol, secs)),
+                    Err(e) => {
+                        tracing::debug!("  banded LP: {e:?}; Clarabel instead");
+                        solve_time += secs;
+                        None
+                    }
+                });
+            let (x_new, status) = if let Some((sol, secs)) = banded {
+                iterations += sol.iterations;
+                solve_time += secs;
+                (sol.x, Status::Optimal)
+            } else {
+                let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
+                let pmat = CscMatrix::zeros((nv, nv));
+                let mut cones = Vec::with_capacity(2 + self.n_soc);
+                cones.push(SupportedConeT::ZeroConeT(n_eq));
+                if self.lin.len() + n_rows > 0 {
+                    cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
                 }
+                cones.extend(std::iter::repeat_n(
+                    SupportedConeT::SecondOrderConeT(3),
+                    self.n_soc,
+                ));
+                let s = settings.clarabel(gap)?;
+                let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
+                    .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
+                super::run_clarabel(&mut solver);
+                let sol = &solver.solution;
+                iterations += sol.iterations;
+                solve_time += sol.solve_time;
+                let status = match sol.status {
+                    SolverStatus::Solved => Status::Optimal,
+                    SolverStatus::AlmostSolved => Status::AlmostOptimal,
+                    other => {
+                        return Err(Error::Solver(format!(
+                            "jerk-limited subproblem: Clarabel stopped with status {other:?}"
+                        )));
+                    }
+                };
+                (std::mem::take(&mut solver.solution.x), status)
             };
             // Any omitted row violated: add it, and with it every omitted row near its bound
             // at this solution (the next solution is likely to lean on them too); after
             // [`ACTIVE_ROUNDS`] rounds, every row (a start far from the optimum can otherwise
             // uncover a few rows per round for many rounds).
             rounds += 1;
-            self.values(&sol.x, &bbar_sites, &mut vals);
+            self.values(&x_new, &bbar_sites, &mut vals);
             let violated = active.iter().zip(&vals).any(|(a, &v)| !a && v > 1.0 + 1e-9);
             let every = rounds >= ACTIVE_ROUNDS;
             let mut added = 0;
@@ -1923,7 +1968,7 @@ impl<'a> Program<'a> {
             );
             if added == 0 {
                 *carried = std::mem::take(&mut active);
-                break (sol.x.clone(), status);
+                break (x_new, status);
             }
         };
         let mut b = Vec::with_capacity(n + 1);

@@ -6,6 +6,7 @@
 //! [`reach`] is the exact O(N) reachability pass on the same discretisation: the fast path, the
 //! cross-check, and the source of precise infeasibility errors.
 
+pub(crate) mod banded;
 pub mod clarabel;
 pub mod double_s;
 // Being edited on the jerk-limited refinement's branch: documented once that lands.
