@@ -495,3 +495,32 @@ fn deep2_pecks_first_by_its_first_peck_then_by_the_others() {
         tp.warnings
     );
 }
+
+/// `DELAY/t` is a dwell of t seconds (CATIA V5 writes `DELAY/   50.000000` at the bottom of each
+/// peck of a deep-hole drilling operation; round 9: the seven dwells, 350 s of a 2,149 s
+/// program, were skipped as a non-motion record and left out of the cycle time). `DELAY/REV,n`
+/// is n spindle revolutions at the last `SPINDL/` speed; without a speed, or with no number, it
+/// is an error naming the line.
+#[test]
+fn delay_is_a_dwell_counted_in_seconds_or_revolutions() {
+    let tp = ok(
+        "UNITS/MM\nSPINDL/600,RPM,CLW\nGOTO/0,0,1\nFEDRAT/100,MMPM\nGOTO/0,0,-5\n\
+                 DELAY/   50.000000\nGOTO/0,0,1\nDELAY/REV,3\nGOTO/0,0,5\n",
+    );
+    let dwells: Vec<(usize, usize, f64)> = tp
+        .dwells
+        .iter()
+        .map(|d| (d.line, d.point, d.seconds))
+        .collect();
+    assert_eq!(dwells.len(), 2, "{:?}", tp.dwells);
+    assert_eq!((dwells[0].0, dwells[0].1), (6, 1));
+    assert_relative_eq!(dwells[0].2, 50.0);
+    assert_eq!((dwells[1].0, dwells[1].1), (8, 2));
+    assert_relative_eq!(dwells[1].2, 0.3, epsilon = 1e-12);
+    assert_relative_eq!(tp.dwell_time(), 50.3, epsilon = 1e-12);
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+
+    err("GOTO/0,0,1\nDELAY/REV,3\n", 2, &["DELAY/REV", "SPINDL"]);
+    err("GOTO/0,0,1\nDELAY/1,2\n", 2, &["DELAY", "seconds"]);
+    err("GOTO/0,0,1\nDELAY/-1\n", 2, &["DELAY", "out of range"]);
+}

@@ -28,6 +28,9 @@
 //!   negative or non-finite feed. Before the first `FEDRAT` points get [`Feed::Unspecified`].
 //! * `RAPID` — the *next* `GOTO` only is a rapid move ([`Feed::Rapid`]); the programmed feed
 //!   resumes after it.
+//! * `DELAY/t` (seconds) and `DELAY/REV,n` (n spindle revolutions at the last `SPINDL/`
+//!   speed) — a dwell at the current point ([`Toolpath::dwells`]), counted in the cycle time
+//!   like a G-code `G4`.
 //! * `MULTAX/ON` (or bare `MULTAX`) and `MULTAX/OFF`. Under `OFF` the orientation is frozen at its
 //!   last value and the `i,j,k` of a 6-number `GOTO` are ignored (they must still be numbers,
 //!   but a zero vector is not an error there). A file without any `MULTAX` record behaves as
@@ -136,7 +139,6 @@ pub const NON_MOTION_WORDS: &[&str] = &[
     "MACHIN",
     "AUXFUN",
     "PPFUN",
-    "DELAY",
     "STOP",
     "OPSTOP",
     "END",
@@ -326,6 +328,68 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// `DELAY/t` (seconds) or `DELAY/REV, n` (`DELAY/n, REV`: n spindle revolutions at the
+    /// last `SPINDL/` speed): the tool dwells at the current point. The motion is unchanged but
+    /// the time counts, as a G-code `G4` does (CATIA and NX write it in drilling and
+    /// spring-pass operations).
+    fn delay(&mut self, line: usize, minor: &str) -> Result<()> {
+        let fields: Vec<String> = minor
+            .split(',')
+            .map(|f| f.trim().to_ascii_uppercase())
+            .filter(|f| !f.is_empty())
+            .collect();
+        let revolutions = fields.iter().any(|f| matches!(f.as_str(), "REV" | "REVS"));
+        let values: Vec<&String> = fields
+            .iter()
+            .filter(|f| {
+                !matches!(
+                    f.as_str(),
+                    "REV" | "REVS" | "SEC" | "SECS" | "SECOND" | "SECONDS"
+                )
+            })
+            .collect();
+        let [value] = values.as_slice() else {
+            return Err(self.error(
+                line,
+                format!(
+                    "DELAY/{}: expected a time in seconds (DELAY/t) or spindle revolutions \
+                     (DELAY/REV, n)",
+                    minor.trim()
+                ),
+            ));
+        };
+        let n = number(value)
+            .map_err(|bad| self.error(line, format!("DELAY: the time {}", bad.describe())))?;
+        let seconds = if revolutions {
+            match self.spindle_changes.last().map(|s| s.rpm) {
+                Some(rpm) if rpm > 0.0 => n * 60.0 / rpm,
+                _ => {
+                    return Err(self.error(
+                        line,
+                        "DELAY/REV: a dwell in spindle revolutions needs the spindle speed \
+                         (a SPINDL/ record before it)",
+                    ));
+                }
+            }
+        } else {
+            n
+        };
+        if !(0.0..=1e6).contains(&seconds) {
+            return Err(self.error(
+                line,
+                format!("DELAY: a dwell of {seconds} s is out of range"),
+            ));
+        }
+        if seconds > 0.0 {
+            self.dwells.push(Dwell {
+                point: self.points.len().saturating_sub(1),
+                seconds,
+                line,
+            });
+        }
+        Ok(())
+    }
+
     /// `CUTTER/d, r, …` or NX's `TLDATA/MILL, d, r, length, taper, tip`: the tool from the
     /// next move on (diameter and corner radius in the program's units; r 0 when not given).
     fn cutter(&mut self, line: usize, word: &str, args: &str) -> Result<()> {
@@ -381,6 +445,7 @@ impl<'a> Reader<'a> {
             ("CNTRL", Some(minor)) => self.cntrl(line, minor),
             ("CYCLE", Some(minor)) => self.cycle(line, minor),
             ("CUTTER", Some(minor)) => self.cutter(line, "CUTTER", minor),
+            ("DELAY", Some(minor)) => self.delay(line, minor),
             ("SPINDL", Some(minor)) => {
                 self.spindle(line, minor);
                 Ok(())
@@ -398,7 +463,7 @@ impl<'a> Reader<'a> {
                      output the toolpath linearised"
                 ),
             )),
-            (word @ ("GOTO" | "FROM" | "FEDRAT" | "UNITS"), None) => {
+            (word @ ("GOTO" | "FROM" | "FEDRAT" | "UNITS" | "DELAY"), None) => {
                 Err(self.error(line, format!("{word}: missing `/` and parameters")))
             }
             _ => {
