@@ -1346,3 +1346,23 @@ fn a_macro_argument_read_before_it_is_set_names_the_macro_call() {
         &["`#100` is read before it is set"],
     );
 }
+
+/// Fusion's Snapmaker (Marlin) post writes `G4 S2` for a 2 s dwell (round 9: four of the
+/// Titans of CNC Snapmaker programs). Here S is the spindle speed, so the dwell has no time:
+/// still refused, but the refusal names the Marlin reading and says to write `G4 P…`.
+#[test]
+fn a_marlin_g4_s_dwell_names_the_marlin_reading() {
+    err(
+        ";Pockets\nM3 P100\nG4 S2\nG21\nG90\nG0 X1 Y1 Z5\n",
+        3,
+        &["G4 without P", "Marlin", "`G4 S…` as seconds", "`G4 P…`"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "G21 G90\nG4 S2\n",
+        2,
+        &["Marlin", "milliseconds in Fanuc"],
+    );
+    // Without S the message stays the short one.
+    err("G21 G90\nG4\n", 2, &["G4 without P (the dwell time)"]);
+}

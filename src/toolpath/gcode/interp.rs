@@ -1399,6 +1399,17 @@ impl<'a> Interpreter<'a> {
                     Some(_) if !x.point => x.value / 1000.0,
                     _ => x.value,
                 },
+                // Marlin (Snapmaker, Prusa firmware) reads `G4 S2` as 2 s; here S is the
+                // spindle speed and the dwell has no time.
+                (None, None) if block.letter('S').is_some() => {
+                    return Err(self.error(
+                        line,
+                        "G4 without P (the dwell time): its S is a spindle speed here, \
+                         although Marlin firmware (Snapmaker, Fusion's Marlin posts) reads \
+                         `G4 S…` as seconds; write the dwell as `G4 P…` (seconds in LinuxCNC, \
+                         milliseconds in Fanuc)",
+                    ));
+                }
                 (None, None) => return Err(self.error(line, "G4 without P (the dwell time)")),
             }
         };
