@@ -524,3 +524,36 @@ fn delay_is_a_dwell_counted_in_seconds_or_revolutions() {
     err("GOTO/0,0,1\nDELAY/1,2\n", 2, &["DELAY", "seconds"]);
     err("GOTO/0,0,1\nDELAY/-1\n", 2, &["DELAY", "out of range"]);
 }
+
+/// `TLAXIS/i,j,k` sets the tool axis of the following moves, under `MULTAX/OFF` too (round 9:
+/// CAMWorks writes `TLAXIS/ 0.000000,-1.000000,0.000000` for a side face and CATIA V5
+/// `TLAXIS/ 0.000000, 0.000000, 1.000000`; both were skipped with a warning, leaving the axis
+/// vertical). A `TLAXIS` with other than 3 numbers, or a zero axis, is an error.
+#[test]
+fn tlaxis_sets_the_tool_axis_of_the_following_moves() {
+    let tp = ok(
+        "UNITS/MM\nMULTAX/OFF\nGOTO/0,0,10\nTLAXIS/ 0.000000,-2.000000,0.000000\n\
+                 GOTO/0,-10,0\nGOTO/5,-10,0\n",
+    );
+    let axes: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.o).collect();
+    assert_eq!(axes[0], Vector3::new(0.0, 0.0, 1.0));
+    assert_eq!(axes[1], Vector3::new(0.0, -1.0, 0.0));
+    assert_eq!(axes[2], Vector3::new(0.0, -1.0, 0.0));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+
+    err("GOTO/0,0,1\nTLAXIS/0,1\n", 2, &["TLAXIS", "3 numbers"]);
+    err("GOTO/0,0,1\nTLAXIS/0,0,0\n", 2, &["TLAXIS", "zero length"]);
+}
+
+/// `ROTABL/a,AAXIS,…` (CAMWorks: the table turned 90° before each side-face operation, the
+/// GOTOs after it in the turned part's frame) moves a rotary axis: it was skipped with a
+/// warning; it is now an error naming the word and what to do.
+#[test]
+fn a_rotary_table_index_is_an_error_naming_it() {
+    err(
+        "UNITS/ MM\nROTABL/ 1.570796,AAXIS,TABLE,CCLW\nRAPID/\nGOTO/ -30.0,-15.0,25.0\n",
+        2,
+        &["ROTABL", "rotary table", "GOTO/x,y,z,i,j,k"],
+    );
+    err("ROTHED/ 90,BAXIS\n", 1, &["ROTHED", "rotary head"]);
+}

@@ -28,6 +28,8 @@
 //!   negative or non-finite feed. Before the first `FEDRAT` points get [`Feed::Unspecified`].
 //! * `RAPID` — the *next* `GOTO` only is a rapid move ([`Feed::Rapid`]); the programmed feed
 //!   resumes after it.
+//! * `TLAXIS/i,j,k` — the tool axis of the following moves, as a 6-number `GOTO` sets it (also
+//!   under `MULTAX/OFF`); a 3-number `GOTO` keeps it.
 //! * `DELAY/t` (seconds) and `DELAY/REV,n` (n spindle revolutions at the last `SPINDL/`
 //!   speed) — a dwell at the current point ([`Toolpath::dwells`]), counted in the cycle time
 //!   like a G-code `G4`.
@@ -96,7 +98,8 @@
 //!
 //! Motion records this reader cannot represent are errors rather than being skipped, because
 //! skipping them would silently change the geometry: see [`UNSUPPORTED_MOTION_WORDS`]
-//! (`GOHOME`, `INDIRV`, `GOFWD`, …).
+//! (`GOHOME`, `INDIRV`, `GOFWD`, …), and `ROTABL`/`ROTHED` (a rotary table or head index: the
+//! moves after it are written in the turned part's frame).
 //!
 //! Every error is an [`Error::Parse`] naming the file and the 1-based line where the record
 //! starts.
@@ -328,6 +331,34 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// `TLAXIS/i,j,k`: the tool axis of the following moves (a 3-number `GOTO` keeps it), in the
+    /// `MSYS` frame where one is set; read under `MULTAX/OFF` too, since it is the way a fixed
+    /// tool axis is given (CAMWorks writes `TLAXIS/0,-1,0` for a side face, CATIA
+    /// `TLAXIS/0,0,1` before every tool change).
+    fn tlaxis(&mut self, line: usize, minor: &str) -> Result<()> {
+        let v = self.numbers(line, "TLAXIS", minor)?;
+        let [i, j, k] = v.as_slice() else {
+            return Err(self.error(
+                line,
+                format!(
+                    "TLAXIS: expected the tool axis as 3 numbers (i,j,k), found {}",
+                    v.len()
+                ),
+            ));
+        };
+        let Some(v) = crate::toolpath::unit_tool_vector(Vector3::new(*i, *j, *k)) else {
+            return Err(self.error(
+                line,
+                format!("TLAXIS: tool axis ({i}, {j}, {k}) has zero length"),
+            ));
+        };
+        self.orientation = match self.msys {
+            Some((_, r)) => r * v,
+            None => v,
+        };
+        Ok(())
+    }
+
     /// `DELAY/t` (seconds) or `DELAY/REV, n` (`DELAY/n, REV`: n spindle revolutions at the
     /// last `SPINDL/` speed): the tool dwells at the current point. The motion is unchanged but
     /// the time counts, as a G-code `G4` does (CATIA and NX write it in drilling and
@@ -446,6 +477,18 @@ impl<'a> Reader<'a> {
             ("CYCLE", Some(minor)) => self.cycle(line, minor),
             ("CUTTER", Some(minor)) => self.cutter(line, "CUTTER", minor),
             ("DELAY", Some(minor)) => self.delay(line, minor),
+            ("TLAXIS", Some(minor)) => self.tlaxis(line, minor),
+            (word @ ("ROTABL" | "ROTHED"), _) => Err(self.error(
+                line,
+                format!(
+                    "{word}: a rotary {} index (it turns a rotary axis), which feedopt does not \
+                     read from a CL file, so the moves after it would be in the wrong place: \
+                     output the toolpath in one fixed frame with tool vectors \
+                     (MULTAX/ON, GOTO/x,y,z,i,j,k or TLAXIS/i,j,k), or post it for the machine \
+                     as G-code",
+                    if word == "ROTABL" { "table" } else { "head" }
+                ),
+            )),
             ("SPINDL", Some(minor)) => {
                 self.spindle(line, minor);
                 Ok(())
