@@ -557,3 +557,43 @@ fn a_rotary_table_index_is_an_error_naming_it() {
     );
     err("ROTHED/ 90,BAXIS\n", 1, &["ROTHED", "rotary head"]);
 }
+
+/// Fusion's `MOVARC/cx,cy,cz, i,j,k, r, ANGLE, a` states the sweep. An arc is counter-clockwise
+/// about (i,j,k); a post that wrote a clockwise arc's axis unreversed (the 2011 HSMWorks APT
+/// post writes `getCircularNormal()` as it is) made a 270° arc of a 90° one with no error,
+/// and a helix of two turns was read as one. A stated ANGLE that the end point does not make
+/// is now an error; one that it makes reads as before.
+#[test]
+fn a_movarc_angle_the_end_point_does_not_make_is_an_error() {
+    // A quarter circle counter-clockwise about +Z from (10,0) to (0,10): 90°.
+    let good = "UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\n\
+                MOVARC/0, 0, 0, 0., 0., 1., 10., ANGLE, 90.\nGOTO/0,10,0\n";
+    let tp = ok(good);
+    assert_relative_eq!(tp.points.last().unwrap().p.y, 10.0);
+    // The same record with the axis reversed sweeps 270°.
+    err(
+        &good.replace("0., 0., 1.", "0., 0., -1."),
+        4,
+        &["MOVARC", "ANGLE 90", "sweeps 270.0000", "wrong way"],
+    );
+    // One turn of a helix, the end straight below the start: a full turn, not a plunge.
+    let tp = ok("UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\n\
+                 MOVARC/0,0,0,0,0,1,10,ANGLE,360.\nGOTO/10,0,-2\n");
+    let length: f64 = tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
+    let helix = (std::f64::consts::TAU * 10.0).hypot(2.0);
+    assert!(
+        length > 0.99 * helix && length < helix,
+        "{length} vs {helix}"
+    );
+    // Two turns of a helix, start and end over each other: one MOVARC reads one turn.
+    err(
+        "UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\nMOVARC/0,0,0,0,0,1,10,ANGLE,720.\nGOTO/10,0,-2\n",
+        4,
+        &["ANGLE 720", "more than once"],
+    );
+    err(
+        "GOTO/10,0,0\nMOVARC/0,0,0,0,0,1,10,ANGLE\nGOTO/0,10,0\n",
+        2,
+        &["MOVARC: ANGLE is missing"],
+    );
+}

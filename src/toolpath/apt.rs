@@ -68,7 +68,10 @@
 //!   ([`super::gcode::ARC_RADIUS_MISMATCH_MM`]) make a spiral. End = start is a full circle.
 //!   The arc is cut into chords exactly as G2/G3 are ([`super::arc_chords`]: sagitta at most
 //!   [`super::gcode::MAX_CHORD_ERROR_MM`]), every chord end a CL point. A radius `r` that
-//!   differs from the start point's distance by more than that tolerance is an error.
+//!   differs from the start point's distance by more than that tolerance is an error, and so is
+//!   a Fusion `MOVARC/…, r, ANGLE, a` whose sweep a differs from the one the end point makes
+//!   by more than [`ARC_ANGLE_MISMATCH_DEG`] (an axis pointing the wrong way, or an arc of more
+//!   than one turn).
 //! * `NURBS/` (NX): the `KNOT/` and `CNTRL/x,y,z[,w]` records that follow (until any other
 //!   record) define a (rational) B-spline whose degree is knots − control points − 1; the curve
 //!   is evaluated (de Boor) and sampled adaptively until every sample interval's chord lies
@@ -171,6 +174,11 @@ pub const UNSUPPORTED_MOTION_WORDS: &[&str] = &[
     "GOHOME", "GOFWD", "GOLFT", "GORGT", "GOUP", "GODOWN", "GOBACK", "INDIRV", "INDIRP", "PSIS",
     "AUTOPS",
 ];
+
+/// Largest difference between a `MOVARC`'s stated `ANGLE` and the sweep its end point makes,
+/// degrees. The angle is written to a few decimals, far below 0.5°; a reversed axis turns a
+/// sweep θ into 360° − θ, which this catches unless θ is within 0.25° of a half turn.
+pub const ARC_ANGLE_MISMATCH_DEG: f64 = 0.5;
 
 /// Most CL points one NURBS curve may become.
 pub const NURBS_MAX_POINTS: usize = 1_000_000;
@@ -282,6 +290,8 @@ struct ArcSpec {
     centre: Vector3<f64>,
     axis: Vector3<f64>,
     radius: Option<f64>,
+    /// The sweep the record states (`MOVARC/…, ANGLE, a`), degrees.
+    angle: Option<f64>,
 }
 
 /// A `CYCLE/` in force.
@@ -786,6 +796,21 @@ impl<'a> Reader<'a> {
         }
         let radius = (fields.len() >= 7 && number(fields[6]).is_ok())
             .then(|| v[6] * self.units.mm_per_unit());
+        // Fusion's `MOVARC/…, r, ANGLE, a`: the sweep in degrees, checked against the one the
+        // end point makes.
+        let angle = match fields
+            .iter()
+            .position(|f| f.trim().eq_ignore_ascii_case("ANGLE"))
+        {
+            Some(at) => Some(
+                fields
+                    .get(at + 1)
+                    .ok_or(BadNumber::Missing)
+                    .and_then(|f| number(f))
+                    .map_err(|bad| self.error(line, format!("{word}: ANGLE {}", bad.describe())))?,
+            ),
+            None => None,
+        };
         let centre = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
         let axis = Vector3::new(v[3], v[4], v[5]);
         if axis.norm().is_nan() || axis.norm() <= 1e-9 {
@@ -807,6 +832,7 @@ impl<'a> Reader<'a> {
                 centre,
                 axis,
                 radius,
+                angle,
             },
         ));
         Ok(())
@@ -851,11 +877,35 @@ impl<'a> Reader<'a> {
         let u = rs / r0;
         let w = n.cross(&u);
         let angle_end = re.dot(&w).atan2(re.dot(&u));
-        let sweep = if (end - start).norm() < 1e-9 {
+        // End = start is a full circle; so is a Fusion helix turn (`ANGLE, 360.`) whose end
+        // lies straight along the axis from its start.
+        let full_turn = arc
+            .angle
+            .is_some_and(|a| (a.abs() - 360.0).abs() <= ARC_ANGLE_MISMATCH_DEG)
+            && (re - rs).norm() < 1e-6;
+        let sweep = if (end - start).norm() < 1e-9 || full_turn {
             std::f64::consts::TAU
         } else {
             angle_end.rem_euclid(std::f64::consts::TAU)
         };
+        if let Some(a) = arc.angle
+            && (a.abs() - sweep.to_degrees()).abs() > ARC_ANGLE_MISMATCH_DEG
+        {
+            return Err(self.error(
+                arc_line,
+                format!(
+                    "MOVARC: ANGLE {a}°, but the arc from the start point to the next GOTO, \
+                     counter-clockwise about the axis ({:.6}, {:.6}, {:.6}), sweeps {:.4}°: the \
+                     axis points the wrong way (a clockwise arc needs the axis reversed) or \
+                     the arc turns more than once, which one MOVARC cannot say to feedopt; \
+                     output the toolpath with arcs of at most one turn, or linearised",
+                    n.x,
+                    n.y,
+                    n.z,
+                    sweep.to_degrees()
+                ),
+            ));
+        }
         let along0 = n.dot(&(start - arc.centre));
         let along1 = n.dot(&(end - arc.centre));
         let chords = super::arc_chords(sweep, r0.max(r1))
