@@ -495,3 +495,105 @@ fn deep2_pecks_first_by_its_first_peck_then_by_the_others() {
         tp.warnings
     );
 }
+
+/// `DELAY/t` is a dwell of t seconds (CATIA V5 writes `DELAY/   50.000000` at the bottom of each
+/// peck of a deep-hole drilling operation; round 9: the seven dwells, 350 s of a 2,149 s
+/// program, were skipped as a non-motion record and left out of the cycle time). `DELAY/REV,n`
+/// is n spindle revolutions at the last `SPINDL/` speed; without a speed, or with no number, it
+/// is an error naming the line.
+#[test]
+fn delay_is_a_dwell_counted_in_seconds_or_revolutions() {
+    let tp = ok(
+        "UNITS/MM\nSPINDL/600,RPM,CLW\nGOTO/0,0,1\nFEDRAT/100,MMPM\nGOTO/0,0,-5\n\
+                 DELAY/   50.000000\nGOTO/0,0,1\nDELAY/REV,3\nGOTO/0,0,5\n",
+    );
+    let dwells: Vec<(usize, usize, f64)> = tp
+        .dwells
+        .iter()
+        .map(|d| (d.line, d.point, d.seconds))
+        .collect();
+    assert_eq!(dwells.len(), 2, "{:?}", tp.dwells);
+    assert_eq!((dwells[0].0, dwells[0].1), (6, 1));
+    assert_relative_eq!(dwells[0].2, 50.0);
+    assert_eq!((dwells[1].0, dwells[1].1), (8, 2));
+    assert_relative_eq!(dwells[1].2, 0.3, epsilon = 1e-12);
+    assert_relative_eq!(tp.dwell_time(), 50.3, epsilon = 1e-12);
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+
+    err("GOTO/0,0,1\nDELAY/REV,3\n", 2, &["DELAY/REV", "SPINDL"]);
+    err("GOTO/0,0,1\nDELAY/1,2\n", 2, &["DELAY", "seconds"]);
+    err("GOTO/0,0,1\nDELAY/-1\n", 2, &["DELAY", "out of range"]);
+}
+
+/// `TLAXIS/i,j,k` sets the tool axis of the following moves, under `MULTAX/OFF` too (round 9:
+/// CAMWorks writes `TLAXIS/ 0.000000,-1.000000,0.000000` for a side face and CATIA V5
+/// `TLAXIS/ 0.000000, 0.000000, 1.000000`; both were skipped with a warning, leaving the axis
+/// vertical). A `TLAXIS` with other than 3 numbers, or a zero axis, is an error.
+#[test]
+fn tlaxis_sets_the_tool_axis_of_the_following_moves() {
+    let tp = ok(
+        "UNITS/MM\nMULTAX/OFF\nGOTO/0,0,10\nTLAXIS/ 0.000000,-2.000000,0.000000\n\
+                 GOTO/0,-10,0\nGOTO/5,-10,0\n",
+    );
+    let axes: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.o).collect();
+    assert_eq!(axes[0], Vector3::new(0.0, 0.0, 1.0));
+    assert_eq!(axes[1], Vector3::new(0.0, -1.0, 0.0));
+    assert_eq!(axes[2], Vector3::new(0.0, -1.0, 0.0));
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+
+    err("GOTO/0,0,1\nTLAXIS/0,1\n", 2, &["TLAXIS", "3 numbers"]);
+    err("GOTO/0,0,1\nTLAXIS/0,0,0\n", 2, &["TLAXIS", "zero length"]);
+}
+
+/// `ROTABL/a,AAXIS,…` (CAMWorks: the table turned 90° before each side-face operation, the
+/// GOTOs after it in the turned part's frame) moves a rotary axis: it was skipped with a
+/// warning; it is now an error naming the word and what to do.
+#[test]
+fn a_rotary_table_index_is_an_error_naming_it() {
+    err(
+        "UNITS/ MM\nROTABL/ 1.570796,AAXIS,TABLE,CCLW\nRAPID/\nGOTO/ -30.0,-15.0,25.0\n",
+        2,
+        &["ROTABL", "rotary table", "GOTO/x,y,z,i,j,k"],
+    );
+    err("ROTHED/ 90,BAXIS\n", 1, &["ROTHED", "rotary head"]);
+}
+
+/// Fusion's `MOVARC/cx,cy,cz, i,j,k, r, ANGLE, a` states the sweep. An arc is counter-clockwise
+/// about (i,j,k); a post that wrote a clockwise arc's axis unreversed (the 2011 HSMWorks APT
+/// post writes `getCircularNormal()` as it is) made a 270° arc of a 90° one with no error,
+/// and a helix of two turns was read as one. A stated ANGLE that the end point does not make
+/// is now an error; one that it makes reads as before.
+#[test]
+fn a_movarc_angle_the_end_point_does_not_make_is_an_error() {
+    // A quarter circle counter-clockwise about +Z from (10,0) to (0,10): 90°.
+    let good = "UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\n\
+                MOVARC/0, 0, 0, 0., 0., 1., 10., ANGLE, 90.\nGOTO/0,10,0\n";
+    let tp = ok(good);
+    assert_relative_eq!(tp.points.last().unwrap().p.y, 10.0);
+    // The same record with the axis reversed sweeps 270°.
+    err(
+        &good.replace("0., 0., 1.", "0., 0., -1."),
+        4,
+        &["MOVARC", "ANGLE 90", "sweeps 270.0000", "wrong way"],
+    );
+    // One turn of a helix, the end straight below the start: a full turn, not a plunge.
+    let tp = ok("UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\n\
+                 MOVARC/0,0,0,0,0,1,10,ANGLE,360.\nGOTO/10,0,-2\n");
+    let length: f64 = tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
+    let helix = (std::f64::consts::TAU * 10.0).hypot(2.0);
+    assert!(
+        length > 0.99 * helix && length < helix,
+        "{length} vs {helix}"
+    );
+    // Two turns of a helix, start and end over each other: one MOVARC reads one turn.
+    err(
+        "UNITS/MM\nGOTO/10,0,0\nFEDRAT/100,MMPM\nMOVARC/0,0,0,0,0,1,10,ANGLE,720.\nGOTO/10,0,-2\n",
+        4,
+        &["ANGLE 720", "more than once"],
+    );
+    err(
+        "GOTO/10,0,0\nMOVARC/0,0,0,0,0,1,10,ANGLE\nGOTO/0,10,0\n",
+        2,
+        &["MOVARC: ANGLE is missing"],
+    );
+}

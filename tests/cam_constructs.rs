@@ -1808,3 +1808,27 @@ fn sinumerik_dc_acp_acn_ac_ic_axis_words() {
         "{e}"
     );
 }
+
+/// Fusion's Fanuc turning post (system A) writes `G50 S6000`, the spindle speed limit, and
+/// feeds per revolution under `G99`; with no U or W word such a program (round 9: ardikaidzal
+/// 1002.nc, a facing pass `G96 S200` / `G1 F1.`) was read as milling, G50 as a scaling
+/// cancel, F1 as 1 mm/min: 15,795 s and no error. `G50` with S or axis words now names a
+/// turning program; a bare `G50` (Fanuc M, Tormach: scaling cancel) still reads.
+#[test]
+fn a_fanuc_g50_spindle_limit_names_a_turning_program() {
+    let e = fanuc_error("%\nO01002\nG98 G18\nG21\nG50 S6000\nG53 G0 X0.\nG99\nG1 X-1.6 F1.\n");
+    assert!(
+        e.contains("t.nc:5") && e.contains("`G50` with S") && e.contains("turning program"),
+        "{e}"
+    );
+    let e = fanuc_error("G21 G90\nG50 X100. Z50.\n");
+    assert!(
+        e.contains("t.nc:2") && e.contains("position setting"),
+        "{e}"
+    );
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G17 G40 G49 G50 G80\nG0 X1. Y2. Z3.\n",
+    );
+    assert_eq!(tp.points.last().unwrap().p.x, 1.0);
+}

@@ -1318,11 +1318,13 @@ fn text_after_a_fanuc_end_of_block_semicolon_names_the_semicolon() {
 
 /// A Fusion lathe post's `G28 U0. W0.` (round 8) read in the Fanuc dialect: the refusal of
 /// the U word says that on a Fanuc lathe U and W are X and Z incremental, a turning program.
+/// (The program's `G50 S6000` is left out here: since round 9 that line stops first, naming a
+/// turning program too.)
 #[test]
 fn a_fanuc_u_word_names_the_lathe_reading() {
     err_in(
         Dialect::Fanuc,
-        "%\nO2001\nN10 G99 G18\nN11 G21\nN12 G50 S6000\nN13 G28 U0. W0.\n",
+        "%\nO2001\nN10 G99 G18\nN11 G21\nN12 G97 S1000 M3\nN13 G28 U0. W0.\n",
         6,
         &["`U0.`", "lathe", "turning program"],
     );
@@ -1345,4 +1347,24 @@ fn a_macro_argument_read_before_it_is_set_names_the_macro_call() {
         2,
         &["`#100` is read before it is set"],
     );
+}
+
+/// Fusion's Snapmaker (Marlin) post writes `G4 S2` for a 2 s dwell (round 9: four of the
+/// Titans of CNC Snapmaker programs). Here S is the spindle speed, so the dwell has no time:
+/// still refused, but the refusal names the Marlin reading and says to write `G4 P…`.
+#[test]
+fn a_marlin_g4_s_dwell_names_the_marlin_reading() {
+    err(
+        ";Pockets\nM3 P100\nG4 S2\nG21\nG90\nG0 X1 Y1 Z5\n",
+        3,
+        &["G4 without P", "Marlin", "`G4 S…` as seconds", "`G4 P…`"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "G21 G90\nG4 S2\n",
+        2,
+        &["Marlin", "milliseconds in Fanuc"],
+    );
+    // Without S the message stays the short one.
+    err("G21 G90\nG4\n", 2, &["G4 without P (the dwell time)"]);
 }

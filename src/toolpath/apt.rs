@@ -28,6 +28,11 @@
 //!   negative or non-finite feed. Before the first `FEDRAT` points get [`Feed::Unspecified`].
 //! * `RAPID` — the *next* `GOTO` only is a rapid move ([`Feed::Rapid`]); the programmed feed
 //!   resumes after it.
+//! * `TLAXIS/i,j,k` — the tool axis of the following moves, as a 6-number `GOTO` sets it (also
+//!   under `MULTAX/OFF`); a 3-number `GOTO` keeps it.
+//! * `DELAY/t` (seconds) and `DELAY/REV,n` (n spindle revolutions at the last `SPINDL/`
+//!   speed) — a dwell at the current point ([`Toolpath::dwells`]), counted in the cycle time
+//!   like a G-code `G4`.
 //! * `MULTAX/ON` (or bare `MULTAX`) and `MULTAX/OFF`. Under `OFF` the orientation is frozen at its
 //!   last value and the `i,j,k` of a 6-number `GOTO` are ignored (they must still be numbers,
 //!   but a zero vector is not an error there). A file without any `MULTAX` record behaves as
@@ -63,7 +68,10 @@
 //!   ([`super::gcode::ARC_RADIUS_MISMATCH_MM`]) make a spiral. End = start is a full circle.
 //!   The arc is cut into chords exactly as G2/G3 are ([`super::arc_chords`]: sagitta at most
 //!   [`super::gcode::MAX_CHORD_ERROR_MM`]), every chord end a CL point. A radius `r` that
-//!   differs from the start point's distance by more than that tolerance is an error.
+//!   differs from the start point's distance by more than that tolerance is an error, and so is
+//!   a Fusion `MOVARC/…, r, ANGLE, a` whose sweep a differs from the one the end point makes
+//!   by more than [`ARC_ANGLE_MISMATCH_DEG`] (an axis pointing the wrong way, or an arc of more
+//!   than one turn).
 //! * `NURBS/` (NX): the `KNOT/` and `CNTRL/x,y,z[,w]` records that follow (until any other
 //!   record) define a (rational) B-spline whose degree is knots − control points − 1; the curve
 //!   is evaluated (de Boor) and sampled adaptively until every sample interval's chord lies
@@ -93,7 +101,8 @@
 //!
 //! Motion records this reader cannot represent are errors rather than being skipped, because
 //! skipping them would silently change the geometry: see [`UNSUPPORTED_MOTION_WORDS`]
-//! (`GOHOME`, `INDIRV`, `GOFWD`, …).
+//! (`GOHOME`, `INDIRV`, `GOFWD`, …), and `ROTABL`/`ROTHED` (a rotary table or head index: the
+//! moves after it are written in the turned part's frame).
 //!
 //! Every error is an [`Error::Parse`] naming the file and the 1-based line where the record
 //! starts.
@@ -136,7 +145,6 @@ pub const NON_MOTION_WORDS: &[&str] = &[
     "MACHIN",
     "AUXFUN",
     "PPFUN",
-    "DELAY",
     "STOP",
     "OPSTOP",
     "END",
@@ -166,6 +174,11 @@ pub const UNSUPPORTED_MOTION_WORDS: &[&str] = &[
     "GOHOME", "GOFWD", "GOLFT", "GORGT", "GOUP", "GODOWN", "GOBACK", "INDIRV", "INDIRP", "PSIS",
     "AUTOPS",
 ];
+
+/// Largest difference between a `MOVARC`'s stated `ANGLE` and the sweep its end point makes,
+/// degrees. The angle is written to a few decimals, far below 0.5°; a reversed axis turns a
+/// sweep θ into 360° − θ, which this catches unless θ is within 0.25° of a half turn.
+pub const ARC_ANGLE_MISMATCH_DEG: f64 = 0.5;
 
 /// Most CL points one NURBS curve may become.
 pub const NURBS_MAX_POINTS: usize = 1_000_000;
@@ -277,6 +290,8 @@ struct ArcSpec {
     centre: Vector3<f64>,
     axis: Vector3<f64>,
     radius: Option<f64>,
+    /// The sweep the record states (`MOVARC/…, ANGLE, a`), degrees.
+    angle: Option<f64>,
 }
 
 /// A `CYCLE/` in force.
@@ -324,6 +339,96 @@ impl<'a> Reader<'a> {
         if let Some(rpm) = args.split(',').find_map(|a| a.trim().parse::<f64>().ok()) {
             SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
         }
+    }
+
+    /// `TLAXIS/i,j,k`: the tool axis of the following moves (a 3-number `GOTO` keeps it), in the
+    /// `MSYS` frame where one is set; read under `MULTAX/OFF` too, since it is the way a fixed
+    /// tool axis is given (CAMWorks writes `TLAXIS/0,-1,0` for a side face, CATIA
+    /// `TLAXIS/0,0,1` before every tool change).
+    fn tlaxis(&mut self, line: usize, minor: &str) -> Result<()> {
+        let v = self.numbers(line, "TLAXIS", minor)?;
+        let [i, j, k] = v.as_slice() else {
+            return Err(self.error(
+                line,
+                format!(
+                    "TLAXIS: expected the tool axis as 3 numbers (i,j,k), found {}",
+                    v.len()
+                ),
+            ));
+        };
+        let Some(v) = crate::toolpath::unit_tool_vector(Vector3::new(*i, *j, *k)) else {
+            return Err(self.error(
+                line,
+                format!("TLAXIS: tool axis ({i}, {j}, {k}) has zero length"),
+            ));
+        };
+        self.orientation = match self.msys {
+            Some((_, r)) => r * v,
+            None => v,
+        };
+        Ok(())
+    }
+
+    /// `DELAY/t` (seconds) or `DELAY/REV, n` (`DELAY/n, REV`: n spindle revolutions at the
+    /// last `SPINDL/` speed): the tool dwells at the current point. The motion is unchanged but
+    /// the time counts, as a G-code `G4` does (CATIA and NX write it in drilling and
+    /// spring-pass operations).
+    fn delay(&mut self, line: usize, minor: &str) -> Result<()> {
+        let fields: Vec<String> = minor
+            .split(',')
+            .map(|f| f.trim().to_ascii_uppercase())
+            .filter(|f| !f.is_empty())
+            .collect();
+        let revolutions = fields.iter().any(|f| matches!(f.as_str(), "REV" | "REVS"));
+        let values: Vec<&String> = fields
+            .iter()
+            .filter(|f| {
+                !matches!(
+                    f.as_str(),
+                    "REV" | "REVS" | "SEC" | "SECS" | "SECOND" | "SECONDS"
+                )
+            })
+            .collect();
+        let [value] = values.as_slice() else {
+            return Err(self.error(
+                line,
+                format!(
+                    "DELAY/{}: expected a time in seconds (DELAY/t) or spindle revolutions \
+                     (DELAY/REV, n)",
+                    minor.trim()
+                ),
+            ));
+        };
+        let n = number(value)
+            .map_err(|bad| self.error(line, format!("DELAY: the time {}", bad.describe())))?;
+        let seconds = if revolutions {
+            match self.spindle_changes.last().map(|s| s.rpm) {
+                Some(rpm) if rpm > 0.0 => n * 60.0 / rpm,
+                _ => {
+                    return Err(self.error(
+                        line,
+                        "DELAY/REV: a dwell in spindle revolutions needs the spindle speed \
+                         (a SPINDL/ record before it)",
+                    ));
+                }
+            }
+        } else {
+            n
+        };
+        if !(0.0..=1e6).contains(&seconds) {
+            return Err(self.error(
+                line,
+                format!("DELAY: a dwell of {seconds} s is out of range"),
+            ));
+        }
+        if seconds > 0.0 {
+            self.dwells.push(Dwell {
+                point: self.points.len().saturating_sub(1),
+                seconds,
+                line,
+            });
+        }
+        Ok(())
     }
 
     /// `CUTTER/d, r, …` or NX's `TLDATA/MILL, d, r, length, taper, tip`: the tool from the
@@ -381,6 +486,19 @@ impl<'a> Reader<'a> {
             ("CNTRL", Some(minor)) => self.cntrl(line, minor),
             ("CYCLE", Some(minor)) => self.cycle(line, minor),
             ("CUTTER", Some(minor)) => self.cutter(line, "CUTTER", minor),
+            ("DELAY", Some(minor)) => self.delay(line, minor),
+            ("TLAXIS", Some(minor)) => self.tlaxis(line, minor),
+            (word @ ("ROTABL" | "ROTHED"), _) => Err(self.error(
+                line,
+                format!(
+                    "{word}: a rotary {} index (it turns a rotary axis), which feedopt does not \
+                     read from a CL file, so the moves after it would be in the wrong place: \
+                     output the toolpath in one fixed frame with tool vectors \
+                     (MULTAX/ON, GOTO/x,y,z,i,j,k or TLAXIS/i,j,k), or post it for the machine \
+                     as G-code",
+                    if word == "ROTABL" { "table" } else { "head" }
+                ),
+            )),
             ("SPINDL", Some(minor)) => {
                 self.spindle(line, minor);
                 Ok(())
@@ -398,7 +516,7 @@ impl<'a> Reader<'a> {
                      output the toolpath linearised"
                 ),
             )),
-            (word @ ("GOTO" | "FROM" | "FEDRAT" | "UNITS"), None) => {
+            (word @ ("GOTO" | "FROM" | "FEDRAT" | "UNITS" | "DELAY"), None) => {
                 Err(self.error(line, format!("{word}: missing `/` and parameters")))
             }
             _ => {
@@ -678,6 +796,21 @@ impl<'a> Reader<'a> {
         }
         let radius = (fields.len() >= 7 && number(fields[6]).is_ok())
             .then(|| v[6] * self.units.mm_per_unit());
+        // Fusion's `MOVARC/…, r, ANGLE, a`: the sweep in degrees, checked against the one the
+        // end point makes.
+        let angle = match fields
+            .iter()
+            .position(|f| f.trim().eq_ignore_ascii_case("ANGLE"))
+        {
+            Some(at) => Some(
+                fields
+                    .get(at + 1)
+                    .ok_or(BadNumber::Missing)
+                    .and_then(|f| number(f))
+                    .map_err(|bad| self.error(line, format!("{word}: ANGLE {}", bad.describe())))?,
+            ),
+            None => None,
+        };
         let centre = self.world(Vector3::new(v[0], v[1], v[2]) * self.units.mm_per_unit());
         let axis = Vector3::new(v[3], v[4], v[5]);
         if axis.norm().is_nan() || axis.norm() <= 1e-9 {
@@ -699,6 +832,7 @@ impl<'a> Reader<'a> {
                 centre,
                 axis,
                 radius,
+                angle,
             },
         ));
         Ok(())
@@ -743,11 +877,35 @@ impl<'a> Reader<'a> {
         let u = rs / r0;
         let w = n.cross(&u);
         let angle_end = re.dot(&w).atan2(re.dot(&u));
-        let sweep = if (end - start).norm() < 1e-9 {
+        // End = start is a full circle; so is a Fusion helix turn (`ANGLE, 360.`) whose end
+        // lies straight along the axis from its start.
+        let full_turn = arc
+            .angle
+            .is_some_and(|a| (a.abs() - 360.0).abs() <= ARC_ANGLE_MISMATCH_DEG)
+            && (re - rs).norm() < 1e-6;
+        let sweep = if (end - start).norm() < 1e-9 || full_turn {
             std::f64::consts::TAU
         } else {
             angle_end.rem_euclid(std::f64::consts::TAU)
         };
+        if let Some(a) = arc.angle
+            && (a.abs() - sweep.to_degrees()).abs() > ARC_ANGLE_MISMATCH_DEG
+        {
+            return Err(self.error(
+                arc_line,
+                format!(
+                    "MOVARC: ANGLE {a}°, but the arc from the start point to the next GOTO, \
+                     counter-clockwise about the axis ({:.6}, {:.6}, {:.6}), sweeps {:.4}°: the \
+                     axis points the wrong way (a clockwise arc needs the axis reversed) or \
+                     the arc turns more than once, which one MOVARC cannot say to feedopt; \
+                     output the toolpath with arcs of at most one turn, or linearised",
+                    n.x,
+                    n.y,
+                    n.z,
+                    sweep.to_degrees()
+                ),
+            ));
+        }
         let along0 = n.dot(&(start - arc.centre));
         let along1 = n.dot(&(end - arc.centre));
         let chords = super::arc_chords(sweep, r0.max(r1))

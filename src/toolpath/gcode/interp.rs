@@ -1088,6 +1088,35 @@ impl<'a> Interpreter<'a> {
                         ));
                     }
                 }
+                // G50 cancels scaling on a mill (Fanuc M series, Tormach) and takes no
+                // words; on a lathe (Fanuc T series, G-code system A; PathPilot lathe) `G50
+                // S…` limits the spindle speed and `G50 X… Z…` sets the position. Ignoring
+                // those would read a turning program, F per revolution and all, as milling.
+                Action::Ignored
+                    if text.trim_start_matches(['G', 'g']).parse::<f64>() == Ok(50.0)
+                        && (block.letter('S').is_some()
+                            || block.axes.iter().any(Option::is_some)) =>
+                {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{text}` with {}: a lathe's {} (Fanuc T series, G-code system A), \
+                             so this is a turning program (X a diameter, F per revolution \
+                             under G99), which feedopt does not read: it reads milling \
+                             programs. On a mill, G50 cancels scaling and takes no words",
+                            if block.letter('S').is_some() {
+                                "S"
+                            } else {
+                                "axis words"
+                            },
+                            if block.letter('S').is_some() {
+                                "spindle speed limit"
+                            } else {
+                                "position setting"
+                            }
+                        ),
+                    ));
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -1399,6 +1428,17 @@ impl<'a> Interpreter<'a> {
                     Some(_) if !x.point => x.value / 1000.0,
                     _ => x.value,
                 },
+                // Marlin (Snapmaker, Prusa firmware) reads `G4 S2` as 2 s; here S is the
+                // spindle speed and the dwell has no time.
+                (None, None) if block.letter('S').is_some() => {
+                    return Err(self.error(
+                        line,
+                        "G4 without P (the dwell time): its S is a spindle speed here, \
+                         although Marlin firmware (Snapmaker, Fusion's Marlin posts) reads \
+                         `G4 S…` as seconds; write the dwell as `G4 P…` (seconds in LinuxCNC, \
+                         milliseconds in Fanuc)",
+                    ));
+                }
                 (None, None) => return Err(self.error(line, "G4 without P (the dwell time)")),
             }
         };
