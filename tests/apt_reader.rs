@@ -597,3 +597,33 @@ fn a_movarc_angle_the_end_point_does_not_make_is_an_error() {
         &["MOVARC: ANGLE is missing"],
     );
 }
+
+/// A three-axis machine's tool cannot tilt: a CL point whose tool vector is not +Z (here a
+/// `TLAXIS/0,-1,0` for a horizontal tool) is an error naming its line, not a move read with
+/// the tool along +Z.
+#[test]
+fn a_tilted_tool_vector_on_a_three_axis_machine_is_an_error() {
+    use feedopt::machine::Machine;
+    use feedopt::optimize::{Options, optimize};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/xyz_pocket");
+    let m = Machine::from_file(&dir.join("machine.json")).expect("machine");
+    let tilted = parse(
+        Path::new("t.cls"),
+        "FEDRAT/MMPM,600\nGOTO/0,0,10\nTLAXIS/0,-1,0\nGOTO/10,0,10\nFINI\n",
+    )
+    .unwrap();
+    let e = optimize(&m, &tilted, &Options::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 4") && e.contains("tool vector") && e.contains("xyz"),
+        "{e}"
+    );
+    // Along +Z it solves.
+    let vertical = parse(
+        Path::new("v.cls"),
+        "FEDRAT/MMPM,600\nGOTO/0,0,10\nTLAXIS/0,0,1\nGOTO/10,0,10\nFINI\n",
+    )
+    .unwrap();
+    assert!(optimize(&m, &vertical, &Options::default()).is_ok());
+}

@@ -249,7 +249,8 @@ impl Kinematics {
         });
         let lines: Vec<usize> = points.iter().map(|p| p.line).collect();
         let names = match self {
-            Kinematics::Xyz | Kinematics::Joint { .. } => return Ok(vec![[0.0; 2]; points.len()]),
+            Kinematics::Xyz => return xyz_angles(points),
+            Kinematics::Joint { .. } => return Ok(vec![[0.0; 2]; points.len()]),
             Kinematics::Dresser(d) => return dresser_angles(d, points, travel[0]),
             Kinematics::FourthAxis(r) => return fourth_axis_angles(*r, points, travel[0]),
             Kinematics::HeadHead { .. } => {
@@ -401,6 +402,20 @@ impl Effective {
         }
         Some(e)
     }
+}
+
+/// A three-axis machine's (no) angles: a tool vector other than +z is an error naming its CL
+/// line. The tool of such a machine cannot tilt; reading the point with the tool along +Z
+/// would put the tool tip where the program does not (a CL file's `TLAXIS/0,-1,0` or
+/// `GOTO/x,y,z,i,j,k` for a horizontal tool), quietly.
+fn xyz_angles(points: &[ClPoint]) -> Result<Vec<[f64; 2]>> {
+    if let Some(p) = points.iter().find(|p| (p.o - Vector3::z()).norm() > 1e-9) {
+        return Err(Error::Infeasible(format!(
+            "CL point at line {}: a tool vector ({}, {}, {}) on a machine of type xyz, whose              tool stays along +Z: give a machine file with the rotary axes that tilt it              (head_head, table_table, head_table), or a toolpath with the tool along +Z",
+            p.line, p.o.x, p.o.y, p.o.z
+        )));
+    }
+    Ok(vec![[0.0; 2]; points.len()])
 }
 
 /// A fourth axis's angle at every CL point: its programmed position (0 where the program never
