@@ -80,7 +80,28 @@ impl Dexel {
 
     /// Removes `[lo, hi]`; returns what was removed (length 0: nothing). As [`remove`] on
     /// the intervals.
+    ///
+    /// Inline where `[lo, hi]` misses the material (most of a cut's removals: the tool's back
+    /// passes through what the step before left), the rest out of line: all material lies in
+    /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(iv[0], lo) …
+    /// min(iv[1], hi) is empty and [`Dexel::remove_any`] would return [`Cut::NONE`] unchanged.
+    #[inline]
     pub fn remove(&mut self, lo: f64, hi: f64) -> Cut {
+        let (z0, z1) = match self {
+            Dexel::Empty => return Cut::NONE,
+            Dexel::One(iv) => (iv[0], iv[1]),
+            Dexel::Two(v) => (v[0][0], v[1][1]),
+            Dexel::Many(_) => return self.remove_any(lo, hi),
+        };
+        if z1 <= lo || z0 >= hi {
+            return Cut::NONE;
+        }
+        self.remove_any(lo, hi)
+    }
+
+    /// [`Dexel::remove`] on any dexel.
+    #[inline(never)]
+    fn remove_any(&mut self, lo: f64, hi: f64) -> Cut {
         match self {
             Dexel::Empty => Cut::NONE,
             Dexel::One(iv) => {
@@ -115,30 +136,33 @@ impl Dexel {
                 if cut.length == 0.0 {
                     return cut;
                 }
-                // What stays of each interval [lo, hi] overlaps (sorted; three at most: a split
-                // leaves the other interval whole).
-                let mut out = [[0.0; 2]; 3];
-                let mut n = 0;
-                for iv in [f, l] {
-                    if iv[1] <= lo || iv[0] >= hi {
-                        out[n] = iv;
-                        n += 1;
-                        continue;
+                // What stays of each interval: its parts below lo and above hi (either the
+                // whole interval where [lo, hi] misses it, the other empty: f[1] ≤ lo gives
+                // [f[0], f[1]] and [hi, f[1]], hi > lo ≥ f[1]), those not empty kept in order
+                // (three at most: a split leaves the other interval whole). Built in registers
+                // (`put`), not in an array indexed by a count, whose reads the processor cannot
+                // take from the writes just before.
+                let mut kept = (0, [[0.0; 2]; 3]);
+                let mut put = |a: f64, b: f64| {
+                    if a < b {
+                        match kept.0 {
+                            0 => kept.1[0] = [a, b],
+                            1 => kept.1[1] = [a, b],
+                            _ => kept.1[2] = [a, b],
+                        }
+                        kept.0 += 1;
                     }
-                    if iv[0] < lo {
-                        out[n] = [iv[0], lo];
-                        n += 1;
-                    }
-                    if iv[1] > hi {
-                        out[n] = [hi, iv[1]];
-                        n += 1;
-                    }
-                }
+                };
+                put(f[0], f[1].min(lo));
+                put(f[0].max(hi), f[1]);
+                put(l[0], l[1].min(lo));
+                put(l[0].max(hi), l[1]);
+                let (n, [x, y, z]) = kept;
                 *self = match n {
                     0 => Dexel::Empty,
-                    1 => Dexel::One(out[0]),
-                    2 => Dexel::Two([out[0], out[1]]),
-                    _ => Dexel::Many(out.to_vec()),
+                    1 => Dexel::One(x),
+                    2 => Dexel::Two([x, y]),
+                    _ => Dexel::Many(vec![x, y, z]),
                 };
                 cut
             }
