@@ -694,11 +694,11 @@ pub(crate) fn cut_step(
                             for &(_, i, [lo, hi]) in ended.iter() {
                                 note(cx(i), band.dexel(i, j).remove(lo, hi));
                             }
+                            // (A cell no pose crosses has the run [∞, −∞], which removes
+                            // nothing: Dexel::remove tells it without a call.)
                             band.each(j, ua, ub, |i, cell| {
                                 let [lo, hi] = run[i - ua];
-                                if lo <= hi {
-                                    note(cx(i), cell.remove(lo, hi));
-                                }
+                                note(cx(i), cell.remove(lo, hi));
                             });
                         }
                         acc

@@ -84,19 +84,34 @@ impl Dexel {
     /// Inline where `[lo, hi]` misses the material (most of a cut's removals: the tool's back
     /// passes through what the step before left), the rest out of line: all material lies in
     /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(iv[0], lo) …
-    /// min(iv[1], hi) is empty and [`Dexel::remove_any`] would return [`Cut::NONE`] unchanged.
+    /// min(iv[1], hi) is empty and [`Dexel::remove_any`] would return [`Cut::NONE`] unchanged;
+    /// so it does where lo > hi (shorter than [`MIN_CUT_MM`]: a miss, [∞, −∞], too), and where
+    /// `[lo, hi]` lies in the gap [g0, g1] between the two intervals of a [`Dexel::Two`]
+    /// (g0 ≤ lo, hi ≤ g1: both overlaps empty, the same way; a tilted tool passing again
+    /// through the tunnel it cut). The tests are joined without short-circuit, one branch
+    /// whose outcome the data decide instead of several.
     #[inline]
     pub fn remove(&mut self, lo: f64, hi: f64) -> Cut {
-        let (z0, z1) = match self {
-            Dexel::Empty => return Cut::NONE,
-            Dexel::One(iv) => (iv[0], iv[1]),
-            Dexel::Two(v) => (v[0][0], v[1][1]),
-            Dexel::Many(_) => return self.remove_any(lo, hi),
+        // (No gap: [∞, −∞].)
+        let ((z0, z1), (g0, g1)) = match self {
+            Dexel::Empty => (
+                (f64::INFINITY, f64::NEG_INFINITY),
+                (f64::INFINITY, f64::NEG_INFINITY),
+            ),
+            Dexel::One(iv) => ((iv[0], iv[1]), (f64::INFINITY, f64::NEG_INFINITY)),
+            Dexel::Two(v) => ((v[0][0], v[1][1]), (v[0][1], v[1][0])),
+            // Three or more intervals (a Many of two or fewer becomes Two, One or Empty).
+            Dexel::Many(v) => (
+                (v[0][0], v[v.len() - 1][1]),
+                (f64::INFINITY, f64::NEG_INFINITY),
+            ),
         };
-        if z1 <= lo || z0 >= hi {
-            return Cut::NONE;
+        let in_gap = (g0 <= lo) & (hi <= g1);
+        if (lo <= hi) & (z1 > lo) & (z0 < hi) & !in_gap {
+            self.remove_any(lo, hi)
+        } else {
+            Cut::NONE
         }
-        self.remove_any(lo, hi)
     }
 
     /// [`Dexel::remove`] on any dexel.
@@ -162,19 +177,35 @@ impl Dexel {
                     0 => Dexel::Empty,
                     1 => Dexel::One(x),
                     2 => Dexel::Two([x, y]),
-                    _ => Dexel::Many(vec![x, y, z]),
+                    _ => three(x, y, z),
                 };
                 cut
             }
-            Dexel::Many(v) => {
-                let cut = remove(v, lo, hi);
-                if v.len() <= 2 {
-                    *self = Dexel::from_intervals(std::mem::take(v));
-                }
-                cut
-            }
+            Dexel::Many(_) => self.remove_many(lo, hi),
         }
     }
+
+    /// [`Dexel::remove`] on a [`Dexel::Many`]: out of line, so that the heap's work does not
+    /// weigh on every call of the inline forms' [`Dexel::remove_any`].
+    #[inline(never)]
+    fn remove_many(&mut self, lo: f64, hi: f64) -> Cut {
+        let Dexel::Many(v) = self else {
+            return self.remove_any(lo, hi);
+        };
+        let cut = remove(v, lo, hi);
+        if v.len() <= 2 {
+            *self = Dexel::from_intervals(std::mem::take(v));
+        }
+        cut
+    }
+}
+
+/// Three intervals on the heap (a split of one of two), out of line as
+/// [`Dexel::remove_many`].
+#[inline(never)]
+#[cold]
+fn three(x: [f64; 2], y: [f64; 2], z: [f64; 2]) -> Dexel {
+    Dexel::Many(vec![x, y, z])
 }
 
 /// The tiles of one row of tiles (its [`TILE`] grid rows), for a cut that changes them; the
