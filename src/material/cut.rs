@@ -58,6 +58,7 @@
 //! - a plunge (f along O, |O × f| < 1e-9 |f|): a_e is the diameter of the disc of area A,
 //!   φ = 360°.
 
+use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -286,51 +287,7 @@ pub fn pose_spacing(tool: &Tool, cell: f64) -> f64 {
 /// convex set meeting the line in one interval, joined (they overlap). Widened by 1e-9 mm so
 /// that a cell the tool only touches is still visited.
 pub fn capsule_row(a: [f64; 2], b: [f64; 2], r: f64, y: f64) -> Option<[f64; 2]> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for c in [a, b] {
-        let e = r * r - (y - c[1]) * (y - c[1]);
-        if e >= 0.0 {
-            let s = e.sqrt();
-            lo = lo.min(c[0] - s);
-            hi = hi.max(c[0] + s);
-        }
-    }
-    // The band between the end discs: the rectangle of half-width r along the segment.
-    if let Some(band) = rectangle_row(a, b, r, 0.0, y).filter(|band| band[0] <= band[1]) {
-        lo = lo.min(band[0]);
-        hi = hi.max(band[1]);
-    }
-    (lo <= hi).then_some([lo - 1e-9, hi + 1e-9])
-}
-
-/// The x interval (empty where `[0] > [1]`) where the line at `y` meets the rectangle of
-/// half-width `r` about the segment from `a` to `b` (XY), lengthened by `ends` at both ends;
-/// `None` where `a` = `b` (no direction).
-fn rectangle_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    if len2 == 0.0 {
-        return None;
-    }
-    let len = len2.sqrt();
-    // With q = (x, y): −ends·|d| ≤ (q − a)·d ≤ |d|² + ends·|d| and |(q − a) × d| ≤ r |d|,
-    // each k x + m in a range.
-    let mut band = [f64::NEG_INFINITY, f64::INFINITY];
-    let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
-        if k == 0.0 {
-            if m < c0 || m > c1 {
-                band = [f64::INFINITY, f64::NEG_INFINITY];
-            }
-        } else {
-            let (u, v) = ((c0 - m) / k, (c1 - m) / k);
-            band[0] = band[0].max(u.min(v));
-            band[1] = band[1].min(u.max(v));
-        }
-    };
-    let (e, w) = (ends * len, r * len);
-    clip(dx, (y - a[1]) * dy - a[0] * dx, -e, len2 + e);
-    clip(dy, -(y - a[1]) * dx - a[0] * dy, -w, w);
-    Some(band)
+    Footprint::new(a, b, r, f64::INFINITY).capsule_row(y)
 }
 
 /// The x interval where the line at `y` meets the rectangle of half-width `r` about the
@@ -339,32 +296,164 @@ fn rectangle_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<
 /// lies in it with `ends` = R·|O_z|: a point of the disc of radius R normal to O projects
 /// onto the axis' XY direction û at most R·|O_z| = R·|(û, 0) − ((û, 0)·O) O| from its centre.
 /// `None` also where `a` = `b` (no direction: no bound).
+#[cfg(test)]
 fn axis_row(a: [f64; 2], b: [f64; 2], r: f64, ends: f64, y: f64) -> Option<[f64; 2]> {
-    rectangle_row(a, b, r, ends, y).map(|band| [band[0] - 1e-9, band[1] + 1e-9])
+    Footprint::new(a, b, r, ends).axis_row(y)
 }
 
-/// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule of
-/// [`capsule_row`] and, for a tilted pose (`ends` finite), the rectangle of [`axis_row`].
-#[allow(clippy::too_many_arguments)]
-fn capsule_cells(
-    d: (f64, f64),
+/// A rectangle of half-width `r` about the segment from `a` to `b` (XY), lengthened by `ends`
+/// at both ends, with what its rows share (`a` ≠ `b`).
+#[derive(Debug, Clone, Copy)]
+struct Rectangle {
+    a1: f64,
+    /// b − a.
+    dx: f64,
+    dy: f64,
+    /// a[0]·dx, a[0]·dy.
+    adx: f64,
+    ady: f64,
+    /// −ends·|d|, |d|² + ends·|d|, r·|d|.
+    e0: f64,
+    e1: f64,
+    w: f64,
+}
+
+impl Rectangle {
+    /// `None` where `a` = `b` (no direction).
+    fn new(a: [f64; 2], b: [f64; 2], r: f64, ends: f64) -> Option<Rectangle> {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        if len2 == 0.0 {
+            return None;
+        }
+        let len = len2.sqrt();
+        let (e, w) = (ends * len, r * len);
+        Some(Rectangle {
+            a1: a[1],
+            dx,
+            dy,
+            adx: a[0] * dx,
+            ady: a[0] * dy,
+            e0: -e,
+            e1: len2 + e,
+            w,
+        })
+    }
+
+    /// The x interval (empty where `[0] > [1]`) where the line at `y` meets the rectangle.
+    fn row(&self, y: f64) -> [f64; 2] {
+        // With q = (x, y): −ends·|d| ≤ (q − a)·d ≤ |d|² + ends·|d| and |(q − a) × d| ≤ r |d|,
+        // each k x + m in a range.
+        let mut band = [f64::NEG_INFINITY, f64::INFINITY];
+        let mut clip = |k: f64, m: f64, c0: f64, c1: f64| {
+            if k == 0.0 {
+                if m < c0 || m > c1 {
+                    band = [f64::INFINITY, f64::NEG_INFINITY];
+                }
+            } else {
+                let (u, v) = ((c0 - m) / k, (c1 - m) / k);
+                band[0] = band[0].max(u.min(v));
+                band[1] = band[1].min(u.max(v));
+            }
+        };
+        let (dx, dy) = (self.dx, self.dy);
+        clip(dx, (y - self.a1) * dy - self.adx, self.e0, self.e1);
+        clip(dy, -(y - self.a1) * dx - self.ady, -self.w, self.w);
+        band
+    }
+}
+
+/// Where a tool may reach, seen from above: the capsule of radius `r` about the segment from
+/// `a` to `b` (XY) and, for a tilted pose, the rectangle of half-width `r` along it lengthened
+/// by `ends` (module doc, "Which dexels"); what depends on the segment alone is computed once
+/// for all grid rows.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Footprint {
     a: [f64; 2],
     b: [f64; 2],
-    r: f64,
-    ends: f64,
-    y: f64,
-    range: (usize, usize),
-) -> Option<(usize, usize)> {
-    let [mut x0, mut x1] = capsule_row(a, b, r, y)?;
-    if ends.is_finite() {
-        if let Some([u0, u1]) = axis_row(a, b, r, ends, y) {
-            (x0, x1) = (x0.max(u0), x1.min(u1));
+    /// r².
+    rr: f64,
+    /// The band between the end discs (lengthened by 0).
+    band: Option<Rectangle>,
+    /// The rectangle lengthened by `ends` (`None`: `ends` infinite, or `a` = `b`).
+    axis: Option<Rectangle>,
+}
+
+impl Footprint {
+    fn new(a: [f64; 2], b: [f64; 2], r: f64, ends: f64) -> Footprint {
+        Footprint {
+            a,
+            b,
+            rr: r * r,
+            band: Rectangle::new(a, b, r, 0.0),
+            axis: if ends.is_finite() {
+                Rectangle::new(a, b, r, ends)
+            } else {
+                None
+            },
         }
     }
-    let (ox, hx) = d;
-    let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
-    let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
-    (i0 <= i1).then_some((i0 as usize, i1 as usize))
+
+    /// [`capsule_row`].
+    fn capsule_row(&self, y: f64) -> Option<[f64; 2]> {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for c in [self.a, self.b] {
+            let e = self.rr - (y - c[1]) * (y - c[1]);
+            if e >= 0.0 {
+                let s = e.sqrt();
+                lo = lo.min(c[0] - s);
+                hi = hi.max(c[0] + s);
+            }
+        }
+        // The band between the end discs: the rectangle of half-width r along the segment.
+        if let Some(band) = self
+            .band
+            .map(|b| b.row(y))
+            .filter(|band| band[0] <= band[1])
+        {
+            lo = lo.min(band[0]);
+            hi = hi.max(band[1]);
+        }
+        (lo <= hi).then_some([lo - 1e-9, hi + 1e-9])
+    }
+
+    /// The rectangle's row, widened by 1e-9 mm as [`capsule_row`] (`None`: no rectangle).
+    fn axis_row(&self, y: f64) -> Option<[f64; 2]> {
+        self.axis
+            .map(|q| q.row(y))
+            .map(|band| [band[0] - 1e-9, band[1] + 1e-9])
+    }
+
+    /// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule and the
+    /// rectangle, on a grid of cells `d` = (x of cell 0's edge, cell width).
+    fn cells(&self, d: (f64, f64), y: f64, range: (usize, usize)) -> Option<(usize, usize)> {
+        let [mut x0, mut x1] = self.capsule_row(y)?;
+        if let Some([u0, u1]) = self.axis_row(y) {
+            (x0, x1) = (x0.max(u0), x1.min(u1));
+        }
+        let (ox, hx) = d;
+        let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
+        let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
+        (i0 <= i1).then_some((i0 as usize, i1 as usize))
+    }
+}
+
+/// One pose's crossings `row` (the previous pose's `before`) joined into each cell's `run`,
+/// `starts` counting the poses that cross a cell after one that does not ([`cut_step`]).
+///
+/// Without branches, and compiled also for the vector instructions of newer processors
+/// (`multiversion`, as [`Pose::hits_row`]): a cut does this once per pose and cell, as often as
+/// it crosses. The minimum and maximum are comparisons, not `f64::min`/`max`, whose handling of
+/// NaN costs instructions here: a crossing is finite or [`NO_HIT`] (±∞), never NaN, and on
+/// numbers both give the same value.
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn join_row(run: &mut [[f64; 2]], starts: &mut [f64], before: &[[f64; 2]], row: &[[f64; 2]]) {
+    for (((run, n), p), h) in run.iter_mut().zip(starts.iter_mut()).zip(before).zip(row) {
+        let start = (h[0] <= h[1]) & (p[0] > p[1]);
+        *n += if start { 1.0 } else { 0.0 };
+        run[0] = if h[0] < run[0] { h[0] } else { run[0] };
+        run[1] = if h[1] > run[1] { h[1] } else { run[1] };
+    }
 }
 
 /// The crossings of a tilted step's last pose with the dexel lines, kept for the next step,
@@ -416,17 +505,26 @@ pub(crate) fn cut_step(
     let r = tool.radius();
     let vertical = poses == 1;
     // Every pose once (tilted): the tool there and its projected axis segment.
-    let pose_list: Vec<(Pose, [f64; 2], [f64; 2])> = if vertical {
+    let pose_list: Vec<(Pose, Footprint)> = if vertical {
         Vec::new()
     } else {
         (0..poses)
             .map(|j| {
                 let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
                 let top = p + o * tool.flute_length;
-                (Pose::new(tool, &p, &o), [p.x, p.y], [top.x, top.y])
+                let ends = r * o.z.abs();
+                let foot = Footprint::new([p.x, p.y], [top.x, top.y], r, ends);
+                (Pose::new(tool, &p, &o), foot)
             })
             .collect()
     };
+    // A vertical step's tool lies in the capsule about its tip's path.
+    let vertical_foot = Footprint::new(
+        [step.p0.x, step.p0.y],
+        [step.p1.x, step.p1.y],
+        r,
+        f64::INFINITY,
+    );
     // This step's number; its first pose's crossings where the previous step's last pose is it.
     let (prev, this) = (shared.step, shared.step + 1);
     let reuse = !vertical && shared.pose == Some((pose_list[0].0.tip(), pose_list[0].0.axis()));
@@ -478,9 +576,7 @@ pub(crate) fn cut_step(
                                     acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
                             };
                             if vertical {
-                                let (a, b) = ([step.p0.x, step.p0.y], [step.p1.x, step.p1.y]);
-                                let Some((ia, ib)) =
-                                    capsule_cells((x0, hx), a, b, r, f64::INFINITY, y, (i0, i1))
+                                let Some((ia, ib)) = vertical_foot.cells((x0, hx), y, (i0, i1))
                                 else {
                                     continue;
                                 };
@@ -500,10 +596,11 @@ pub(crate) fn cut_step(
                             // Pose by pose over the cells of its capsule: each pose's crossings
                             // (no dexel is read), joined into runs; then the runs are removed.
                             ranges.clear();
-                            ranges.extend(pose_list.iter().map(|(pose, a, b)| {
-                                let ends = r * pose.axis().z.abs();
-                                capsule_cells((x0, hx), *a, *b, r, ends, y, (i0, i1))
-                            }));
+                            ranges.extend(
+                                pose_list
+                                    .iter()
+                                    .map(|(_, foot)| foot.cells((x0, hx), y, (i0, i1))),
+                            );
                             let (mut ua, mut ub) = (usize::MAX, 0);
                             for &(ia, ib) in ranges.iter().flatten() {
                                 (ua, ub) = (ua.min(ia), ub.max(ib));
@@ -512,14 +609,19 @@ pub(crate) fn cut_step(
                                 continue;
                             }
                             let width = ub - ua + 1;
-                            hits.clear();
+                            // Each pose's line of `hits`: its crossings on its cells, misses
+                            // on the others (every entry written once).
                             hits.resize(poses * width, NO_HIT);
                             for k in 0..poses {
+                                let line = &mut hits[k * width..(k + 1) * width];
                                 let Some((ia, ib)) = ranges[k] else {
+                                    line.fill(NO_HIT);
                                     continue;
                                 };
+                                line[..ia - ua].fill(NO_HIT);
+                                line[ib - ua + 1..].fill(NO_HIT);
                                 let pose = &pose_list[k].0;
-                                let row = &mut hits[k * width + ia - ua..=k * width + ib - ua];
+                                let row = &mut line[ia - ua..=ib - ua];
                                 // k = 0 reads the shared row where it has the cells, k = poses − 1
                                 // ≥ 1 writes it.
                                 let s0 = row_shared.start;
@@ -560,13 +662,7 @@ pub(crate) fn cut_step(
                             for k in 1..poses {
                                 let (before, row) =
                                     hits[(k - 1) * width..(k + 1) * width].split_at(width);
-                                for (((run, n), p), h) in
-                                    run.iter_mut().zip(starts.iter_mut()).zip(before).zip(row)
-                                {
-                                    let start = h[0] <= h[1] && p[0] > p[1];
-                                    *n += f64::from(u8::from(start));
-                                    *run = [run[0].min(h[0]), run[1].max(h[1])];
-                                }
+                                join_row(run, starts, before, row);
                             }
                             ended.clear();
                             for (c, run) in run.iter_mut().enumerate() {
@@ -598,11 +694,11 @@ pub(crate) fn cut_step(
                             for &(_, i, [lo, hi]) in ended.iter() {
                                 note(cx(i), band.dexel(i, j).remove(lo, hi));
                             }
+                            // (A cell no pose crosses has the run [∞, −∞], which removes
+                            // nothing: Dexel::remove tells it without a call.)
                             band.each(j, ua, ub, |i, cell| {
                                 let [lo, hi] = run[i - ua];
-                                if lo <= hi {
-                                    note(cx(i), cell.remove(lo, hi));
-                                }
+                                note(cx(i), cell.remove(lo, hi));
                             });
                         }
                         acc

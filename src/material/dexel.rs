@@ -80,7 +80,43 @@ impl Dexel {
 
     /// Removes `[lo, hi]`; returns what was removed (length 0: nothing). As [`remove`] on
     /// the intervals.
+    ///
+    /// Inline where `[lo, hi]` misses the material (most of a cut's removals: the tool's back
+    /// passes through what the step before left), the rest out of line: all material lies in
+    /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(iv[0], lo) …
+    /// min(iv[1], hi) is empty and the removal would return [`Cut::NONE`] unchanged;
+    /// so it does where lo > hi (shorter than [`MIN_CUT_MM`]: a miss, [∞, −∞], too), and where
+    /// `[lo, hi]` lies in the gap [g0, g1] between the two intervals of a [`Dexel::Two`]
+    /// (g0 ≤ lo, hi ≤ g1: both overlaps empty, the same way; a tilted tool passing again
+    /// through the tunnel it cut). The tests are joined without short-circuit, one branch
+    /// whose outcome the data decide instead of several.
+    #[inline]
     pub fn remove(&mut self, lo: f64, hi: f64) -> Cut {
+        // (No gap: [∞, −∞].)
+        let ((z0, z1), (g0, g1)) = match self {
+            Dexel::Empty => (
+                (f64::INFINITY, f64::NEG_INFINITY),
+                (f64::INFINITY, f64::NEG_INFINITY),
+            ),
+            Dexel::One(iv) => ((iv[0], iv[1]), (f64::INFINITY, f64::NEG_INFINITY)),
+            Dexel::Two(v) => ((v[0][0], v[1][1]), (v[0][1], v[1][0])),
+            // Three or more intervals (a Many of two or fewer becomes Two, One or Empty).
+            Dexel::Many(v) => (
+                (v[0][0], v[v.len() - 1][1]),
+                (f64::INFINITY, f64::NEG_INFINITY),
+            ),
+        };
+        let in_gap = (g0 <= lo) & (hi <= g1);
+        if (lo <= hi) & (z1 > lo) & (z0 < hi) & !in_gap {
+            self.remove_any(lo, hi)
+        } else {
+            Cut::NONE
+        }
+    }
+
+    /// [`Dexel::remove`] on any dexel.
+    #[inline(never)]
+    fn remove_any(&mut self, lo: f64, hi: f64) -> Cut {
         match self {
             Dexel::Empty => Cut::NONE,
             Dexel::One(iv) => {
@@ -89,7 +125,7 @@ impl Dexel {
                 if hi - lo < MIN_CUT_MM || b0 <= lo || a0 >= hi {
                     return Cut::NONE;
                 }
-                let (a, b) = (a0.max(lo), b0.min(hi));
+                let (a, b) = (larger(a0, lo), smaller(b0, hi));
                 if b - a < MIN_CUT_MM {
                     return Cut::NONE;
                 }
@@ -115,42 +151,61 @@ impl Dexel {
                 if cut.length == 0.0 {
                     return cut;
                 }
-                // What stays of each interval [lo, hi] overlaps (sorted; three at most: a split
-                // leaves the other interval whole).
-                let mut out = [[0.0; 2]; 3];
-                let mut n = 0;
-                for iv in [f, l] {
-                    if iv[1] <= lo || iv[0] >= hi {
-                        out[n] = iv;
-                        n += 1;
-                        continue;
+                // What stays of each interval: its parts below lo and above hi (either the
+                // whole interval where [lo, hi] misses it, the other empty: f[1] ≤ lo gives
+                // [f[0], f[1]] and [hi, f[1]], hi > lo ≥ f[1]), those not empty kept in order
+                // (three at most: a split leaves the other interval whole). Built in registers
+                // (`put`), not in an array indexed by a count, whose reads the processor cannot
+                // take from the writes just before.
+                let mut kept = (0, [[0.0; 2]; 3]);
+                let mut put = |a: f64, b: f64| {
+                    if a < b {
+                        match kept.0 {
+                            0 => kept.1[0] = [a, b],
+                            1 => kept.1[1] = [a, b],
+                            _ => kept.1[2] = [a, b],
+                        }
+                        kept.0 += 1;
                     }
-                    if iv[0] < lo {
-                        out[n] = [iv[0], lo];
-                        n += 1;
-                    }
-                    if iv[1] > hi {
-                        out[n] = [hi, iv[1]];
-                        n += 1;
-                    }
-                }
+                };
+                put(f[0], smaller(f[1], lo));
+                put(larger(f[0], hi), f[1]);
+                put(l[0], smaller(l[1], lo));
+                put(larger(l[0], hi), l[1]);
+                let (n, [x, y, z]) = kept;
                 *self = match n {
                     0 => Dexel::Empty,
-                    1 => Dexel::One(out[0]),
-                    2 => Dexel::Two([out[0], out[1]]),
-                    _ => Dexel::Many(out.to_vec()),
+                    1 => Dexel::One(x),
+                    2 => Dexel::Two([x, y]),
+                    _ => three(x, y, z),
                 };
                 cut
             }
-            Dexel::Many(v) => {
-                let cut = remove(v, lo, hi);
-                if v.len() <= 2 {
-                    *self = Dexel::from_intervals(std::mem::take(v));
-                }
-                cut
-            }
+            Dexel::Many(_) => self.remove_many(lo, hi),
         }
     }
+
+    /// [`Dexel::remove`] on a [`Dexel::Many`]: out of line, so that the heap's work does not
+    /// weigh on every call of the inline forms' [`Dexel::remove_any`].
+    #[inline(never)]
+    fn remove_many(&mut self, lo: f64, hi: f64) -> Cut {
+        let Dexel::Many(v) = self else {
+            return self.remove_any(lo, hi);
+        };
+        let cut = remove(v, lo, hi);
+        if v.len() <= 2 {
+            *self = Dexel::from_intervals(std::mem::take(v));
+        }
+        cut
+    }
+}
+
+/// Three intervals on the heap (a split of one of two), out of line as
+/// [`Dexel::remove_many`].
+#[inline(never)]
+#[cold]
+fn three(x: [f64; 2], y: [f64; 2], z: [f64; 2]) -> Dexel {
+    Dexel::Many(vec![x, y, z])
 }
 
 /// The tiles of one row of tiles (its [`TILE`] grid rows), for a cut that changes them; the
@@ -381,16 +436,30 @@ impl Dexels {
     }
 }
 
+/// The smaller of two numbers, neither NaN (interval ends and crossings never are): the
+/// value `f64::min` gives, by one comparison, without the instructions its handling of NaN
+/// costs on every removal.
+#[inline]
+fn smaller(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// The larger of two numbers, neither NaN, as [`smaller`].
+#[inline]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
 /// What removing `[lo, hi]` would take from `intervals`: the overlaps of at least
 /// [`MIN_CUT_MM`], their total length and z range (length 0: nothing).
 fn overlap(intervals: &[[f64; 2]], lo: f64, hi: f64) -> Cut {
     let mut cut = Cut::NONE;
     for iv in intervals {
-        let (a, b) = (iv[0].max(lo), iv[1].min(hi));
+        let (a, b) = (larger(iv[0], lo), smaller(iv[1], hi));
         if b - a >= MIN_CUT_MM {
             cut.length += b - a;
-            cut.z_lo = cut.z_lo.min(a);
-            cut.z_hi = cut.z_hi.max(b);
+            cut.z_lo = smaller(cut.z_lo, a);
+            cut.z_hi = larger(cut.z_hi, b);
         }
     }
     cut
