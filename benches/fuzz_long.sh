@@ -45,7 +45,7 @@ mem_gb=${FUZZ_MEM_GB:-4}
 mkdir -p "$out"
 
 cargo test --release --test fuzz_cli --no-run 2> "$out/build.log" || { cat "$out/build.log" >&2; exit 2; }
-bin=$(grep -o 'target/release/deps/fuzz_cli-[0-9a-f]*' "$out/build.log" | tail -1)
+bin=$(grep -o '[^ (]*release/deps/fuzz_cli-[0-9a-f]*' "$out/build.log" | tail -1)
 rm -f "$out/build.log"
 [ -x "$bin" ] || { echo "fuzz_long.sh: cannot find the test binary" >&2; exit 2; }
 # A copy of its own: a build in this tree during the campaign (hours) does not change the

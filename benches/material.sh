@@ -41,7 +41,8 @@ if [ -n "${FEEDOPT:-}" ]; then
   bin=$FEEDOPT
 else
   cargo build --release --quiet
-  bin=target/release/feedopt
+  # Where cargo put it (CARGO_TARGET_DIR moves it out of target/).
+  bin=${CARGO_TARGET_DIR:-target}/release/feedopt
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -18,7 +18,8 @@ shared=../shared/realworld
 [ -d "$shared" ] || { echo "needs $shared beside the crate" >&2; exit 2; }
 [ -x /usr/bin/time ] || { echo "needs GNU time at /usr/bin/time (apt-get install time)" >&2; exit 2; }
 cargo build --release --quiet
-bin=target/release/feedopt
+# Where cargo put it (CARGO_TARGET_DIR moves it out of target/).
+bin=${CARGO_TARGET_DIR:-target}/release/feedopt
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
