@@ -44,7 +44,9 @@ rows=(
   "camotics_bear|$cam/machines/xyz_mill.json|$cam/camotics_bear.nc|"
   "camotics_flower_mold|$cam/machines/xyz_mill.json|$cam/camotics_flower_mold.nc|"
   "nx_roeders_rfm600|$cam/machines/xyz_mill.json|$cam/nx_roeders_rfm600_finish.nc|"
-  "aamorim_boss|$cam/machines/xyz_mill.json|$cam/aamorim_boss.apt|"
+  # boss's side operations tilt the tool to +X (CSYS, line 5551 on): a three-axis mill
+  # refuses it (54c345c), the shared B/C trunnion takes it.
+  "aamorim_boss|$cam/machines/trt_bc_spinner_u5.json|$cam/aamorim_boss.apt|"
   "aamorim_basemach|$cam/machines/xyz_mill.json|$cam/aamorim_basemach.apt|"
   "nx_mori_nmv5000|$cam/machines/trt_bc_mori_nmv5000.json|$cam/nx_mori_nmv5000_mm.nc|"
   "nx_dmu70evo_840d|$cam/machines/headtable_dmu70.json|$cam/nx_dmu70evo_840d.mpf|"

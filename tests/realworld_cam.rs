@@ -116,3 +116,27 @@ fn the_five_axis_programs_keep_their_angles_near_the_programmed_ones() {
         assert!(worst <= 2.0 + 1e-9, "{file}: the angles stray {worst}°");
     }
 }
+
+/// aamorim's boss (SolidWorks CAM APT) has four side operations: `CSYS/0,0,1.,…` with the
+/// tool along +X (from line 5551 on, and at 11188, 12063 and 12362). A three-axis mill cannot
+/// tilt its tool, so there the program is refused naming the first such point (it was read
+/// with the tool along +Z before, quietly); a machine that tilts it (the shared Spinner U5,
+/// a B/C trunnion) solves it, verified.
+#[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
+fn a_program_with_side_operations_needs_a_machine_that_tilts_the_tool() {
+    use feedopt::optimize::{Options, optimize_input};
+    let solve = |machine: &str| {
+        let m = Machine::from_file(&dir().join("machines").join(machine)).expect("machine");
+        let (input, _) = read("aamorim_boss.apt", machine).unwrap_or_else(|e| panic!("{e}"));
+        optimize_input(&m, &input, &Options::default())
+    };
+    let e = solve("xyz_mill.json").unwrap_err().to_string();
+    assert!(
+        e.contains("line 5553") && e.contains("tool vector (1, 0, 0)"),
+        "{e}"
+    );
+    let sol = solve("trt_bc_spinner_u5.json").expect("solves");
+    eprintln!("boss on the Spinner U5: {:.4} s", sol.schedule.cycle_time);
+    assert!(sol.verification.verified);
+}

@@ -411,7 +411,9 @@ impl Effective {
 fn xyz_angles(points: &[ClPoint]) -> Result<Vec<[f64; 2]>> {
     if let Some(p) = points.iter().find(|p| (p.o - Vector3::z()).norm() > 1e-9) {
         return Err(Error::Infeasible(format!(
-            "CL point at line {}: a tool vector ({}, {}, {}) on a machine of type xyz, whose              tool stays along +Z: give a machine file with the rotary axes that tilt it              (head_head, table_table, head_table), or a toolpath with the tool along +Z",
+            "CL point at line {}: a tool vector ({}, {}, {}) on a machine of type xyz, whose \
+             tool stays along +Z: give a machine file with the rotary axes that tilt it \
+             (head_head, table_table, head_table), or a toolpath with the tool along +Z",
             p.line, p.o.x, p.o.y, p.o.z
         )));
     }
