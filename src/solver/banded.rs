@@ -53,6 +53,8 @@ const EQ_REG: f64 = 1e-12;
 const DYNAMIC_REG: f64 = 1e-13;
 /// Fraction of the step to the boundary of the positive orthant taken.
 const STEP_FRACTION: f64 = 0.99;
+/// A row's rounding allowance, relative to the sum of its terms' magnitudes ([`Lp::rows_hold`]).
+const TERMS_TOL: f64 = 1e-13;
 /// Passes of Ruiz equilibration of the rows and columns.
 const RUIZ_PASSES: usize = 10;
 /// Steps of iterative refinement per KKT solve.
@@ -106,12 +108,13 @@ impl Lp {
         }
     }
 
-    /// Every row holds at `z` to `tol` relative to its own terms: `|a·z − h|` (an equality)
-    /// or `a·z − h` (an inequality) at most `tol (|h| + Σ|a_j z_j|)`. Invariant under the
-    /// scaling of rows and columns, so a row with large coefficients (the rest ends' ü–b
-    /// equality over a short interval) holds as tightly in its own units as any other; a
-    /// residual relative to the scaled variables' norm let such a row drift, and the jerk at a
-    /// rest end with it.
+    /// Every row holds at `z` in its own units: `|a·z − h|` (an equality) or `a·z − h` (an
+    /// inequality) at most `tol |h|` plus [`TERMS_TOL`] of `Σ|a_j z_j|` (rounding). Invariant
+    /// under the scaling of rows and columns. Relative to the terms alone it was not enough:
+    /// a jerk row over a short interval is a small difference of terms a million times its
+    /// bound (coefficients in 1/Δu³), so 1e-8 of the terms let the jerk between the LP's sites
+    /// exceed its limit by percents, and the local refinement, dividing those intervals
+    /// further, made it worse round after round (the jerk-limited impeller's rest ends).
     fn rows_hold(&self, z: &[f64], tol: f64) -> bool {
         (0..self.rows()).all(|r| {
             let (mut a, mut abs) = (0.0, 0.0);
@@ -122,7 +125,7 @@ impl Lp {
             }
             let h = self.rhs[r];
             let viol = if r < self.n_eq { (a - h).abs() } else { a - h };
-            viol <= tol * (h.abs() + abs)
+            viol <= tol * h.abs() + TERMS_TOL * abs
         })
     }
 
