@@ -184,11 +184,8 @@ fn the_double_s_agrees_with_the_programme() {
     assert_verified_with_jerk(&closed, "zig-zag");
 }
 
-/// The bundled 5-axis problem with its jerk-limited machine: slower than acceleration-limited,
-/// every limit (jerk too) kept; with the jerk limits scaled up the time comes down to the
-/// acceleration-limited one.
-#[test]
-fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
+/// The bundled 5-axis problem with its jerk-limited machine, on 1,500 stations.
+fn bundled_jerk_problem() -> (Machine, feedopt::toolpath::Toolpath, Options) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
     let m = Machine::from_file(&dir.join("machine_jerk.json")).expect("machine");
     let tp = feedopt::toolpath::read(&dir.join("impeller_blade.cls")).expect("toolpath");
@@ -196,6 +193,15 @@ fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
         stations: Some(1500),
         ..Options::default()
     };
+    (m, tp, o)
+}
+
+/// The bundled 5-axis problem with its jerk-limited machine: slower than acceleration-limited,
+/// every limit (jerk too) kept; with the jerk limits scaled up the time comes down to the
+/// acceleration-limited one.
+#[test]
+fn bundled_five_axis_problem_converges_to_the_acceleration_limited_time() {
+    let (m, tp, o) = bundled_jerk_problem();
     let accel = optimize(&m.without_jerk(), &tp, &o).expect("accel");
     let t_acc = accel.schedule.cycle_time;
     let mut last = f64::INFINITY;
@@ -252,13 +258,7 @@ fn fixed_grid_with(
 /// bundled 5-axis problem with its jerk limits, and both verify.
 #[test]
 fn banded_lp_and_clarabel_agree_on_the_bundled_problem() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/seed_head_head");
-    let m = Machine::from_file(&dir.join("machine_jerk.json")).expect("machine");
-    let tp = feedopt::toolpath::read(&dir.join("impeller_blade.cls")).expect("toolpath");
-    let o = Options {
-        stations: Some(1500),
-        ..Options::default()
-    };
+    let (m, tp, o) = bundled_jerk_problem();
     let (banded, v1) = fixed_grid_with(&m, &tp, &o, LpSolver::Banded);
     let (clarabel, v2) = fixed_grid_with(&m, &tp, &o, LpSolver::Clarabel);
     eprintln!("banded LP {banded:.6} s, Clarabel {clarabel:.6} s");
@@ -269,26 +269,38 @@ fn banded_lp_and_clarabel_agree_on_the_bundled_problem() {
     assert!(v1 && v2, "verified: banded {v1}, Clarabel {v2}");
 }
 
+/// The cycle time of COPP path `idx` on its fixed grid with the SCP's settings `jerk`, its
+/// windows solved on `threads` threads (0: every core).
+fn copp_time_with(dir: &Path, idx: usize, jerk: JerkOptions, threads: usize) -> f64 {
+    let (m, path, _) = copp_case(dir, idx);
+    let mut o = Options {
+        refine_until_verified: false,
+        jerk,
+        ..copp_options()
+    };
+    o.solver.threads = threads;
+    optimize_joint(&m, &path, &o)
+        .expect("solve")
+        .schedule
+        .cycle_time
+}
+
 /// The same on two COPP paths (7 axes, jerk limits, 1,000 intervals).
 #[test]
 #[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn banded_lp_and_clarabel_agree_on_copp_paths() {
     let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
     for idx in [1, 3] {
-        let (m, path, _) = copp_case(&dir, idx);
         let solve = |lp_solver| {
-            let o = Options {
-                refine_until_verified: false,
-                jerk: JerkOptions {
+            copp_time_with(
+                &dir,
+                idx,
+                JerkOptions {
                     lp_solver,
                     ..JerkOptions::default()
                 },
-                ..copp_options()
-            };
-            optimize_joint(&m, &path, &o)
-                .expect("solve")
-                .schedule
-                .cycle_time
+                0,
+            )
         };
         let (banded, clarabel) = (solve(LpSolver::Banded), solve(LpSolver::Clarabel));
         eprintln!("path {idx}: banded LP {banded:.6} s, Clarabel {clarabel:.6} s");
@@ -305,20 +317,16 @@ fn banded_lp_and_clarabel_agree_on_copp_paths() {
 #[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn linearised_and_cone_objectives_agree() {
     let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
-    let (m, path, _) = copp_case(&dir, 1);
     let solve = |objective| {
-        let o = Options {
-            refine_until_verified: false,
-            jerk: JerkOptions {
+        copp_time_with(
+            &dir,
+            1,
+            JerkOptions {
                 objective,
                 ..JerkOptions::default()
             },
-            ..copp_options()
-        };
-        optimize_joint(&m, &path, &o)
-            .expect("solve")
-            .schedule
-            .cycle_time
+            0,
+        )
     };
     let (lp, cones) = (solve(Objective::Linearised), solve(Objective::Cones));
     eprintln!("linearised {lp:.6} s, cones {cones:.6} s");
@@ -328,20 +336,11 @@ fn linearised_and_cone_objectives_agree() {
 /// The cycle time of COPP path `idx` on its fixed grid, cut into windows of `window` stations
 /// solved on `threads` threads (`usize::MAX`: one piece).
 fn copp_fixed_grid_time(dir: &Path, idx: usize, window: usize, threads: usize) -> f64 {
-    let (m, path, _) = copp_case(dir, idx);
-    let mut o = Options {
-        refine_until_verified: false,
-        jerk: JerkOptions {
-            window,
-            ..JerkOptions::default()
-        },
-        ..copp_options()
+    let jerk = JerkOptions {
+        window,
+        ..JerkOptions::default()
     };
-    o.solver.threads = threads;
-    optimize_joint(&m, &path, &o)
-        .expect("solve")
-        .schedule
-        .cycle_time
+    copp_time_with(dir, idx, jerk, threads)
 }
 
 /// Cutting a span into windows at velocity plateaus (b and ü fixed there, each window its own
