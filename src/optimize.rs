@@ -341,7 +341,13 @@ fn optimize_path(
     let mark = LOCAL_MARK * options.verify.tolerance;
     let (mut v, mut marks) = plan.verify_marked(&lv, options, mark)?;
     let mut round = 0;
-    while !v.verified && options.refine_until_verified && round < options.local_rounds {
+    // The worst excess over a limit after each round ([`diverging`]).
+    let mut excess = vec![worst_excess(&v)];
+    while !v.verified
+        && options.refine_until_verified
+        && round < options.local_rounds
+        && !diverging(&excess)
+    {
         tracing::debug!(
             "verify: {} intervals ({} marked), worst {:?}",
             v.violating_intervals,
@@ -366,6 +372,11 @@ fn optimize_path(
             t0.elapsed().as_secs_f64() - solved
         );
         round += 1;
+        excess.push(worst_excess(&v));
+    }
+    let diverged = diverging(&excess);
+    if diverged && !v.verified {
+        tracing::debug!("local refinement stopped: the worst excess grew round after round");
     }
     if round > 0 && !v.verified {
         lv.rebuild_schedule(&plan)?;
@@ -381,7 +392,7 @@ fn optimize_path(
     let mut tries = 0;
     while !v.verified
         && options.refine_until_verified
-        && round >= options.local_rounds
+        && (round >= options.local_rounds || diverged)
         && tries < SLOW_DOWN_TRIES
     {
         let mut factors: Vec<f64> = vec![1.0; lv.solutions.len()];
@@ -572,6 +583,27 @@ const MAX_LOCAL_SPLIT: usize = 8;
 /// Rounds of local refinement where the re-simulation failed before giving up (each round
 /// divides the excess between stations by four or more).
 const MAX_LOCAL_ROUNDS: usize = 12;
+
+/// The worst ratio to a limit a re-simulation found, less one (0 where it found none).
+fn worst_excess(v: &crate::verify::Verification) -> f64 {
+    v.violations
+        .iter()
+        .map(|w| w.ratio - 1.0)
+        .fold(0.0, f64::max)
+}
+
+/// Whether the local refinement is making things worse: the worst excess over a limit at
+/// least doubled in each of the last two rounds. Dividing intervals where the re-simulation
+/// found a limit exceeded shrinks the excess as Δu² wherever the profile converges; where it
+/// grows instead (a bulge of jerk between the sites near a rest end: 1.002, 1.011, 2.4, 21, …
+/// of the limit), each round's stations multiply by up to eight, and twelve rounds would take
+/// minutes and gigabytes before the spans are slowed down. Then they are slowed down at once.
+fn diverging(excess: &[f64]) -> bool {
+    match excess {
+        [.., a, b, c] => *b >= 2.0 * a && *c >= 2.0 * b && *c > 0.0,
+        _ => false,
+    }
+}
 
 /// Times the spans still over a limit after the local refinement are slowed down (the
 /// violations a re-simulation lists are its worst, so a span it left out may show in the
@@ -1787,6 +1819,20 @@ mod tests {
     }
 
     /// m parts take an excess e (∝ Δu²) to e/m²: at most a quarter of the tolerance when m is
+    /// The local refinement gives up on an excess that doubles twice in a row, not on one
+    /// that wanders or shrinks.
+    #[test]
+    fn a_refinement_whose_excess_keeps_doubling_is_diverging() {
+        assert!(!diverging(&[0.019]));
+        assert!(!diverging(&[0.019, 0.0028]));
+        assert!(!diverging(&[0.019, 0.0028, 0.0011]));
+        assert!(!diverging(&[0.002, 0.003, 0.004]));
+        assert!(diverging(&[0.002, 0.011, 1.4]));
+        assert!(diverging(&[0.5, 0.002, 0.011, 1.4]));
+        assert!(!diverging(&[0.002, 0.011, 0.015]));
+        assert!(!diverging(&[0.0, 0.0, 0.0]));
+    }
+
     /// not capped; at least a halving; at most MAX_LOCAL_SPLIT.
     #[test]
     fn local_parts_bring_a_second_order_excess_under_the_tolerance() {
