@@ -376,7 +376,9 @@ fn optimize_path(
     }
     let diverged = diverging(&excess);
     if diverged && !v.verified {
-        tracing::debug!("local refinement stopped: the worst excess grew round after round");
+        tracing::debug!(
+            "local refinement stopped: the worst excess grew round after round: {excess:?}"
+        );
     }
     if round > 0 && !v.verified {
         lv.rebuild_schedule(&plan)?;
@@ -593,17 +595,24 @@ fn worst_excess(v: &crate::verify::Verification) -> f64 {
 }
 
 /// Whether the local refinement is making things worse: the worst excess over a limit at
-/// least doubled in each of the last two rounds. Dividing intervals where the re-simulation
-/// found a limit exceeded shrinks the excess as Δu² wherever the profile converges; where it
-/// grows instead (a bulge of jerk between the sites near a rest end: 1.002, 1.011, 2.4, 21, …
-/// of the limit), each round's stations multiply by up to eight, and twelve rounds would take
-/// minutes and gigabytes before the spans are slowed down. Then they are slowed down at once.
+/// least doubled in each of the last two rounds, to [`DIVERGED_EXCESS`] or more. Dividing
+/// intervals where the re-simulation found a limit exceeded shrinks the excess as Δu²
+/// wherever the profile converges; where it grows instead (a bulge of jerk between the sites
+/// near a rest end: 1.002, 1.011, 2.4, 21, … of the limit), each round's stations multiply by
+/// up to eight, and twelve rounds would take minutes and gigabytes before the spans are
+/// slowed down. Then they are slowed down at once. Excesses of a few per cent wander from
+/// interval to interval as rounds move the clock and are left to the rounds: CAMotics bear
+/// with jerk limits went 4.2, 6.8, 1.1, 3.4, 8.0 % and then settled.
 fn diverging(excess: &[f64]) -> bool {
     match excess {
-        [.., a, b, c] => *b >= 2.0 * a && *c >= 2.0 * b && *c > 0.0,
+        [.., a, b, c] => *b >= 2.0 * a && *c >= 2.0 * b && *c >= DIVERGED_EXCESS,
         _ => false,
     }
 }
+
+/// The excess over a limit (25 %) below which the local refinement is not judged diverging
+/// (the runaways seen reached 40 % and 140 % in their third round, the wandering 8 %).
+const DIVERGED_EXCESS: f64 = 0.25;
 
 /// Times the spans still over a limit after the local refinement are slowed down (the
 /// violations a re-simulation lists are its worst, so a span it left out may show in the
@@ -1831,6 +1840,10 @@ mod tests {
         assert!(diverging(&[0.5, 0.002, 0.011, 1.4]));
         assert!(!diverging(&[0.002, 0.011, 0.015]));
         assert!(!diverging(&[0.0, 0.0, 0.0]));
+        // Small excesses that wander: left to the rounds.
+        assert!(!diverging(&[0.0005, 0.0012, 0.0073]));
+        assert!(diverging(&[0.0028, 0.0276, 0.395]));
+        assert!(!diverging(&[0.042, 0.068, 0.011, 0.0335, 0.0798]));
     }
 
     /// not capped; at least a halving; at most MAX_LOCAL_SPLIT.
