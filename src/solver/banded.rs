@@ -16,9 +16,10 @@
 //! (ordering, symbolic analysis, its cone machinery). The factorisation is not where most of an
 //! iteration goes, though: the products with the constraint matrix (a few per iteration, O(nnz)
 //! each) cost about as much in either solver. Measured on the 20 COPP paths with jerk limits
-//! (one thread, CPU time of the whole jerk-limited solve): 9.4 s with Clarabel for every
-//! subproblem, 6.6 s with this solver; the LinuxCNC impeller with jerk = 10 × acceleration
-//! 26.9 s → 14.5 s.
+//! (one thread, CPU time of the whole jerk-limited solve, the same minutes): 9.4 s with
+//! Clarabel for every subproblem, 6.5 s with this solver; the LinuxCNC impeller with jerk =
+//! 10 × acceleration (`benches/realworld.sh`, 2026-11-26 14:15 and 19:44): 27.9 → 16.3 s of
+//! CPU, 14.3 → 8.4 s on two cores.
 //!
 //! The method is Mehrotra's predictor–corrector (Nocedal & Wright, *Numerical Optimization*,
 //! 2nd ed., §14.2, also for the starting point's shift; the least-squares start is CVXOPT's,
