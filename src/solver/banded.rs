@@ -213,7 +213,7 @@ impl Kkt {
         if bw > MAX_BANDWIDTH {
             return Err(Unsolved::NotBanded(bw));
         }
-        Ok(Kkt {
+        let mut kkt = Kkt {
             pos_col,
             pos_eq,
             bw,
@@ -225,7 +225,9 @@ impl Kkt {
             k0: Vec::new(),
             pair_start: Vec::new(),
             pairs: Vec::new(),
-        })
+        };
+        kkt.pairs(lp);
+        Ok(kkt)
     }
 
     fn at(&mut self, i: usize, j: usize) -> &mut f64 {
@@ -257,8 +259,10 @@ impl Kkt {
         self.pair_start.push(self.pairs.len());
     }
 
-    /// Fills and factorises K for inequality weights `w` (one per inequality row).
-    fn factor(&mut self, lp: &Lp, w: &[f64], rho: f64, delta: f64) {
+    /// Fills and factorises K for inequality weights `w` (one per inequality row), with ρ =
+    /// [`STATIC_REG`] and δ = [`EQ_REG`].
+    fn factor(&mut self, lp: &Lp, w: &[f64]) {
+        let (rho, delta) = (STATIC_REG, EQ_REG);
         self.band.fill(0.0);
         for (r, &wr) in w.iter().enumerate() {
             for &(at, v) in &self.pairs[self.pair_start[r]..self.pair_start[r + 1]] {
@@ -374,8 +378,6 @@ struct Newton<'a> {
     kkt: Kkt,
     /// W = λ/s per inequality.
     w: Vec<f64>,
-    rho: f64,
-    delta: f64,
     rhs: Vec<f64>,
     sol: Vec<f64>,
     res: Vec<f64>,
@@ -407,7 +409,8 @@ impl Newton<'_> {
         }
     }
 
-    /// Solves [GᵀWG Eᵀ; E 0](dz, dnu) = (a, b) (a per column, b per equality), refined twice.
+    /// Solves [GᵀWG Eᵀ; E 0](dz, dnu) = (a, b) (a per column, b per equality), with
+    /// [`REFINE`] steps of refinement.
     fn solve(&mut self, a: &[f64], b: &[f64], dz: &mut [f64], dnu: &mut [f64]) {
         let (lp, size) = (self.lp, self.kkt.size);
         self.rhs.resize(size, 0.0);
@@ -473,7 +476,8 @@ pub(crate) fn solve(
     tol_gap: f64,
 ) -> Result<LpSolution, Unsolved> {
     let n = q.len();
-    // Rows scaled to unit largest coefficient.
+    // Rows scaled to unit largest coefficient (before Ruiz's passes below; they start from
+    // it).
     let mut lp = Lp {
         n,
         start: Vec::with_capacity(rows.len() + 1),
@@ -532,8 +536,7 @@ pub(crate) fn solve(
         *qj *= cost;
     }
     let m = lp.rows() - n_eq;
-    let mut kkt = Kkt::new(&lp)?;
-    kkt.pairs(&lp);
+    let kkt = Kkt::new(&lp)?;
     let (h, f) = (&lp.rhs[n_eq..], &lp.rhs[..n_eq]);
     let (norm_h, norm_f, norm_q) = (norm_inf(h), norm_inf(f), norm_inf(&lp.q));
 
@@ -541,8 +544,6 @@ pub(crate) fn solve(
         lp: &lp,
         kkt,
         w: vec![1.0; m],
-        rho: STATIC_REG,
-        delta: EQ_REG,
         rhs: Vec::new(),
         sol: Vec::new(),
         res: Vec::new(),
@@ -555,13 +556,12 @@ pub(crate) fn solve(
 
     // Starting point (CVXOPT): z minimises |G z − h|² subject to E z = f, s = h − G z; λ is
     // the least-norm dual G w with Gᵀ(G w) + Eᵀ ν = −q, E w = 0; both shifted into the interior.
-    nt.kkt.factor(&lp, &nt.w, nt.rho, nt.delta);
+    nt.kkt.factor(&lp, &nt.w);
     {
         let mut hg = vec![0.0; lp.rows()];
         hg[n_eq..].copy_from_slice(h);
         lp.mul_t(&hg, &mut col);
-        let a = col.clone();
-        nt.solve(&a, f, &mut z, &mut nu);
+        nt.solve(&col, f, &mut z, &mut nu);
         lp.mul(&z, &mut ax);
         for i in 0..m {
             s[i] = h[i] - ax[n_eq + i];
@@ -613,7 +613,7 @@ pub(crate) fn solve(
     let mut y = vec![0.0; lp.rows()];
     let mut a_rhs = vec![0.0; n];
     let mut t = vec![0.0; lp.rows()];
-    let neg_re = |r_e: &[f64]| r_e.iter().map(|v| -v).collect::<Vec<f64>>();
+    let mut neg_r_e = vec![0.0; n_eq];
 
     let mut best_merit = f64::INFINITY;
     let mut inv_s = vec![0.0; m];
@@ -631,6 +631,7 @@ pub(crate) fn solve(
         }
         for e in 0..n_eq {
             r_e[e] = ax[e] - f[e];
+            neg_r_e[e] = -r_e[e];
         }
         let norm_z = norm_inf(&z);
         let pres = norm_inf(&r_p).max(norm_inf(&r_e)) / (1.0 + norm_h.max(norm_f).max(norm_z));
@@ -665,7 +666,7 @@ pub(crate) fn solve(
             inv_s[i] = 1.0 / s[i];
             nt.w[i] = lam[i] * inv_s[i];
         }
-        nt.kkt.factor(&lp, &nt.w, nt.rho, nt.delta);
+        nt.kkt.factor(&lp, &nt.w);
 
         // One Newton solve for the complementarity right-hand side r_c:
         // GᵀWG dz + Eᵀ dν = −r_d − Gᵀ S⁻¹(Λ r_p − r_c), E dz = −r_e;
@@ -684,7 +685,7 @@ pub(crate) fn solve(
             for (a, r) in a_rhs.iter_mut().zip(&r_d) {
                 *a = -r - *a;
             }
-            nt.solve(&a_rhs, &neg_re(&r_e), dz, dnu);
+            nt.solve(&a_rhs, &neg_r_e, dz, dnu);
             lp.mul(dz, &mut t);
             for i in 0..m {
                 ds[i] = -r_p[i] - t[n_eq + i];

@@ -1404,6 +1404,14 @@ struct Program<'a> {
     lp_solver: LpSolver,
 }
 
+/// What Clarabel returned for one subproblem ([`Program::clarabel`]).
+struct ClarabelAnswer {
+    x: Vec<f64>,
+    status: Status,
+    iterations: u32,
+    solve_time: f64,
+}
+
 impl<'a> Program<'a> {
     fn new(
         p: &'a SpanProblem,
@@ -1784,6 +1792,51 @@ impl<'a> Program<'a> {
     /// One convex subproblem, the jerk rows linearised at the profile (`bbar`, `abar`; without
     /// `abar`, the acceleration-limited reach profile, whose b̄ inside an interval is
     /// interpolated linearly). `carried`: the previous subproblem's active rows, updated.
+    /// One subproblem by Clarabel: `all`'s first `n_eq` rows equalities, then the velocity
+    /// bounds and `n_rows` active rows (non-negative cone), then the cones.
+    fn clarabel(
+        &self,
+        all: Rows,
+        n_eq: usize,
+        n_rows: usize,
+        q: &[f64],
+        settings: &SolverSettings,
+        gap: f64,
+    ) -> Result<ClarabelAnswer> {
+        let (m, nv) = (all.h.len(), self.lay.len());
+        let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
+        let pmat = CscMatrix::zeros((nv, nv));
+        let mut cones = Vec::with_capacity(2 + self.n_soc);
+        cones.push(SupportedConeT::ZeroConeT(n_eq));
+        if self.lin.len() + n_rows > 0 {
+            cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
+        }
+        cones.extend(std::iter::repeat_n(
+            SupportedConeT::SecondOrderConeT(3),
+            self.n_soc,
+        ));
+        let s = settings.clarabel(gap)?;
+        let mut solver = DefaultSolver::new(&pmat, q, &a, &all.h, &cones, s)
+            .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
+        super::run_clarabel(&mut solver);
+        let sol = &mut solver.solution;
+        let status = match sol.status {
+            SolverStatus::Solved => Status::Optimal,
+            SolverStatus::AlmostSolved => Status::AlmostOptimal,
+            other => {
+                return Err(Error::Solver(format!(
+                    "jerk-limited subproblem: Clarabel stopped with status {other:?}"
+                )));
+            }
+        };
+        Ok(ClarabelAnswer {
+            x: std::mem::take(&mut sol.x),
+            status,
+            iterations: sol.iterations,
+            solve_time: sol.solve_time,
+        })
+    }
+
     fn solve(
         &self,
         bbar: &[f64],
@@ -1889,7 +1942,6 @@ impl<'a> Program<'a> {
                 n_rows += 1;
             }
             all.append(&self.soc);
-            let m = all.h.len();
             // A linear subproblem is banded: the banded interior-point method first; Clarabel
             // where it does not answer (it then also tells infeasibility apart). Its gap is a
             // hundredth of Clarabel's: at Clarabel's, ü at stations on a velocity plateau (where
@@ -1897,53 +1949,26 @@ impl<'a> Program<'a> {
             // the bundled problem's rest end the jerk between the LP's sites, which the 1 ms
             // re-simulation checks, came out 0.2 % over its limit; two or three iterations more
             // settle it (the COPP paths: the same cycle times to 5e-7).
-            let banded = (self.n_soc == 0 && self.lp_solver == LpSolver::Banded)
-                .then(|| {
-                    let started = std::time::Instant::now();
-                    let r = super::banded::solve(&q, &all, n_eq, settings.tol_feas, 1e-2 * gap);
-                    (r, started.elapsed().as_secs_f64())
-                })
-                .and_then(|(r, secs)| match r {
-                    Ok(sol) => Some((sol, secs)),
-                    Err(e) => {
-                        tracing::debug!("  banded LP: {e:?}; Clarabel instead");
-                        solve_time += secs;
-                        None
-                    }
-                });
-            let (x_new, status) = if let Some((sol, secs)) = banded {
-                iterations += sol.iterations;
-                solve_time += secs;
-                (sol.x, Status::Optimal)
+            let banded = if self.n_soc == 0 && self.lp_solver == LpSolver::Banded {
+                let started = std::time::Instant::now();
+                let r = super::banded::solve(&q, &all, n_eq, settings.tol_feas, 1e-2 * gap);
+                solve_time += started.elapsed().as_secs_f64();
+                r.map_err(|e| tracing::debug!("  banded LP: {e:?}; Clarabel instead"))
+                    .ok()
             } else {
-                let a = CscMatrix::new_from_triplets(m, nv, all.i, all.j, all.v);
-                let pmat = CscMatrix::zeros((nv, nv));
-                let mut cones = Vec::with_capacity(2 + self.n_soc);
-                cones.push(SupportedConeT::ZeroConeT(n_eq));
-                if self.lin.len() + n_rows > 0 {
-                    cones.push(SupportedConeT::NonnegativeConeT(self.lin.len() + n_rows));
+                None
+            };
+            let (x_new, status) = match banded {
+                Some(sol) => {
+                    iterations += sol.iterations;
+                    (sol.x, Status::Optimal)
                 }
-                cones.extend(std::iter::repeat_n(
-                    SupportedConeT::SecondOrderConeT(3),
-                    self.n_soc,
-                ));
-                let s = settings.clarabel(gap)?;
-                let mut solver = DefaultSolver::new(&pmat, &q, &a, &all.h, &cones, s)
-                    .map_err(|e| Error::Solver(format!("problem setup: {e:?}")))?;
-                super::run_clarabel(&mut solver);
-                let sol = &solver.solution;
-                iterations += sol.iterations;
-                solve_time += sol.solve_time;
-                let status = match sol.status {
-                    SolverStatus::Solved => Status::Optimal,
-                    SolverStatus::AlmostSolved => Status::AlmostOptimal,
-                    other => {
-                        return Err(Error::Solver(format!(
-                            "jerk-limited subproblem: Clarabel stopped with status {other:?}"
-                        )));
-                    }
-                };
-                (std::mem::take(&mut solver.solution.x), status)
+                None => {
+                    let sol = self.clarabel(all, n_eq, n_rows, &q, settings, gap)?;
+                    iterations += sol.iterations;
+                    solve_time += sol.solve_time;
+                    (sol.x, sol.status)
+                }
             };
             // Any omitted row violated: add it, and with it every omitted row near its bound
             // at this solution (the next solution is likely to lean on them too); after
