@@ -341,13 +341,52 @@ fn optimize_path(
     let mark = LOCAL_MARK * options.verify.tolerance;
     let (mut v, mut marks) = plan.verify_marked(&lv, options, mark)?;
     let mut round = 0;
-    // The worst excess over a limit after each round ([`diverging`]).
-    let mut excess = vec![worst_excess(&v)];
-    while !v.verified
-        && options.refine_until_verified
-        && round < options.local_rounds
-        && !diverging(&excess)
-    {
+    let n_spans = lv.problems.len();
+    // Per span, its worst excess over a limit in the last verifications ([`diverging`]).
+    let mut excess: Vec<Vec<f64>> = vec![Vec::new(); n_spans];
+    record_excess(&mut excess, &v);
+    // Spans slowed down instead of refined, each one's slow-down factor so far, and the time
+    // the slow-downs cost.
+    let mut frozen = vec![false; n_spans];
+    let mut slowed: Vec<f64> = vec![1.0; n_spans];
+    let mut slow_cost = 0.0;
+    // A span whose refinement diverged that cannot be slowed down on its own.
+    let mut stuck = false;
+    while !v.verified && options.refine_until_verified && round < options.local_rounds {
+        // A span whose excess grows round after round as its intervals are divided runs
+        // slower instead, and the others go on being refined. (Stopping the whole refinement
+        // there left the other spans' small excesses to the slow-down below, whose every try
+        // moved the clock and found new ones: the Röders finishing program with jerk limits
+        // failed so, after one span's excess went 0.7 %, 15 %, 220 % on intervals of 1e-7 mm
+        // at a rest end.)
+        let runaway: Vec<bool> = (0..n_spans)
+            .map(|s| {
+                excess[s].last().is_some_and(|&e| e > 0.0) && (frozen[s] || diverging(&excess[s]))
+            })
+            .collect();
+        if runaway.contains(&true) {
+            let Some(factors) =
+                slow_down_factors(&v.violations, n_spans, |s| runaway[s], |s| at_rest(&lv, s))
+            else {
+                stuck = true;
+                break;
+            };
+            tracing::debug!(
+                "local refinement round {round}: {} span(s) slowed down (their excess grew \
+                 round after round, or the solver failed on their finer grid)",
+                factors.iter().filter(|&&f| f > 1.0).count()
+            );
+            slow_cost += slow_spans(&mut lv, &factors, &mut slowed)?;
+            for (si, &f) in factors.iter().enumerate() {
+                frozen[si] |= f > 1.0;
+            }
+            lv.rebuild_schedule(&plan)?;
+            (v, marks) = plan.verify_marked(&lv, options, mark)?;
+            round += 1;
+            record_excess(&mut excess, &v);
+            continue;
+        }
+        marks.retain(|m| !frozen[m.span]);
         tracing::debug!(
             "verify: {} intervals ({} marked), worst {:?}",
             v.violating_intervals,
@@ -357,11 +396,19 @@ fn optimize_path(
         let t0 = std::time::Instant::now();
         plan.progress
             .stage("adding stations where the re-simulation found a limit exceeded");
-        let touched = plan.refine_where_violated(&mut lv, &marks, options)?;
+        let (touched, failed) = plan.refine_where_violated(&mut lv, &marks, options)?;
         let solved = t0.elapsed().as_secs_f64();
-        // The spans solved again first, on their own (the others passed and have not changed);
-        // the whole path once they pass (its clock samples each span at other instants).
-        (v, marks) = plan.verify_spans(&lv, &touched, options, mark)?;
+        // The spans solved again first, on their own (the others passed and have not changed),
+        // with those the solver failed on, which are slowed down in the next round where they
+        // exceed a limit; the whole path once they pass (its clock samples each span at other
+        // instants).
+        let mut check = touched.clone();
+        for &si in &failed {
+            frozen[si] = true;
+            check.push(si);
+        }
+        check.sort_unstable();
+        (v, marks) = plan.verify_spans(&lv, &check, options, mark)?;
         if v.verified {
             lv.rebuild_schedule(&plan)?;
             (v, marks) = plan.verify_marked(&lv, options, mark)?;
@@ -372,12 +419,12 @@ fn optimize_path(
             t0.elapsed().as_secs_f64() - solved
         );
         round += 1;
-        excess.push(worst_excess(&v));
+        record_excess(&mut excess, &v);
     }
-    let diverged = diverging(&excess);
-    if diverged && !v.verified {
+    if stuck {
         tracing::debug!(
-            "local refinement stopped: the worst excess grew round after round: {excess:?}"
+            "local refinement stopped: a span's worst excess grew round after round, and it \
+             does not start and end at rest"
         );
     }
     if round > 0 && !v.verified {
@@ -385,40 +432,21 @@ fn optimize_path(
     }
     // The local refinement did not settle (each round's re-simulation found the excess in
     // other intervals): the spans still over a limit run slower instead, each by the least
-    // factor that brings its worst excess within the limit (velocity and feed fall as 1/f,
-    // acceleration and chord error as 1/f², jerk as 1/f³), so that the schedule returned
-    // keeps every limit; the time that costs is added to the error estimate and said.
-    // Each span's factor so far (a span a later try slows again multiplies its factors).
-    let mut slowed: Vec<f64> = vec![1.0; lv.solutions.len()];
-    let before_slowing = lv.schedule.cycle_time;
+    // factor that brings its worst excess within the limit ([`slow_down_factors`]), so that
+    // the schedule returned keeps every limit; the time that costs is added to the error
+    // estimate and said.
     let mut tries = 0;
     while !v.verified
         && options.refine_until_verified
-        && (round >= options.local_rounds || diverged)
+        && (round >= options.local_rounds || stuck)
         && tries < SLOW_DOWN_TRIES
     {
-        let mut factors: Vec<f64> = vec![1.0; lv.solutions.len()];
-        for w in &v.violations {
-            let k = match w.kind {
-                Quantity::Velocity | Quantity::Feed => 1.0,
-                Quantity::Acceleration | Quantity::Chord => 2.0,
-                Quantity::Jerk => 3.0,
-            };
-            let p = &lv.problems[w.span];
-            if !w.ratio.is_finite() || p.b_start != 0.0 || p.b_end != 0.0 {
-                factors.clear();
-                break;
-            }
-            let f = w.ratio.powf(1.0 / k) * (1.0 + SLOW_DOWN_MARGIN);
-            factors[w.span] = factors[w.span].max(f);
-        }
-        if factors.is_empty() {
+        let Some(factors) =
+            slow_down_factors(&v.violations, n_spans, |_| true, |s| at_rest(&lv, s))
+        else {
             break;
-        }
-        for (si, &f) in factors.iter().enumerate().filter(|(_, f)| **f > 1.0) {
-            lv.solutions[si].slow_down(f);
-            slowed[si] *= f;
-        }
+        };
+        slow_cost += slow_spans(&mut lv, &factors, &mut slowed)?;
         lv.rebuild_schedule(&plan)?;
         v = plan.verify_marked(&lv, options, mark)?.0;
         tries += 1;
@@ -428,7 +456,7 @@ fn optimize_path(
     let spans_slowed = slowed.iter().filter(|&&f| f > 1.0).count();
     if spans_slowed > 0 && v.verified {
         let largest = slowed.iter().copied().fold(1.0, f64::max);
-        let cost = lv.schedule.cycle_time - before_slowing;
+        let cost = slow_cost;
         let added = cost / lv.schedule.cycle_time;
         error_estimate = error_estimate.map(|e| e + added);
         let why = format!(
@@ -586,12 +614,68 @@ const MAX_LOCAL_SPLIT: usize = 8;
 /// divides the excess between stations by four or more).
 const MAX_LOCAL_ROUNDS: usize = 12;
 
-/// The worst ratio to a limit a re-simulation found, less one (0 where it found none).
-fn worst_excess(v: &crate::verify::Verification) -> f64 {
-    v.violations
-        .iter()
-        .map(|w| w.ratio - 1.0)
-        .fold(0.0, f64::max)
+/// Appends each span's worst excess over a limit in `v` (its worst ratio less one, 0 where it
+/// has none) to that span's history, of which the last three are kept ([`diverging`]).
+fn record_excess(excess: &mut [Vec<f64>], v: &Verification) {
+    let mut worst = vec![0.0_f64; excess.len()];
+    for w in &v.violations {
+        worst[w.span] = worst[w.span].max(w.ratio - 1.0);
+    }
+    for (h, w) in excess.iter_mut().zip(worst) {
+        if h.len() == 3 {
+            h.remove(0);
+        }
+        h.push(w);
+    }
+}
+
+/// Whether span `si` of `lv` starts and ends at rest (so that it can run slower on its own).
+fn at_rest(lv: &Level, si: usize) -> bool {
+    let p = &lv.problems[si];
+    p.b_start == 0.0 && p.b_end == 0.0
+}
+
+/// Runs each span `si` of `lv` slower by `factors[si]` where that is above 1 (its time then
+/// grows by that factor: b and ü scale by 1/f²), multiplying `slowed[si]`; returns the time
+/// added.
+fn slow_spans(lv: &mut Level, factors: &[f64], slowed: &mut [f64]) -> Result<f64> {
+    let mut cost = 0.0;
+    for (si, &f) in factors.iter().enumerate().filter(|(_, f)| **f > 1.0) {
+        let t: f64 = interval_times(&lv.problems[si], &lv.solutions[si])?
+            .iter()
+            .sum();
+        lv.solutions[si].slow_down(f);
+        slowed[si] *= f;
+        cost += (f - 1.0) * t;
+    }
+    Ok(cost)
+}
+
+/// Per span, the least factor by which running it slower brings the worst of its violations
+/// in `v` within the limit, with [`SLOW_DOWN_MARGIN`] (velocity and feed fall as 1/f,
+/// acceleration and chord error as 1/f², jerk as 1/f³), for the spans `which` selects, 1 for
+/// the others (of `n`); `None` where such a span cannot be slowed down on its own (it does not
+/// start and end at rest: `at_rest`) or an excess is not finite.
+fn slow_down_factors(
+    violations: &[Violation],
+    n: usize,
+    which: impl Fn(usize) -> bool,
+    at_rest: impl Fn(usize) -> bool,
+) -> Option<Vec<f64>> {
+    let mut factors = vec![1.0_f64; n];
+    for w in violations.iter().filter(|w| which(w.span)) {
+        let k = match w.kind {
+            Quantity::Velocity | Quantity::Feed => 1.0,
+            Quantity::Acceleration | Quantity::Chord => 2.0,
+            Quantity::Jerk => 3.0,
+        };
+        if !w.ratio.is_finite() || !at_rest(w.span) {
+            return None;
+        }
+        let f = w.ratio.powf(1.0 / k) * (1.0 + SLOW_DOWN_MARGIN);
+        factors[w.span] = factors[w.span].max(f);
+    }
+    Some(factors)
 }
 
 /// Whether the local refinement is making things worse: the worst excess over a limit at
@@ -1593,13 +1677,14 @@ impl Plan<'_> {
     /// nearly: [`LOCAL_MARK`]) into equal parts (as many as its excess asks, [`local_parts`])
     /// and solves the spans concerned again, in parallel: the excess between stations falls as
     /// Δu², so a round or two suffice, and only where the path needs it. Returns the spans
-    /// solved again; the level's schedule is left for the caller to rebuild.
+    /// solved again and those, from rest to rest, the solver failed on, which keep their
+    /// profiles; the level's schedule is left for the caller to rebuild.
     fn refine_where_violated(
         &self,
         lv: &mut Level,
         marks: &[Violation],
         options: &Options,
-    ) -> Result<Vec<usize>> {
+    ) -> Result<(Vec<usize>, Vec<usize>)> {
         use rayon::prelude::*;
         let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); lv.problems.len()];
         for viol in marks {
@@ -1612,7 +1697,7 @@ impl Plan<'_> {
             .enumerate()
             .filter(|(_, ks)| !ks.is_empty())
             .collect();
-        let solved: Vec<(usize, SpanProblem, SpanSolution)> = jobs
+        let solved: Vec<(usize, Option<(SpanProblem, SpanSolution)>)> = jobs
             .into_par_iter()
             .map(|(si, mut ks)| {
                 // One entry per interval (its worst violation's, the most parts).
@@ -1627,15 +1712,29 @@ impl Plan<'_> {
                 }
                 self.check_travel(si, &p)?;
                 (p.b_start, p.b_end) = (old.b_start, old.b_end);
-                let s =
-                    self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true)?;
-                Ok((si, p, s))
+                match self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true) {
+                    Ok(s) => Ok((si, Some((p, s)))),
+                    // A span from rest to rest whose finer grid the solver fails on keeps its
+                    // profile, to be slowed down where it exceeds a limit (the caller's
+                    // `failed`): one such span failed the whole Röders finishing program with
+                    // jerk limits (Clarabel's InsufficientProgress on intervals of 1e-6 mm
+                    // at a curvature peak).
+                    Err(Error::Solver(e)) if old.b_start == 0.0 && old.b_end == 0.0 => {
+                        tracing::debug!("span {si}: {e}; its profile is kept");
+                        Ok((si, None))
+                    }
+                    Err(e) => Err(e),
+                }
             })
             .collect::<Vec<Result<_>>>()
             .into_iter()
             .collect::<Result<_>>()?;
-        let mut touched = Vec::with_capacity(solved.len());
-        for (si, p, s) in solved {
+        let (mut touched, mut failed) = (Vec::with_capacity(solved.len()), Vec::new());
+        for (si, solved) in solved {
+            let Some((p, s)) = solved else {
+                failed.push(si);
+                continue;
+            };
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
@@ -1643,7 +1742,7 @@ impl Plan<'_> {
             lv.solutions[si] = s;
             touched.push(si);
         }
-        Ok(touched)
+        Ok((touched, failed))
     }
 
     /// Re-simulates spans `which` of a level on their own (each on its own clock, from 0), with
@@ -1827,7 +1926,6 @@ mod tests {
         assert_eq!(divide(&u, &[]), u.to_vec());
     }
 
-    /// m parts take an excess e (∝ Δu²) to e/m²: at most a quarter of the tolerance when m is
     /// The local refinement gives up on an excess that doubles twice in a row, not on one
     /// that wanders or shrinks.
     #[test]
@@ -1846,6 +1944,90 @@ mod tests {
         assert!(!diverging(&[0.042, 0.068, 0.011, 0.0335, 0.0798]));
     }
 
+    /// Each span's history holds its last three worst excesses, 0 where it had none; a span
+    /// whose excess keeps doubling is told apart from one that converges beside it.
+    #[test]
+    fn each_span_keeps_its_own_excess_history() {
+        let violation = |span: usize, ratio: f64| Violation {
+            span,
+            interval: 0,
+            u: 0.0,
+            t: 0.0,
+            axis: Some(0),
+            kind: Quantity::Jerk,
+            value: ratio,
+            limit: 1.0,
+            ratio,
+        };
+        let verification = |violations: Vec<Violation>| Verification {
+            verified: violations.is_empty(),
+            violating_intervals: violations.len(),
+            violations,
+            ..Verification::default()
+        };
+        let mut excess = vec![Vec::new(); 3];
+        for round in [
+            vec![
+                violation(0, 1.003),
+                violation(1, 1.004),
+                violation(1, 1.002),
+            ],
+            vec![violation(0, 1.02), violation(1, 1.001)],
+            vec![violation(0, 1.3)],
+            vec![violation(0, 1.9), violation(2, 1.01)],
+        ] {
+            record_excess(&mut excess, &verification(round));
+        }
+        let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        assert!(close(&excess[0], &[0.02, 0.3, 0.9]), "{:?}", excess[0]);
+        assert!(close(&excess[1], &[0.001, 0.0, 0.0]), "{:?}", excess[1]);
+        assert!(close(&excess[2], &[0.0, 0.0, 0.01]), "{:?}", excess[2]);
+        assert!(excess.iter().all(|h| h.len() == 3));
+        assert!(!diverging(&excess[1]) && !diverging(&excess[2]));
+        // 0.003, 0.02, 0.3 doubled twice to over a quarter.
+        let mut first = vec![Vec::new(); 1];
+        for r in [1.003, 1.02, 1.3] {
+            record_excess(&mut first, &verification(vec![violation(0, r)]));
+        }
+        assert!(diverging(&first[0]));
+    }
+
+    /// A span is slowed by the least factor that brings its worst excess within the limit:
+    /// velocity falls as 1/f, acceleration as 1/f², jerk as 1/f³; a span that does not start
+    /// and end at rest cannot be slowed on its own.
+    #[test]
+    fn slow_down_factors_follow_the_powers_of_each_quantity() {
+        let violation = |span: usize, kind: Quantity, ratio: f64| Violation {
+            span,
+            interval: 0,
+            u: 0.0,
+            t: 0.0,
+            axis: Some(0),
+            kind,
+            value: ratio,
+            limit: 1.0,
+            ratio,
+        };
+        let vs = [
+            violation(0, Quantity::Jerk, 1.331),
+            violation(0, Quantity::Velocity, 1.05),
+            violation(1, Quantity::Acceleration, 1.21),
+            violation(2, Quantity::Feed, 1.5),
+        ];
+        let m = 1.0 + SLOW_DOWN_MARGIN;
+        let f = slow_down_factors(&vs, 4, |s| s < 2, |_| true).expect("at rest");
+        assert!((f[0] - 1.1 * m).abs() < 1e-12, "{f:?}");
+        assert!((f[1] - 1.1 * m).abs() < 1e-12, "{f:?}");
+        assert_eq!((f[2], f[3]), (1.0, 1.0));
+        // After slowing by f, each excess is within its limit: r / f^k ≤ 1.
+        assert!(1.331 / f[0].powi(3) <= 1.0 && 1.05 / f[0] <= 1.0 && 1.21 / f[1].powi(2) <= 1.0);
+        assert!(slow_down_factors(&vs, 4, |_| true, |s| s != 2).is_none());
+        assert!(slow_down_factors(&vs, 4, |s| s < 2, |s| s != 2).is_some());
+        let bad = [violation(0, Quantity::Jerk, f64::INFINITY)];
+        assert!(slow_down_factors(&bad, 1, |_| true, |_| true).is_none());
+    }
+
+    /// m parts take an excess e (∝ Δu²) to e/m²: at most a quarter of the tolerance when m is
     /// not capped; at least a halving; at most MAX_LOCAL_SPLIT.
     #[test]
     fn local_parts_bring_a_second_order_excess_under_the_tolerance() {

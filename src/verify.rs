@@ -190,7 +190,7 @@ pub struct Violation {
 }
 
 /// The outcome of a re-simulation.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct Verification {
     /// No sample exceeds any limit by more than the tolerance.
     pub verified: bool,
