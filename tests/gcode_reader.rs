@@ -1368,3 +1368,32 @@ fn a_marlin_g4_s_dwell_names_the_marlin_reading() {
     // Without S the message stays the short one.
     err("G21 G90\nG4\n", 2, &["G4 without P (the dwell time)"]);
 }
+
+/// Makino's Pro3 posts (NX, round 10) write `G05 P10000` before a cut and `G05 P0` after it:
+/// high-precision contour control (HPCC) on and off, the look-ahead of the Fanuc 16i/18i-MB,
+/// which moves nothing. It was refused as an unknown G code. Any other G05 is high-speed
+/// cycle machining (motion from data held in the control) and stays an error naming it.
+#[test]
+fn fanuc_g05_high_precision_contour_control_moves_nothing() {
+    let plain = "O1\nG21 G90 G17\nG0 X0 Y0 Z5\nG1 Z0 F300\nX10 Y5\nG0 Z5\nM30\n";
+    let hpcc = "O1\nG21 G90 G17\nG05 P10000\nG0 X0 Y0 Z5\nG1 Z0 F300\nX10 Y5\nG05 P0\nG0 Z5\nM30\n";
+    let a = ok_in(Dialect::Fanuc, plain);
+    let b = ok_in(Dialect::Fanuc, hpcc);
+    assert_eq!(a.points.len(), b.points.len());
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert!(close(p.p, q.p, 1e-12), "{:?} vs {:?}", p.p, q.p);
+        assert_eq!(p.feed, q.feed);
+    }
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG21 G90\nG0 X0 Y0 Z0\nG05 P2\n",
+        4,
+        &["`G05 P2`", "G05 P10000", "high-speed cycle machining"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG21 G90\nG05\n",
+        3,
+        &["`G05` without P", "G05 P0"],
+    );
+}

@@ -1117,6 +1117,31 @@ impl<'a> Interpreter<'a> {
                         ),
                     ));
                 }
+                // Fanuc G05: `G05 P10000` switches high-precision contour control (HPCC, the
+                // look-ahead of the 16i/18i/21i-MB) on and `G05 P0` off, moving nothing
+                // (Makino's Pro3 posts write them around every cut). With another P, or none,
+                // G05 is high-speed cycle machining (`G05 P1`…: a cycle of binary motion data
+                // held in the control), whose moves the program does not carry.
+                Action::Ignored
+                    if text.trim_start_matches(['G', 'g']).parse::<f64>() == Ok(5.0)
+                        && !matches!(block.letter('P'), Some(p) if p.value == 10000.0 || p.value == 0.0) =>
+                {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "{}: only `G05 P10000` and `G05 P0` (high-precision contour \
+                             control on and off, no motion) are read; another G05 runs \
+                             high-speed cycle machining, motion from data held in the control \
+                             that the program does not carry: post the moves as G1/G2/G3",
+                            block
+                                .letter('P')
+                                .map_or(format!("`{text}` without P"), |p| format!(
+                                    "`{text} P{}`",
+                                    p.value
+                                ))
+                        ),
+                    ));
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
