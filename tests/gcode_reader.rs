@@ -1397,3 +1397,47 @@ fn fanuc_g05_high_precision_contour_control_moves_nothing() {
         &["`G05` without P", "G05 P0"],
     );
 }
+
+/// An arc whose end is off its circle says what the block shows the program meant. A lathe
+/// program (NX's Giddings & Lewis 802L post, round 10) writes `G02 X… Z… I… K…` with no G18:
+/// read in G17, K is not a centre word and the radius check fails, which named neither. NX's
+/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines, gives I J from the
+/// end point (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: 0.2756 from the end,
+/// 0.4541 from the start).
+#[test]
+fn an_arc_off_its_circle_names_what_the_block_shows() {
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG20 G90 G17\nG0 X1.055 Z4.7043\nG02 X1.0143 Z4.745 I-.0407 K0.0 F.03\n",
+        4,
+        &[
+            "not on the circle",
+            "gives K",
+            "G17 arc does not use",
+            "G18",
+        ],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG20 G90 G17\nG0 X1.8701 Y-.3937 Z0\nG03 X1.6439 Y-.5118 I0.0 J.2756 F20.\n",
+        4,
+        &[
+            "not on the circle",
+            "I J measured from the end point",
+            "wrong point",
+        ],
+    );
+    // An arc that fits neither way keeps the plain message.
+    match parse(
+        Path::new("bad.ngc"),
+        "G21 G90 G17\nG0 X0 Y0 Z0\nG2 X10 Y0 I3 J0 F100\n",
+        Dialect::LinuxCnc,
+    ) {
+        Err(Error::Parse { line, message, .. }) => {
+            assert_eq!(line, 3);
+            assert!(message.contains("not on the circle"), "{message}");
+            assert!(!message.contains(';'), "{message}");
+        }
+        other => panic!("expected the radius error, got {other:?}"),
+    }
+}

@@ -2873,15 +2873,45 @@ impl<'a> Interpreter<'a> {
 
         let r_start = (s0 - c0).hypot(s1 - c1);
         let r_end = (e0 - c0).hypot(e1 - c1);
-        let mismatch = (r_end - r_start).abs();
-        if mismatch > ARC_RADIUS_MISMATCH_MM
-            && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r_start.max(r_end)
-        {
+        let off_circle = |r_start: f64, r_end: f64| {
+            let mismatch = (r_end - r_start).abs();
+            mismatch > ARC_RADIUS_MISMATCH_MM
+                && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r_start.max(r_end)
+        };
+        if off_circle(r_start, r_end) {
+            // What the program most likely meant, where the block shows it: a centre word
+            // of another plane (a lathe's `G02 X… Z… I… K…` read in G17), or I J K measured
+            // from the end point (NX sample posts), which no control reads so.
+            let mut hint = String::new();
+            if block.centre[n].is_some() {
+                hint = format!(
+                    "; the block gives {}, which a {plane} arc does not use: an arc in another \
+                     plane needs its G17/G18/G19 first (a turning program's X–Z arcs are G18, \
+                     and feedopt reads milling programs)",
+                    centre_names[n]
+                );
+            } else if in_plane
+                && block.arc_centre.is_none()
+                && block.radius.is_none()
+                && !block.centre_as[a].unwrap_or(self.arc_distance == Distance::Absolute)
+                && !block.centre_as[b].unwrap_or(self.arc_distance == Distance::Absolute)
+            {
+                let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
+                let (f0, f1) = (e0 + word(a), e1 + word(b));
+                if !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1)) {
+                    hint = format!(
+                        "; {} {} measured from the end point instead would fit, but they are the \
+                         centre's offset from the start point: the post wrote them from the \
+                         wrong point",
+                        centre_names[a], centre_names[b]
+                    );
+                }
+            }
             return Err(self.error(
                 line,
                 format!(
                     "arc end point is not on the circle: radius {r_end:.4} mm at the end, \
-                     {r_start:.4} mm at the start"
+                     {r_start:.4} mm at the start{hint}"
                 ),
             ));
         }
