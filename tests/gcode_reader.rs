@@ -1441,3 +1441,17 @@ fn an_arc_off_its_circle_names_what_the_block_shows() {
         other => panic!("expected the radius error, got {other:?}"),
     }
 }
+
+/// NX writes a posted program into an "Information listing" (round 10: the Mazak Nexus 510,
+/// Mitsubishi VR33 and Okuma 7000M samples) whose header starts with a rule of `=`. The error
+/// said "unexpected character `=`"; it now says that the line is not G-code and what to do.
+#[test]
+fn a_line_of_text_where_a_block_starts_is_named() {
+    err(
+        "============================================================\nG21 G90\nG0 X1 Y1 Z1\n",
+        1,
+        &["`=` at the start of a block", "not G-code", "remove it"],
+    );
+    // Inside a block the short message stays.
+    err("G21 G90\nG0 X1 = Y1\n", 2, &["unexpected character `=`"]);
+}

@@ -294,6 +294,15 @@ fn lex_letters(
                          G0/G1/G2/G3 moves"
                     )
                 }
+                // A line that does not start as a block is text, not G-code: NX writes its
+                // posted programs into an "Information listing" whose header is a rule of
+                // `=` and `Name : value` lines.
+                _ if chars[..i].iter().all(|c| c.is_whitespace()) => format!(
+                    "unexpected character `{c}` at the start of a block: a block starts with an \
+                     address letter (N, G, X, …), a comment `( … )` or `;`, or `/`; a line of \
+                     text (a listing's header, as NX's \"Information listing\" writes with \
+                     `====`) is not G-code: remove it"
+                ),
                 _ => format!("unexpected character `{c}`"),
             });
         }
