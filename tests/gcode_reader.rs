@@ -1455,3 +1455,18 @@ fn a_line_of_text_where_a_block_starts_is_named() {
     // Inside a block the short message stays.
     err("G21 G90\nG0 X1 = Y1\n", 2, &["unexpected character `=`"]);
 }
+
+/// NX's DeVlieg 120 post writes `N8 T00O00` (round 10). The program names no dialect, so it is
+/// read as LinuxCNC, and the O word was refused as "O-word control flow (if, while, do, repeat)
+/// is not supported", which it is not: an O word after other words is neither an O-word
+/// statement nor a program number. The error now says so; an O word that starts its block
+/// (after a line number at most) keeps the control-flow message.
+#[test]
+fn an_o_word_after_other_words_is_named_as_such() {
+    err(
+        "G21 G90\nN8 T00O00\n",
+        2,
+        &["`O00` after `N8", "T00` in the same block", "own line"],
+    );
+    err("G21 G90\nN8 O00\n", 2, &["O-word control flow"]);
+}
