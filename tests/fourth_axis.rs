@@ -225,3 +225,37 @@ fn the_rotary_angle_is_held_to_its_chords() {
     let worst = s.path.deviation().1.to_degrees();
     assert!(worst <= 0.0111, "the angle strays {worst}° from its chords");
 }
+
+/// A block that turns only the table at a programmed feed (NX's Mazak Nexus 510 four-axis
+/// sample, round 10: `B274.5` … at F9.8, 9.8 °/min) is timed at F by a control; feedopt caps
+/// the tool-tip feed, which does not bind while the tip stands, so the turn runs at the
+/// axis's limits and the cycle time leaves the programmed duration out. Until the schedule
+/// caps a turn by its programmed time, the reader says so at the block (once, with the count);
+/// a rapid turn, or a turn with X Y Z moving (F over the combined distance), is not named.
+#[test]
+fn a_turn_alone_at_a_programmed_feed_is_named() {
+    let (_, ctx) = setup('B');
+    let named = |tp: &Toolpath| -> Vec<usize> {
+        tp.warnings
+            .iter()
+            .filter(|w| w.message.contains("turns only rotary axes"))
+            .map(|w| w.line)
+            .collect()
+    };
+    let tp = read(
+        &ctx,
+        Dialect::Fanuc,
+        "O1\nG21 G90 G94\nG1 X0 Y0 Z0 B0 F100\nB90.\nG1 Y10. B100. F100\nG0 B0\nM30\n",
+    )
+    .unwrap();
+    assert_eq!(named(&tp), vec![4]);
+    for dialect in [Dialect::LinuxCnc, Dialect::Sinumerik] {
+        let tp = read(
+            &ctx,
+            dialect,
+            "G90 G94\nG1 X0 Y0 Z0 B0 F100\nG1 B90\nG0 B0\nM30\n",
+        )
+        .unwrap();
+        assert_eq!(named(&tp), vec![3], "{dialect:?}");
+    }
+}

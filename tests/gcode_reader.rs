@@ -1368,3 +1368,105 @@ fn a_marlin_g4_s_dwell_names_the_marlin_reading() {
     // Without S the message stays the short one.
     err("G21 G90\nG4\n", 2, &["G4 without P (the dwell time)"]);
 }
+
+/// Makino's Pro3 posts (NX, round 10) write `G05 P10000` before a cut and `G05 P0` after it:
+/// high-precision contour control (HPCC) on and off, the look-ahead of the Fanuc 16i/18i-MB,
+/// which moves nothing. It was refused as an unknown G code. Any other G05 is high-speed
+/// cycle machining (motion from data held in the control) and stays an error naming it.
+#[test]
+fn fanuc_g05_high_precision_contour_control_moves_nothing() {
+    let plain = "O1\nG21 G90 G17\nG0 X0 Y0 Z5\nG1 Z0 F300\nX10 Y5\nG0 Z5\nM30\n";
+    let hpcc = "O1\nG21 G90 G17\nG05 P10000\nG0 X0 Y0 Z5\nG1 Z0 F300\nX10 Y5\nG05 P0\nG0 Z5\nM30\n";
+    let a = ok_in(Dialect::Fanuc, plain);
+    let b = ok_in(Dialect::Fanuc, hpcc);
+    assert_eq!(a.points.len(), b.points.len());
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert!(close(p.p, q.p, 1e-12), "{:?} vs {:?}", p.p, q.p);
+        assert_eq!(p.feed, q.feed);
+    }
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG21 G90\nG0 X0 Y0 Z0\nG05 P2\n",
+        4,
+        &["`G05 P2`", "G05 P10000", "high-speed cycle machining"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG21 G90\nG05\n",
+        3,
+        &["`G05` without P", "G05 P0"],
+    );
+}
+
+/// An arc whose end is off its circle says what the block shows the program meant. A lathe
+/// program (NX's Giddings & Lewis 802L post, round 10) writes `G02 X… Z… I… K…` with no G18:
+/// read in G17, K is not a centre word and the radius check fails, which named neither. NX's
+/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines, gives I J from the
+/// end point (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: 0.2756 from the end,
+/// 0.4541 from the start).
+#[test]
+fn an_arc_off_its_circle_names_what_the_block_shows() {
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG20 G90 G17\nG0 X1.055 Z4.7043\nG02 X1.0143 Z4.745 I-.0407 K0.0 F.03\n",
+        4,
+        &[
+            "not on the circle",
+            "gives K",
+            "G17 arc does not use",
+            "G18",
+        ],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG20 G90 G17\nG0 X1.8701 Y-.3937 Z0\nG03 X1.6439 Y-.5118 I0.0 J.2756 F20.\n",
+        4,
+        &[
+            "not on the circle",
+            "I J measured from the end point",
+            "wrong point",
+        ],
+    );
+    // An arc that fits neither way keeps the plain message.
+    match parse(
+        Path::new("bad.ngc"),
+        "G21 G90 G17\nG0 X0 Y0 Z0\nG2 X10 Y0 I3 J0 F100\n",
+        Dialect::LinuxCnc,
+    ) {
+        Err(Error::Parse { line, message, .. }) => {
+            assert_eq!(line, 3);
+            assert!(message.contains("not on the circle"), "{message}");
+            assert!(!message.contains(';'), "{message}");
+        }
+        other => panic!("expected the radius error, got {other:?}"),
+    }
+}
+
+/// NX writes a posted program into an "Information listing" (round 10: the Mazak Nexus 510,
+/// Mitsubishi VR33 and Okuma 7000M samples) whose header starts with a rule of `=`. The error
+/// said "unexpected character `=`"; it now says that the line is not G-code and what to do.
+#[test]
+fn a_line_of_text_where_a_block_starts_is_named() {
+    err(
+        "============================================================\nG21 G90\nG0 X1 Y1 Z1\n",
+        1,
+        &["`=` at the start of a block", "not G-code", "remove it"],
+    );
+    // Inside a block the short message stays.
+    err("G21 G90\nG0 X1 = Y1\n", 2, &["unexpected character `=`"]);
+}
+
+/// NX's DeVlieg 120 post writes `N8 T00O00` (round 10). The program names no dialect, so it is
+/// read as LinuxCNC, and the O word was refused as "O-word control flow (if, while, do, repeat)
+/// is not supported", which it is not: an O word after other words is neither an O-word
+/// statement nor a program number. The error now says so; an O word that starts its block
+/// (after a line number at most) keeps the control-flow message.
+#[test]
+fn an_o_word_after_other_words_is_named_as_such() {
+    err(
+        "G21 G90\nN8 T00O00\n",
+        2,
+        &["`O00` after `N8", "T00` in the same block", "own line"],
+    );
+    err("G21 G90\nN8 O00\n", 2, &["O-word control flow"]);
+}

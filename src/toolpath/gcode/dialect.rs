@@ -774,6 +774,10 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("2", Mo(Motion::ArcCw)),
         ("3", Mo(Motion::ArcCcw)),
         ("4", Action::Dwell),
+        // G05 P10000 / G05 P0: high-precision contour control on / off (the look-ahead of
+        // the Fanuc 16i/18i/21i-MB), no motion; any other G05 is refused where it is read
+        // (`Interpreter`: high-speed cycle machining runs motion from data in the control).
+        ("5", Action::Ignored),
         ("5.1", Action::Ignored),
         ("6.2", Unsup(SPLINES)),
         ("8", Action::Ignored),

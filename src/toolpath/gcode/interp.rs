@@ -1117,6 +1117,31 @@ impl<'a> Interpreter<'a> {
                         ),
                     ));
                 }
+                // Fanuc G05: `G05 P10000` switches high-precision contour control (HPCC, the
+                // look-ahead of the 16i/18i/21i-MB) on and `G05 P0` off, moving nothing
+                // (Makino's Pro3 posts write them around every cut). With another P, or none,
+                // G05 is high-speed cycle machining (`G05 P1`…: a cycle of binary motion data
+                // held in the control), whose moves the program does not carry.
+                Action::Ignored
+                    if text.trim_start_matches(['G', 'g']).parse::<f64>() == Ok(5.0)
+                        && !matches!(block.letter('P'), Some(p) if p.value == 10000.0 || p.value == 0.0) =>
+                {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "{}: only `G05 P10000` and `G05 P0` (high-precision contour \
+                             control on and off, no motion) are read; another G05 runs \
+                             high-speed cycle machining, motion from data held in the control \
+                             that the program does not carry: post the moves as G1/G2/G3",
+                            block
+                                .letter('P')
+                                .map_or(format!("`{text}` without P"), |p| format!(
+                                    "`{text} P{}`",
+                                    p.value
+                                ))
+                        ),
+                    ));
+                }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
                 Action::Unsupported(message) => {
@@ -2699,6 +2724,20 @@ impl<'a> Interpreter<'a> {
             .map(|i| (end[i] - start[i]).powi(2))
             .sum::<f64>()
             .sqrt();
+        let machine_coordinates = self.machine.is_some_and(|m| m.machine_coordinates);
+        if !moves_xyz && rotary > 0.0 && (machine_coordinates || self.tcp != Tcp::Off) {
+            // The block's time, rotary travel / F, reaches the schedule only as a tool-tip
+            // speed (chord / time): where the tip stands (a four-axis machine's X Y Z, or
+            // tool-tip mode) that caps nothing, and the turn runs at the axis' limits. Said,
+            // since a slow F makes the control take longer than the cycle time reported.
+            self.warn(
+                line,
+                "a block that turns only rotary axes while the tool tip stands still: feedopt \
+                 caps the tool-tip feed, so this turn runs at the rotary axis' limits, not at \
+                 F (degrees per minute); where F is the slower, the control takes longer than \
+                 the cycle time reported (`feedopt compare` times such blocks at F)",
+            );
+        }
         let diameters = self.machine.map_or([None; 3], |m| m.feed_diameter);
         if rotary > 0.0 && self.spec.rotary_feed == RotaryFeed::Combined && self.tcp == Tcp::Off {
             // Fanuc: F over the combined distance, linear axes in F's unit (mm or inch),
@@ -2848,15 +2887,45 @@ impl<'a> Interpreter<'a> {
 
         let r_start = (s0 - c0).hypot(s1 - c1);
         let r_end = (e0 - c0).hypot(e1 - c1);
-        let mismatch = (r_end - r_start).abs();
-        if mismatch > ARC_RADIUS_MISMATCH_MM
-            && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r_start.max(r_end)
-        {
+        let off_circle = |r_start: f64, r_end: f64| {
+            let mismatch = (r_end - r_start).abs();
+            mismatch > ARC_RADIUS_MISMATCH_MM
+                && mismatch > ARC_RADIUS_MISMATCH_RELATIVE * r_start.max(r_end)
+        };
+        if off_circle(r_start, r_end) {
+            // What the program most likely meant, where the block shows it: a centre word
+            // of another plane (a lathe's `G02 X… Z… I… K…` read in G17), or I J K measured
+            // from the end point (NX sample posts), which no control reads so.
+            let mut hint = String::new();
+            if block.centre[n].is_some() {
+                hint = format!(
+                    "; the block gives {}, which a {plane} arc does not use: an arc in another \
+                     plane needs its G17/G18/G19 first (a turning program's X–Z arcs are G18, \
+                     and feedopt reads milling programs)",
+                    centre_names[n]
+                );
+            } else if in_plane
+                && block.arc_centre.is_none()
+                && block.radius.is_none()
+                && !block.centre_as[a].unwrap_or(self.arc_distance == Distance::Absolute)
+                && !block.centre_as[b].unwrap_or(self.arc_distance == Distance::Absolute)
+            {
+                let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
+                let (f0, f1) = (e0 + word(a), e1 + word(b));
+                if !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1)) {
+                    hint = format!(
+                        "; {} {} measured from the end point instead would fit, but they are the \
+                         centre's offset from the start point: the post wrote them from the \
+                         wrong point",
+                        centre_names[a], centre_names[b]
+                    );
+                }
+            }
             return Err(self.error(
                 line,
                 format!(
                     "arc end point is not on the circle: radius {r_end:.4} mm at the end, \
-                     {r_start:.4} mm at the start"
+                     {r_start:.4} mm at the start{hint}"
                 ),
             ));
         }

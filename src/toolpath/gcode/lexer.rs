@@ -294,6 +294,15 @@ fn lex_letters(
                          G0/G1/G2/G3 moves"
                     )
                 }
+                // A line that does not start as a block is text, not G-code: NX writes its
+                // posted programs into an "Information listing" whose header is a rule of
+                // `=` and `Name : value` lines.
+                _ if chars[..i].iter().all(|c| c.is_whitespace()) => format!(
+                    "unexpected character `{c}` at the start of a block: a block starts with an \
+                     address letter (N, G, X, …), a comment `( … )` or `;`, or `/`; a line of \
+                     text (a listing's header, as NX's \"Information listing\" writes with \
+                     `====`) is not G-code: remove it"
+                ),
                 _ => format!("unexpected character `{c}`"),
             });
         }
@@ -313,6 +322,20 @@ fn lex_letters(
             });
         }
         if let Some(Address::Unsupported(message)) = address {
+            // An O word after other words (NX's DeVlieg post: `T00O00`) is no O-word statement,
+            // whose `o…` starts its block: say so rather than naming control flow.
+            let before: String = chars[..i].iter().collect::<String>().trim().to_string();
+            let numbered = before.strip_prefix(['N', 'n']).is_some_and(|rest| {
+                rest.trim().chars().all(|c| c.is_ascii_digit()) && !rest.trim().is_empty()
+            });
+            if letter == 'O' && !before.is_empty() && !numbered {
+                return Err(format!(
+                    "`{letter}{text_value}` after `{before}` in the same block: an O word starts \
+                     its block (an O-word statement `o100 sub|call|if|…`, or a program number on \
+                     a line of its own), so this one is neither: remove it or give it its own \
+                     line"
+                ));
+            }
             return Err(format!("`{letter}{text_value}`: {message}"));
         }
         if end < chars.len()
