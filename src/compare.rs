@@ -130,16 +130,13 @@ pub const SCHEDULES: &[Entry] = &[
 ];
 
 fn programmed(ctx: &Context) -> Result<std::result::Result<Candidate, String>> {
-    let toolpath = match ctx.input {
-        Input::Cl(t) => t,
-        Input::Joint(_) => return Ok(Err("a joint-space path has no programmed feed".into())),
-    };
+    if let Input::Joint(_) = ctx.input {
+        return Ok(Err("a joint-space path has no programmed feed".into()));
+    }
     let profile = baseline::programmed_feed(
         ctx.machine,
         &ctx.reference.path,
         &ctx.reference.kinematics,
-        Some(toolpath),
-        ctx.options.solve.geometry.feed_override,
         ctx.options.solve.verify.period,
     )?;
     Ok(profile.map(|p| realize(ctx, &p, Vec::new())))

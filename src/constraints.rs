@@ -520,6 +520,10 @@ pub fn point_bound(
         0.0
     };
     let mut best = velocity_bound(machine, acceleration.len(), jet, tip_speed, cap.0);
+    // On a reorientation the cap is on u̇ itself, the rate of turn (rad/s; [`Span::feed_caps`]).
+    if kind == SpanKind::Reorientation && cap.0 * cap.0 < best.0 {
+        best = (cap.0 * cap.0, Bound::Feed);
+    }
     if let (Bound::Feed, Some(limit)) = (best.1, cap.1) {
         best.1 = Bound::Process(limit);
     }

@@ -181,7 +181,7 @@ pub struct Violation {
     pub axis: Option<usize>,
     /// What exceeds its limit.
     pub kind: Quantity,
-    /// The value (mm/s, mm/s², °/s, °/s²).
+    /// The value (mm/s, mm/s², °/s, °/s²; a reorientation's rate of turn against its feed cap in °/s).
     pub value: f64,
     /// The limit on the value's side (`min` for a negative value).
     pub limit: f64,
@@ -532,6 +532,8 @@ struct Point {
     dddq: Option<[f64; MAX_AXES]>,
     /// κ |P'|² of the tool tip on a moving span ([`Chord::curvature_term`]), else 0.
     bend: f64,
+    /// On a reorientation: the feed cap is on u̇, the rate of turn ([`Span::feed_caps`]).
+    turn: bool,
 }
 
 impl Point {
@@ -552,6 +554,7 @@ impl Point {
             } else {
                 0.0
             },
+            turn: span.kind == SpanKind::Reorientation,
         }
     }
 }
@@ -614,8 +617,13 @@ impl Accumulator {
                 (span, interval, u, t),
             );
         }
-        if cap.is_finite() && speed > 0.0 {
-            let v = speed * r;
+        if cap.is_finite() && (speed > 0.0 || pt.turn) {
+            // A reorientation's rate of turn u̇ against its cap, both in °/s.
+            let (v, cap) = if pt.turn {
+                (r.to_degrees(), cap.to_degrees())
+            } else {
+                (speed * r, cap)
+            };
             let x = if v > 0.0 { ratio(cap, v) } else { 0.0 };
             self.worst_feed = self.worst_feed.max(x);
             self.note(None, Quantity::Feed, v, cap, x, (span, interval, u, t));

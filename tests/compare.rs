@@ -456,3 +456,41 @@ fn dwells_count_in_every_row_as_in_solve() {
         solved.schedule.cycle_time
     );
 }
+
+/// A table turned alone at F, out and back (round 10: NX's Mazak Nexus 510 four-axis sample):
+/// every row times each block at its programmed rate of turn, F = 100 °/min, 54 s a block.
+/// The programmed row counted the move's whole time on every piece the geometry cut it into at
+/// the reversal (4,104 s here; 1,128,184 s for the Mazak program), and the controller and
+/// feedopt ran the turn at B's limits (2.2 s).
+#[test]
+fn a_turn_alone_at_f_takes_its_programmed_time_in_every_row() {
+    let m = common::machine(
+        r#"{"name": "4-axis", "kinematics": {"type": "xyzb"},
+            "axes": {"X": {"velocity": 500, "acceleration": 3000},
+                     "Y": {"velocity": 500, "acceleration": 3000},
+                     "Z": {"velocity": 500, "acceleration": 3000},
+                     "B": {"velocity": 100, "acceleration": 500, "min": -720, "max": 720}},
+            "feed": {"max": 500}}"#,
+    );
+    let tp = feedopt::toolpath::gcode::parse(
+        Path::new("turn.ngc"),
+        "G21 G90 G94\nG1 X0 Y0 Z0 B0 F100\nG1 B90\nB0\nM2\n",
+        feedopt::toolpath::gcode::Dialect::LinuxCnc,
+    )
+    .expect("reads");
+    let mut o = CompareOptions::default();
+    o.solve.solver_kind = SolverKind::Reach;
+    let cmp = compare(&m, &Input::Cl(tp), "turn", &o).expect("compare");
+    // 2 × 90° at 100/60 °/s; (within the angular tolerance, 0.01°, the fitted turn may cut
+    // its reversal short by up to 0.02°).
+    let want = 2.0 * 54.0;
+    for key in ["programmed", "controller", "feedopt"] {
+        let t = cmp.row(key).expect("row").cycle_time_s;
+        assert!(
+            (t - want).abs() <= 2e-3 * want,
+            "{key}: {t} s, want {want} s"
+        );
+    }
+    assert!(cmp.row("controller").unwrap().verified);
+    assert!(cmp.row("feedopt").unwrap().verified);
+}

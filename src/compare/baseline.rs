@@ -22,13 +22,10 @@
 //! stricter than LinuxCNC in tool-tip mode, which limits the Cartesian and rotary *coordinates*
 //! and does not check the joints at all; it is exact for a 3-axis Cartesian machine.
 
-use std::collections::HashMap;
-
 use crate::error::{Error, Result};
 use crate::geometry::{Path, SpanKind};
 use crate::kinematics::{Kinematics, MAX_AXES};
 use crate::machine::Machine;
-use crate::toolpath::{Feed, Toolpath};
 
 /// grbl's default junction deviation (`$11`), mm.
 pub const DEFAULT_JUNCTION_DEVIATION_MM: f64 = 0.01;
@@ -146,10 +143,11 @@ fn must_stop(a: &Block, b: &Block) -> bool {
 
 /// The programmed feed run as is: u̇ constant per block at the block's programmed feed
 /// (the span's feed cap: the program's feed, times the override, within the machine's maximum
-/// feed; a rapid or a block without feed at the machine's maximum feed). A G93 block on a pure
-/// reorientation runs at its programmed rate Δu/t; any other reorientation block at the
-/// fastest rate the axes' velocity limits allow along it (the program gives no tool-tip feed
-/// for it).
+/// feed; a rapid or a block without feed at the machine's maximum feed). A block that only
+/// turns the tool with a programmed time (G93, or rotary axes alone at F) runs at its rate of
+/// turn, the move's Δu/t (the span's cap, [`Span::feed_caps`]: the whole move's, on every
+/// piece of it); any other reorientation block at the fastest rate the axes' velocity limits
+/// allow along it (the program gives no tool-tip feed for it).
 ///
 /// No acceleration is planned: every change of feed (from rest at the start, between blocks,
 /// to rest before a reorientation and at the end) is taken within one servo period `period`,
@@ -164,32 +162,21 @@ pub fn programmed_feed(
     machine: &Machine,
     path: &Path,
     kin: &Kinematics,
-    toolpath: Option<&Toolpath>,
-    feed_override: f64,
     period: f64,
 ) -> Result<std::result::Result<Profile, String>> {
     let na = kin.n_axes();
     let blocks = blocks(path, kin);
-    let times: HashMap<usize, f64> = toolpath
-        .map(|t| {
-            t.points
-                .iter()
-                .filter_map(|p| match p.feed {
-                    Feed::BlockTime(s) if s > 0.0 => Some((p.line, s)),
-                    _ => None,
-                })
-                .collect()
-        })
-        .unwrap_or_default();
     let mut feeds = Vec::with_capacity(blocks.len());
     for b in &blocks {
         let span = &path.spans[b.span];
         let f = match b.kind {
             SpanKind::Moving => span.feed_caps[b.index],
             SpanKind::Joint => f64::INFINITY,
-            SpanKind::Reorientation => match times.get(&b.line) {
-                Some(&t) => feed_override * b.length() / t,
-                None => axis_limits(machine, na, &b.joint_direction).0,
+            // (Each piece's own Δu over the move's whole time counted a move the geometry
+            // cut into pieces once per piece: B0 B90 B0 at F9.8, 41,878 s for 1,102 s.)
+            SpanKind::Reorientation => match span.feed_caps[b.index] {
+                cap if cap.is_finite() => cap,
+                _ => axis_limits(machine, na, &b.joint_direction).0,
             },
         };
         if !(f.is_finite() && f > 0.0) {
@@ -338,11 +325,8 @@ pub fn plan_controller(
     let mut planned: Vec<PlannedBlock> = Vec::with_capacity(blocks.len());
     for b in blocks {
         let (v, a) = axis_limits(machine, na, &b.joint_direction);
-        let cap = if b.kind == SpanKind::Moving {
-            path.spans[b.span].feed_caps[b.index]
-        } else {
-            f64::INFINITY
-        };
+        // Of the tip's speed on a moving span, of the rate of turn on a reorientation.
+        let cap = path.spans[b.span].feed_caps[b.index];
         let nominal = v.min(cap);
         if !nominal.is_finite() {
             return Err(Error::Usage(format!(

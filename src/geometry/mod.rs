@@ -91,7 +91,8 @@ pub struct Span {
     /// w(u) = (Px, Py, Pz, θ1, θ2); its knots are the CL points of the span and the points
     /// [`Path::build`] inserts on the programmed chords between them ([`INSERTED`]).
     pub spline: CubicSpline<PATH_DIM>,
-    /// Feed cap (mm/s) of the move between knot k and k+1 (`f64::INFINITY`: none).
+    /// Feed cap of the move between knot k and k+1 (`f64::INFINITY`: none): of the tip's speed
+    /// (mm/s) on a moving span, of the rate of turn u̇ (rad/s) on a reorientation.
     pub feed_caps: Vec<f64>,
     /// Source line of the CL point at each knot.
     pub lines: Vec<usize>,
@@ -228,11 +229,27 @@ impl Path {
                 "the toolpath needs at least two CL points",
             ));
         }
-        // The cap of the move from point `a` to point `b`: a G93 block's programmed time
-        // implies the tool-tip speed chord/time.
-        let cap = |a: usize, b: usize| -> f64 {
+        // The cap of the move from point `a` to point `b`. Where the tip moves, on its speed
+        // (mm/s): a block's programmed time (G93) implies chord / time. On a reorientation (the
+        // tip stands, u is the rotary angles' travel, radians) on the rate of turn (rad/s): a
+        // block's programmed time (a turn of rotary axes alone at F, as the reader times it for
+        // its control) implies the angles' travel / time; a feed of the tip caps nothing
+        // there, nor does the machine's maximum feed. (A turn alone at F9.8 ran at the axis's
+        // limits: NX's Mazak Nexus 510 four-axis sample, 622.7 s for about 24,600 s.)
+        let cap = |a: usize, b: usize, moving: bool| -> f64 {
             let m = feed_max.unwrap_or(f64::INFINITY);
             let k = options.feed_override;
+            if !moving {
+                return match pts[b].feed {
+                    Feed::BlockTime(t) if !options.ignore_programmed_feed && t > 0.0 => {
+                        let turn = ((angles[b][0] - angles[a][0]).powi(2)
+                            + (angles[b][1] - angles[a][1]).powi(2))
+                        .sqrt();
+                        k * turn / t
+                    }
+                    _ => f64::INFINITY,
+                };
+            }
             match pts[b].feed {
                 _ if options.ignore_programmed_feed => m,
                 Feed::Programmed(v) => (k * v).min(m),
@@ -261,7 +278,7 @@ impl Path {
                     w
                 })
                 .collect();
-            let mut feed_caps: Vec<f64> = idx.windows(2).map(|w| cap(w[0], w[1])).collect();
+            let mut feed_caps: Vec<f64> = idx.windows(2).map(|w| cap(w[0], w[1], moving)).collect();
             let mut lines: Vec<usize> = idx.iter().map(|&i| pts[i].line).collect();
             let refitted = moving && profile_normal && options.tolerance_mm > 0.0;
             if refitted {

@@ -2724,20 +2724,6 @@ impl<'a> Interpreter<'a> {
             .map(|i| (end[i] - start[i]).powi(2))
             .sum::<f64>()
             .sqrt();
-        let machine_coordinates = self.machine.is_some_and(|m| m.machine_coordinates);
-        if !moves_xyz && rotary > 0.0 && (machine_coordinates || self.tcp != Tcp::Off) {
-            // The block's time, rotary travel / F, reaches the schedule only as a tool-tip
-            // speed (chord / time): where the tip stands (a four-axis machine's X Y Z, or
-            // tool-tip mode) that caps nothing, and the turn runs at the axis' limits. Said,
-            // since a slow F makes the control take longer than the cycle time reported.
-            self.warn(
-                line,
-                "a block that turns only rotary axes while the tool tip stands still: feedopt \
-                 caps the tool-tip feed, so this turn runs at the rotary axis' limits, not at \
-                 F (degrees per minute); where F is the slower, the control takes longer than \
-                 the cycle time reported (`feedopt compare` times such blocks at F)",
-            );
-        }
         let diameters = self.machine.map_or([None; 3], |m| m.feed_diameter);
         if rotary > 0.0 && self.spec.rotary_feed == RotaryFeed::Combined && self.tcp == Tcp::Off {
             // Fanuc: F over the combined distance, linear axes in F's unit (mm or inch),
