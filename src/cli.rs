@@ -977,14 +977,14 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
     )?;
     Ok(format!(
         "wrote {} ({} dialect): {} blocks ({} under G93), {} merged, {} added by Δθ\n\
-         schedule cycle time {:.4} s, program time {:.4} s\n",
+         schedule cycle time {:.4} s, program time {:.4} s (dwells included)\n",
         args.output.display(),
         args.dialect,
         prog.blocks,
         prog.inverse_time_blocks,
         prog.merged,
         prog.split,
-        solution.schedule.cycle_time,
+        solution.schedule.cycle_time + path.dwell_time(),
         prog.time
     ))
 }

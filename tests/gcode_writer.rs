@@ -72,9 +72,10 @@ fn round_trip(
         "{dialect}: reader warnings {:?}",
         &said[..said.len().min(3)]
     );
-    // Every block after the first carries a time (no rapid, no missing F).
-    let time = programmed_time(&back).unwrap();
-    let cycle = sol.schedule.cycle_time;
+    // Every block after the first carries a time (no rapid, no missing F); the dwells are
+    // written where they were (G4).
+    let time = programmed_time(&back).unwrap() + back.dwell_time();
+    let cycle = sol.schedule.cycle_time + input.dwell_time();
     assert!(
         (time - cycle).abs() <= 5e-3 * cycle,
         "{dialect}: programmed {time} s vs schedule {cycle} s"
@@ -413,4 +414,59 @@ fn a_head_table_with_table_a_writes_its_b_words_as_the_axis_stands() {
     let sol = optimize(&m, &t, &options).unwrap();
     let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
     assert!(prog.inverse_time_blocks > 0);
+}
+
+/// The program's dwells are written where they stand (G4 after the block that reaches the
+/// point, in each dialect's word: LinuxCNC P s, Fanuc X s, Sinumerik F s) and the program's
+/// time includes them, as the cycle time does. The writer left them out: the NX DMU 70 eVo
+/// program's 75.0 s of drilling dwells (CYCLE83 at the holes' bottoms) were missing from the
+/// program it wrote, which ran 75 s short of the schedule it reported, and drilled without
+/// them.
+#[test]
+fn dwells_are_written_where_they_stand() {
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let input = toolpath::gcode::parse(
+        Path::new("drill.ngc"),
+        "G21 G90 G94\nG0 X0 Y0 Z5\nG4 P0.5\nG1 Z-3 F300\nG4 P1.25\nG1 Z-3\nG4 P0.75\n\
+         G0 Z5\nG0 X20\nG1 Z-3 F300\nG4 P2\nG0 Z5\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    assert_eq!(input.dwell_time(), 4.5);
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let (prog, _) = round_trip(&m, &input, &sol, &options.geometry, dialect);
+        assert_eq!(prog.dwell_time, 4.5, "{dialect}");
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.ngc");
+        std::fs::write(&out, &prog.text).unwrap();
+        let back = match toolpath::read_as(&out, Some(toolpath::Format::Gcode), dialect).unwrap() {
+            toolpath::Input::Cl(t) => t,
+            toolpath::Input::Joint(_) => unreachable!(),
+        };
+        // Where: the start (0.5 s), the first hole's bottom (1.25 + 0.75 s: the second move
+        // there repeats the point), the second hole's bottom (2 s).
+        let at: Vec<([f64; 3], f64)> = back
+            .dwells
+            .iter()
+            .map(|d| {
+                let p = back.points[d.point].p;
+                ([p.x, p.y, p.z], d.seconds)
+            })
+            .collect();
+        let want = [
+            ([0.0, 0.0, 5.0], 0.5),
+            ([0.0, 0.0, -3.0], 2.0),
+            ([20.0, 0.0, -3.0], 2.0),
+        ];
+        assert_eq!(at.len(), want.len(), "{dialect}: {at:?}\n{}", prog.text);
+        for ((p, s), (wp, ws)) in at.iter().zip(&want) {
+            assert!(
+                p.iter().zip(wp).all(|(a, b)| (a - b).abs() < 1e-9) && (s - ws).abs() < 1e-9,
+                "{dialect}: {at:?}"
+            );
+        }
+    }
 }

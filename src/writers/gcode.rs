@@ -28,6 +28,14 @@
 //! of its neighbour (0.35 µm at 35 mm/s). No F is therefore absurd, and no time is lost: the
 //! merged block takes both blocks' time.
 //!
+//! **Dwells.** The program's dwells ([`Toolpath::dwells`]) are written where they stand: a G4
+//! after the block that reaches the point (a dwell at a point the geometry drops, a repeat of
+//! the point before, at that point; one at a merged tiny block's end, at the block kept), in
+//! each dialect's word: LinuxCNC `G4 P` seconds, Fanuc `G4 X` seconds (with a decimal point,
+//! to the control's 1 ms; `P` would count milliseconds), Sinumerik `G4 F` seconds. The
+//! program's time counts them, as the cycle time does. Spindle, coolant and tool words are
+//! not written: the program is the motion, its feeds and its dwells.
+//!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
 //! the schedule's. Only the first point is reached by a G0, as every program starts: that move
@@ -114,8 +122,10 @@ pub struct Program {
     pub blocks: usize,
     /// Of those, blocks under G93.
     pub inverse_time_blocks: usize,
-    /// Sum of the written block times, s.
+    /// Sum of the written block times, s, and of the dwells (`dwell_time`).
     pub time: f64,
+    /// Sum of the written dwells (G4), s: the program's, each where it stands.
+    pub dwell_time: f64,
     /// Blocks merged away because they were shorter than [`MIN_BLOCK_TIME_S`].
     pub merged: usize,
     /// Blocks added by the Δθ rule.
@@ -133,6 +143,10 @@ struct Node {
     t: f64,
     /// Source line of the CL point (0 for a point added by the Δθ rule).
     line: usize,
+    /// The CL point (`None` for a point added by the Δθ rule).
+    point: Option<usize>,
+    /// The program's dwells here, s (written as G4 after the block that reaches the point).
+    dwell: f64,
 }
 
 /// The words of one dialect.
@@ -239,6 +253,8 @@ fn nodes(
             angles: angles[idx[k]],
             t: tl.time_at(u),
             line: pts[idx[k]].line,
+            point: Some(idx[k]),
+            dwell: 0.0,
         };
         if si == 0 {
             out.push(node(0, us[0]));
@@ -286,11 +302,40 @@ fn nodes(
                         angles: [w[3], w[4]],
                         t: tl.time_at(u),
                         line: 0,
+                        point: None,
+                        dwell: 0.0,
                     });
                     split += 1;
                 }
             }
             out.push(node(k, ub));
+        }
+    }
+    // Each dwell where the tool stands: at the last point written at or before its own (a point
+    // the geometry drops stands where the one before it does).
+    let mut dwells: Vec<(usize, f64)> = toolpath
+        .dwells
+        .iter()
+        .filter(|d| d.seconds > 0.0)
+        .map(|d| (d.point, d.seconds))
+        .collect();
+    dwells.sort_by_key(|d| d.0);
+    let mut next = dwells.iter().peekable();
+    let written: Vec<usize> = (0..out.len()).filter(|&i| out[i].point.is_some()).collect();
+    for (w, &i) in written.iter().enumerate() {
+        let here = out[i].point.unwrap_or(0);
+        let until = written
+            .get(w + 1)
+            .and_then(|&j| out[j].point)
+            .unwrap_or(usize::MAX);
+        // (A dwell before the first point is the first point's.)
+        while let Some(&&(p, secs)) = next.peek() {
+            if p >= until {
+                break;
+            }
+            debug_assert!(p >= here || w == 0);
+            out[i].dwell += secs;
+            next.next();
         }
     }
     if out.len() > MAX_BLOCKS + 1 {
@@ -449,29 +494,54 @@ pub fn program(
         (w, p, r)
     };
     let mut keep: Vec<usize> = vec![0];
+    // The dwell written after each kept node: its own and those of the nodes merged into it
+    // (a merged node lies within 10 µs of travel of the kept one).
+    let mut dwell_after: Vec<f64> = vec![nodes[0].dwell];
     let mut merged = 0usize;
     for i in 1..nodes.len() {
         let last = *keep.last().unwrap_or(&0);
         let same = written(&nodes[i]).0 == written(&nodes[last]).0;
         let tiny = nodes[i].t - nodes[last].t < MIN_BLOCK_TIME_S;
         if i == nodes.len() - 1 {
+            let mut dwell = nodes[i].dwell;
             if same || (tiny && keep.len() > 1) {
                 // The last block merges with the one before (its end point is the program's).
                 if keep.len() > 1 {
                     keep.pop();
+                    dwell += dwell_after.pop().unwrap_or(0.0);
                     merged += 1;
                 } else if same {
                     merged += 1;
+                    if let Some(d) = dwell_after.last_mut() {
+                        *d += dwell;
+                    }
                     continue;
                 }
             }
             keep.push(i);
+            dwell_after.push(dwell);
         } else if same || tiny {
             merged += 1;
+            if let Some(d) = dwell_after.last_mut() {
+                *d += nodes[i].dwell;
+            }
         } else {
             keep.push(i);
+            dwell_after.push(nodes[i].dwell);
         }
     }
+    // G4 in each dialect's unit and word: LinuxCNC P seconds; Fanuc X seconds (with a decimal
+    // point, to the control's 1 ms; P would count milliseconds); Sinumerik F seconds.
+    // The block and the time it holds, as written.
+    let dwell_block = |secs: f64| -> (String, f64) {
+        let (word, number) = match options.dialect {
+            Dialect::Fanuc => ("X", format!("{secs:.3}")),
+            Dialect::Sinumerik => ("F", coord(secs)),
+            _ => ("P", coord(secs)),
+        };
+        let value = number.parse().unwrap_or(secs);
+        (format!("G4 {word}{number}"), value)
+    };
 
     let mut text = String::new();
     let comment = |s: &str| (w.comment)(s);
@@ -488,8 +558,17 @@ pub fn program(
         text,
         "{}",
         comment(&format!(
-            "schedule cycle time {:.6} s; G93 F = 60 / block time s, G94 F in mm/min",
-            solution.schedule.cycle_time
+            "schedule cycle time {:.6} s{}; G93 F = 60 / block time s, G94 F in mm/min",
+            solution.schedule.cycle_time + toolpath.dwell_time(),
+            if toolpath.dwell_time() > 0.0 {
+                format!(
+                    " = motion {:.6} s + dwells {:.6} s",
+                    solution.schedule.cycle_time,
+                    toolpath.dwell_time()
+                )
+            } else {
+                String::new()
+            }
         ))
     );
     if options.dialect == Dialect::Fanuc {
@@ -508,8 +587,17 @@ pub fn program(
     let _ = writeln!(text, "G0 {}", words0.join(" "));
     let mut inverse_mode = false;
     let (mut blocks, mut inverse_blocks, mut total) = (0usize, 0usize, 0.0f64);
+    let mut dwell_time = 0.0;
+    let mut dwell = |text: &mut String, secs: f64| {
+        if secs > 0.0 {
+            let (block, value) = dwell_block(secs);
+            let _ = writeln!(text, "{block}");
+            dwell_time += value;
+        }
+    };
+    dwell(&mut text, dwell_after[0]);
     let mut prev_t = first.t;
-    for &i in &keep[1..] {
+    for (w, &i) in keep.iter().enumerate().skip(1) {
         let n = &nodes[i];
         let (ws, p, r) = written(n);
         let dt = n.t - prev_t;
@@ -541,6 +629,7 @@ pub fn program(
             chord * 60.0 / fv
         };
         let _ = writeln!(text, "{mode}G1 {} F{fw}", ws.join(" "));
+        dwell(&mut text, dwell_after[w]);
         blocks += 1;
         (prev_p, prev_r, prev_t) = (p, r, n.t);
     }
@@ -557,7 +646,8 @@ pub fn program(
         text,
         blocks,
         inverse_time_blocks: inverse_blocks,
-        time: total,
+        time: total + dwell_time,
+        dwell_time,
         merged,
         split,
     })
