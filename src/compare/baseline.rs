@@ -145,7 +145,7 @@ fn must_stop(a: &Block, b: &Block) -> bool {
 /// (the span's feed cap: the program's feed, times the override, within the machine's maximum
 /// feed; a rapid or a block without feed at the machine's maximum feed). A block that only
 /// turns the tool with a programmed time (G93, or rotary axes alone at F) runs at its rate of
-/// turn, the move's Δu/t (the span's cap, [`Span::feed_caps`]: the whole move's, on every
+/// turn, the move's Δu/t (the span's cap, [`crate::geometry::Span::feed_caps`]: the whole move's, on every
 /// piece of it); any other reorientation block at the fastest rate the axes' velocity limits
 /// allow along it (the program gives no tool-tip feed for it).
 ///

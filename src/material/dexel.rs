@@ -83,8 +83,8 @@ impl Dexel {
     ///
     /// Inline where `[lo, hi]` misses the material (most of a cut's removals: the tool's back
     /// passes through what the step before left), the rest out of line: all material lies in
-    /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(iv[0], lo) …
-    /// min(iv[1], hi) is empty and the removal would return [`Cut::NONE`] unchanged;
+    /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(`iv[0]`, lo) …
+    /// min(`iv[1]`, hi) is empty and the removal would return [`Cut::NONE`] unchanged;
     /// so it does where lo > hi (shorter than [`MIN_CUT_MM`]: a miss, [∞, −∞], too), and where
     /// `[lo, hi]` lies in the gap [g0, g1] between the two intervals of a [`Dexel::Two`]
     /// (g0 ≤ lo, hi ≤ g1: both overlaps empty, the same way; a tilted tool passing again

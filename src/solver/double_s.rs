@@ -243,7 +243,7 @@ const MAX_PARTS: usize = 256;
 
 /// The profile's stations (offset by `u0`) and its solution under the motion laws (module doc):
 /// the fewest parts per −J phase (doubling from 4) that keep the laws within
-/// [`TIME_TOLERANCE`] and [`JERK_TOLERANCE`]; `None` where even [`MAX_PARTS`] do not (the
+/// [`TIME_TOLERANCE`] and [`JERK_TOLERANCE`]; `None` where even `MAX_PARTS` do not (the
 /// general solver then takes the span).
 pub fn profile_stations(s: &DoubleS, u0: f64) -> Option<(Vec<f64>, SpanSolution)> {
     let exact = s.duration();

@@ -104,7 +104,7 @@ pub struct JerkOptions {
 /// The solver of the SCP's linear subproblems.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LpSolver {
-    /// The banded interior-point method ([`super::banded`]), with Clarabel where it does not
+    /// The banded interior-point method (`solver::banded`), with Clarabel where it does not
     /// answer (a subproblem it cannot solve within its iteration cap, e.g. an infeasible one).
     #[default]
     Banded,
@@ -518,7 +518,7 @@ pub fn rest_bounds(
 /// half of the span, so the estimate errs short: a constant-jerk interval that ends before
 /// the switch is exact, one that ends after it is not.
 ///
-/// An axis whose q' is rounding ([`STILL_AXIS`] of the largest |q'|) does not move along the
+/// An axis whose q' is rounding (`STILL_AXIS` of the largest |q'|) does not move along the
 /// path there and bounds no path jerk: its 1e-16 would make J 1e20 and the phase 1e-35 long,
 /// a first interval no solver can scale (the fuzz corpus's hand-made APT program on a B-head
 /// machine with jerk limits on Z only: every subproblem of that span stopped Clarabel).
