@@ -1020,7 +1020,7 @@ pub fn interpolate(args: &InterpolateArgs) -> Result<String> {
         args.output.display(),
         sp.count,
         args.period,
-        solution.schedule.cycle_time,
+        solution.schedule.cycle_time + solution.path.holds.iter().sum::<f64>(),
         sp.axes.join(" ")
     ))
 }

@@ -12,7 +12,10 @@
 //! # Samples
 //!
 //! [`sample`] gives one [`Sample`] at every t = kT from 0 while kT is before the cycle time,
-//! and one at the cycle time itself (so the last period may be shorter). At each sample the
+//! and one at the cycle time itself (so the last period may be shorter). The program's dwells
+//! ([`crate::geometry::Path::holds`]) are part of the time: where the tool dwells between two
+//! spans, the setpoints hold its position, at rest, for the dwell's duration, and the cycle
+//! time counts them, as `solve` reports it. At each sample the
 //! path is evaluated from the span's spline at u(t) and pushed through the kinematics — never
 //! interpolated between stations: q, and the analytic q̇ = q′ u̇, q̈ = q″ b + q′ ü. The arc length
 //! s is the interval's start station's s plus Simpson's rule on |P′| over [u_i, u]; the feed
@@ -124,7 +127,9 @@ pub fn for_each(
 ) -> Result<SetpointsHeader> {
     crate::validate::period("period", period)?;
     let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
-    let cycle = timeline.cycle_time;
+    let holds = &solution.path.holds;
+    let hold = |s: usize| holds.get(s).copied().unwrap_or(0.0);
+    let cycle = timeline.cycle_time + holds.iter().sum::<f64>();
     let estimate = (cycle / period).ceil();
     if !(estimate.is_finite() && estimate < MAX_SAMPLES as f64) {
         return Err(Error::Usage(format!(
@@ -138,26 +143,39 @@ pub fn for_each(
     let kin = &solution.kinematics;
     let na = kin.n_axes().min(machine.axes.len());
     let spans = &solution.path.spans;
-    // The instants, as the sampling loop below takes them: the count first.
+    // The instants, as the sampling loop below takes them: the count first. `offset`: the
+    // dwells so far, by which the clock runs ahead of the schedule's.
     let instants = |visit: &mut Visit| {
         let mut k: u64 = 0;
-        for (span, tl) in spans.iter().zip(&timeline.spans) {
-            for i in 0..tl.u.len() - 1 {
-                let t_end = tl.t[i + 1];
-                loop {
-                    let t = k as f64 * period;
-                    if t >= t_end {
-                        break;
-                    }
-                    visit(span, tl, i, t, t_end)?;
-                    k += 1;
+        let mut offset = 0.0;
+        let mut stand = |k: &mut u64, end: f64, span, tl, at: At| -> Result<()> {
+            loop {
+                let t = *k as f64 * period;
+                if t >= end {
+                    return Ok(());
                 }
+                visit(span, tl, at, t)?;
+                *k += 1;
+            }
+        };
+        for (si, (span, tl)) in spans.iter().zip(&timeline.spans).enumerate() {
+            if si == 0 && hold(0) > 0.0 {
+                stand(&mut k, tl.t[0] + hold(0), span, tl, At::Start)?;
+                offset += hold(0);
+            }
+            for i in 0..tl.u.len() - 1 {
+                stand(&mut k, tl.t[i + 1] + offset, span, tl, At::Move(i, offset))?;
+            }
+            let h = hold(si + 1);
+            if h > 0.0 {
+                stand(&mut k, tl.t[tl.t.len() - 1] + offset + h, span, tl, At::End)?;
+                offset += h;
             }
         }
         Ok::<(), Error>(())
     };
     let mut count = 0usize;
-    instants(&mut |_, _, _, _, _| {
+    instants(&mut |_, _, _, _| {
         count += 1;
         Ok(())
     })?;
@@ -189,10 +207,33 @@ pub fn for_each(
         }
         each(&s)
     };
-    instants(&mut |span, tl, i, t, t_end| {
-        let dur = t_end - tl.t[i];
-        let iv = tl.interval(i);
-        emit(point(span, kin, na, tl, i, iv.at(t - tl.t[i], dur), t))
+    instants(&mut |span, tl, at, t| {
+        let last = tl.u.len() - 2;
+        match at {
+            At::Move(i, offset) => {
+                let dur = tl.t[i + 1] - tl.t[i];
+                let iv = tl.interval(i);
+                emit(point(
+                    span,
+                    kin,
+                    na,
+                    tl,
+                    i,
+                    iv.at(t - offset - tl.t[i], dur),
+                    t,
+                ))
+            }
+            At::Start => emit(point(span, kin, na, tl, 0, tl.interval(0).ends().0, t)),
+            At::End => emit(point(
+                span,
+                kin,
+                na,
+                tl,
+                last,
+                tl.interval(last).ends().1,
+                t,
+            )),
+        }
     })?;
     // The final instant: the end of the last span.
     if let Some((span, tl)) = last {
@@ -203,9 +244,17 @@ pub fn for_each(
     Ok(header)
 }
 
-/// What [`for_each`] does at one sampling instant: span, its timeline, interval, t and the
-/// interval's end time.
-type Visit<'a> = dyn FnMut(&Span, &SpanTimeline, usize, f64, f64) -> Result<()> + 'a;
+/// Where a sampling instant falls: in interval i of a span's motion (with the dwells before
+/// it, by which the clock is ahead of the schedule's), or in a dwell at the span's start or end.
+#[derive(Debug, Clone, Copy)]
+enum At {
+    Move(usize, f64),
+    Start,
+    End,
+}
+
+/// What [`for_each`] does at one sampling instant: span, its timeline, where and t.
+type Visit<'a> = dyn FnMut(&Span, &SpanTimeline, At, f64) -> Result<()> + 'a;
 
 /// The setpoint at state `st` within interval `i` of a span.
 fn point(

@@ -286,3 +286,113 @@ fn streamed_setpoints_are_the_collected_ones() {
         );
     }
 }
+
+/// The program's dwells are part of the setpoints' time: where the tool dwells between two
+/// moves the setpoints hold its position, at rest, for the dwell's duration, and the motion
+/// around them is the schedule's, shifted by the dwells before it. (They were left out: the NX
+/// DMU 70 eVo program's setpoints ran 1,056.27 s, its cycle time 1,131.30 s with 75.03 s of
+/// drilling dwells.)
+#[test]
+fn dwells_hold_the_position_for_their_time() {
+    let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let read = |text: &str| {
+        toolpath::gcode::parse(
+            Path::new("drill.ngc"),
+            text,
+            toolpath::gcode::Dialect::LinuxCnc,
+        )
+        .unwrap()
+    };
+    let program = "G21 G90 G94\nG0 X0 Y0 Z5\nG4 P0.25\nG1 Z-3 F300\nG4 P1.5\nG1 Z5\n\
+                   G1 X20 F600\nG1 Z-3 F300\nG4 P0.5\nG1 Z5\nG4 P0.3\nM2\n";
+    let with = read(program);
+    let without = read(
+        &program
+            .lines()
+            .filter(|l| !l.starts_with("G4"))
+            .collect::<Vec<_>>()
+            .join("\n"),
+    );
+    assert!((with.dwell_time() - 2.55).abs() < 1e-12);
+    let options = Options {
+        solver_kind: SolverKind::Reach,
+        ..Options::default()
+    };
+    let (a, b) = (
+        optimize(&m, &with, &options).unwrap(),
+        optimize(&m, &without, &options).unwrap(),
+    );
+    // Before the first move, after the first plunge, after the second, at the end.
+    let holds = &a.path.holds;
+    assert_eq!(holds.len(), a.path.spans.len() + 1);
+    let nonzero: Vec<f64> = holds.iter().copied().filter(|&h| h > 0.0).collect();
+    assert_eq!(nonzero, vec![0.25, 1.5, 0.5, 0.3], "{holds:?}");
+    assert_eq!(holds[0], 0.25);
+    assert_eq!(*holds.last().unwrap(), 0.3);
+    let motion = b.schedule.cycle_time;
+    assert!((a.schedule.cycle_time - motion).abs() < 1e-9 * motion);
+    let period = 1e-3;
+    let (sa, sb) = (
+        sample(&m, &a, period).unwrap(),
+        sample(&m, &b, period).unwrap(),
+    );
+    let cycle = motion + 2.55;
+    assert_eq!(sa.samples.len(), (cycle / period).ceil() as usize + 1);
+    assert!((sa.samples.last().unwrap().t - cycle).abs() < 1e-12);
+    // Each dwell's interval on the clock: it starts where its span ends (the schedule's time
+    // plus the dwells before).
+    let span_end = |s: usize| {
+        b.schedule
+            .stations
+            .iter()
+            .filter(|st| st.span == s)
+            .map(|st| st.t)
+            .fold(0.0, f64::max)
+    };
+    // Each dwell's interval on the clock and where the tool stands.
+    let points = [
+        [0.0, 0.0, 5.0],
+        [0.0, 0.0, -3.0],
+        [20.0, 0.0, -3.0],
+        [20.0, 0.0, 5.0],
+    ];
+    let mut stands: Vec<(f64, f64)> = vec![(0.0, holds[0])];
+    let mut shift = holds[0];
+    for (s, &h) in holds.iter().enumerate().skip(1) {
+        if h > 0.0 {
+            let start = span_end(s - 1) + shift;
+            stands.push((start, start + h));
+            shift += h;
+        }
+    }
+    let mut held = 0;
+    for p in &sa.samples {
+        if let Some(k) = stands.iter().position(|(s, e)| p.t > *s && p.t < *e) {
+            // Inside a dwell: where it stands, at rest.
+            let err = (0..3)
+                .map(|i| (p.q[i] - points[k][i]).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-9 && p.feed == 0.0, "t = {}: {:?}", p.t, &p.q[..3]);
+            held += 1;
+            continue;
+        }
+        // Outside: the dwell-free setpoint at the time less the dwells before (every dwell a
+        // whole number of periods, so that is one of its instants).
+        let before: f64 = stands
+            .iter()
+            .filter(|(_, e)| *e <= p.t)
+            .map(|(s, e)| e - s)
+            .sum();
+        let j = ((p.t - before) / period).round() as usize;
+        let q = &sb.samples[j.min(sb.samples.len() - 1)];
+        let err = (0..3).map(|i| (p.q[i] - q.q[i]).abs()).fold(0.0, f64::max);
+        assert!(
+            err < 1e-6,
+            "t = {}: {:?} vs {:?}",
+            p.t,
+            &p.q[..3],
+            &q.q[..3]
+        );
+    }
+    assert!((held as f64 - 2.55 / period).abs() <= 8.0, "{held}");
+}

@@ -188,6 +188,11 @@ impl Span {
 pub struct Path {
     /// The rest-to-rest spans, in path order.
     pub spans: Vec<Span>,
+    /// The program's dwells where the tool stands, s: `holds[0]` before the first span's
+    /// motion, `holds[s + 1]` after span s (empty: none). Each dwell stands at the last point
+    /// the geometry keeps at or before its own, which [`span_points`] made a span boundary
+    /// (one inside a span, which cannot happen, would count at the span's end).
+    pub holds: Vec<f64>,
 }
 
 impl Path {
@@ -413,8 +418,29 @@ impl Path {
                 process: None,
             }
         });
-        Ok(Path { spans })
+        let holds = span_holds(toolpath, &plan);
+        Ok(Path { spans, holds })
     }
+}
+
+/// [`Path::holds`] of the spans `plan` ([`span_points`]) makes of `toolpath`.
+fn span_holds(toolpath: &Toolpath, plan: &[Vec<usize>]) -> Vec<f64> {
+    let dwells = || toolpath.dwells.iter().filter(|d| d.seconds > 0.0);
+    if dwells().next().is_none() {
+        return Vec::new();
+    }
+    let mut holds = vec![0.0; plan.len() + 1];
+    for d in dwells() {
+        let p = d.point;
+        // The span that p falls in: at its first point (or a repeat of it), the hold before
+        // it; further in, the hold after it; past every span, after the last.
+        let at = plan
+            .iter()
+            .position(|idx| p < idx[idx.len() - 1])
+            .map_or(plan.len(), |s| if p < plan[s][1] { s } else { s + 1 });
+        holds[at] += d.seconds;
+    }
+    holds
 }
 
 /// [`Span::points`] of a knot that is not a CL point: inserted on the programmed chord between
@@ -612,6 +638,7 @@ impl Path {
             None => CubicSpline::new(&u, &q),
         };
         Ok(Path {
+            holds: Vec::new(),
             spans: vec![Span {
                 deviation: (0.0, 0.0),
                 kind: SpanKind::Joint,
