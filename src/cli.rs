@@ -474,7 +474,7 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
         toolpath::Input::Joint(_) => 0.0,
     };
     if let Some(out) = &args.output {
-        writers::write_schedule(out, &solution.schedule)?;
+        writers::write_schedule(out, &solution.schedule, &solution.path.holds)?;
     }
     #[cfg(feature = "plot")]
     if let Some(plot) = &args.plot {

@@ -336,6 +336,56 @@ fn csv_schedule() {
     w.assert_listing(&["machine.json", "line.cls", "out.csv"]);
 }
 
+/// The schedule file's times count the program's dwells as `cycle_time_s` does: a dwell is
+/// the gap between the last station of the span before it and the first of the next, where
+/// the tool stands (they were left out: the last t fell short of the cycle time by them).
+#[test]
+fn the_schedule_file_counts_the_dwells() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write(
+        "dwell.ngc",
+        "G21 G90 G94\nG0 X0 Y0 Z0\nG1 X10 F600\nG4 P1.5\nG1 X20\nG4 P0.5\nM2\n",
+    );
+    let out = w.run(&[
+        "solve",
+        "-m",
+        "machine.json",
+        "dwell.ngc",
+        "--json",
+        "-o",
+        "out.csv",
+    ]);
+    assert_success(&out);
+    let summary = parse_json(&stdout(&out), "stdout");
+    let cycle_time = num(&summary["cycle_time_s"], "cycle_time_s");
+    assert_rel(
+        num(&summary["dwell_time_s"], "dwell_time_s"),
+        2.0,
+        1e-12,
+        "dwells",
+    );
+    let csv = w.read("out.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("CSV header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_rel(
+        rows[rows.len() - 1][col("t")],
+        cycle_time - 0.5,
+        1e-9,
+        "last t",
+    );
+    // The two spans meet at X10, where the tool stands 1.5 s.
+    let k = rows.iter().position(|r| r[col("span")] == 1.0).unwrap();
+    let (end, start) = (&rows[k - 1], &rows[k]);
+    assert_eq!((end[col("q_X")], start[col("q_X")]), (10.0, 10.0));
+    assert_eq!((end[col("v")], start[col("v")]), (0.0, 0.0));
+    assert_rel(start[col("t")] - end[col("t")], 1.5, 1e-9, "dwell gap");
+}
+
 #[test]
 fn json_schedule() {
     let w = Work::new();

@@ -168,13 +168,28 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 /// Writes `schedule` to `path`, in the format of its extension (`.json` or `.csv`), streamed
 /// to the file: the working set does not grow with the schedule (a 1.08 M-station schedule's
-/// JSON document took 7.6 GB built in memory).
-pub fn write_schedule(path: &Path, schedule: &Schedule) -> Result<()> {
+/// JSON document took 7.6 GB built in memory). `holds`: the program's dwells
+/// ([`crate::geometry::Path::holds`]), which the stations' times and the cycle time include.
+pub fn write_schedule(path: &Path, schedule: &Schedule, holds: &[f64]) -> Result<()> {
     let format = output_format(path, SCHEDULE)?;
     write_atomically_with(path, |w| match format {
-        Format::Json => write_schedule_json(schedule, w),
-        _ => write_schedule_csv(schedule, w),
+        Format::Json => write_schedule_json(schedule, holds, w),
+        _ => write_schedule_csv(schedule, holds, w),
     })
+}
+
+/// Per span, the dwells before its motion starts ([`crate::geometry::Path::holds`]: the one
+/// before the first span and those after each span before it), s; and their total.
+fn dwells_before(schedule: &Schedule, holds: &[f64]) -> (Vec<f64>, f64) {
+    let spans = schedule.stations.last().map_or(0, |s| s.span + 1);
+    let hold = |s: usize| holds.get(s).copied().unwrap_or(0.0);
+    let mut before = Vec::with_capacity(spans);
+    let mut sum = hold(0);
+    for s in 0..spans {
+        before.push(sum);
+        sum += hold(s + 1);
+    }
+    (before, holds.iter().sum())
 }
 
 fn parent_dir(path: &Path) -> &Path {
@@ -185,16 +200,22 @@ fn parent_dir(path: &Path) -> &Path {
 }
 
 /// The schedule as JSON: `{"units": {…}, "axes": [...], "cycle_time_s": …, "stations":
-/// [{span, u, s, t, v, a, q: {X: …}, qd: {…}, qdd: {…}}, …]}`, one station a line.
-pub fn schedule_json(schedule: &Schedule) -> Result<Vec<u8>> {
+/// [{span, u, s, t, v, a, q: {X: …}, qd: {…}, qdd: {…}}, …]}`, one station a line; t and
+/// `cycle_time_s` count the program's dwells `holds`, as [`schedule_csv`].
+pub fn schedule_json(schedule: &Schedule, holds: &[f64]) -> Result<Vec<u8>> {
     let mut out = Vec::new();
-    write_schedule_json(schedule, &mut out)
+    write_schedule_json(schedule, holds, &mut out)
         .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
     Ok(out)
 }
 
 /// [`schedule_json`], written to `w` station by station.
-pub fn write_schedule_json(schedule: &Schedule, w: &mut dyn Write) -> std::io::Result<()> {
+pub fn write_schedule_json(
+    schedule: &Schedule,
+    holds: &[f64],
+    w: &mut dyn Write,
+) -> std::io::Result<()> {
+    let (before, dwells) = dwells_before(schedule, holds);
     let num = |w: &mut dyn Write, x: f64| -> std::io::Result<()> {
         serde_json::to_writer(&mut *w, &x).map_err(std::io::Error::other)
     };
@@ -208,7 +229,7 @@ pub fn write_schedule_json(schedule: &Schedule, w: &mut dyn Write) -> std::io::R
         "{{\n  \"units\": {{\"length\": \"mm\", \"angle\": \"deg\", \"time\": \"s\"}},\n  \"axes\": [{}],\n  \"cycle_time_s\": ",
         names.join(", ")
     )?;
-    num(w, schedule.cycle_time)?;
+    num(w, schedule.cycle_time + dwells)?;
     write!(w, ",\n  \"stations\": [")?;
     for (i, s) in schedule.stations.iter().enumerate() {
         write!(
@@ -217,7 +238,8 @@ pub fn write_schedule_json(schedule: &Schedule, w: &mut dyn Write) -> std::io::R
             if i > 0 { "," } else { "" },
             s.span
         )?;
-        for (key, x) in [("u", s.u), ("s", s.s), ("t", s.t), ("v", s.v), ("a", s.a)] {
+        let t = s.t + before[s.span];
+        for (key, x) in [("u", s.u), ("s", s.s), ("t", t), ("v", s.v), ("a", s.a)] {
             write!(w, ", \"{key}\": ")?;
             num(w, x)?;
         }
@@ -238,16 +260,23 @@ pub fn write_schedule_json(schedule: &Schedule, w: &mut dyn Write) -> std::io::R
     writeln!(w, "\n  ]\n}}")
 }
 
-/// The schedule as CSV, one row per station: `span,u,s,t,v,a,q_X,…,qd_X,…,qdd_X,…`.
-pub fn schedule_csv(schedule: &Schedule) -> String {
+/// The schedule as CSV, one row per station: `span,u,s,t,v,a,q_X,…,qd_X,…,qdd_X,…`. The times
+/// count the program's dwells `holds` (a dwell after span s: the gap between its last station
+/// and span s + 1's first, where the tool stands).
+pub fn schedule_csv(schedule: &Schedule, holds: &[f64]) -> String {
     let mut out = Vec::new();
     // (Writing to a Vec cannot fail, and every byte written is UTF-8.)
-    let _ = write_schedule_csv(schedule, &mut out);
+    let _ = write_schedule_csv(schedule, holds, &mut out);
     String::from_utf8(out).unwrap_or_default()
 }
 
 /// [`schedule_csv`], written to `w` station by station.
-pub fn write_schedule_csv(schedule: &Schedule, w: &mut dyn Write) -> std::io::Result<()> {
+pub fn write_schedule_csv(
+    schedule: &Schedule,
+    holds: &[f64],
+    w: &mut dyn Write,
+) -> std::io::Result<()> {
+    let (before, _) = dwells_before(schedule, holds);
     write!(w, "span,u,s,t,v,a")?;
     for prefix in ["q", "qd", "qdd"] {
         for n in &schedule.axes {
@@ -256,7 +285,8 @@ pub fn write_schedule_csv(schedule: &Schedule, w: &mut dyn Write) -> std::io::Re
     }
     writeln!(w)?;
     for (i, s) in schedule.stations.iter().enumerate() {
-        write!(w, "{},{},{},{},{},{}", s.span, s.u, s.s, s.t, s.v, s.a)?;
+        let t = s.t + before[s.span];
+        write!(w, "{},{},{},{},{},{}", s.span, s.u, s.s, t, s.v, s.a)?;
         for x in [schedule.q(i), schedule.qd(i), schedule.qdd(i)] {
             for v in x {
                 write!(w, ",{v}")?;
