@@ -170,7 +170,7 @@ pub const MAX_SWEEP_FACTOR: f64 = 1e3;
 pub struct SweepPoint {
     /// The swept limit's max side at this step.
     pub limit: f64,
-    /// Cycle time T at `limit`, s.
+    /// Cycle time T at `limit`, s (the program's dwells included, as `solve` reports it).
     pub cycle_time_s: f64,
     /// dT/dv from the dual variables, s per unit of the limit (`None` with the reach solver).
     pub sensitivity_dual: Option<f64>,
@@ -411,6 +411,12 @@ pub fn sweep(
 ) -> Result<Sweep> {
     options.validate()?;
     optimize::check_inputs(machine, &options.solve).map_err(|e| e.within("solve"))?;
+    // The program's dwells: part of every step's cycle time, as `solve` reports it (they do
+    // not depend on the limit).
+    let dwells = match input {
+        Input::Cl(t) => t.dwell_time(),
+        Input::Joint(_) => 0.0,
+    };
     let axis = machine
         .axes
         .iter()
@@ -534,11 +540,11 @@ pub fn sweep(
             .map(|d| (d - fd).abs() / d.abs());
         points.push(SweepPoint {
             limit: v,
-            cycle_time_s: mid.cycle_time,
+            cycle_time_s: mid.cycle_time + dwells,
             sensitivity_dual: mid.sensitivity,
             sensitivity_fd: fd,
-            cycle_time_minus_s: minus.cycle_time,
-            cycle_time_plus_s: plus.cycle_time,
+            cycle_time_minus_s: minus.cycle_time + dwells,
+            cycle_time_plus_s: plus.cycle_time + dwells,
             sensitivity_dual_minus: minus.sensitivity,
             sensitivity_dual_plus: plus.sensitivity,
             binds,

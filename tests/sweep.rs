@@ -372,3 +372,47 @@ fn the_command_writes_csv_json_and_svg_and_names_unknown_axes() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!bad.exists());
 }
+
+/// The program's dwells are part of every step's cycle time, as `solve` reports it; dT/dv
+/// does not see them. (The sweep reported the motion alone: the NX DMU 70 eVo program's
+/// nominal step said 1,056.27 s where solve says 1,131.30 s with 75.03 s of dwells.) The
+/// closed form of the line at each step, plus the dwells.
+#[test]
+fn the_dwells_count_in_every_step() {
+    let l = 100.0;
+    let m = xyz(400.0, 500.0);
+    let mut tp = match line(l) {
+        Input::Cl(t) => t,
+        Input::Joint(_) => unreachable!(),
+    };
+    tp.dwells.push(toolpath::Dwell {
+        point: 0,
+        seconds: 1.25,
+        line: 1,
+    });
+    tp.dwells.push(toolpath::Dwell {
+        point: 1,
+        seconds: 0.5,
+        line: 2,
+    });
+    let s = run(
+        &m,
+        &Input::Cl(tp),
+        SweepOptions::new("X", SweptLimit::Acceleration, 200.0, 800.0, 3),
+        2,
+    );
+    for p in &s.points {
+        let want = 2.0 * (l / p.limit).sqrt() + 1.75;
+        assert!(
+            rel(p.cycle_time_s, want) < 1e-7,
+            "{} vs {want}",
+            p.cycle_time_s
+        );
+        let fd = -(l / p.limit).sqrt() / p.limit;
+        assert!(
+            rel(p.sensitivity_fd, fd) < 1e-3,
+            "{} vs {fd}",
+            p.sensitivity_fd
+        );
+    }
+}
