@@ -454,3 +454,48 @@ fn spans_the_refinement_has_not_settled_are_slowed_down_until_they_verify() {
         );
     }
 }
+
+/// A turn of the table alone at F is held to its rate of turn, and the re-simulation checks
+/// that rate as it checks the feed (in °/s): the schedule run 5 % faster (b × 1.1025) turns
+/// 5 % over F, a feed violation with no axis, while B's velocity limit, far above, holds.
+#[test]
+fn a_turn_alone_run_too_fast_exceeds_its_rate_of_turn() {
+    let m = machine(
+        r#"{"name": "4-axis", "kinematics": {"type": "xyzb"},
+            "axes": {"X": {"velocity": 500, "acceleration": 3000},
+                     "Y": {"velocity": 500, "acceleration": 3000},
+                     "Z": {"velocity": 500, "acceleration": 3000},
+                     "B": {"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}"#,
+    );
+    let text = "G21 G90 G94\nG1 X0 Y0 Z0 B0 F600\nG1 B90\nM2\n";
+    let ctx = feedopt::toolpath::MachineContext::new(&m, &feedopt::machine::References::default());
+    let t = feedopt::toolpath::gcode::parse_for(
+        std::path::Path::new("turn.ngc"),
+        text,
+        feedopt::toolpath::gcode::Dialect::LinuxCnc.spec(),
+        Some(&ctx),
+    )
+    .expect("reads");
+    let mut sol = solve(&m, &t, &Options::default());
+    // 90° at 600 °/min = 10 °/s: 9 s and v/a.
+    let want = 9.0 + 10.0 / 500.0;
+    assert!((sol.schedule.cycle_time - want).abs() < 1e-4 * want);
+    let v = check(&m, &sol, &VerifyOptions::default());
+    assert!(v.verified, "{:?}", v.violations.first());
+    tamper(&mut sol, 1.05 * 1.05);
+    let v = check(&m, &sol, &VerifyOptions::default());
+    assert!(!v.verified);
+    // (The ramps' acceleration, 10 % over, is the worst; on the plateau the rate of turn.)
+    let feed: Vec<_> = v
+        .violations
+        .iter()
+        .filter(|x| x.kind == Quantity::Feed)
+        .collect();
+    assert!(!feed.is_empty(), "{:?}", v.violations);
+    assert!(feed.iter().all(|x| x.axis.is_none()));
+    let worst = feed[0];
+    assert!((worst.ratio - 1.05).abs() < 2e-3, "{worst:?}");
+    assert!((worst.limit - 10.0).abs() < 1e-9, "{worst:?}");
+    assert!((v.worst_feed - 1.05).abs() < 2e-3, "{}", v.worst_feed);
+    assert!(v.worst[3].velocity < 0.2, "{:?}", v.worst[3]);
+}
