@@ -647,7 +647,38 @@ pub fn check(args: &CheckArgs) -> Result<String> {
             "s"
         }
     ));
+    // The shank findings once, with how many moves follow (a deep relief with too short a
+    // flute length makes every move one); `--json` lists each.
+    use crate::material::check::FindingKind;
+    let shank: Vec<_> = report
+        .findings
+        .iter()
+        .filter(|f| f.kind == FindingKind::Shank)
+        .collect();
+    let mut shank_said = false;
     for f in &report.findings {
+        if f.kind == FindingKind::Shank {
+            if shank_said {
+                continue;
+            }
+            shank_said = true;
+            let more = if shank.len() > 1 {
+                let deepest = shank.iter().map(|x| x.shank_depth).fold(0.0, f64::max);
+                format!(
+                    " (and {} more moves like it, up to {deepest:.3} mm, the last at line {})",
+                    shank.len() - 1,
+                    shank[shank.len() - 1].line
+                )
+            } else {
+                String::new()
+            };
+            s.push_str(&format!(
+                "{}:{}: {f}{more}\n",
+                args.toolpath.display(),
+                f.line
+            ));
+            continue;
+        }
         s.push_str(&format!("{}:{}: {f}\n", args.toolpath.display(), f.line));
     }
     Ok(s)

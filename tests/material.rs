@@ -387,6 +387,7 @@ fn chip_thinning_follows_its_formula() {
         engagement_angle: 36.87,
         rapid: false,
         programmed_feed: None,
+        shank_depth: 0.0,
     };
     let (v, by) = lim.bound(&s, 10.0, 3).unwrap();
     assert_eq!(by, ProcessLimit::ChipLoad);
@@ -449,6 +450,47 @@ fn the_overload_check_lists_exactly_the_overloads_and_the_rapid_through_stock() 
     );
     // At a feed override of 0.5 nothing but the rapid is left.
     assert_eq!(overloads(&sim, &m, 0.5).len(), 1);
+}
+
+/// A cut deeper than the flutes are long leaves material standing above them where the shank
+/// goes: an error-level finding at each such move, with how far it reaches (10 − 8 = 2 mm
+/// here), but not at a plunge, which clears its own hole; with flutes long enough, none. (The CAMotics bear, a 17 mm relief, with the default
+/// 2 D = 6.35 mm flutes of a 3.175 mm ball: its first plunge and every move after it; before,
+/// only its last retract showed, as a rapid through the material left above the flutes.)
+#[test]
+fn a_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
+    use feedopt::material::check::{FindingKind, Severity, overloads};
+    let tp = path(&[
+        [20.0, 20.0, 10.0],
+        [20.0, 20.0, 1.0],
+        [20.0, 20.0, -10.0],
+        [60.0, 20.0, -10.0],
+        [60.0, 20.0, 10.0],
+    ]);
+    let shank = |flutes: f64| -> Vec<(usize, f64)> {
+        let m = material(
+            Tool::new(10.0, 0.0, flutes, 3).unwrap(),
+            0.2,
+            ProcessLimits::default(),
+        );
+        let sim = material::simulate(&tp, &m).unwrap();
+        overloads(&sim, &m, 1.0)
+            .iter()
+            .inspect(|f| assert_eq!(f.severity, Severity::Error, "{f:?}"))
+            .filter(|f| f.kind == FindingKind::Shank)
+            .map(|f| (f.line, f.shank_depth))
+            .collect()
+    };
+    let found = shank(8.0);
+    // The plunge (line 3) clears its own hole: its flutes pass through everything above them.
+    // The slot (line 4) leaves the top 2 mm uncut where the shank goes; the retract (line 5)
+    // starts with the shank in them, the flutes' top 0.75 mm below the stock's top after its
+    // first step (of 1.25 mm, D/8).
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert_eq!((found[0].0, found[1].0), (4, 5), "{found:?}");
+    assert!((found[0].1 - 2.0).abs() < 1e-9, "{found:?}");
+    assert!((found[1].1 - 0.75).abs() < 1e-9, "{found:?}");
+    assert!(shank(12.0).is_empty());
 }
 
 /// A second identical pass cuts air: it runs at the air feed (or the machine's limits), the

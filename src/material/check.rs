@@ -6,7 +6,10 @@
 //! second. A rapid (`G0` / `RAPID`) that removes material is an error-level finding whatever
 //! the limits, once it removes more than one cell cube (h_x·h_y·min(h_x, h_y)): less is the
 //! grid grazing a wall the tool slides along (a retract along the tool axis), not a cut.
-//! Excesses up to [`CHECK_TOLERANCE`] are not reported.
+//! Excesses up to [`CHECK_TOLERANCE`] are not reported. A cutting move whose vertical tool
+//! leaves material standing more than a cell above its flutes' top is an error-level finding
+//! too: the shank (or the holder) runs into it (a tool whose flutes are longer than the
+//! default 2 D needs its flute length given).
 
 use super::cut::Sample;
 use super::{Material, ProcessLimit, Simulation};
@@ -25,10 +28,24 @@ pub enum Severity {
     Error,
 }
 
+/// Which kind of finding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FindingKind {
+    /// The programmed feed exceeds a process limit.
+    Overload,
+    /// A rapid through material.
+    Rapid,
+    /// Material above the flutes' top where a cutting move takes the tool: the shank in it.
+    Shank,
+}
+
 /// What the check found about one CL move.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Finding {
-    /// Warning (a limit exceeded) or error (a rapid through material).
+    /// Which kind.
+    pub kind: FindingKind,
+    /// Warning (a limit exceeded) or error (a rapid through material, the shank in it).
     pub severity: Severity,
     /// Source line of the CL point the move ends at.
     pub line: usize,
@@ -46,11 +63,22 @@ pub struct Finding {
     pub removed: f64,
     /// A at the worst sample, mm².
     pub area: f64,
+    /// How far material reaches above the flutes' top, mm ([`FindingKind::Shank`]; else 0).
+    pub shank_depth: f64,
 }
 
 /// `warning: …` or `error: …` (the caller puts the file and line in front).
 impl std::fmt::Display for Finding {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.kind == FindingKind::Shank {
+            return write!(
+                f,
+                "error: material stands {:.3} mm above the flutes' top where this move takes the \
+                 tool: the shank runs into it (if the tool's flutes are longer, give \
+                 --tool-flute-length or the tool table's)",
+                self.shank_depth
+            );
+        }
         match (self.limit, self.programmed_feed, self.allowed_feed) {
             (Some(l), Some(p), Some(a)) => write!(
                 f,
@@ -85,6 +113,7 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
             if removed > grazing {
                 let area = group.iter().map(|s| s.area).fold(0.0, f64::max);
                 out.push(Finding {
+                    kind: FindingKind::Rapid,
                     severity: Severity::Error,
                     line: first.line,
                     point: first.point,
@@ -94,9 +123,27 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
                     excess: 0.0,
                     removed,
                     area,
+                    shank_depth: 0.0,
                 });
             }
             return;
+        }
+        let shank_depth = group.iter().map(|s| s.shank_depth).fold(0.0, f64::max);
+        if shank_depth > sim.cell.0.min(sim.cell.1) {
+            let area = group.iter().map(|s| s.area).fold(0.0, f64::max);
+            out.push(Finding {
+                kind: FindingKind::Shank,
+                severity: Severity::Error,
+                line: first.line,
+                point: first.point,
+                limit: None,
+                programmed_feed: first.programmed_feed.map(|f| f * feed_override),
+                allowed_feed: None,
+                excess: 0.0,
+                removed,
+                area,
+                shank_depth,
+            });
         }
         let Some(feed) = first.programmed_feed.map(|f| f * feed_override) else {
             return;
@@ -117,6 +164,7 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
             let excess = feed / allowed - 1.0;
             if excess > CHECK_TOLERANCE {
                 out.push(Finding {
+                    kind: FindingKind::Overload,
                     severity: Severity::Warning,
                     line: first.line,
                     point: first.point,
@@ -126,6 +174,7 @@ pub fn overloads(sim: &Simulation, m: &Material, feed_override: f64) -> Vec<Find
                     excess,
                     removed,
                     area,
+                    shank_depth: 0.0,
                 });
             }
         }

@@ -91,6 +91,11 @@ pub struct Sample {
     pub rapid: bool,
     /// The move's programmed feed, mm/s (`None`: rapid, inverse-time or none).
     pub programmed_feed: Option<f64>,
+    /// How far material reaches above the flutes' top where the tool passes, mm (0: nowhere):
+    /// there the shank, above the flute length, runs into it. Checked on a vertical tool's
+    /// steps, where the flutes' top is the tool's upper bound of each crossing; a tilted
+    /// step's shank is not checked.
+    pub shank_depth: f64,
 }
 
 /// Per-step sums over the dexels a step cut.
@@ -98,17 +103,21 @@ pub struct Sample {
 struct Acc {
     length: f64,
     axial_max: f64,
+    /// The most material left above the flutes' top over the step's cells (vertical tool).
+    shank: f64,
 }
 
 impl Acc {
     const ZERO: Acc = Acc {
         length: 0.0,
         axial_max: f64::NEG_INFINITY,
+        shank: 0.0,
     };
     fn join(self, o: Acc) -> Acc {
         Acc {
             length: self.length + o.length,
             axial_max: self.axial_max.max(o.axial_max),
+            shank: self.shank.max(o.shank),
         }
     }
 }
@@ -565,6 +574,7 @@ pub(crate) fn cut_step(
                                 continue;
                             }
                             let y = y0 + (j as f64 + 0.5) * hy;
+                            let mut shank = 0.0_f64;
                             let mut note = |x: f64, c: super::dexel::Cut| {
                                 if c.length <= 0.0 {
                                     return;
@@ -589,8 +599,14 @@ pub(crate) fn cut_step(
                                         vertical_sweep(tool, &step.p0, &step.p1, x, y)
                                     {
                                         note(x, cell.remove(lo, hi));
+                                        // [lo, hi] reaches the flutes' top: what stands
+                                        // above it is in the shank's way.
+                                        if let Some([_, top]) = cell.extent() {
+                                            shank = shank.max(top - hi);
+                                        }
                                     }
                                 });
+                                acc.shank = acc.shank.max(shank);
                                 continue;
                             }
                             // Pose by pose over the cells of its capsule: each pose's crossings
@@ -748,6 +764,7 @@ pub(crate) fn cut_step(
         engagement_angle,
         rapid: false,
         programmed_feed: None,
+        shank_depth: acc.shank,
     }
 }
 
