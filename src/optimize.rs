@@ -420,16 +420,13 @@ fn optimize_path(
         let t0 = std::time::Instant::now();
         plan.progress
             .stage("adding stations where the re-simulation found a limit exceeded");
-        for m in &marks {
-            let e = excess[m.span].last().copied().unwrap_or(0.0);
-            if least.get(&m.span).is_none_or(|(l, ..)| e < *l) {
-                least.insert(
-                    m.span,
-                    (e, lv.problems[m.span].clone(), lv.solutions[m.span].clone()),
-                );
+        let (touched, failed, replaced) = plan.refine_where_violated(&mut lv, &marks, options)?;
+        for (si, p, sol) in replaced {
+            let e = excess[si].last().copied().unwrap_or(0.0);
+            if least.get(&si).is_none_or(|(l, ..)| e < *l) {
+                least.insert(si, (e, p, sol));
             }
         }
-        let (touched, failed) = plan.refine_where_violated(&mut lv, &marks, options)?;
         let solved = t0.elapsed().as_secs_f64();
         // The spans solved again first, on their own (the others passed and have not changed),
         // with those the solver failed on, which are slowed down in the next round where they
@@ -667,6 +664,14 @@ fn record_excess(excess: &mut [Vec<f64>], v: &Verification) {
         h.push(w);
     }
 }
+
+/// What [`Plan::refine_where_violated`] did: the spans solved again, those the solver failed
+/// on, and each replaced span's former problem and profile.
+type RefineOutcome = (
+    Vec<usize>,
+    Vec<usize>,
+    Vec<(usize, SpanProblem, SpanSolution)>,
+);
 
 /// Whether span `si` of `lv` starts and ends at rest (so that it can run slower on its own).
 fn at_rest(lv: &Level, si: usize) -> bool {
@@ -1718,14 +1723,15 @@ impl Plan<'_> {
     /// nearly: [`LOCAL_MARK`]) into equal parts (as many as its excess asks, [`local_parts`])
     /// and solves the spans concerned again, in parallel: the excess between stations falls as
     /// Δu², so a round or two suffice, and only where the path needs it. Returns the spans
-    /// solved again and those, from rest to rest, the solver failed on, which keep their
-    /// profiles; the level's schedule is left for the caller to rebuild.
+    /// solved again, those from rest to rest the solver failed on, which keep their profiles,
+    /// and the problems and profiles the new ones replaced; the level's schedule is left for
+    /// the caller to rebuild.
     fn refine_where_violated(
         &self,
         lv: &mut Level,
         marks: &[Violation],
         options: &Options,
-    ) -> Result<(Vec<usize>, Vec<usize>)> {
+    ) -> Result<RefineOutcome> {
         use rayon::prelude::*;
         let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); lv.problems.len()];
         for viol in marks {
@@ -1771,6 +1777,7 @@ impl Plan<'_> {
             .into_iter()
             .collect::<Result<_>>()?;
         let (mut touched, mut failed) = (Vec::with_capacity(solved.len()), Vec::new());
+        let mut replaced = Vec::with_capacity(solved.len());
         for (si, solved) in solved {
             let Some((p, s)) = solved else {
                 failed.push(si);
@@ -1779,11 +1786,14 @@ impl Plan<'_> {
             lv.iterations += s.iterations;
             lv.solve_time += s.solve_time;
             lv.status = lv.status.worst(s.status);
-            lv.problems[si] = p;
-            lv.solutions[si] = s;
+            replaced.push((
+                si,
+                std::mem::replace(&mut lv.problems[si], p),
+                std::mem::replace(&mut lv.solutions[si], s),
+            ));
             touched.push(si);
         }
-        Ok((touched, failed))
+        Ok((touched, failed, replaced))
     }
 
     /// Re-simulates spans `which` of a level on their own (each on its own clock, from 0), with

@@ -28,7 +28,8 @@
 //! of its neighbour (0.35 µm at 35 mm/s). No F is therefore absurd, and no time is lost: the
 //! merged block takes both blocks' time.
 //!
-//! **Dwells.** The program's dwells ([`Toolpath::dwells`]) are written where they stand: a G4
+//! **Dwells.** The program's dwells ([`crate::geometry::Path::holds`]) are written where they
+//! stand: a G4
 //! after the block that reaches the point (a dwell at a point the geometry drops, a repeat of
 //! the point before, at that point; one at a merged tiny block's end, at the block kept), in
 //! each dialect's word: LinuxCNC `G4 P` seconds, Fanuc `G4 X` seconds (with a decimal point,
@@ -143,8 +144,6 @@ struct Node {
     t: f64,
     /// Source line of the CL point (0 for a point added by the Δθ rule).
     line: usize,
-    /// The CL point (`None` for a point added by the Δθ rule).
-    point: Option<usize>,
     /// The program's dwells here, s (written as G4 after the block that reaches the point).
     dwell: f64,
 }
@@ -253,11 +252,16 @@ fn nodes(
             angles: angles[idx[k]],
             t: tl.time_at(u),
             line: pts[idx[k]].line,
-            point: Some(idx[k]),
             dwell: 0.0,
         };
+        // The program's dwells stand at span boundaries (Path::holds): before the first
+        // span's motion, and after each span, at its last point.
+        let hold = |s: usize| solution.path.holds.get(s).copied().unwrap_or(0.0);
         if si == 0 {
-            out.push(node(0, us[0]));
+            out.push(Node {
+                dwell: hold(0),
+                ..node(0, us[0])
+            });
         }
         for k in 1..idx.len() {
             let (ua, ub) = (us[k - 1], us[k]);
@@ -302,40 +306,20 @@ fn nodes(
                         angles: [w[3], w[4]],
                         t: tl.time_at(u),
                         line: 0,
-                        point: None,
                         dwell: 0.0,
                     });
                     split += 1;
                 }
             }
-            out.push(node(k, ub));
-        }
-    }
-    // Each dwell where the tool stands: at the last point written at or before its own (a point
-    // the geometry drops stands where the one before it does).
-    let mut dwells: Vec<(usize, f64)> = toolpath
-        .dwells
-        .iter()
-        .filter(|d| d.seconds > 0.0)
-        .map(|d| (d.point, d.seconds))
-        .collect();
-    dwells.sort_by_key(|d| d.0);
-    let mut next = dwells.iter().peekable();
-    let written: Vec<usize> = (0..out.len()).filter(|&i| out[i].point.is_some()).collect();
-    for (w, &i) in written.iter().enumerate() {
-        let here = out[i].point.unwrap_or(0);
-        let until = written
-            .get(w + 1)
-            .and_then(|&j| out[j].point)
-            .unwrap_or(usize::MAX);
-        // (A dwell before the first point is the first point's.)
-        while let Some(&&(p, secs)) = next.peek() {
-            if p >= until {
-                break;
-            }
-            debug_assert!(p >= here || w == 0);
-            out[i].dwell += secs;
-            next.next();
+            let dwell = if k + 1 == idx.len() {
+                hold(si + 1)
+            } else {
+                0.0
+            };
+            out.push(Node {
+                dwell,
+                ..node(k, ub)
+            });
         }
     }
     if out.len() > MAX_BLOCKS + 1 {
