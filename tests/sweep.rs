@@ -186,6 +186,67 @@ fn on_a_circle_the_duals_include_the_acceleration_limited_velocity_bound() {
     }
 }
 
+/// A zig-zag of `n` straight moves of 10 mm along X, 5 mm across.
+fn zigzag(n: usize) -> Input {
+    let pts: Vec<_> = (0..=n)
+        .map(|k| (Vector3::new(10.0 * k as f64, 5.0 * (k % 2) as f64, 0.0), UP))
+        .collect();
+    Input::Cl(toolpath(&pts, None))
+}
+
+/// The two ways to dT/dv agree: a cone program per span with Clarabel's multipliers, and the
+/// central difference (ε = 1e-6) of the lattice relaxation's largest profile where that is the
+/// exact optimum (the default). On the zig-zag every span is lattice-exact, so by default no
+/// cone program is solved; around the circle the relaxation breaks the centripetal rows where
+/// X's tangent vanishes, so the span is a cone program either way, with the same answer.
+#[test]
+fn the_lattice_derivative_equals_clarabels_duals() {
+    let m = machine(
+        r#"{"name": "xy", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 40, "acceleration": 1000},
+                     "Y": {"velocity": 400, "acceleration": 2000},
+                     "Z": {"velocity": 1e4, "acceleration": 1000}}}"#,
+    );
+    for (name, path, lattice_cones) in [
+        ("zig-zag", zigzag(12), 0),
+        ("circle", circle(20.0, 3, 120), 1),
+    ] {
+        for (which, from, to) in [
+            (SweptLimit::Acceleration, 500.0, 1500.0),
+            (SweptLimit::Velocity, 20.0, 60.0),
+        ] {
+            let o = SweepOptions::new("X", which, from, to, 3);
+            let lattice = run(&m, &path, o.clone(), 2000);
+            let duals = run(
+                &m,
+                &path,
+                SweepOptions {
+                    lattice: false,
+                    ..o
+                },
+                2000,
+            );
+            for (a, b) in lattice.points.iter().zip(&duals.points) {
+                let (da, db) = (a.sensitivity_dual.unwrap(), b.sensitivity_dual.unwrap());
+                eprintln!(
+                    "{name}, {which} {}: T {} / {}, dT/dv {da} / {db}, FD {}, cone spans {} / {} of {}",
+                    a.limit,
+                    a.cycle_time_s,
+                    b.cycle_time_s,
+                    a.sensitivity_fd,
+                    a.cone_spans,
+                    b.cone_spans,
+                    duals.spans
+                );
+                assert_eq!((a.cone_spans, b.cone_spans), (lattice_cones, duals.spans));
+                assert!(rel(a.cycle_time_s, b.cycle_time_s) < 1e-6);
+                assert!(da < 0.0, "the {which} limit binds at {}", a.limit);
+                assert!(rel(da, db) < 1e-3, "{which} {}: {da} against {db}", a.limit);
+            }
+        }
+    }
+}
+
 #[test]
 fn an_asymmetric_limit_is_scaled_proportionally() {
     let l = scaled_limit(
@@ -267,15 +328,16 @@ fn check_impeller_sweep(s: &Sweep) {
     );
 }
 
-/// The full-resolution study: automatic refinement at the nominal limits (30,867 stations
-/// since the adaptive refinement; 1.4 M when this test was written), then Clarabel at every
-/// step on those stations: `cargo test --release --test sweep -- --ignored --nocapture`.
+/// The full-resolution study: automatic refinement at the nominal limits (31,267 stations
+/// since the local refinement; 1.4 M when this test was written), then every step on those
+/// stations (the lattice optimum on every span: 3 s in release; Clarabel on every span, 4 s;
+/// it was ignored as slow while the stations were 1.4 M).
 /// The steps stop at 240 °/s² (C's acceleration holds the feed down on 0.7 % of the time
 /// there): at the nominal 300 °/s² (0.5 %) the limits that bind change within ±1 %, so that
 /// step is not smooth and has no finite difference to compare (it made this test fail with
 /// three steps from 60 to 300, before and after the constraint generation alike).
 #[test]
-#[ignore]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
 fn impeller_c_acceleration_sweep_at_full_resolution() {
     let dir = linuxcnc().expect("../shared is present (cfg shared_data)");
     let m = Machine::from_file(&dir.join("impeller-7bl-xyzac.machine.json")).unwrap();
