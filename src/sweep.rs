@@ -414,9 +414,12 @@ impl Study<'_> {
             let t = solver::interval_times(p, &s)?.iter().sum();
             Ok(Some((s, t)))
         };
-        let Some((s, _)) = exact(p)? else {
+        let Some((mut s, _)) = exact(p)? else {
             return Ok(None);
         };
+        // The exact optimum of the discretisation, as `solver::optimal` calls it (the passes
+        // label their profile greedy: in general it is only feasible).
+        s.status = Status::Optimal;
         let mut times = [0.0; 2];
         for (t, mu) in times.iter_mut().zip([1.0 - LATTICE_EPS, 1.0 + LATTICE_EPS]) {
             let machine = with_limit(self.machine, self.axis, self.which, value * mu);
@@ -496,6 +499,26 @@ pub fn sweep(
 ) -> Result<Sweep> {
     options.validate()?;
     optimize::check_inputs(machine, &options.solve).map_err(|e| e.within("solve"))?;
+    // The steps are the convex problem of velocity and acceleration limits (its optimum and
+    // its derivative): a jerk-limited schedule is not, so the study refuses jerk limits rather
+    // than re-simulate acceleration-limited steps against them; with `jerk_limited` off
+    // (`--no-jerk`) they are dropped from the machine, for the steps and their check alike.
+    let unlimited;
+    let machine = if !machine.has_jerk() {
+        machine
+    } else if options.solve.jerk_limited {
+        return Err(Error::option(
+            "solve.jerk_limited",
+            format!(
+                "the machine {} has jerk limits, and the sweep studies the velocity and \
+                 acceleration limits only: drop the jerk limits (--no-jerk) to sweep without them",
+                machine.name
+            ),
+        ));
+    } else {
+        unlimited = machine.without_jerk();
+        &unlimited
+    };
     // The program's dwells: part of every step's cycle time, as `solve` reports it (they do
     // not depend on the limit).
     let dwells = match input {

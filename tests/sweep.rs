@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use feedopt::machine::{Limit, Machine};
 use feedopt::optimize::Options;
+use feedopt::solver::Status;
 use feedopt::sweep::{Sweep, SweepOptions, SweptLimit, scaled_limit, sweep};
 use feedopt::toolpath::{self, Input};
 use nalgebra::Vector3;
@@ -476,5 +477,35 @@ fn the_dwells_count_in_every_step() {
             "{} vs {fd}",
             p.sensitivity_fd
         );
+    }
+}
+
+#[test]
+fn a_machine_with_jerk_limits_is_refused_unless_they_are_dropped() {
+    // The steps are the velocity- and acceleration-limited problem. Before, `--no-jerk` dropped
+    // the jerk limits from the stations' solve but not from the steps' re-simulation, so every
+    // step came out unverified (the flower mould: `N` at every step); without `--no-jerk` the
+    // error came from the stations' reachability solve and named the wrong remedy.
+    let m = machine(
+        r#"{"name": "xyz with jerk", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 100, "acceleration": 500, "jerk": 2000},
+                     "Y": {"velocity": 100, "acceleration": 500, "jerk": 2000},
+                     "Z": {"velocity": 100, "acceleration": 500, "jerk": 2000}}}"#,
+    );
+    let o = SweepOptions::new("X", SweptLimit::Acceleration, 400.0, 600.0, 2);
+    let e = sweep(&m, &zigzag(4), "zigzag", &o).unwrap_err().to_string();
+    assert!(e.contains("jerk limits") && e.contains("--no-jerk"), "{e}");
+    let mut o = o;
+    o.solve.jerk_limited = false;
+    o.solve.stations = Some(400);
+    let s = sweep(&m, &zigzag(4), "zigzag", &o).unwrap();
+    for p in &s.points {
+        assert!(
+            p.verified,
+            "{} mm/s²: worst ratio {}",
+            p.limit, p.worst_ratio
+        );
+        // Every span is lattice-exact: the optimum, not a fallback.
+        assert_eq!((p.status, p.cone_spans), (Status::Optimal, 0));
     }
 }
