@@ -224,8 +224,9 @@ pub struct SolveArgs {
 /// The solve options every subcommand that solves shares (`solve`, `compare`, `sweep`,
 /// `gcode`, `interpolate`): one declaration, flattened into each.
 pub struct SolveOptions {
-    /// Total station count, 2 to 4,000,000 (default: refined automatically until doubling
-    /// changes the cycle time by less than 0.01 %).
+    /// Total station count, 2 to 4,000,000 (default: refined automatically where it changes
+    /// the cycle time, interval by interval, until the estimated error of the cycle time is
+    /// below 0.01 % of it).
     #[arg(long)]
     pub stations: Option<usize>,
     /// Most stations the automatic refinement may use (it stops before a round that would
