@@ -112,7 +112,8 @@ pub struct CheckArgs {
     /// Machine file with `stock`, `tool` and `process` sections.
     #[arg(long, short)]
     pub machine: PathBuf,
-    /// Toolpath file (APT CL or G-code).
+    /// Toolpath file: APT CL (.cls, .apt) or G-code (.ngc, .nc, .gcode, .tap, Sinumerik .mpf,
+    /// Heidenhain .h, …; the dialect is detected from the content).
     pub toolpath: PathBuf,
     /// Print one JSON object (the material report with its `findings`).
     #[arg(long)]
@@ -188,7 +189,8 @@ pub struct SolveArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
     pub machine: PathBuf,
-    /// Toolpath file (APT CL: .cls, .apt; joint-space CSV: .csv).
+    /// Toolpath file: APT CL (.cls, .apt), G-code (.ngc, .nc, .gcode, .tap, Sinumerik .mpf,
+    /// Heidenhain .h, …; the dialect is detected from the content) or a joint-space CSV (.csv).
     pub toolpath: PathBuf,
     /// Print one JSON object with the summary instead of the readable report.
     #[arg(long)]
@@ -898,7 +900,8 @@ pub struct PlanArgs {
     /// Machine file (JSON: kinematics, axis limits, maximum feed).
     #[arg(long, short)]
     pub machine: PathBuf,
-    /// Toolpath file (APT CL: .cls, .apt; G-code: .ngc, .nc, .gcode, .tap).
+    /// Toolpath file: APT CL (.cls, .apt) or G-code (.ngc, .nc, .gcode, .tap, Sinumerik .mpf,
+    /// Heidenhain .h, …; the dialect is detected from the content).
     pub toolpath: PathBuf,
     #[command(flatten)]
     /// The solve options every subcommand shares.
