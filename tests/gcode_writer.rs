@@ -335,8 +335,24 @@ fn the_cli_writes_a_program_and_rejects_joint_space_input() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&out).unwrap();
-    assert!(text.starts_with("%\n") && text.trim_end().ends_with('%'));
+    assert!(text.starts_with("%\nO1000\n") && text.trim_end().ends_with('%'));
     assert!(String::from_utf8_lossy(&o.stdout).contains("peak feed"));
+    // The written program says it is a Fanuc program (its O number): solve reads it so.
+    let o = run(&[
+        "solve",
+        "--json",
+        "--solver",
+        "reach",
+        "--machine",
+        "problems/xyz_pocket/machine.json",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (j["dialect"].as_str(), j["dialect_by"].as_str()),
+        (Some("fanuc"), Some("content"))
+    );
     // Joint-space input: a clear error, nothing written.
     let csv = dir.path().join("joint.csv");
     std::fs::write(&csv, "s,q_0\n0,0\n1,1\n2,3\n").unwrap();

@@ -73,7 +73,7 @@
 //! | dialect | units, plane | TCP on / off | comments | end |
 //! |---|---|---|---|---|
 //! | linuxcnc | `G21 G90 G17` | `M428` / `M429` (the trt sims' remaps) | `( … )` | `M30` |
-//! | fanuc | `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
+//! | fanuc | `%`, `O1000`, `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
 //! | sinumerik | `G710 G90 G17` | `TRAORI` / `TRAFOOF` | `; …` | `M30` |
 //!
 //! TCP is switched on only on machines with rotary axes (not on a four-axis machine, `xyza`,
@@ -123,6 +123,9 @@ const MAX_HALVINGS: u32 = 20;
 /// splits blocks, and the count is checked while the splits are computed, before anything is
 /// written.
 pub const MAX_BLOCKS: usize = 1_000_000;
+
+/// The program number of a written Fanuc program.
+pub const FANUC_PROGRAM_NUMBER: &str = "O1000";
 
 /// Significant digits of F.
 const F_DIGITS: i32 = 7;
@@ -684,7 +687,9 @@ pub fn program(
         ))
     );
     if options.dialect == Dialect::Fanuc {
-        text.insert_str(0, "%\n");
+        // A Fanuc program in memory carries its number: `%`, then `O…` (which is also what
+        // tells feedopt's reader, and a user, that the file is a Fanuc program).
+        text.insert_str(0, &format!("%\n{FANUC_PROGRAM_NUMBER}\n"));
     }
     for h in w.header {
         let _ = writeln!(text, "{h}");
