@@ -15,12 +15,15 @@
 //! count from the limits; letting it run at every step would change the discretisation from
 //! step to step, so T(v) would carry discretisation jumps (spoiling monotonicity) and a finite
 //! difference would mix two discretisations. The sweep therefore solves once, at the nominal
-//! limits, with the reachability pass (fast, and its refinement converges where the
-//! discretisation does) and the user's station options (`--stations N` or automatic), and
-//! takes that solve's stations — including those added where its re-simulation failed — for
-//! every step and every finite difference. Each step's schedule is still re-simulated at the
-//! servo period; a step whose limits call for finer stations reports `verified: false` and its
-//! worst ratio rather than being refined.
+//! limits, with the steps' own solver and the user's station options (`--stations N` or
+//! automatic), and takes that solve's stations — including those added where its
+//! re-simulation failed — for every step and every finite difference. Each step's schedule is
+//! still re-simulated at the servo period; a step whose limits call for finer stations reports
+//! `verified: false` and its worst ratio rather than being refined. (The stations came from a
+//! reachability solve until round 11: its profile verified on them, but the cone program's
+//! optimum on the same stations, which rides other limits between stations, did not, so the
+//! step at the machine's own limit was unverified on four of twelve real programs, NX's Mori
+//! NMV5000 program by 20.6 %, while `solve` verified there.)
 //!
 //! **The sensitivity from the duals.** Scale the swept limit by μ around a step (μ = 1 there);
 //! then dT/dv = (1/v)·dT/dμ. Per span, with the multipliers of
@@ -563,15 +566,9 @@ pub fn sweep(
             ));
         }
     }
-    // The stations: one reach solve at the nominal limits, as `solve` would refine them.
-    let base = optimize_input(
-        machine,
-        input,
-        &Options {
-            solver_kind: SolverKind::Reach,
-            ..options.solve.clone()
-        },
-    )?;
+    // The stations: one solve at the nominal limits with the steps' solver, as `solve` would
+    // refine them (its verification adds the stations that solver's profile needs).
+    let base = optimize_input(machine, input, &options.solve)?;
     let mut solve_options = options.solve.clone();
     solve_options.solver.window = usize::MAX;
     solve_options.solver.threads = 1;

@@ -171,7 +171,7 @@ fn four_axis_machine_files_name_their_axes() {
 /// per block, without a tool-tip mode switch, and it reads back on the same machine.
 #[test]
 fn the_written_program_stays_in_machine_coordinates() {
-    use feedopt::writers::gcode::{GcodeOptions, program};
+    use feedopt::writers::gcode::{BlockFeed, GcodeOptions, program};
     let (m, ctx) = setup('A');
     let tp = read(
         &ctx,
@@ -189,6 +189,7 @@ fn the_written_program_stays_in_machine_coordinates() {
         &GcodeOptions {
             dialect: Dialect::LinuxCnc,
             max_rotation_deg: None,
+            block_feed: BlockFeed::Average,
         },
     )
     .unwrap();

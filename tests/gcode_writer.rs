@@ -13,7 +13,9 @@ use feedopt::machine::Machine;
 use feedopt::optimize::{Options, Solution, optimize};
 use feedopt::solver::SolverKind;
 use feedopt::toolpath::{self, ClPoint, Feed, Toolpath, gcode::Dialect};
-use feedopt::writers::gcode::{GcodeOptions, Program, program, programmed_time, write_gcode};
+use feedopt::writers::gcode::{
+    BlockFeed, GcodeOptions, Program, program, programmed_time, write_gcode,
+};
 use nalgebra::Vector3;
 
 fn root() -> PathBuf {
@@ -53,6 +55,7 @@ fn round_trip(
     let options = GcodeOptions {
         dialect,
         max_rotation_deg: None,
+        block_feed: BlockFeed::Average,
     };
     let prog = write_gcode(&out, m, input, sol, geometry, &options).unwrap();
     let back = match toolpath::read_as(&out, Some(toolpath::Format::Gcode), dialect).unwrap() {
@@ -258,6 +261,7 @@ fn the_rotary_step_rule_splits_dresser_blocks_and_keeps_the_time() {
     let o = GcodeOptions {
         dialect: Dialect::LinuxCnc,
         max_rotation_deg: Some(3.0),
+        block_feed: BlockFeed::Average,
     };
     let prog = program(&m, &t, &sol, &options.geometry, &o).unwrap();
     assert_eq!((prog.blocks, prog.split), (36, 27));
@@ -331,8 +335,24 @@ fn the_cli_writes_a_program_and_rejects_joint_space_input() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&out).unwrap();
-    assert!(text.starts_with("%\n") && text.trim_end().ends_with('%'));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("program time"));
+    assert!(text.starts_with("%\nO1000\n") && text.trim_end().ends_with('%'));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("peak feed"));
+    // The written program says it is a Fanuc program (its O number): solve reads it so.
+    let o = run(&[
+        "solve",
+        "--json",
+        "--solver",
+        "reach",
+        "--machine",
+        "problems/xyz_pocket/machine.json",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (j["dialect"].as_str(), j["dialect_by"].as_str()),
+        (Some("fanuc"), Some("content"))
+    );
     // Joint-space input: a clear error, nothing written.
     let csv = dir.path().join("joint.csv");
     std::fs::write(&csv, "s,q_0\n0,0\n1,1\n2,3\n").unwrap();
@@ -374,6 +394,7 @@ fn blended_corners_are_written_as_the_blends_the_schedule_runs() {
     let o = GcodeOptions {
         dialect: Dialect::LinuxCnc,
         max_rotation_deg: None,
+        block_feed: BlockFeed::Average,
     };
     let prog = write_gcode(&out, &m, &t, &sol, &options.geometry, &o).unwrap();
     let back =
@@ -468,5 +489,98 @@ fn dwells_are_written_where_they_stand() {
                 "{dialect}: {at:?}"
             );
         }
+    }
+}
+
+/// The schedule's cycle time of `t` and that of the program written from it with
+/// `block_feed`, read back and solved again on the same machine (a control that plans its
+/// acceleration within the machine's limits).
+fn written_and_solved_again(
+    m: &Machine,
+    t: &Toolpath,
+    block_feed: BlockFeed,
+    dialect: Dialect,
+) -> (f64, f64, Program) {
+    let options = Options::default();
+    let sol = optimize(m, t, &options).unwrap();
+    let o = GcodeOptions {
+        dialect,
+        max_rotation_deg: None,
+        block_feed,
+    };
+    let prog = program(m, t, &sol, &options.geometry, &o).unwrap();
+    let back = toolpath::gcode::parse(Path::new("back.ngc"), &prog.text, dialect).unwrap();
+    assert!(back.warnings.is_empty(), "{:?}", back.warnings);
+    let again = optimize(m, &back, &options).unwrap();
+    (sol.schedule.cycle_time, again.schedule.cycle_time, prog)
+}
+
+#[test]
+fn peak_feeds_let_a_control_that_accelerates_run_the_schedules_time() {
+    // One 400 mm move at F30000 (500 mm/s) on a mill that accelerates at 1000 mm/s²: the
+    // schedule ramps up over 125 mm and down over 125 mm, 400/500 + 500/1000 = 1.3 s.
+    let m = common::machine(
+        r#"{"name": "mill", "kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 500, "acceleration": 1000},
+                     "Y": {"velocity": 500, "acceleration": 1000},
+                     "Z": {"velocity": 500, "acceleration": 1000}},
+            "feed": {"max": 500}}"#,
+    );
+    let t = toolpath::gcode::parse(
+        Path::new("line.ngc"),
+        "G21 G90 G94\nG1 X0 Y0 Z0 F30000\nG1 X400\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    // Average: F is 400 mm / 1.3 s = 307.7 mm/s, which a control reaches only after
+    // accelerating: solved again, 400/307.7 + 0.3077 = 1.608 s.
+    let (cycle, again, prog) =
+        written_and_solved_again(&m, &t, BlockFeed::Average, Dialect::LinuxCnc);
+    assert!((cycle - 1.3).abs() < 1e-3, "{cycle}");
+    assert!((prog.time - cycle).abs() < 1e-6, "{}", prog.time);
+    assert!((again - 1.6077).abs() < 2e-3, "average: {again} s");
+    // Peak: F is the schedule's top feed, 500 mm/s (F30000.00): the control's ramps are the
+    // schedule's and so is its time; at F without accelerating the block would take 0.8 s.
+    let (cycle, again, prog) = written_and_solved_again(&m, &t, BlockFeed::Peak, Dialect::LinuxCnc);
+    assert!(
+        prog.text
+            .contains("G1 X400.000000 Y0.000000 Z0.000000 F30000.00"),
+        "{}",
+        prog.text
+    );
+    assert!((prog.time - 0.8).abs() < 1e-6, "{}", prog.time);
+    assert!(
+        (again - cycle).abs() <= 1e-4 * cycle,
+        "peak: {again} s against {cycle} s"
+    );
+}
+
+#[test]
+fn peak_feeds_hold_for_g93_blocks_and_turns_on_the_spot() {
+    // The head-head path: a move, a turn of the tool on the spot (a G93 block of its own), a
+    // move while turning back (G93), each starting and ending at rest.
+    let m = Machine::from_file(&root().join("problems/seed_head_head/machine.json")).unwrap();
+    let up = common::UP;
+    let tilted = Vector3::new(0.0, -0.3, 1.0).normalize();
+    let pts = [
+        (Vector3::new(0.0, 0.0, 50.0), up),
+        (Vector3::new(40.0, 0.0, 50.0), up),
+        (Vector3::new(40.0, 0.0, 50.0), tilted),
+        (Vector3::new(80.0, 10.0, 50.0), up),
+    ];
+    let t = common::toolpath(&pts, Some(50.0));
+    for dialect in Dialect::GCODE {
+        let (cycle, average, _) = written_and_solved_again(&m, &t, BlockFeed::Average, dialect);
+        let (_, peak, prog) = written_and_solved_again(&m, &t, BlockFeed::Peak, dialect);
+        assert!(prog.inverse_time_blocks == 2, "{}", prog.text);
+        assert!(prog.time < cycle, "{} vs {cycle}", prog.time);
+        assert!(
+            average > cycle * 1.01,
+            "{dialect}: average {average} vs {cycle}"
+        );
+        assert!(
+            (peak - cycle).abs() <= 1e-3 * cycle,
+            "{dialect}: peak {peak} vs {cycle}"
+        );
     }
 }

@@ -509,3 +509,55 @@ fn a_machine_with_jerk_limits_is_refused_unless_they_are_dropped() {
         assert_eq!((p.status, p.cone_spans), (Status::Optimal, 0));
     }
 }
+
+#[test]
+fn the_step_at_the_machines_own_limit_verifies_where_solve_does() {
+    // A B/C trunnion in tool-tip mode: a move that tilts the table to B90 C90, a short move
+    // that turns it back to B64.761 C45 while the tip moves 0.5 mm (NX's Mori NMV5000
+    // program, round 11, in miniature), then straight moves. The sweep takes one solve's
+    // stations for every step; when that solve was a reachability solve, its profile verified
+    // on them but the cone program's optimum on the same stations did not (worst ratio 1.0016
+    // at the machine's own X acceleration, 1.206 on the whole NX program), while `solve`
+    // verified there.
+    let m = machine(
+        r#"{"name": "B/C trunnion", "kinematics": {"type": "table_table_bc",
+              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0, "x-offset": 0,
+              "z-offset": 0},
+            "axes": {"X": {"velocity": 500, "acceleration": 3000},
+                     "Y": {"velocity": 500, "acceleration": 3000},
+                     "Z": {"velocity": 500, "acceleration": 3000},
+                     "B": {"velocity": 60, "acceleration": 600},
+                     "C": {"velocity": 60, "acceleration": 600}},
+            "feed": {"max": 500}}"#,
+    );
+    let program = "G21 G90 G94\nG43.4 H1\nG1 X-29.463 Y17.678 Z29.167 B0 C0 F250.\n\
+                   G1 X-37.207 Y24.805 Z0 B90. C90.\nX0 Y0\nX-.471 Y-.201 B64.761 C45.\n\
+                   X-3.769 Y-1.607\nX-41.458 Y14.464\n";
+    let t = toolpath::gcode::parse(
+        Path::new("trunnion.nc"),
+        program,
+        toolpath::gcode::Dialect::Fanuc,
+    )
+    .unwrap();
+    let input = Input::Cl(t);
+    let solved = feedopt::optimize::optimize_input(&m, &input, &Options::default()).unwrap();
+    let s = sweep(
+        &m,
+        &input,
+        "trunnion.nc",
+        &SweepOptions::new("X", SweptLimit::Acceleration, 3000.0, 6000.0, 2),
+    )
+    .unwrap();
+    let own = &s.points[0];
+    assert!(
+        own.verified,
+        "the step at the machine's own limit: worst ratio {}",
+        own.worst_ratio
+    );
+    assert!(
+        rel(own.cycle_time_s, solved.schedule.cycle_time) < 1e-5,
+        "sweep {} s, solve {} s",
+        own.cycle_time_s,
+        solved.schedule.cycle_time
+    );
+}

@@ -16,7 +16,7 @@ use feedopt::sweep::{MAX_STEPS, SweepOptions, SweptLimit, sweep};
 use feedopt::toolpath::joint_csv;
 use feedopt::toolpath::{Input, Toolpath};
 use feedopt::validate::{MAX_END_FEED, MAX_PERIOD_S, MIN_PERIOD_S};
-use feedopt::writers::gcode::{GcodeOptions, program};
+use feedopt::writers::gcode::{BlockFeed, GcodeOptions, program};
 use nalgebra::Vector3;
 
 use common::{UP, machine, toolpath};
@@ -304,6 +304,7 @@ fn rotation_per_block_at_least_0_001_degrees() {
         let o = GcodeOptions {
             dialect: Default::default(),
             max_rotation_deg: Some(d),
+            block_feed: BlockFeed::Average,
         };
         let (field, reason) = invalid_option(program(&m, &t, &sol, &geometry, &o));
         assert_eq!(field, "max_rotation_deg");
@@ -312,6 +313,7 @@ fn rotation_per_block_at_least_0_001_degrees() {
     let o = GcodeOptions {
         dialect: Default::default(),
         max_rotation_deg: Some(1.0),
+        block_feed: BlockFeed::Average,
     };
     program(&m, &t, &sol, &geometry, &o).unwrap();
 }

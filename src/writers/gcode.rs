@@ -15,13 +15,35 @@
 //!
 //! # Feed words
 //!
-//! * A block that moves a rotary axis is written under **G93** (inverse time): F = 1 / block
-//!   time in minutes = 60 / Δt.
-//! * A block where only X, Y, Z move is written under **G94**: F = chord / Δt in mm/min, the
-//!   chord measured between the coordinates as written.
+//! What a block's F states is [`GcodeOptions::block_feed`]:
 //!
-//! F is written with 7 significant digits (always with a decimal point): each block's time is
-//! then exact to 5e-7, so the file's total time matches the schedule's far within 0.1 %.
+//! * [`BlockFeed::Peak`] (the command line's default): the **fastest feed the schedule
+//!   reaches along the block** (the largest tool-tip feed at its stations, its ends included).
+//!   A control accelerates and brakes between the blocks' feeds itself; under these F the
+//!   schedule is feasible (it never runs faster than a block's F), and no motion under them
+//!   can be faster than the schedule, which is time-optimal under the same limits and F no
+//!   higher than the program's: a control that plans within the machine's limits runs the
+//!   schedule's time. feedopt's own solve of the written program is such a control: NX's
+//!   DMU 70 eVo program (840D, 1,198 lines), solved again from the written program, takes
+//!   the schedule's time within 1e-4 (written with average feeds: 1.1 % longer; the Spinner
+//!   keychain 7.2 %, the Röders finish 2.7 %). The program's time at its F without any
+//!   acceleration ([`Program::time`]) is then shorter than the schedule's.
+//! * [`BlockFeed::Average`]: the schedule's **average** over the block, chord / Δt: the
+//!   program's time at its F is the schedule's (a control that changed feed without
+//!   accelerating would run it), but a control that accelerates cannot: along a block that
+//!   starts from rest it must first reach the average, which the schedule passes halfway up
+//!   its ramp (the first interval from rest alone takes 25 % longer).
+//!
+//! * A block that moves a rotary axis is written under **G93** (inverse time): F = 60 / the
+//!   block's time in s: Δt (average), or the time the block takes at its peak feed (peak:
+//!   the chord at the peak tool-tip feed; on a turn on the spot, the turn at the peak rate
+//!   of turn), which is what the reader caps the tool tip (the turn) by.
+//! * A block where only X, Y, Z move is written under **G94**: F in mm/min, the peak
+//!   tool-tip feed (peak) or chord / Δt (average), the chord measured between the
+//!   coordinates as written.
+//!
+//! F is written with 7 significant digits (always with a decimal point): each block's time
+//! at its F is then exact to 5e-7.
 //! **Tiny blocks**: a block shorter than [`MIN_BLOCK_TIME_S`] (10 µs, F = 6,000,000 under G93)
 //! is merged with the next one — its end point is not written (the last block merges with the
 //! one before instead). Because every feed is capped, such a point lies within 10 µs of travel
@@ -51,7 +73,7 @@
 //! | dialect | units, plane | TCP on / off | comments | end |
 //! |---|---|---|---|---|
 //! | linuxcnc | `G21 G90 G17` | `M428` / `M429` (the trt sims' remaps) | `( … )` | `M30` |
-//! | fanuc | `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
+//! | fanuc | `%`, `O1000`, `G21 G90 G17` | `G43.4 H1` / `G49` | `( … )` | `M30`, `%` lines |
 //! | sinumerik | `G710 G90 G17` | `TRAORI` / `TRAFOOF` | `; …` | `M30` |
 //!
 //! TCP is switched on only on machines with rotary axes (not on a four-axis machine, `xyza`,
@@ -102,6 +124,9 @@ const MAX_HALVINGS: u32 = 20;
 /// written.
 pub const MAX_BLOCKS: usize = 1_000_000;
 
+/// The program number of a written Fanuc program.
+pub const FANUC_PROGRAM_NUMBER: &str = "O1000";
+
 /// Significant digits of F.
 const F_DIGITS: i32 = 7;
 
@@ -112,6 +137,40 @@ pub struct GcodeOptions {
     pub dialect: Dialect,
     /// Δθ: the largest turn of any rotary axis within one block, degrees (`None`: no limit).
     pub max_rotation_deg: Option<f64>,
+    /// What each block's F states: the schedule's peak feed along it or its average.
+    pub block_feed: BlockFeed,
+}
+
+/// What a written block's F states (see the module doc, "Feed words").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BlockFeed {
+    /// The fastest feed the schedule reaches along the block: a control that accelerates
+    /// within the machine's limits runs the schedule's time.
+    #[default]
+    Peak,
+    /// The schedule's average feed over the block: the blocks' times at their F add up to
+    /// the schedule's, for a control that would change feed without accelerating.
+    Average,
+}
+
+impl std::str::FromStr for BlockFeed {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "peak" => Ok(BlockFeed::Peak),
+            "average" => Ok(BlockFeed::Average),
+            _ => Err(format!("`{s}`: give peak or average")),
+        }
+    }
+}
+
+impl std::fmt::Display for BlockFeed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BlockFeed::Peak => "peak",
+            BlockFeed::Average => "average",
+        })
+    }
 }
 
 /// A written program and what it contains.
@@ -123,7 +182,9 @@ pub struct Program {
     pub blocks: usize,
     /// Of those, blocks under G93.
     pub inverse_time_blocks: usize,
-    /// Sum of the written block times, s, and of the dwells (`dwell_time`).
+    /// Sum of the written blocks' times at their F (no acceleration), s, and of the dwells
+    /// (`dwell_time`): the schedule's cycle time under [`BlockFeed::Average`], less under
+    /// [`BlockFeed::Peak`].
     pub time: f64,
     /// Sum of the written dwells (G4), s: the program's, each where it stands.
     pub dwell_time: f64,
@@ -146,6 +207,28 @@ struct Node {
     line: usize,
     /// The program's dwells here, s (written as G4 after the block that reaches the point).
     dwell: f64,
+    /// The block that ends here: the fastest tool-tip feed (mm/s) and rate u̇ (span units/s)
+    /// the schedule reaches along it, and its length in u.
+    peak: Peak,
+}
+
+/// The fastest tool-tip feed and u̇ along a block, and its length in u.
+#[derive(Debug, Clone, Copy, Default)]
+struct Peak {
+    v: f64,
+    udot: f64,
+    du: f64,
+}
+
+impl Peak {
+    /// Two consecutive blocks as one.
+    fn join(self, o: Peak) -> Peak {
+        Peak {
+            v: self.v.max(o.v),
+            udot: self.udot.max(o.udot),
+            du: self.du + o.du,
+        }
+    }
 }
 
 /// The words of one dialect.
@@ -243,16 +326,41 @@ fn nodes(
         )));
     }
     let pts = &toolpath.points;
+    let stations = &solution.schedule.stations;
     let mut out: Vec<Node> = Vec::new();
     let mut split = 0usize;
+    let mut offset = 0usize;
     for (si, ((idx, span), tl)) in plan.iter().zip(spans).zip(&timeline.spans).enumerate() {
         let us = point_parameters(toolpath, idx, span)?;
-        let node = |k: usize, u: f64| Node {
+        let first = offset;
+        offset += tl.u.len();
+        // The fastest tool-tip feed and u̇ at the span's stations from ua to ub (both
+        // included: CL points are stations; between stations b is linear in u, or under the
+        // jerk-limited law within the verification's bounds, so √b peaks at a station).
+        let peak = |ua: f64, ub: f64| {
+            let lo = tl.u.partition_point(|&x| x < ua);
+            let hi =
+                tl.u.partition_point(|&x| x <= ub)
+                    .max(lo + 1)
+                    .min(tl.u.len());
+            let lo = lo.min(hi - 1);
+            let mut p = Peak {
+                du: ub - ua,
+                ..Peak::default()
+            };
+            for j in lo..hi {
+                p.v = p.v.max(stations.get(first + j).map_or(0.0, |s| s.v));
+                p.udot = p.udot.max(tl.b[j].max(0.0).sqrt());
+            }
+            p
+        };
+        let node = |k: usize, u: f64, peak: Peak| Node {
             p: [pts[idx[k]].p.x, pts[idx[k]].p.y, pts[idx[k]].p.z],
             angles: angles[idx[k]],
             t: tl.time_at(u),
             line: pts[idx[k]].line,
             dwell: 0.0,
+            peak,
         };
         // The program's dwells stand at span boundaries (Path::holds): before the first
         // span's motion, and after each span, at its last point.
@@ -260,11 +368,13 @@ fn nodes(
         if si == 0 {
             out.push(Node {
                 dwell: hold(0),
-                ..node(0, us[0])
+                ..node(0, us[0], Peak::default())
             });
         }
         for k in 1..idx.len() {
             let (ua, ub) = (us[k - 1], us[k]);
+            // Where the block's last piece starts (after the Δθ rule's points).
+            let mut last_u = ua;
             if let Some(step) = max_rotation_rad {
                 // The span's curve between the block's ends, shifted linearly so that it meets
                 // the programmed points there (they differ by at most the fitting tolerance).
@@ -300,6 +410,7 @@ fn nodes(
                 }
                 for j in 1..parts {
                     let u = ua + (ub - ua) * j as f64 / parts as f64;
+                    let u0 = ua + (ub - ua) * (j - 1) as f64 / parts as f64;
                     let w = at(u);
                     out.push(Node {
                         p: [w[0], w[1], w[2]],
@@ -307,10 +418,13 @@ fn nodes(
                         t: tl.time_at(u),
                         line: 0,
                         dwell: 0.0,
+                        peak: peak(u0, u),
                     });
                     split += 1;
+                    last_u = u;
                 }
             }
+
             let dwell = if k + 1 == idx.len() {
                 hold(si + 1)
             } else {
@@ -318,7 +432,7 @@ fn nodes(
             };
             out.push(Node {
                 dwell,
-                ..node(k, ub)
+                ..node(k, ub, peak(last_u, ub))
             });
         }
     }
@@ -481,18 +595,24 @@ pub fn program(
     // The dwell written after each kept node: its own and those of the nodes merged into it
     // (a merged node lies within 10 µs of travel of the kept one).
     let mut dwell_after: Vec<f64> = vec![nodes[0].dwell];
+    // The peaks of each kept node's block, with those of the blocks merged into it.
+    let mut peak_of: Vec<Peak> = vec![Peak::default()];
+    let mut pending = Peak::default();
     let mut merged = 0usize;
     for i in 1..nodes.len() {
         let last = *keep.last().unwrap_or(&0);
         let same = written(&nodes[i]).0 == written(&nodes[last]).0;
         let tiny = nodes[i].t - nodes[last].t < MIN_BLOCK_TIME_S;
+        let peak = pending.join(nodes[i].peak);
         if i == nodes.len() - 1 {
             let mut dwell = nodes[i].dwell;
+            let mut peak = peak;
             if same || (tiny && keep.len() > 1) {
                 // The last block merges with the one before (its end point is the program's).
                 if keep.len() > 1 {
                     keep.pop();
                     dwell += dwell_after.pop().unwrap_or(0.0);
+                    peak = peak_of.pop().unwrap_or_default().join(peak);
                     merged += 1;
                 } else if same {
                     merged += 1;
@@ -504,14 +624,18 @@ pub fn program(
             }
             keep.push(i);
             dwell_after.push(dwell);
+            peak_of.push(peak);
         } else if same || tiny {
             merged += 1;
+            pending = peak;
             if let Some(d) = dwell_after.last_mut() {
                 *d += nodes[i].dwell;
             }
         } else {
             keep.push(i);
             dwell_after.push(nodes[i].dwell);
+            peak_of.push(peak);
+            pending = Peak::default();
         }
     }
     // G4 in each dialect's unit and word: LinuxCNC P seconds; Fanuc X seconds (with a decimal
@@ -542,7 +666,7 @@ pub fn program(
         text,
         "{}",
         comment(&format!(
-            "schedule cycle time {:.6} s{}; G93 F = 60 / block time s, G94 F in mm/min",
+            "schedule cycle time {:.6} s{}; {}",
             solution.schedule.cycle_time + toolpath.dwell_time(),
             if toolpath.dwell_time() > 0.0 {
                 format!(
@@ -552,11 +676,20 @@ pub fn program(
                 )
             } else {
                 String::new()
+            },
+            match options.block_feed {
+                BlockFeed::Peak => {
+                    "F: the fastest feed of the schedule along each block (G94 mm/min, G93 60 / \
+                     the block's time at it)"
+                }
+                BlockFeed::Average => "G93 F = 60 / block time s, G94 F in mm/min",
             }
         ))
     );
     if options.dialect == Dialect::Fanuc {
-        text.insert_str(0, "%\n");
+        // A Fanuc program in memory carries its number: `%`, then `O…` (which is also what
+        // tells feedopt's reader, and a user, that the file is a Fanuc program).
+        text.insert_str(0, &format!("%\n{FANUC_PROGRAM_NUMBER}\n"));
     }
     for h in w.header {
         let _ = writeln!(text, "{h}");
@@ -595,15 +728,26 @@ pub fn program(
         let chord =
             ((p[0] - prev_p[0]).powi(2) + (p[1] - prev_p[1]).powi(2) + (p[2] - prev_p[2]).powi(2))
                 .sqrt();
+        // The block's time at its F: Δt (average), or at the peak feed (never longer than Δt:
+        // the peak is at least the average).
+        let pk = peak_of[w];
+        let at_peak = match options.block_feed {
+            BlockFeed::Average => dt,
+            BlockFeed::Peak if chord > 0.0 && pk.v > 0.0 => (chord / pk.v).min(dt),
+            BlockFeed::Peak if chord == 0.0 && pk.udot > 0.0 && pk.du > 0.0 => {
+                (pk.du / pk.udot).min(dt)
+            }
+            BlockFeed::Peak => dt,
+        };
         let (mode, f) = if turns || chord == 0.0 {
             inverse_blocks += 1;
             let m = if inverse_mode { "" } else { "G93 " };
             inverse_mode = true;
-            (m, 60.0 / dt)
+            (m, 60.0 / at_peak)
         } else {
             let m = if inverse_mode { "G94 " } else { "" };
             inverse_mode = false;
-            (m, chord * 60.0 / dt)
+            (m, chord * 60.0 / at_peak)
         };
         let fw = feed_number(f);
         let fv: f64 = fw.parse().unwrap_or(f);
