@@ -260,6 +260,51 @@ pub fn vertical_sweep(
     Some([lo, z(ta).max(z(tb)) + tool.flute_length])
 }
 
+/// [`vertical_sweep`]'s lower end on a run of dexel lines of one grid row, for a level move
+/// (p0.z = p1.z, not on the spot) of a flat or ball-nose tool: `out[k]` for the line through
+/// x = `x0` + (ia + k + ½)·`hx` and `y`, ∞ where the tool does not reach it. The same
+/// operations as [`vertical_sweep`]'s (the closest approach, clamped to the move), so the same
+/// values bit for bit (test), written without branches so that the compiler vectorises them:
+/// a 3-axis program's level moves are most of its check.
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn level_row(
+    tool: &Tool,
+    p0: &Vector3<f64>,
+    p1: &Vector3<f64>,
+    y: f64,
+    (x0, hx): (f64, f64),
+    ia: usize,
+    out: &mut [f64],
+) {
+    let (r, rc) = (tool.radius(), tool.corner_radius);
+    let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
+    let ay = p0.y - y;
+    let qa = dx * dx + dy * dy;
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let ax = p0.x - x;
+        let qb = ax * dx + ay * dy;
+        let qc = ax * ax + ay * ay;
+        let disc = qb * qb - qa * (qc - r * r);
+        let sq = disc.max(0.0).sqrt();
+        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+        let t = (-qb / qa).clamp(0.0, 1.0);
+        let d = (qa * t * t + 2.0 * qb * t + qc).max(0.0).sqrt().min(r);
+        let e = d - (r - rc);
+        let bottom = if e <= 0.0 {
+            0.0
+        } else {
+            rc - (rc * rc - e * e).max(0.0).sqrt()
+        };
+        *o = if disc >= 0.0 && ta <= tb {
+            p0.z + bottom
+        } else {
+            f64::INFINITY
+        };
+    }
+}
+
 /// The lowest z at which the vertical line through (x, y) enters the capsule of radius `r`
 /// about the segment from `c0` to `c1` (not vertical), if it does: a ray from below the
 /// capsule, met first by the cylinder about the segment's line between the end planes, else
@@ -571,6 +616,13 @@ pub(crate) fn cut_step(
             })
             .collect()
     };
+    // A level vertical step of a flat or ball-nose tool (not on the spot): its dexels' lower
+    // ends row by row.
+    let (dx, dy) = (step.p1.x - step.p0.x, step.p1.y - step.p0.y);
+    let level = vertical
+        && step.p1.z == step.p0.z
+        && dx * dx + dy * dy > 1e-24
+        && (tool.corner_radius == 0.0 || tool.corner_radius >= r);
     // A vertical step's tool lies in the capsule about its tip's path.
     let vertical_foot = Footprint::new(
         [step.p0.x, step.p0.y],
@@ -634,14 +686,24 @@ pub(crate) fn cut_step(
                                 else {
                                     continue;
                                 };
+                                // A level move: the row's lower ends at once ([`level_row`]).
+                                if level {
+                                    starts.resize(ib - ia + 1, 0.0);
+                                    level_row(tool, &step.p0, &step.p1, y, (x0, hx), ia, starts);
+                                }
                                 band.each(j, ia, ib, |i, cell| {
                                     if matches!(cell, Dexel::Empty) {
                                         return;
                                     }
                                     let x = cx(i);
-                                    if let Some([lo, hi]) =
+                                    let swept = if level {
+                                        let lo = starts[i - ia];
+                                        (lo < f64::INFINITY)
+                                            .then_some([lo, step.p0.z + tool.flute_length])
+                                    } else {
                                         vertical_sweep(tool, &step.p0, &step.p1, x, y)
-                                    {
+                                    };
+                                    if let Some([lo, hi]) = swept {
                                         note(x, cell.remove(lo, hi));
                                         // [lo, hi] reaches the flutes' top: what stands
                                         // above it is in the shank's way.
@@ -918,6 +980,37 @@ mod tests {
 
     /// Every point of a tilted tool lies in the rectangle of `axis_row`, whose ends are
     /// tighter than the capsule's.
+    /// A level move's row of lower ends is [`vertical_sweep`]'s, bit for bit, for flat and
+    /// ball-nose tools, over rows that miss, graze and cross the swept capsule.
+    #[test]
+    fn a_level_rows_lower_ends_are_vertical_sweeps() {
+        for tool in [
+            Tool::new(6.0, 3.0, 12.0, 2).unwrap(),
+            Tool::new(8.0, 0.0, 16.0, 3).unwrap(),
+        ] {
+            let (p0, p1) = (Vector3::new(0.3, -0.2, -1.5), Vector3::new(0.9, 0.55, -1.5));
+            let (x0, hx, ia) = (-6.0, 0.1, 3);
+            let mut out = vec![0.0; 120];
+            let mut hits = 0;
+            for jy in 0..100 {
+                let y = -4.5 + 0.093 * jy as f64;
+                level_row(&tool, &p0, &p1, y, (x0, hx), ia, &mut out);
+                for (k, &lo) in out.iter().enumerate() {
+                    let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+                    match vertical_sweep(&tool, &p0, &p1, x, y) {
+                        Some([l, h]) => {
+                            assert_eq!(lo.to_bits(), l.to_bits(), "({x}, {y})");
+                            assert_eq!(h, p0.z + tool.flute_length);
+                            hits += 1;
+                        }
+                        None => assert_eq!(lo, f64::INFINITY, "({x}, {y})"),
+                    }
+                }
+            }
+            assert!(hits > 1000, "{hits}");
+        }
+    }
+
     /// The closed form for a ball on a ramp agrees with golden-section search on the swept
     /// ball's lower surface, on random ramps and lines (up, down, steep, shallow; lines near
     /// the capsule's edge and through its ends).
