@@ -305,6 +305,83 @@ fn level_row(
     }
 }
 
+/// [`vertical_sweep`] on a run of dexel lines of one grid row, for a ramp (p0.z ≠ p1.z, not a
+/// plunge) of a flat or ball-nose tool: `out[k]` for the line through x = `x0` + (ia + k +
+/// ½)·`hx` and `y`, [`NO_HIT`] where the tool does not reach it, a NaN lower end where the
+/// capsule's closed form needs [`vertical_sweep`]'s golden-section search (it did not meet the
+/// line in rounding). The same operations as [`vertical_sweep`] and [`capsule_bottom`], so the
+/// same values bit for bit (test), without branches (vectorised; multiversion).
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn ramp_row(
+    tool: &Tool,
+    p0: &Vector3<f64>,
+    p1: &Vector3<f64>,
+    y: f64,
+    (x0, hx): (f64, f64),
+    ia: usize,
+    out: &mut [[f64; 2]],
+) {
+    let (r, rc, lf) = (tool.radius(), tool.corner_radius, tool.flute_length);
+    let ball = rc >= r;
+    let (dx, dy, dz) = (p1.x - p0.x, p1.y - p0.y, p1.z - p0.z);
+    let ay = p0.y - y;
+    let qa = dx * dx + dy * dy;
+    // The capsule of the ball's centres ([`capsule_bottom`]).
+    let (c0, c1) = (
+        Vector3::new(p0.x, p0.y, p0.z + r),
+        Vector3::new(p1.x, p1.y, p1.z + r),
+    );
+    let z0 = c0.z.min(c1.z) - r - 1.0;
+    let ba = c1 - c0;
+    let (baba, bard) = (ba.dot(&ba), ba.z);
+    let a = baba - bard * bard;
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let ax = p0.x - x;
+        let qb = ax * dx + ay * dy;
+        let qc = ax * ax + ay * ay;
+        let disc = qb * qb - qa * (qc - r * r);
+        let sq = disc.max(0.0).sqrt();
+        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+        let (za, zb) = (p0.z + dz * ta, p0.z + dz * tb);
+        let hi = za.max(zb) + lf;
+        // A flat end mill: the lower end at an end of the reach (vertical_sweep's g there).
+        let flat = za.min(zb);
+        // A ball: the capsule's bottom on the line.
+        let oa = Vector3::new(x - c0.x, y - c0.y, z0 - c0.z);
+        let (baoa, rdoa, oaoa) = (ba.dot(&oa), oa.z, oa.dot(&oa));
+        let b = baba * rdoa - baoa * bard;
+        let c = baba * oaoa - baoa * baoa - r * r * baba;
+        let h = b * b - a * c;
+        let s = (-b - h.max(0.0).sqrt()) / a;
+        let along = baoa + s * bard;
+        let body = along > 0.0 && along < baba;
+        let (ox, oy, oz) = if along <= 0.0 {
+            (oa.x, oa.y, oa.z)
+        } else {
+            (x - c1.x, y - c1.y, z0 - c1.z)
+        };
+        let (b2, c2) = (oz, ox * ox + oy * oy + oz * oz - r * r);
+        let h2 = b2 * b2 - c2;
+        let cap = z0 - b2 - h2.max(0.0).sqrt();
+        let sphere = if body { z0 + s } else { cap };
+        let closed = h >= 0.0 && a > 0.0 && (body || h2 >= 0.0);
+        let lo = if !ball {
+            flat
+        } else if closed {
+            sphere
+        } else {
+            f64::NAN
+        };
+        *o = if disc >= 0.0 && ta <= tb {
+            [lo, hi]
+        } else {
+            NO_HIT
+        };
+    }
+}
+
 /// The lowest z at which the vertical line through (x, y) enters the capsule of radius `r`
 /// about the segment from `c0` to `c1` (not vertical), if it does: a ray from below the
 /// capsule, met first by the cylinder about the segment's line between the end planes, else
@@ -623,6 +700,11 @@ pub(crate) fn cut_step(
         && step.p1.z == step.p0.z
         && dx * dx + dy * dy > 1e-24
         && (tool.corner_radius == 0.0 || tool.corner_radius >= r);
+    // A ramp (not a plunge) of such a tool: its dexels' ends row by row ([`ramp_row`]).
+    let ramp = vertical
+        && step.p1.z != step.p0.z
+        && dx * dx + dy * dy > 1e-24
+        && (tool.corner_radius == 0.0 || tool.corner_radius >= r);
     // A vertical step's tool lies in the capsule about its tip's path.
     let vertical_foot = Footprint::new(
         [step.p0.x, step.p0.y],
@@ -686,10 +768,15 @@ pub(crate) fn cut_step(
                                 else {
                                     continue;
                                 };
-                                // A level move: the row's lower ends at once ([`level_row`]).
+                                // A level move or a ramp: the row's ends at once
+                                // ([`level_row`], [`ramp_row`]; a ramp's cells it leaves to
+                                // golden-section search are NaN).
                                 if level {
                                     starts.resize(ib - ia + 1, 0.0);
                                     level_row(tool, &step.p0, &step.p1, y, (x0, hx), ia, starts);
+                                } else if ramp {
+                                    run.resize(ib - ia + 1, NO_HIT);
+                                    ramp_row(tool, &step.p0, &step.p1, y, (x0, hx), ia, run);
                                 }
                                 band.each(j, ia, ib, |i, cell| {
                                     if matches!(cell, Dexel::Empty) {
@@ -700,6 +787,9 @@ pub(crate) fn cut_step(
                                         let lo = starts[i - ia];
                                         (lo < f64::INFINITY)
                                             .then_some([lo, step.p0.z + tool.flute_length])
+                                    } else if ramp && !run[i - ia][0].is_nan() {
+                                        let h = run[i - ia];
+                                        (h[0] <= h[1]).then_some(h)
                                     } else {
                                         vertical_sweep(tool, &step.p0, &step.p1, x, y)
                                     };
@@ -1008,6 +1098,42 @@ mod tests {
                 }
             }
             assert!(hits > 1000, "{hits}");
+        }
+    }
+
+    /// A ramp's row of crossings is [`vertical_sweep`]'s, bit for bit, for flat and ball-nose
+    /// tools, up and down, over rows that miss, graze and cross the swept volume.
+    #[test]
+    fn a_ramps_row_is_vertical_sweeps() {
+        for tool in [
+            Tool::new(6.0, 3.0, 12.0, 2).unwrap(),
+            Tool::new(8.0, 0.0, 16.0, 3).unwrap(),
+        ] {
+            for dz in [0.37, -0.21, 2.5] {
+                let (p0, p1) = (
+                    Vector3::new(0.3, -0.2, -1.5),
+                    Vector3::new(0.9, 0.55, -1.5 + dz),
+                );
+                let (x0, hx, ia) = (-6.0, 0.1, 3);
+                let mut out = vec![[0.0; 2]; 120];
+                let mut hits = 0;
+                for jy in 0..100 {
+                    let y = -4.5 + 0.093 * jy as f64;
+                    ramp_row(&tool, &p0, &p1, y, (x0, hx), ia, &mut out);
+                    for (k, h) in out.iter().enumerate() {
+                        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+                        match vertical_sweep(&tool, &p0, &p1, x, y) {
+                            Some([l, u]) => {
+                                assert_eq!(h[0].to_bits(), l.to_bits(), "({x}, {y})");
+                                assert_eq!(h[1].to_bits(), u.to_bits(), "({x}, {y})");
+                                hits += 1;
+                            }
+                            None => assert!(h[0] > h[1], "({x}, {y}): {h:?}"),
+                        }
+                    }
+                }
+                assert!(hits > 1000, "{hits}");
+            }
         }
     }
 
