@@ -1478,3 +1478,184 @@ fn an_error_in_a_block_delete_block_names_block_delete() {
     ));
     assert!(!e.contains("--block-delete"), "{e}");
 }
+
+/// A hand-written A/C table (A about X carrying C, as on a DMU 85 monoBLOCK), table centre at
+/// the origin, A's travel `a_min`…`a_max`; slow X Y Z, so that the swing of the linear axes
+/// while the table turns under a held tool tip (outside TCPM) differs between the two
+/// solutions and shows in the time.
+fn ac_table(a_min: f64, a_max: f64) -> (feedopt::machine::Machine, MachineContext) {
+    let m = common::machine(&format!(
+        r#"{{"name": "A/C table", "kinematics": {{"type": "table_table_ac",
+              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+              "y-offset": 0, "z-offset": 0, "conventional-directions": true}},
+            "axes": {{"X": {{"velocity": 50, "acceleration": 500}},
+                     "Y": {{"velocity": 50, "acceleration": 500}},
+                     "Z": {{"velocity": 50, "acceleration": 500}},
+                     "A": {{"velocity": 60, "acceleration": 600, "min": {a_min}, "max": {a_max}}},
+                     "C": {{"velocity": 120, "acceleration": 1200}}}},
+            "feed": {{"max": 500}}}}"#
+    ));
+    let ctx = MachineContext::new(&m, &feedopt::machine::References::default());
+    (m, ctx)
+}
+
+fn read_on(ctx: &MachineContext, text: &str) -> Result<Toolpath, String> {
+    parse_for(
+        Path::new("t.h"),
+        text,
+        Dialect::Heidenhain.spec(),
+        Some(ctx),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// The rotary angles (degrees, A and C) the kinematics gives every point.
+fn ac_angles(m: &feedopt::machine::Machine, tp: &Toolpath) -> Vec<[f64; 2]> {
+    feedopt::kinematics::Kinematics::new(m)
+        .rotary_angles(&tp.points, &m.axes)
+        .unwrap()
+        .iter()
+        .map(|a| a.map(f64::to_degrees))
+        .collect()
+}
+
+/// `PLANE SPATIAL SPA90 SPB0 SPC90 STAY SEQ±` and `L A+Q120 C+Q122 M126`, as hyperMILL posts
+/// for a DMU 85 monoBLOCK ("A-90 C270" in its comment for SEQ-): the tool axis is
+/// Rz(90°)·Rx(90°)·Z = +X, which an A/C table reaches at A +90°, C +90° or at A −90°,
+/// C 270°. SEQ+ takes the first (A, the master axis, positive), SEQ− the second; from C 0
+/// under M126 C goes the shorter way, to −90°. Each reads, solves and times as the same
+/// program with the positions written out (`L A-90 C+270`, the tilted plane's point
+/// (10, 20, 5) as Rz(90°)·Rx(90°)·(10, 20, 5) = (5, 10, 20)); until 2026-11-27 SEQ was skipped
+/// and SEQ− ran at A +90°, C +90°.
+#[test]
+fn plane_seq_picks_the_master_axis_sign() {
+    let (m, ctx) = ac_table(-120.0, 120.0);
+    let seq = |s: &str| {
+        format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 STAY {s} TABLE ROT\n\
+             6 L A+Q120 C+Q122 R0 FMAX M126\n7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
+        )
+    };
+    let explicit = |a: &str, c: &str| {
+        format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n5 L A{a} C{c} R0 FMAX M126\n\
+             6 L X+5 Y+10 Z+20 FMAX\n7 END PGM T MM\n"
+        )
+    };
+    let time = |tp: &Toolpath| {
+        let s = optimize(&m, tp, &Options::default()).unwrap();
+        assert!(s.verification.verified);
+        s.schedule.cycle_time
+    };
+    let mut times = Vec::new();
+    for (s, a, c, want) in [
+        ("SEQ-", "-90", "+270", [-90.0, -90.0]),
+        ("SEQ+", "+90", "+90", [90.0, 90.0]),
+    ] {
+        let tp = read_on(&ctx, &seq(s)).unwrap();
+        assert_eq!(tp.points.len(), 3, "{s}");
+        // The positioning block carries the control's positions (A, B, C).
+        assert_eq!(tp.points[1].rotary, Some([want[0], 0.0, want[1]]), "{s}");
+        assert!(close(tp.points[2].p, v(5.0, 10.0, 20.0), 1e-12), "{s}");
+        assert!(close(tp.points[2].o, v(1.0, 0.0, 0.0), 1e-12), "{s}");
+        let got = ac_angles(&m, &tp);
+        for k in 1..3 {
+            assert!(
+                (got[k][0] - want[0]).abs() < 1e-9 && (got[k][1] - want[1]).abs() < 1e-9,
+                "{s}: point {k} at A, C = {:?}, want {want:?}",
+                got[k]
+            );
+        }
+        let written = read_on(&ctx, &explicit(a, c)).unwrap();
+        let wa = ac_angles(&m, &written);
+        assert!((wa[2][0] - want[0]).abs() < 1e-9 && (wa[2][1] - want[1]).abs() < 1e-9);
+        let (t, tw) = (time(&tp), time(&written));
+        assert!(
+            (t - tw).abs() <= 1e-9 * tw,
+            "{s}: {t} s, written out {tw} s"
+        );
+        times.push(t);
+    }
+    // The two solutions swing X Y Z differently here: the choice shows in the time.
+    assert!(
+        (times[0] - times[1]).abs() > 0.01 * times[1],
+        "SEQ- {} s, SEQ+ {} s",
+        times[0],
+        times[1]
+    );
+
+    // PLANE … TURN SEQ-: the turn itself goes to A −90°, C −90°.
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 TURN SEQ- FMAX\n6 L X+10 Y+20 Z+5 FMAX\n"
+        ),
+    )
+    .unwrap();
+    let got = ac_angles(&m, &tp);
+    assert!(
+        got[1..]
+            .iter()
+            .all(|a| (a[0] + 90.0).abs() < 1e-9 && (a[1] + 90.0).abs() < 1e-9),
+        "{got:?}"
+    );
+
+    // A's travel −10…120°: SEQ- asks for A −90°, outside it; the control refuses, and so does
+    // the reader, naming the line and SEQ. SEQ+ runs at A +90°.
+    let (m2, ctx2) = ac_table(-10.0, 120.0);
+    let e = read_on(&ctx2, &seq("SEQ-")).unwrap_err();
+    assert!(
+        e.contains("t.h:6:") && e.contains("SEQ-") && e.contains("A negative"),
+        "{e}"
+    );
+    assert!(e.contains("A [-10, 120]°"), "{e}");
+    let tp = read_on(&ctx2, &seq("SEQ+")).unwrap();
+    assert!((ac_angles(&m2, &tp)[2][0] - 90.0).abs() < 1e-9);
+
+    // Without SEQ the kinematics chooses, as before: the solution within travel (A −120…10°:
+    // A −90°), or from A 0 the positive one.
+    let no_seq = seq("");
+    let (m3, ctx3) = ac_table(-120.0, 10.0);
+    let tp = read_on(&ctx3, &no_seq).unwrap();
+    assert!(tp.points.iter().all(|p| p.rotary.is_none() || p.line == 5));
+    assert!((ac_angles(&m3, &tp)[2][0] + 90.0).abs() < 1e-9);
+    let tp = read_on(&ctx, &no_seq).unwrap();
+    assert!((ac_angles(&m, &tp)[2][0] - 90.0).abs() < 1e-9);
+
+    // Tilt 0 (hyperMILL's `SPA0 SPB0 SPC0 … SEQ+`): one solution, nothing to choose.
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA0 SPB0 SPC0 STAY SEQ+ TABLE ROT\n\
+             6 L A+Q120 C+Q122 R0 FMAX M126\n7 L X+10 Y+20 Z+5 FMAX\n"
+        ),
+    )
+    .unwrap();
+    assert!(ac_angles(&m, &tp).iter().all(|a| a == &[0.0, 0.0]));
+    let tp = read(&format!(
+        "{HEADER}4 L X+40 Y+30 Z+50 FMAX
+5 PLANE SPATIAL SPA0 SPB0 SPC0 STAY SEQ+ TABLE ROT
+\
+             6 L A+Q120 C+Q122 R0 FMAX M126\n"
+    ));
+    assert!(
+        tp.warnings.iter().all(|w| !w.message.contains("SEQ")),
+        "{:?}",
+        tp.warnings
+    );
+    // Read without a machine file the solution cannot be computed: a warning naming SEQ.
+    let tp = read(&seq("SEQ-"));
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 6 && w.message.contains("SEQ-")),
+        "{:?}",
+        tp.warnings
+    );
+    // A SEQ without its sign is an error.
+    let e = read_on(&ctx, &seq("SEQ")).unwrap_err();
+    assert!(e.contains("t.h:6:") && e.contains("SEQ+ or SEQ-"), "{e}");
+}

@@ -99,8 +99,15 @@ impl Layout {
 
     fn travel_text(&self, i: usize) -> String {
         self.travel[i].map_or("unlimited".to_string(), |(lo, hi)| {
-            format!("[{}, {}]°", self.degrees(i, lo), self.degrees(i, hi))
+            // To 1e-9°: 120° read back through radians is 119.99999999999999°.
+            let deg = |x: f64| (self.position(i, x) * 1e9).round() / 1e9;
+            format!("[{}, {}]°", deg(lo), deg(hi))
         })
+    }
+
+    /// Axis `i`'s position, degrees, at path angle `x` (radians), unrounded.
+    pub fn position(&self, i: usize, x: f64) -> f64 {
+        (x + self.offset[i]).to_degrees()
     }
 
     /// Axis `i`'s position, degrees, at path angle `x` (radians); with an offset, to 1e-9°
@@ -430,6 +437,86 @@ impl Walker<'_> {
     }
 }
 
+/// Heidenhain's `PLANE … SEQ+` / `SEQ−` ("selecting one of several solutions"): of the two
+/// solutions of a tool vector (tilt ≥ 0 and spin, or the tilt negated and the spin turned by
+/// π), the one whose tilt axis stands at a positive (`positive`) or negative angle. The tilt
+/// axis is the control's *master axis*: the first rotary axis from the tool, the second from
+/// the table (A of an A/C table, A of a C/A head, B of a B head over a C table). Each solution
+/// is shifted by multiples of 2π nearest `current` within travel, as rule 2 shifts them, and
+/// its tilt axis's position there must have the sign asked for (0, the singular pose, has
+/// either); where both qualify, the nearer to `current` is taken. `Err` (a message naming the
+/// axes, without a line) when no solution with that sign lies within travel: the control
+/// reports an error there too.
+pub fn sequence(
+    tilt: f64,
+    spin: Option<f64>,
+    layout: &Layout,
+    positive: bool,
+    current: [f64; 2],
+) -> std::result::Result<[f64; 2], String> {
+    let l = layout;
+    let (pt, ps) = l.split(current);
+    let master = l.names[l.tilt];
+    let wanted = |x: f64| {
+        let deg = l.degrees(l.tilt, x);
+        if positive { deg >= -1e-9 } else { deg <= 1e-9 }
+    };
+    let branches = match spin {
+        Some(s) => [(tilt, s), (-tilt, s + PI)],
+        // Any spin gives the tool vector: it stays.
+        None => [(tilt, ps), (-tilt, ps)],
+    };
+    let mut best: Option<([f64; 2], f64)> = None;
+    let mut outside: Vec<String> = Vec::new();
+    for (t, s) in branches {
+        match (fit(t, pt, l.travel[l.tilt]), fit(s, ps, l.travel[l.spin()])) {
+            (Some(ft), Some(fs)) if wanted(ft) => {
+                let cand = l.pair(ft, fs);
+                let d = dist(cand, current);
+                if best.is_none_or(|(_, bd)| d < bd) {
+                    best = Some((cand, d));
+                }
+            }
+            _ if wanted(t) => {
+                let a = l.pair(t, fit(s, ps, None).unwrap_or(s));
+                outside.push(format!(
+                    "{} = {:.4}°, {} = {:.4}°",
+                    l.names[0],
+                    l.degrees(0, a[0]),
+                    l.names[1],
+                    l.degrees(1, a[1])
+                ));
+            }
+            _ => {}
+        }
+    }
+    if let Some((a, _)) = best {
+        return Ok(a);
+    }
+    let sign = if positive { "positive" } else { "negative" };
+    let travel = format!(
+        "{} {}, {} {}",
+        l.names[0],
+        l.travel_text(0),
+        l.names[1],
+        l.travel_text(1)
+    );
+    Err(if outside.is_empty() {
+        format!(
+            "no solution has {master} {sign}: the tool axis needs {master} = {:.4}° or {:.4}° \
+             (travel {travel})",
+            l.degrees(l.tilt, tilt),
+            l.degrees(l.tilt, -tilt)
+        )
+    } else {
+        format!(
+            "the solution with {master} {sign} ({}) is outside the rotary axes' travel \
+             ({travel})",
+            outside.join("; ")
+        )
+    })
+}
+
 /// The rotary angles of every CL point on one continuous branch within travel (see the module
 /// documentation). `lines` names each point's source line for errors; `axis` is the
 /// kinematics' tool axis for a pair of path angles.
@@ -482,6 +569,49 @@ mod tests {
             tilt: h.atan2(k.z),
             spin: (h >= SINGULAR).then(|| k.y.atan2(k.x)),
         }
+    }
+
+    #[test]
+    fn sequence_takes_the_tilt_sign_asked_for_within_travel() {
+        let layout = |tilt_travel: Option<(f64, f64)>, offset: f64| Layout {
+            tilt: 0,
+            travel: [tilt_travel, None],
+            names: ["B", "C"],
+            offset: [offset, 0.0],
+        };
+        let (t, s) = (60f64.to_radians(), 30f64.to_radians());
+        let deg = |a: [f64; 2]| a.map(|x| (x.to_degrees() * 1e9).round() / 1e9);
+        let free = layout(None, 0.0);
+        assert_eq!(
+            deg(sequence(t, Some(s), &free, true, [0.0, 0.0]).unwrap()),
+            [60.0, 30.0]
+        );
+        // The other solution: tilt negated, spin turned by 180°, shifted nearest C 0.
+        assert_eq!(
+            deg(sequence(t, Some(s), &free, false, [0.0, 0.0]).unwrap()),
+            [-60.0, -150.0]
+        );
+        // B −60° outside travel [−50°, 120°]: an error naming B and its travel.
+        let e = sequence(
+            t,
+            Some(s),
+            &layout(Some((-50f64.to_radians(), 120f64.to_radians())), 0.0),
+            false,
+            [0.0; 2],
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("B negative") && e.contains("B = -60.0000°"),
+            "{e}"
+        );
+        // A tilt axis offset by 90° stands at 150° or 30°: never negative.
+        let e = sequence(t, Some(s), &layout(None, FRAC_PI_2), false, [0.0; 2]).unwrap_err();
+        assert!(e.contains("no solution has B negative"), "{e}");
+        // At the pole both solutions are one: either sign takes it.
+        assert_eq!(
+            sequence(0.0, None, &free, false, [0.0, 1.0]).unwrap(),
+            [0.0, 1.0]
+        );
     }
 
     #[test]

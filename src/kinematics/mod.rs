@@ -44,7 +44,6 @@ use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
 use crate::machine::{Axis, KinematicsSpec, Machine, RotaryTable, TrunnionTilt};
-use crate::toolpath::ClPoint;
 use branch::{Layout, Target};
 use dual::{Dual2, Dual3, Real};
 
@@ -74,6 +73,20 @@ pub struct ToolPose {
     pub k: Vector3<f64>,
     /// The path angles, radians.
     pub angles: [f64; 2],
+}
+
+/// What the kinematics reads of a cutter-location point (the readers' `ClPoint` is one): the
+/// tool tip and tool axis in program coordinates, the rotary axis positions the program gave
+/// (`[A, B, C]`, degrees; `None` where it gave the tool vector) and its source line.
+pub trait CutterLocation {
+    /// The tool tip, program coordinates, mm.
+    fn tip(&self) -> Vector3<f64>;
+    /// The unit tool axis, from the tip towards the spindle.
+    fn tool_axis(&self) -> Vector3<f64>;
+    /// Programmed rotary axis positions `[A, B, C]`, degrees.
+    fn rotary(&self) -> Option<[f64; 3]>;
+    /// The 1-based source line.
+    fn line(&self) -> usize;
 }
 
 /// A machine's kinematics, ready to evaluate.
@@ -241,13 +254,17 @@ impl Kinematics {
     /// ([`branch`] states the rules). A path that cannot be followed continuously within
     /// travel, a programmed position outside travel, or a dresser point off the X–Z plane is
     /// an error naming its CL line.
-    pub fn rotary_angles(&self, points: &[ClPoint], axes: &[Axis]) -> Result<Vec<[f64; 2]>> {
+    pub fn rotary_angles<P: CutterLocation>(
+        &self,
+        points: &[P],
+        axes: &[Axis],
+    ) -> Result<Vec<[f64; 2]>> {
         let travel = self.rotary_axes().map(|i| {
             i.and_then(|i| axes.get(i))
                 .and_then(|a| a.travel)
                 .map(|(lo, hi)| (lo.to_radians(), hi.to_radians()))
         });
-        let lines: Vec<usize> = points.iter().map(|p| p.line).collect();
+        let lines: Vec<usize> = points.iter().map(|p| p.line()).collect();
         let names = match self {
             Kinematics::Xyz => return xyz_angles(points),
             Kinematics::Joint { .. } => return Ok(vec![[0.0; 2]; points.len()]),
@@ -276,20 +293,93 @@ impl Kinematics {
         )
     }
 
+    /// The rotary axis positions, degrees as `[A, B, C]`, that a Heidenhain control computes
+    /// for a working plane whose tool axis is `k` (program coordinates) under `PLANE … SEQ+`
+    /// (`positive`) or `SEQ−` (its Q120–Q122): the solution [`branch::sequence`] picks, from
+    /// the positions `current` (`[A, B, C]`, degrees) within the rotary axes' travel `travel`
+    /// (`[A, B, C]`, degrees, `None`: unlimited). `Some` for the axes this kinematics turns,
+    /// `None` for the others; `Ok(None)` where there are no two solutions to choose from: a
+    /// kinematics with fewer than two rotary axes, or `k` along the C axis (tilt 0, any spin).
+    /// `Err`: no solution with that sign within travel (the message names the axes, not the
+    /// line).
+    pub fn sequence_positions(
+        &self,
+        k: &Vector3<f64>,
+        positive: bool,
+        current: [f64; 3],
+        travel: [Option<(f64, f64)>; 3],
+    ) -> std::result::Result<Option<[Option<f64>; 3]>, String> {
+        let (names, tilt_index) = match self {
+            Kinematics::HeadHead { .. } => (["C", "A"], 1),
+            Kinematics::TableTable(t) => (t.tilt.letters(), 0),
+            Kinematics::HeadTable(h) => match h.table {
+                RotaryTable::C => (["B", "C"], 0),
+                RotaryTable::A => (["B", "A"], 0),
+            },
+            _ => return Ok(None),
+        };
+        let letter = |name: &str| match name {
+            "A" => 0,
+            "B" => 1,
+            _ => 2,
+        };
+        let offset = self.angle_offsets();
+        let layout = Layout {
+            tilt: tilt_index,
+            travel: [0, 1].map(|i| {
+                travel[letter(names[i])]
+                    .map(|(lo, hi)| (lo.to_radians() - offset[i], hi.to_radians() - offset[i]))
+            }),
+            names,
+            offset,
+        };
+        let (tilt, spin) = match self {
+            Kinematics::HeadHead { .. } => head_head::tool_vector_ik(k),
+            Kinematics::TableTable(t) => t.tool_vector_ik(k),
+            Kinematics::HeadTable(h) => h.tool_vector_ik(k),
+            _ => return Ok(None),
+        };
+        if spin.is_none() {
+            // The tool along the C axis: both solutions are one (tilt 0).
+            return Ok(None);
+        }
+        let angles = branch::sequence(
+            tilt,
+            spin,
+            &layout,
+            positive,
+            self.angles_from_rotary(current),
+        )?;
+        let mut out = [None; 3];
+        for (i, (name, angle)) in names.iter().zip(angles).enumerate() {
+            out[letter(name)] = Some(layout.position(i, angle));
+        }
+        Ok(Some(out))
+    }
+
     /// [`branch::follow`] for a two-rotary kinematics.
-    fn follow(&self, points: &[ClPoint], lines: &[usize], layout: Layout) -> Result<Vec<[f64; 2]>> {
+    fn follow<P: CutterLocation>(
+        &self,
+        points: &[P],
+        lines: &[usize],
+        layout: Layout,
+    ) -> Result<Vec<[f64; 2]>> {
         let targets: Vec<Target> = points
             .iter()
-            .map(|p| match p.rotary {
+            .map(|p| match p.rotary() {
                 Some(r) => Target::Programmed(self.angles_from_rotary(r)),
                 None => {
                     let (tilt, spin) = match self {
-                        Kinematics::HeadHead { .. } => head_head::tool_vector_ik(&p.o),
-                        Kinematics::TableTable(t) => t.tool_vector_ik(&p.o),
-                        Kinematics::HeadTable(h) => h.tool_vector_ik(&p.o),
+                        Kinematics::HeadHead { .. } => head_head::tool_vector_ik(&p.tool_axis()),
+                        Kinematics::TableTable(t) => t.tool_vector_ik(&p.tool_axis()),
+                        Kinematics::HeadTable(h) => h.tool_vector_ik(&p.tool_axis()),
                         _ => (0.0, None),
                     };
-                    Target::Vector { k: p.o, tilt, spin }
+                    Target::Vector {
+                        k: p.tool_axis(),
+                        tilt,
+                        spin,
+                    }
                 }
             })
             .collect();
@@ -408,13 +498,19 @@ impl Effective {
 /// line. The tool of such a machine cannot tilt; reading the point with the tool along +Z
 /// would put the tool tip where the program does not (a CL file's `TLAXIS/0,-1,0` or
 /// `GOTO/x,y,z,i,j,k` for a horizontal tool), quietly.
-fn xyz_angles(points: &[ClPoint]) -> Result<Vec<[f64; 2]>> {
-    if let Some(p) = points.iter().find(|p| (p.o - Vector3::z()).norm() > 1e-9) {
+fn xyz_angles<P: CutterLocation>(points: &[P]) -> Result<Vec<[f64; 2]>> {
+    if let Some(p) = points
+        .iter()
+        .find(|p| (p.tool_axis() - Vector3::z()).norm() > 1e-9)
+    {
         return Err(Error::Infeasible(format!(
             "CL point at line {}: a tool vector ({}, {}, {}) on a machine of type xyz, whose \
              tool stays along +Z: give a machine file with the rotary axes that tilt it \
              (head_head, table_table, head_table), or a toolpath with the tool along +Z",
-            p.line, p.o.x, p.o.y, p.o.z
+            p.line(),
+            p.tool_axis().x,
+            p.tool_axis().y,
+            p.tool_axis().z
         )));
     }
     Ok(vec![[0.0; 2]; points.len()])
@@ -423,28 +519,28 @@ fn xyz_angles(points: &[ClPoint]) -> Result<Vec<[f64; 2]>> {
 /// A fourth axis's angle at every CL point: its programmed position (0 where the program never
 /// turns it), which must lie within its travel; a tool vector other than +z is an error (such a
 /// machine's program coordinates are its own, the tool always along +z).
-fn fourth_axis_angles(
+fn fourth_axis_angles<P: CutterLocation>(
     r: crate::machine::FourthAxis,
-    points: &[ClPoint],
+    points: &[P],
     travel: Option<(f64, f64)>,
 ) -> Result<Vec<[f64; 2]>> {
     points
         .iter()
         .map(|p| {
-            let line = p.line;
-            if (p.o - Vector3::z()).norm() > 1e-9 {
+            let line = p.line();
+            if (p.tool_axis() - Vector3::z()).norm() > 1e-9 {
                 return Err(Error::Infeasible(format!(
                     "CL point at line {line}: a tool vector ({}, {}, {}) on a machine of type \
                      xyz{}, whose tool stays along +Z (its programs give the {} axis's \
                      position instead)",
-                    p.o.x,
-                    p.o.y,
-                    p.o.z,
+                    p.tool_axis().x,
+                    p.tool_axis().y,
+                    p.tool_axis().z,
                     r.letter().to_ascii_lowercase(),
                     r.letter()
                 )));
             }
-            let theta = p.rotary.map_or(0.0, |q| q[r.index()].to_radians());
+            let theta = p.rotary().map_or(0.0, |q| q[r.index()].to_radians());
             if !branch::within(theta, travel) {
                 let (lo, hi) = travel.unwrap_or_default();
                 return Err(Error::Infeasible(format!(
@@ -463,25 +559,25 @@ fn fourth_axis_angles(
 
 /// The dresser's B along the path: programmed, or the profile normal's angle unwrapped nearest
 /// to the previous point within travel. Points must lie in the X–Z plane.
-fn dresser_angles(
+fn dresser_angles<P: CutterLocation>(
     d: &dresser::Dresser,
-    points: &[ClPoint],
+    points: &[P],
     travel: Option<(f64, f64)>,
 ) -> Result<Vec<[f64; 2]>> {
     /// Largest |Py| (mm) and |o_y| accepted as "in the X–Z plane".
     const OFF_PLANE: f64 = 1e-6;
     let mut out: Vec<[f64; 2]> = Vec::with_capacity(points.len());
     for p in points {
-        let line = p.line;
+        let line = p.line();
         let prev = out.last().map_or(0.0, |a| a[0]);
-        if p.p.y.abs() > OFF_PLANE {
+        if p.tip().y.abs() > OFF_PLANE {
             return Err(Error::Infeasible(format!(
                 "CL point at line {line}: a dresser works in the X–Z plane, but this point has \
                  y = {} mm",
-                p.p.y
+                p.tip().y
             )));
         }
-        let theta = match p.rotary {
+        let theta = match p.rotary() {
             Some(r) => {
                 let b = r[1].to_radians();
                 if !branch::within(b, travel) {
@@ -497,14 +593,14 @@ fn dresser_angles(
                 b
             }
             None => {
-                if p.o.y.abs() > OFF_PLANE {
+                if p.tool_axis().y.abs() > OFF_PLANE {
                     return Err(Error::Infeasible(format!(
                         "CL point at line {line}: a dresser works in the X–Z plane, but this \
                          point's tool vector has y = {}",
-                        p.o.y
+                        p.tool_axis().y
                     )));
                 }
-                let raw = d.tool_vector_ik(&p.o).ok_or_else(|| {
+                let raw = d.tool_vector_ik(&p.tool_axis()).ok_or_else(|| {
                     Error::Infeasible(format!(
                         "CL point at line {line}: the tool vector has no direction in the X–Z plane"
                     ))

@@ -336,6 +336,10 @@ pub struct MachineContext {
     /// [`KinematicsSpec::FourthAxis`]): X Y Z and the angle are the axes' positions, not a tool
     /// tip, and it has no tool-tip mode.
     pub machine_coordinates: bool,
+    /// The machine's kinematics, where the reader computes what a control computes from it
+    /// (Klartext `PLANE … SEQ±`: which of the rotary axes' two solutions, Q120–Q122); `None`:
+    /// the reader leaves that to the kinematics' own choice.
+    pub kinematics: Option<crate::kinematics::Kinematics>,
 }
 
 impl MachineContext {
@@ -394,6 +398,7 @@ impl MachineContext {
             shortest_way: std::array::from_fn(|i| {
                 references.shortest_way.iter().any(|n| n == NAMES[3 + i])
             }),
+            kinematics: Some(crate::kinematics::Kinematics::new(machine)),
         }
     }
 
@@ -716,5 +721,23 @@ pub fn read(path: &Path) -> Result<Toolpath> {
             "{}: a joint-space path, not a CL toolpath",
             path.display()
         ))),
+    }
+}
+
+impl crate::kinematics::CutterLocation for ClPoint {
+    fn tip(&self) -> Vector3<f64> {
+        self.p
+    }
+
+    fn tool_axis(&self) -> Vector3<f64> {
+        self.o
+    }
+
+    fn rotary(&self) -> Option<[f64; 3]> {
+        self.rotary
+    }
+
+    fn line(&self) -> usize {
+        self.line
     }
 }

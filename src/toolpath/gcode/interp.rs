@@ -2423,6 +2423,17 @@ impl<'a> Interpreter<'a> {
             // The tilted plane's tool vector rules: the rotary axes go where it points.
             self.saw_rotary = true;
         }
+        // Under `PLANE … SEQ±` the control computed the positions (Q120–Q122): the rotary
+        // axes go there, as if the block programmed them (axis positions, degrees).
+        let plane_positions = if block.plane_rotary.iter().any(|&q| q) {
+            self.klartext.sequence.take()
+        } else {
+            None
+        };
+        if plane_positions.is_some() {
+            self.klartext.sequence_point = true;
+        }
+        let plane_positions = plane_positions.unwrap_or([None; 3]);
 
         let start = self.pos;
         let mut end = start;
@@ -2431,7 +2442,13 @@ impl<'a> Interpreter<'a> {
         // start).
         let rotary_known = self.saw_rotary;
         for (i, word) in block.axes.iter().enumerate() {
-            let Some(num) = *word else { continue };
+            let from_plane = i >= 3 && plane_positions[i - 3].is_some();
+            let word = if from_plane {
+                plane_positions[i - 3].map(|value| Num { value, point: true })
+            } else {
+                *word
+            };
+            let Some(num) = word else { continue };
             let value = if i < 3 {
                 self.length(num)
             } else {
@@ -2460,10 +2477,12 @@ impl<'a> Interpreter<'a> {
             }
             let incremental = (self.distance == Distance::Incremental || block.incremental[i])
                 && !machine
+                && !from_plane
                 && !block.absolute[i];
-            // A rotary machine coordinate: the program coordinate that the offsets in force
-            // take to it (`push` adds their shift; the X Y Z are converted below).
-            let value = if machine {
+            // A rotary machine coordinate (or a position the control computed for a plane):
+            // the program coordinate that the offsets in force take to it (`push` adds their
+            // shift; the X Y Z are converted below).
+            let value = if machine || from_plane {
                 value - self.offsets.shift()[i]
             } else {
                 value
@@ -2667,13 +2686,15 @@ impl<'a> Interpreter<'a> {
         // Rotary axes shifted by their work offsets (none unless a G10 or G52 gives one).
         let s = self.offsets.shift();
         let q_rot = [q[3] + s[3], q[4] + s[4], q[5] + s[5]];
+        let positioned = std::mem::take(&mut self.klartext.sequence_point);
         let (p, o, rotary) = if frame.is_identity() {
             (Vector3::new(q[0], q[1], q[2]), self.vector, Some(q_rot))
         } else {
             let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
             let o = frame.r * self.vector;
-            // Under a swivel frame the control sets the rotary axes: the tool vector rules.
-            let rotary = if self.swivel.is_some() {
+            // Under a swivel frame the control sets the rotary axes: the tool vector rules,
+            // but where they were positioned to the solution a `PLANE … SEQ±` asked for.
+            let rotary = if self.swivel.is_some() && !positioned {
                 None
             } else {
                 Some(q_rot)

@@ -40,8 +40,8 @@
 //!
 //! `Q`, `QL`, `QR` parameters are read before they are set only by mistake: that is an error
 //! naming the parameter, except `Q120`–`Q122` in a rotary word (`L A+Q120 C+Q122 FMAX`): they
-//! hold the rotary positions the control computes for the active `PLANE`, which the reader
-//! does not need (the tool vector of the tilted plane rules there). Assignments: `Q1 = expr`
+//! hold the rotary positions the control computes for the active `PLANE`: the tool vector of
+//! the tilted plane rules there, and under `SEQ+`/`SEQ-` the solution SEQ selects. Assignments: `Q1 = expr`
 //! (`+ - * /`, parentheses and the functions of [`super::expr`]), `FN 0: Q1 = +5` (assign),
 //! `FN 1` (+), `FN 2` (−), `FN 3` (×), `FN 4` (`DIV`), `FN 5: Q1 = SQRT +Q2`. `FN 16`
 //! (`F-PRINT`) prints and is skipped; every other `FN` is an error naming it.
@@ -83,7 +83,15 @@
 //!   the tool points along the plane's Z. `TURN`/`MOVE` turn the tool there at once (a
 //!   reorientation point; `MB` retracts first); `STAY` leaves the rotary axes where they
 //!   are: the tool keeps its orientation until a block positions a rotary axis, e.g.
-//!   `L A+Q120 C+Q122 FMAX` (Q120–Q122: the control's solution for the plane). `PLANE RESET
+//!   `L A+Q120 C+Q122 FMAX` (Q120–Q122: the control's solution for the plane). Of the
+//!   rotary axes' two solutions for the plane's tool axis the kinematics chooses
+//!   ([`crate::kinematics::branch`]), but `SEQ+`/`SEQ-` selects the one whose master axis
+//!   (the tilting axis: A of an A/C table) stands at a positive or negative angle, as the
+//!   control does: with the machine file's kinematics the reader computes those positions
+//!   ([`crate::kinematics::Kinematics::sequence_positions`], C the shorter way from where it
+//!   stands) and the block that positions the axes (`TURN`/`MOVE` itself, after `STAY` the
+//!   `A+Q120 C+Q122` block) carries them; outside travel that is an error naming the line and
+//!   SEQ (the control's too); read without a machine file, a warning. `PLANE RESET
 //!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
 //!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.

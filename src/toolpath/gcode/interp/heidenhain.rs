@@ -53,6 +53,15 @@ pub(super) struct State {
     /// After `PLANE … STAY`: the tool's orientation (workpiece coordinates) until a block
     /// positions a rotary axis.
     pub(super) stay_orientation: Option<Vector3<f64>>,
+    /// `PLANE … SEQ±` with two solutions for the rotary axes: the positions the control
+    /// computed for the one SEQ asks for (axis positions `[A, B, C]`, degrees; `None` for an
+    /// axis the kinematics does not turn), until a block positions the axes there (`L A+Q120
+    /// C+Q122` after STAY).
+    pub(super) sequence: Option<[Option<f64>; 3]>,
+    /// The next point is where the rotary axes were positioned to such a solution: it carries
+    /// them as programmed positions (elsewhere under a tilted plane the tool vector rules and
+    /// the kinematics chooses).
+    pub(super) sequence_point: bool,
     /// The preset `CYCL DEF 247` activated first (`Some(None)`: one whose Q339 is unknown).
     preset: Option<Option<f64>>,
     /// The line of a `CYCL DEF 7` that left a non-zero shift programmed while a plane was
@@ -647,6 +656,7 @@ impl Interpreter<'_> {
         let mut mode: Option<String> = None;
         let mut mb: Option<Option<f64>> = None;
         let mut values: Vec<(String, f64)> = Vec::new();
+        let mut sequence: Option<bool> = None;
         let mut k = 1;
         while k < words.len() {
             let (name, text) = &words[k];
@@ -667,9 +677,17 @@ impl Interpreter<'_> {
                 },
                 ("MBMAX", "") => mb = Some(None),
                 ("MB", t) => mb = Some(Some(self.klartext_value(line, "MB", t)?)),
-                // The rotary axes' feed, the solution and the table's role: the machine's.
-                ("FMAX" | "TABLE" | "COORD" | "ROT" | "SEQ" | "SYM", _)
-                | ("F" | "ABST" | "DIST", _) => {}
+                // Which of the rotary axes' two solutions: the master axis's sign.
+                ("SEQ", "+") => sequence = Some(true),
+                ("SEQ", "-") => sequence = Some(false),
+                ("SEQ", t) => {
+                    return Err(self.error(
+                        line,
+                        format!("PLANE: `SEQ{t}`: the solution is SEQ+ or SEQ-"),
+                    ));
+                }
+                // The rotary axes' feed and the table's role: the machine's.
+                ("FMAX" | "TABLE" | "COORD" | "ROT" | "SYM", _) | ("F" | "ABST" | "DIST", _) => {}
                 (n, t)
                     if !t.is_empty()
                         && n.chars().all(|c| c.is_ascii_alphabetic())
@@ -766,6 +784,11 @@ impl Interpreter<'_> {
         self.klartext.stay_orientation = None;
         self.set_klartext_frame();
         let after = self.frame_now().r * self.vector;
+        self.klartext.sequence = None;
+        self.klartext.sequence_point = false;
+        if let Some(positive) = sequence {
+            self.klartext.sequence = self.sequence_positions(line, positive, &after)?;
+        }
         if mode == "STAY" {
             if (after - before).norm() > 1e-12 {
                 self.klartext.stay_orientation = Some(before);
@@ -774,6 +797,18 @@ impl Interpreter<'_> {
             if rotation.is_none() {
                 self.pos[3..].fill(0.0);
             }
+            // TURN, MOVE: the rotary axes go to the solution SEQ asked for now; the next point
+            // (this turn's, where the tool turns) stands there.
+            if let Some(p) = self.klartext.sequence.take() {
+                let shift = self.offsets.shift();
+                for (i, v) in p.iter().enumerate() {
+                    if let Some(v) = v {
+                        self.pos[3 + i] = v - shift[3 + i];
+                    }
+                }
+                self.saw_rotary = true;
+                self.klartext.sequence_point = true;
+            }
             if !self.points.is_empty() && (after - before).norm() > 1e-12 {
                 let q = self.pos;
                 self.push(line, &q, Feed::Rapid);
@@ -781,6 +816,52 @@ impl Interpreter<'_> {
         }
         self.tangent = None;
         Ok(())
+    }
+
+    /// The rotary positions the control computes for `PLANE … SEQ+` (`positive`) or `SEQ-`
+    /// whose tool axis is `k` (workpiece coordinates), from the machine's kinematics and
+    /// travel: `None` where there is nothing to choose (a machine with fewer than two rotary
+    /// axes; the tool along the C axis, where both solutions are one) or nothing to choose
+    /// with (a reader without the machine's kinematics: a warning when the tool is tilted).
+    fn sequence_positions(
+        &mut self,
+        line: usize,
+        positive: bool,
+        k: &Vector3<f64>,
+    ) -> Result<Option<[Option<f64>; 3]>> {
+        let seq = if positive { "SEQ+" } else { "SEQ-" };
+        let kinematics = self
+            .machine
+            .and_then(|m| m.kinematics.as_ref().map(|kin| (m, kin)));
+        let Some((machine, kinematics)) = kinematics else {
+            if (k - Vector3::z()).norm() > 1e-9 {
+                self.warn(
+                    line,
+                    format!(
+                        "PLANE … {seq}: which of the rotary axes' two solutions {seq} selects \
+                         depends on the machine's kinematics, which the reader was not given: \
+                         the solution is left to the kinematics (read the program with a \
+                         machine file)"
+                    ),
+                );
+            }
+            return Ok(None);
+        };
+        let shift = self.offsets.shift();
+        let current = [3, 4, 5].map(|i| self.pos[i] + shift[i]);
+        let travel = [3, 4, 5].map(|i| machine.travel[i]);
+        kinematics
+            .sequence_positions(k, positive, current, travel)
+            .map_err(|e| {
+                self.error(
+                    line,
+                    format!(
+                        "PLANE … {seq}: {e}; the control refuses it too: program the other \
+                         SEQ, or check the travel in {}",
+                        machine.file.display()
+                    ),
+                )
+            })
     }
 
     fn tcpm(&mut self, line: usize, args: &str) -> Result<()> {
