@@ -22,6 +22,12 @@
 #   material"), so this assumes a 6 mm ball-nose end mill, flutes 2 D = 12 mm (the default);
 #   TOOL="--tool-diameter 8 --tool-corner-radius 0" bash benches/material.sh runs the
 #   configuration's tool-table T2 (D 8 "end mill") instead.
+# - camotics_bear, nx_roeders (3-axis: a vertical tool, whose cut is exact per dexel):
+#   ../shared/realworld/cam's CAMotics bear (15,163 lines, moves that ramp) with a 3.175 mm ball
+#   and 25 mm flutes (2 D would leave the shank in the relief), and NX's Röders finish (36,746
+#   lines, mostly level moves) with a 6 mm ball assumed (the program names no tool), each on
+#   xyz_mill.json with a box blank around its moves (bear X, Y 0…80, Z down to −17.368; Röders
+#   X −13.2…12.5, Y ±73.3, Z down to −6), 2 mm (bear) and 5 mm (Röders) wider, 1 mm deeper.
 #
 # Prints per row and run: samples, dexels, removed volume (check) or stations and cycle time
 # (solve), wall time and CPU time (user + system, s) and peak resident memory (MB, GNU time's
@@ -66,9 +72,19 @@ if [ -d "$lnx" ]; then
     '{"cylinder": {"center": [0, 0], "radius": 45.44, "z": [-2.65, 39.77]}}'
 fi
 
+cam=../shared/realworld/cam
+if [ -d "$cam" ]; then
+  with_stock $cam/machines/xyz_mill.json "$tmp/bear.json" \
+    '{"box": {"min": [-2, -2, -18.368], "max": [82, 82, 0]}}'
+  with_stock $cam/machines/xyz_mill.json "$tmp/roeders.json" \
+    '{"box": {"min": [-18.243, -78.312, -7], "max": [17.506, 78.312, 0]}}'
+fi
+
 rows=(
   "seed_blade|$seed/machine.json|$tmp/seed.json|$seed/impeller_blade.cls|--tool-diameter 6 --tool-corner-radius 3 --tool-flute-length 50"
   "linuxcnc_impeller|$lnx/impeller-7bl-xyzac.machine.json|$tmp/impeller.json|$lnx/impeller-7bl-xyzac.ngc|${TOOL:---tool-diameter 6 --tool-corner-radius 3}"
+  "camotics_bear|$cam/machines/xyz_mill.json|$tmp/bear.json|$cam/camotics_bear.nc|--tool-diameter 3.175 --tool-corner-radius 1.5875 --tool-flute-length 25"
+  "nx_roeders|$cam/machines/xyz_mill.json|$tmp/roeders.json|$cam/nx_roeders_rfm600_finish.nc|--tool-diameter 6 --tool-corner-radius 3"
 )
 
 # run NAME ARGS…: runs feedopt under GNU time, prints wall s and peak RSS MB into $wall $rss.
