@@ -995,7 +995,10 @@ impl Campaign {
         if let Some(out) = &self.settings.out {
             let path = out.join(&target.name).join("figures.txt");
             let table = self.table_of(&self.figures[self.figures.len() - 1..], "long");
-            if let Err(e) = std::fs::write(&path, table) {
+            // The target's folder exists only where a failure was saved: make it.
+            let written = std::fs::create_dir_all(out.join(&target.name))
+                .and_then(|()| std::fs::write(&path, table));
+            if let Err(e) = written {
                 let e = format!("{HARNESS}: writing {}: {e}", path.display());
                 eprintln!("HARNESS ERROR {}: {e}", target.name);
                 self.harness.push(e);
