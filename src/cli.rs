@@ -1031,7 +1031,8 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
         ),
     };
     Ok(format!(
-        "wrote {} ({} dialect): {} blocks ({} under G93), {} merged, {} added by Δθ\n\
+        "wrote {} ({} dialect): {} blocks ({} under G93), {} merged, {} added by Δθ, {} where \
+         a process limit changes\n\
          schedule cycle time {:.4} s (dwells included); {time}\n",
         args.output.display(),
         args.dialect,
@@ -1039,6 +1040,7 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
         prog.inverse_time_blocks,
         prog.merged,
         prog.split,
+        prog.process_split,
         solution.schedule.cycle_time + path.dwell_time(),
     ))
 }
