@@ -15,7 +15,7 @@
 //! `[min g, max (z + L_f)]` with `g(t) = z(t) + f(d(t))`. z is linear and f(d(t)) convex (f
 //! is convex and non-decreasing, d(t) convex), so g is convex: its minimum lies at an end for
 //! a flat end mill or a plunge, at the closest approach for a level move, on the capsule the
-//! ball sweeps for a ball-nose tool on a ramp (in closed form, `capsule_bottom`), and is found
+//! ball sweeps for a ball-nose tool on a ramp (in closed form, `Capsule::bottom`), and is found
 //! by golden-section search (to 1e-9 mm) for a bull-nose tool on a ramp. Each dexel is thus
 //! cut exactly.
 //!
@@ -229,14 +229,8 @@ pub fn vertical_sweep(
         }
         (0.0, 1.0)
     } else {
-        let disc = qb * qb - qa * (qc - r * r);
-        if disc < 0.0 {
-            return None;
-        }
-        let sq = disc.sqrt();
-        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
-        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
-        if ta > tb {
+        let (hit, ta, tb) = reach(qa, qb, qc, r);
+        if !hit {
             return None;
         }
         (ta, tb)
@@ -251,9 +245,10 @@ pub fn vertical_sweep(
         g((-qb / qa).clamp(ta, tb))
     } else if tool.corner_radius >= r {
         // A ball: the balls about P(t) + R ẑ sweep the capsule about their centres' segment.
-        let c0 = Vector3::new(p0.x, p0.y, p0.z + r);
-        let c1 = Vector3::new(p1.x, p1.y, p1.z + r);
-        capsule_bottom(&c0, &c1, r, x, y).unwrap_or_else(|| golden_min(g, ta, tb))
+        match Capsule::of_ball(p0, p1, r).bottom(x, y) {
+            (lo, true) => lo,
+            _ => golden_min(g, ta, tb),
+        }
     } else {
         golden_min(g, ta, tb)
     };
@@ -276,7 +271,7 @@ fn level_row(
     ia: usize,
     out: &mut [f64],
 ) {
-    let (r, rc) = (tool.radius(), tool.corner_radius);
+    let r = tool.radius();
     let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
     let ay = p0.y - y;
     let qa = dx * dx + dy * dy;
@@ -285,20 +280,11 @@ fn level_row(
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
-        let disc = qb * qb - qa * (qc - r * r);
-        let sq = disc.max(0.0).sqrt();
-        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
-        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+        let (hit, _, _) = reach(qa, qb, qc, r);
         let t = (-qb / qa).clamp(0.0, 1.0);
         let d = (qa * t * t + 2.0 * qb * t + qc).max(0.0).sqrt().min(r);
-        let e = d - (r - rc);
-        let bottom = if e <= 0.0 {
-            0.0
-        } else {
-            rc - (rc * rc - e * e).max(0.0).sqrt()
-        };
-        *o = if disc >= 0.0 && ta <= tb {
-            p0.z + bottom
+        *o = if hit {
+            p0.z + tool.bottom(d)
         } else {
             f64::INFINITY
         };
@@ -309,7 +295,7 @@ fn level_row(
 /// plunge) of a flat or ball-nose tool: `out[k]` for the line through x = `x0` + (ia + k +
 /// ½)·`hx` and `y`, [`NO_HIT`] where the tool does not reach it, a NaN lower end where the
 /// capsule's closed form needs [`vertical_sweep`]'s golden-section search (it did not meet the
-/// line in rounding). The same operations as [`vertical_sweep`] and [`capsule_bottom`], so the
+/// line in rounding). The same operations as [`vertical_sweep`] (and [`Capsule::bottom`]), so the
 /// same values bit for bit (test), without branches (vectorised; multiversion).
 #[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
 fn ramp_row(
@@ -326,47 +312,19 @@ fn ramp_row(
     let (dx, dy, dz) = (p1.x - p0.x, p1.y - p0.y, p1.z - p0.z);
     let ay = p0.y - y;
     let qa = dx * dx + dy * dy;
-    // The capsule of the ball's centres ([`capsule_bottom`]).
-    let (c0, c1) = (
-        Vector3::new(p0.x, p0.y, p0.z + r),
-        Vector3::new(p1.x, p1.y, p1.z + r),
-    );
-    let z0 = c0.z.min(c1.z) - r - 1.0;
-    let ba = c1 - c0;
-    let (baba, bard) = (ba.dot(&ba), ba.z);
-    let a = baba - bard * bard;
+    let capsule = Capsule::of_ball(p0, p1, r);
     for (k, o) in out.iter_mut().enumerate() {
         let x = x0 + ((ia + k) as f64 + 0.5) * hx;
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
-        let disc = qb * qb - qa * (qc - r * r);
-        let sq = disc.max(0.0).sqrt();
-        let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
-        let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+        let (hit, ta, tb) = reach(qa, qb, qc, r);
         let (za, zb) = (p0.z + dz * ta, p0.z + dz * tb);
         let hi = za.max(zb) + lf;
         // A flat end mill: the lower end at an end of the reach (vertical_sweep's g there).
         let flat = za.min(zb);
         // A ball: the capsule's bottom on the line.
-        let oa = Vector3::new(x - c0.x, y - c0.y, z0 - c0.z);
-        let (baoa, rdoa, oaoa) = (ba.dot(&oa), oa.z, oa.dot(&oa));
-        let b = baba * rdoa - baoa * bard;
-        let c = baba * oaoa - baoa * baoa - r * r * baba;
-        let h = b * b - a * c;
-        let s = (-b - h.max(0.0).sqrt()) / a;
-        let along = baoa + s * bard;
-        let body = along > 0.0 && along < baba;
-        let (ox, oy, oz) = if along <= 0.0 {
-            (oa.x, oa.y, oa.z)
-        } else {
-            (x - c1.x, y - c1.y, z0 - c1.z)
-        };
-        let (b2, c2) = (oz, ox * ox + oy * oy + oz * oz - r * r);
-        let h2 = b2 * b2 - c2;
-        let cap = z0 - b2 - h2.max(0.0).sqrt();
-        let sphere = if body { z0 + s } else { cap };
-        let closed = h >= 0.0 && a > 0.0 && (body || h2 >= 0.0);
+        let (sphere, closed) = capsule.bottom(x, y);
         let lo = if !ball {
             flat
         } else if closed {
@@ -374,49 +332,91 @@ fn ramp_row(
         } else {
             f64::NAN
         };
-        *o = if disc >= 0.0 && ta <= tb {
-            [lo, hi]
-        } else {
-            NO_HIT
-        };
+        *o = if hit { [lo, hi] } else { NO_HIT };
     }
 }
 
-/// The lowest z at which the vertical line through (x, y) enters the capsule of radius `r`
-/// about the segment from `c0` to `c1` (not vertical), if it does: a ray from below the
-/// capsule, met first by the cylinder about the segment's line between the end planes, else
-/// by the end sphere on the side where it met that cylinder (the capsule is convex). The
-/// swept volume of a ball-nose tool's ball moving straight, so on a ramp its lower surface on
-/// the line in closed form (what golden-section search finds to 1e-12 of the range, at some
+/// Where the vertical line through (x, y) comes within R of a move's tip path from `p0` (t = 0)
+/// to `p1` (t = 1), seen from above: the quadratic |A + t Δ|² = qa t² + 2 qb t + qc (A the
+/// tip's start minus (x, y), Δ the move, both horizontal; qa > 0) against R², clipped to the
+/// move. Whether it does, and the range [ta, tb] of t. Without branches (the rows'
+/// vectorised loops share it with [`vertical_sweep`], which must give their values).
+#[inline(always)]
+fn reach(qa: f64, qb: f64, qc: f64, r: f64) -> (bool, f64, f64) {
+    let disc = qb * qb - qa * (qc - r * r);
+    let sq = disc.max(0.0).sqrt();
+    let (t0, t1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+    let (ta, tb) = (t0.max(0.0), t1.min(1.0));
+    (disc >= 0.0 && ta <= tb, ta, tb)
+}
+
+/// The capsule of radius `r` about a segment (not vertical): the swept volume of a ball-nose
+/// tool's ball moving straight, whose lowest point on a vertical line is the tool's lower
+/// surface there on a ramp (what golden-section search finds to 1e-12 of the range, at some
 /// sixty evaluations of the tool's profile: half of a 3-axis finishing program's check).
-fn capsule_bottom(c0: &Vector3<f64>, c1: &Vector3<f64>, r: f64, x: f64, y: f64) -> Option<f64> {
-    // The ray starts a millimetre below the capsule's lowest point.
-    let z0 = c0.z.min(c1.z) - r - 1.0;
-    let ba = c1 - c0;
-    let oa = Vector3::new(x - c0.x, y - c0.y, z0 - c0.z);
-    let (baba, bard, baoa, rdoa, oaoa) = (ba.dot(&ba), ba.z, ba.dot(&oa), oa.z, oa.dot(&oa));
-    // The infinite cylinder: a s² + 2 b s + c = 0 (a = ΔX² + ΔY² > 0).
-    let a = baba - bard * bard;
-    let b = baba * rdoa - baoa * bard;
-    let c = baba * oaoa - baoa * baoa - r * r * baba;
-    let h = b * b - a * c;
-    if !(h >= 0.0 && a > 0.0) {
-        return None;
+struct Capsule {
+    c0: Vector3<f64>,
+    c1: Vector3<f64>,
+    r: f64,
+    /// A millimetre below the capsule's lowest point: where the ray up the line starts.
+    z0: f64,
+    ba: Vector3<f64>,
+    baba: f64,
+    /// a = ΔX² + ΔY² of the segment (> 0).
+    a: f64,
+}
+
+impl Capsule {
+    /// The capsule the ball of a ball-nose tool of radius `r` sweeps moving its tip from `p0`
+    /// to `p1`: about its centres' segment.
+    #[inline(always)]
+    fn of_ball(p0: &Vector3<f64>, p1: &Vector3<f64>, r: f64) -> Capsule {
+        let (c0, c1) = (
+            Vector3::new(p0.x, p0.y, p0.z + r),
+            Vector3::new(p1.x, p1.y, p1.z + r),
+        );
+        let ba = c1 - c0;
+        let baba = ba.dot(&ba);
+        Capsule {
+            c0,
+            c1,
+            r,
+            z0: c0.z.min(c1.z) - r - 1.0,
+            ba,
+            baba,
+            a: baba - ba.z * ba.z,
+        }
     }
-    let s = (-b - h.sqrt()) / a;
-    let along = baoa + s * bard;
-    if along > 0.0 && along < baba {
-        return Some(z0 + s);
+
+    /// The lowest z at which the vertical line through (x, y) enters the capsule, and whether
+    /// the closed form found it (not where the line misses the capsule, in rounding): a ray
+    /// from below, met first by the cylinder about the segment's line between the end planes,
+    /// else by the end sphere on the side where it met that cylinder (the capsule is convex).
+    /// Without branches, for the rows' vectorised loop.
+    #[inline(always)]
+    fn bottom(&self, x: f64, y: f64) -> (f64, bool) {
+        let (ba, baba, a, r, z0) = (&self.ba, self.baba, self.a, self.r, self.z0);
+        let oa = Vector3::new(x - self.c0.x, y - self.c0.y, z0 - self.c0.z);
+        let (bard, baoa, rdoa, oaoa) = (ba.z, ba.dot(&oa), oa.z, oa.dot(&oa));
+        // The infinite cylinder: a s² + 2 b s + c = 0.
+        let b = baba * rdoa - baoa * bard;
+        let c = baba * oaoa - baoa * baoa - r * r * baba;
+        let h = b * b - a * c;
+        let s = (-b - h.max(0.0).sqrt()) / a;
+        let along = baoa + s * bard;
+        let body = along > 0.0 && along < baba;
+        // An end sphere: |oc + s ẑ|² = r².
+        let (ox, oy, oz) = if along <= 0.0 {
+            (oa.x, oa.y, oa.z)
+        } else {
+            (x - self.c1.x, y - self.c1.y, z0 - self.c1.z)
+        };
+        let (b2, c2) = (oz, ox * ox + oy * oy + oz * oz - r * r);
+        let h2 = b2 * b2 - c2;
+        let cap = z0 - b2 - h2.max(0.0).sqrt();
+        let closed = h >= 0.0 && a > 0.0 && (body || h2 >= 0.0);
+        (if body { z0 + s } else { cap }, closed)
     }
-    // An end sphere: |oc + s ẑ|² = r².
-    let oc = if along <= 0.0 {
-        oa
-    } else {
-        Vector3::new(x - c1.x, y - c1.y, z0 - c1.z)
-    };
-    let (b, c) = (oc.z, oc.dot(&oc) - r * r);
-    let h = b * b - c;
-    (h >= 0.0).then(|| z0 - b - h.sqrt())
 }
 
 /// The minimum of a convex function on [a, b] (golden-section search, to 1e-12 of the range,
