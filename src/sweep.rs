@@ -319,18 +319,23 @@ impl Study<'_> {
         for (si, (span, old)) in spans.iter().zip(&self.base.problems).enumerate() {
             let mut p = SpanProblem::at_stations(span, kin, &machine, old.u.clone());
             (p.b_start, p.b_end) = (old.b_start, old.b_end);
-            let greedy = solver::reach::solve(&p).map_err(|inf| {
-                Error::Infeasible(format!(
-                    "with the {} {} limit at {value}: span {si}, station {}, nearest CL line {}: {}",
-                    self.machine.axes[self.axis].name,
-                    self.which,
-                    inf.station,
-                    span.nearest_line(p.u[inf.station]),
-                    inf.what
-                ))
-            })?;
+            // The reachability pass, for its profile (`--solver reach`) or to name where the
+            // limits leave no feasible profile. A lattice-exact span needs neither: its
+            // profile meets every row, so the span is feasible.
+            let greedy = |p: &SpanProblem| {
+                solver::reach::solve(p).map_err(|inf| {
+                    Error::Infeasible(format!(
+                        "with the {} {} limit at {value}: span {si}, station {}, nearest CL line {}: {}",
+                        self.machine.axes[self.axis].name,
+                        self.which,
+                        inf.station,
+                        span.nearest_line(p.u[inf.station]),
+                        inf.what
+                    ))
+                })
+            };
             let s = match self.options.solver_kind {
-                SolverKind::Reach => greedy,
+                SolverKind::Reach => greedy(&p)?,
                 SolverKind::Clarabel => {
                     let exact = if self.lattice {
                         self.lattice_optimum(&p, span, old, value)?
@@ -343,6 +348,7 @@ impl Study<'_> {
                             s
                         }
                         None => {
+                            greedy(&p)?;
                             let (s, sens) = solve_with_sensitivity(&p, &self.options.solver)?;
                             dt_dmu += span_dt_dmu(&p, &sens, self.axis, self.which);
                             cone_spans += 1;
