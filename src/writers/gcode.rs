@@ -214,7 +214,8 @@ struct Node {
     angles: [f64; 2],
     /// Time, s.
     t: f64,
-    /// Source line of the CL point (0 for a point added by the Δθ rule).
+    /// Source line of the CL point (0 for a point added by the Δθ rule or at a change of a
+    /// process limit).
     line: usize,
     /// The program's dwells here, s (written as G4 after the block that reaches the point).
     dwell: f64,
