@@ -115,3 +115,15 @@ pub mod toolpath;
 pub mod validate;
 pub mod verify;
 pub mod writers;
+
+/// A small deterministic generator of numbers in [0, 1) for the unit tests (a linear
+/// congruential generator: no dependency needed for a test's random cases).
+#[cfg(test)]
+pub(crate) fn test_rng(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

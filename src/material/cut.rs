@@ -1272,14 +1272,7 @@ mod tests {
     #[test]
     fn a_ramping_balls_lower_surface_is_its_capsules() {
         let tool = Tool::new(6.0, 3.0, 12.0, 2).unwrap();
-        // A small linear congruential generator in [0, 1).
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_rng(0x2545_f491_4f6c_dd1d);
         let mut checked = 0;
         for _ in 0..20_000 {
             let p0 = Vector3::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 4.0 - 2.0);
@@ -1311,13 +1304,7 @@ mod tests {
 
     #[test]
     fn a_tilted_tool_lies_in_its_axis_rectangle() {
-        let mut seed = 9u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng(9);
         let tool = Tool::new(6.0, 3.0, 12.0, 2).unwrap();
         let r = tool.radius();
         for _ in 0..200 {
@@ -1352,13 +1339,7 @@ mod tests {
     /// same material, dexel by dexel.
     #[test]
     fn the_cut_agrees_with_a_plain_reference() {
-        let mut seed = 3u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng(3);
         let stock = Stock::Box {
             min: [0.0, 0.0, -5.0],
             max: [12.0, 9.0, 0.0],

@@ -536,15 +536,7 @@ mod tests {
         assert!(d.is_empty() && (c.length - 6.0).abs() < 1e-12);
     }
 
-    /// A small deterministic generator in [0, 1).
-    fn rng(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::test_rng as rng;
 
     #[test]
     fn untouched_tiles_read_as_the_stock() {

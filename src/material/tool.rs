@@ -387,13 +387,7 @@ mod tests {
     /// the tool (whichever vector instructions this processor runs the row with).
     #[test]
     fn a_row_of_crossings_is_the_crossings_line_by_line() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng(7);
         let (x0, hx) = (-20.0, 0.1);
         let mut out = vec![[0.0; 2]; 400];
         let (mut crossed, mut missed) = (0, 0);
@@ -439,13 +433,7 @@ mod tests {
     /// The line hit agrees with point membership for every shape and many tilted poses.
     #[test]
     fn line_hit_agrees_with_membership() {
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng(11);
         for tool in [
             Tool::new(10.0, 0.0, 20.0, 3).unwrap(),
             Tool::new(10.0, 5.0, 20.0, 2).unwrap(),

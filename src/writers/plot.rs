@@ -915,13 +915,7 @@ mod tests {
     /// interval by interval, the runs are the batch reference's.
     #[test]
     fn coloured_runs_built_interval_by_interval_are_the_batch_ones() {
-        let mut seed = 5u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng(5);
         for n in [10, 2 * BINS, 2 * BINS + 1, 50_000] {
             let mut intervals = Vec::with_capacity(n);
             let (mut s, mut v) = (0.0, 0.0);
