@@ -413,17 +413,13 @@ impl Study<'_> {
         old: &SpanProblem,
         value: f64,
     ) -> Result<Option<(solver::SpanSolution, f64)>> {
-        let exact = |p: &SpanProblem| -> Result<Option<(solver::SpanSolution, f64)>> {
-            let Ok(s) = solver::reach::solve_lattice(p) else {
-                return Ok(None);
-            };
-            if !solver::reach::lattice_violations(p, &s.b, 1e-9).is_empty() {
-                return Ok(None);
-            }
-            let t = solver::interval_times(p, &s)?.iter().sum();
-            Ok(Some((s, t)))
+        let exact = |p: &SpanProblem| -> Option<solver::SpanSolution> {
+            let s = solver::reach::solve_lattice(p).ok()?;
+            solver::reach::lattice_violations(p, &s.b, 1e-9)
+                .is_empty()
+                .then_some(s)
         };
-        let Some((mut s, _)) = exact(p)? else {
+        let Some(mut s) = exact(p) else {
             return Ok(None);
         };
         // The exact optimum of the discretisation, as `solver::optimal` calls it (the passes
@@ -435,8 +431,8 @@ impl Study<'_> {
             let mut q =
                 SpanProblem::at_stations(span, &self.base.kinematics, &machine, old.u.clone());
             (q.b_start, q.b_end) = (old.b_start, old.b_end);
-            match exact(&q)? {
-                Some((_, tq)) => *t = tq,
+            match exact(&q) {
+                Some(sq) => *t = solver::interval_times(&q, &sq)?.iter().sum(),
                 None => return Ok(None),
             }
         }
