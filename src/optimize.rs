@@ -603,7 +603,7 @@ fn ramp_end(p: &SpanProblem, b: &[f64], k: usize) -> Option<f64> {
 
 /// Stations `u` with every interval k of `ks` (pairs (k, m), sorted by k, distinct k) divided
 /// into m equal parts.
-fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
+pub(crate) fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
     let extra: usize = ks.iter().map(|&(_, m)| m.saturating_sub(1)).sum();
     let mut out = Vec::with_capacity(u.len() + extra);
     let mut next = ks.iter().peekable();
@@ -627,7 +627,7 @@ fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
 /// excess e to about e/m². m is chosen to bring e to a quarter of the tolerance, at least 2,
 /// at most [`MAX_LOCAL_SPLIT`]: one round usually suffices where halving took three or four
 /// (the jerk-limited impeller: excess 3.6 % at first).
-fn local_parts(ratio: f64, tolerance: f64) -> usize {
+pub(crate) fn local_parts(ratio: f64, tolerance: f64) -> usize {
     let excess = (ratio - 1.0).max(0.0);
     let m = (excess / (0.25 * tolerance.max(1e-12))).sqrt().ceil();
     if m.is_finite() {
@@ -641,7 +641,7 @@ fn local_parts(ratio: f64, tolerance: f64) -> usize {
 /// local refinement (once the re-simulation has found a limit exceeded). The jerk-limited
 /// impeller with the tolerance itself: four rounds, each finding over the tolerance intervals
 /// that were just under it (1.0011–1.0016 of a limit) on the clock of the round before.
-const LOCAL_MARK: f64 = 0.5;
+pub(crate) const LOCAL_MARK: f64 = 0.5;
 
 /// The most parts one round of local refinement divides an interval into.
 const MAX_LOCAL_SPLIT: usize = 8;

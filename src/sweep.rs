@@ -11,19 +11,30 @@
 //! the study changes one number, not the asymmetry). Every step is therefore the nominal
 //! machine with that axis's limit multiplied by μ = v / max₀.
 //!
-//! **A fixed station set.** The automatic refinement of [`crate::optimize`] picks its station
-//! count from the limits; letting it run at every step would change the discretisation from
-//! step to step, so T(v) would carry discretisation jumps (spoiling monotonicity) and a finite
-//! difference would mix two discretisations. The sweep therefore solves once, at the nominal
-//! limits, with the steps' own solver and the user's station options (`--stations N` or
-//! automatic), and takes that solve's stations — including those added where its
-//! re-simulation failed — for every step and every finite difference. Each step's schedule is
-//! still re-simulated at the servo period; a step whose limits call for finer stations reports
-//! `verified: false` and its worst ratio rather than being refined. (The stations came from a
-//! reachability solve until round 11: its profile verified on them, but the cone program's
-//! optimum on the same stations, which rides other limits between stations, did not, so the
-//! step at the machine's own limit was unverified on four of twelve real programs, NX's Mori
-//! NMV5000 program by 20.6 %, while `solve` verified there.)
+//! **A common station set.** The automatic refinement of [`crate::optimize`] picks its
+//! station count from the limits; letting it run at every step would change the
+//! discretisation from step to step, so T(v) would carry discretisation jumps (spoiling
+//! monotonicity) and a finite difference would mix two discretisations. The sweep therefore
+//! solves once, at the nominal limits, with the steps' own solver and the user's station
+//! options (`--stations N` or automatic), and starts from that solve's stations — including
+//! those added where its re-simulation failed. (The stations came from a reachability solve
+//! until round 11: its profile verified on them, but the cone program's optimum on the same
+//! stations, which rides other limits between stations, did not, so the step at the machine's
+//! own limit was unverified on four of twelve real programs, NX's Mori NMV5000 program by
+//! 20.6 %, while `solve` verified there.)
+//!
+//! Other limits need stations elsewhere: a step whose ramps or curvature-held stretches move
+//! exceeds its limits between the nominal stations (the LinuxCNC impeller's C acceleration at
+//! 40 °/s², 3.3 % over at 31,267 stations, 3.3 times over at 8,887; a test's smooth joint path
+//! 40 % over at a tenth of its velocity limit). Each step's schedule is re-simulated at the
+//! servo period, and where one exceeds a limit, the intervals it marks are divided as `solve`'s
+//! local refinement divides them ([`optimize::local_parts`]) — *for every step* — and the steps
+//! are solved again, up to [`SWEEP_ROUNDS`] times: one station set, fine enough for every
+//! step. While the stations change only some steps run (the two ends of the range first, then
+//! those a run of all found over a limit); all run again on the final set. A step still over
+//! a limit after the last round reports `verified: false` and its worst ratio. The finite
+//! differences' solves, 1 % from their step's limit, are timed but not re-simulated.
+//! (`refine_until_verified: false` keeps the baseline's stations.)
 //!
 //! **The sensitivity from the duals.** Scale the swept limit by μ around a step (μ = 1 there);
 //! then dT/dv = (1/v)·dT/dμ. Per span, with the multipliers of
@@ -101,7 +112,7 @@ use crate::schedule::Schedule;
 use crate::solver::clarabel::{Sensitivity, solve_with_sensitivity};
 use crate::solver::{self, SolverKind, Status};
 use crate::toolpath::Input;
-use crate::verify::verify;
+use crate::verify::{Violation, verify_marked};
 
 /// Which limit of the axis is swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -250,8 +261,11 @@ pub struct Sweep {
     pub nominal_min: f64,
     /// The machine's own limit, max side.
     pub nominal_max: f64,
-    /// Stations (fixed for every step) and spans.
+    /// Stations (the same for every step) and spans.
     pub stations: usize,
+    /// Rounds in which the stations were divided where a step exceeded a limit between them
+    /// (0: the baseline's stations verified every step; module doc).
+    pub refinement_rounds: usize,
     /// Rest-to-rest spans.
     pub spans: usize,
     /// Relative finite-difference step h.
@@ -289,6 +303,9 @@ struct Study<'a> {
     axis: usize,
     which: SweptLimit,
     base: Solution,
+    /// Per span, the stations every step is solved at: the baseline's, with the intervals
+    /// divided where a step's re-simulation found a limit exceeded (module doc).
+    grid: Vec<Vec<f64>>,
     options: Options,
     toolpath: String,
     lattice: bool,
@@ -302,11 +319,16 @@ struct Eval {
     summary: Summary,
     /// Spans solved as cone programs (the others: the lattice relaxation's exact optimum).
     cone_spans: usize,
+    /// Where its re-simulation found a limit exceeded (or nearly, [`optimize::LOCAL_MARK`]);
+    /// empty where it verified.
+    marks: Vec<Violation>,
 }
 
 impl Study<'_> {
-    /// Solves the whole path with the swept limit at `value`, at the baseline's stations.
-    fn evaluate(&self, value: f64) -> Result<Eval> {
+    /// Solves the whole path with the swept limit at `value`, at the study's stations, and
+    /// re-simulates the schedule where `check` (a step's centre; a finite difference's solve
+    /// is only timed).
+    fn evaluate(&self, value: f64, check: bool) -> Result<Eval> {
         let machine = with_limit(self.machine, self.axis, self.which, value);
         let kin = &self.base.kinematics;
         let spans = &self.base.path.spans;
@@ -316,9 +338,8 @@ impl Study<'_> {
         let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
         let mut dt_dmu = 0.0;
         let mut cone_spans = 0;
-        for (si, (span, old)) in spans.iter().zip(&self.base.problems).enumerate() {
-            let mut p = SpanProblem::at_stations(span, kin, &machine, old.u.clone());
-            (p.b_start, p.b_end) = (old.b_start, old.b_end);
+        for (si, span) in spans.iter().enumerate() {
+            let p = self.problem(si, &machine);
             // The reachability pass, for its profile (`--solver reach`) or to name where the
             // limits leave no feasible profile. A lattice-exact span needs neither: its
             // profile meets every row, so the span is feasible.
@@ -338,7 +359,7 @@ impl Study<'_> {
                 SolverKind::Reach => greedy(&p)?,
                 SolverKind::Clarabel => {
                     let exact = if self.lattice {
-                        self.lattice_optimum(&p, span, old, value)?
+                        self.lattice_optimum(&p, si, value)?
                     } else {
                         None
                     };
@@ -364,14 +385,22 @@ impl Study<'_> {
             solutions.push(s);
         }
         let schedule = Schedule::build(&axes, spans, &problems, &solutions)?;
-        let verification = verify(
-            &machine,
-            kin,
-            spans,
-            &problems,
-            &solutions,
-            &self.options.verify,
-        )?;
+        let (verification, mut marks) = if check {
+            verify_marked(
+                &machine,
+                kin,
+                spans,
+                &problems,
+                &solutions,
+                &self.options.verify,
+                optimize::LOCAL_MARK * self.options.verify.tolerance,
+            )?
+        } else {
+            Default::default()
+        };
+        if verification.verified {
+            marks.clear();
+        }
         let cycle_time = schedule.cycle_time;
         let sol = Solution {
             path: self.base.path.clone(),
@@ -399,7 +428,47 @@ impl Study<'_> {
                 .then(|| dt_dmu / machine_limit(&machine, self.axis, self.which).max),
             summary,
             cone_spans,
+            marks,
         })
+    }
+
+    /// Stations over all spans.
+    fn stations(&self) -> usize {
+        self.grid.iter().map(Vec::len).sum()
+    }
+
+    /// The study's stations with every interval some step marked divided as the local
+    /// refinement of `solve` divides it (the most parts any step asks for); `None` where that
+    /// would pass `max_stations`.
+    fn divided(&self, evals: &[Eval], max_stations: usize) -> Option<Vec<Vec<f64>>> {
+        let tolerance = self.options.verify.tolerance;
+        let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.grid.len()];
+        for m in evals.iter().flat_map(|e| &e.marks) {
+            split[m.span].push((m.interval, optimize::local_parts(m.ratio, tolerance)));
+        }
+        let mut grid = self.grid.clone();
+        for (u, ks) in grid.iter_mut().zip(&mut split) {
+            if ks.is_empty() {
+                continue;
+            }
+            ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+            ks.dedup_by_key(|k| k.0);
+            *u = optimize::divide(u, ks);
+        }
+        (grid.iter().map(Vec::len).sum::<usize>() <= max_stations).then_some(grid)
+    }
+
+    /// Span `si`'s problem on the study's stations with `machine`'s limits, its end speeds
+    /// and chord bound as the baseline's.
+    fn problem(&self, si: usize, machine: &Machine) -> SpanProblem {
+        let (span, old) = (&self.base.path.spans[si], &self.base.problems[si]);
+        let mut p =
+            SpanProblem::at_stations(span, &self.base.kinematics, machine, self.grid[si].clone());
+        if let Some(c) = &self.options.verify.chord {
+            p.apply_chord(span, c);
+        }
+        (p.b_start, p.b_end) = (old.b_start, old.b_end);
+        p
     }
 
     /// Where the lattice relaxation's largest profile is the exact optimum of span `p` (the
@@ -409,8 +478,7 @@ impl Study<'_> {
     fn lattice_optimum(
         &self,
         p: &SpanProblem,
-        span: &crate::geometry::Span,
-        old: &SpanProblem,
+        si: usize,
         value: f64,
     ) -> Result<Option<(solver::SpanSolution, f64)>> {
         let exact = |p: &SpanProblem| -> Option<solver::SpanSolution> {
@@ -428,9 +496,7 @@ impl Study<'_> {
         let mut times = [0.0; 2];
         for (t, mu) in times.iter_mut().zip([1.0 - LATTICE_EPS, 1.0 + LATTICE_EPS]) {
             let machine = with_limit(self.machine, self.axis, self.which, value * mu);
-            let mut q =
-                SpanProblem::at_stations(span, &self.base.kinematics, &machine, old.u.clone());
-            (q.b_start, q.b_end) = (old.b_start, old.b_end);
+            let q = self.problem(si, &machine);
             match exact(&q) {
                 Some(sq) => *t = solver::interval_times(&q, &sq)?.iter().sum(),
                 None => return Ok(None),
@@ -439,6 +505,12 @@ impl Study<'_> {
         Ok(Some((s, (times[1] - times[0]) / (2.0 * LATTICE_EPS))))
     }
 }
+
+/// Rounds of dividing the study's stations where a step exceeds a limit between them (module
+/// doc): each divides the excess by four or more, as `solve`'s local refinement; most run only
+/// the steps still over a limit. (The LinuxCNC impeller's C-acceleration study on 8,887
+/// requested stations took 6, to 10,000 stations; `solve` allows 12.)
+pub const SWEEP_ROUNDS: usize = 8;
 
 /// Relative step ε of the lattice optimum's central difference (module doc).
 pub const LATTICE_EPS: f64 = 1e-6;
@@ -575,11 +647,13 @@ pub fn sweep(
     solve_options.solver.window = usize::MAX;
     solve_options.solver.threads = 1;
     solve_options.verify.threads = 1;
-    let study = Study {
+    let grid = base.problems.iter().map(|p| p.u.clone()).collect();
+    let mut study = Study {
         machine,
         axis,
         which,
         base,
+        grid,
         options: solve_options,
         toolpath: toolpath.to_string(),
         lattice: options.lattice,
@@ -591,27 +665,85 @@ pub fn sweep(
         .enumerate()
         .flat_map(|(k, &v)| [(k, 0, v * (1.0 - h)), (k, 1, v), (k, 2, v * (1.0 + h))])
         .collect();
-    #[cfg(feature = "progress")]
-    let bar = options.progress.then(|| {
-        crate::progress::Counter::new(
+    // Every step at the study's stations; where a step's re-simulation finds a limit exceeded
+    // between them, its marked intervals are divided for every step and the steps are solved
+    // again (module doc, "A common station set").
+    // Only some of the steps run while the stations change (probes): first the two ends of
+    // the range, whose limits are furthest from those the baseline's stations were refined
+    // for, then the steps a run of every solve found over a limit, each set until it
+    // verifies; every solve then runs again on the final stations. (The finite differences'
+    // solves, 1 % from their step's, are timed, not re-simulated.)
+    let mut round = 0;
+    let refine = options.solve.refine_until_verified;
+    let mut probes: Vec<(usize, usize, f64)> = if refine && values.len() > 1 {
+        vec![jobs[1], jobs[jobs.len() - 2]]
+    } else {
+        Vec::new()
+    };
+    let evals = loop {
+        let run: Vec<(usize, usize, f64)> = if probes.is_empty() {
+            jobs.clone()
+        } else {
+            probes.clone()
+        };
+        #[cfg(feature = "progress")]
+        let bar = options.progress.then(|| {
+            crate::progress::Counter::new(
+                run.len(),
+                if round == 0 {
+                    format!("{} {} sweep", machine.axes[axis].name, which)
+                } else {
+                    format!(
+                        "{} {} sweep, {} stations (round {round} of refinement)",
+                        machine.axes[axis].name,
+                        which,
+                        study.stations()
+                    )
+                },
+            )
+        });
+        let evals: Vec<Result<Eval>> = run
+            .par_iter()
+            .map(|&(_, which, v)| {
+                let e = study.evaluate(v, which == 1);
+                #[cfg(feature = "progress")]
+                if let Some(b) = &bar {
+                    b.inc();
+                }
+                e
+            })
+            .collect();
+        #[cfg(feature = "progress")]
+        drop(bar);
+        let evals = evals.into_iter().collect::<Result<Vec<Eval>>>()?;
+        tracing::debug!(
+            "sweep: {} of {} solves at {} stations, {} over a limit",
+            run.len(),
             jobs.len(),
-            format!("{} {} sweep", machine.axes[axis].name, which),
-        )
-    });
-    let evals: Vec<Result<Eval>> = jobs
-        .par_iter()
-        .map(|&(_, _, v)| {
-            let e = study.evaluate(v);
-            #[cfg(feature = "progress")]
-            if let Some(b) = &bar {
-                b.inc();
+            study.stations(),
+            evals.iter().filter(|e| !e.marks.is_empty()).count()
+        );
+        let grid = (refine && round < SWEEP_ROUNDS && evals.iter().any(|e| !e.marks.is_empty()))
+            .then(|| study.divided(&evals, options.solve.max_stations))
+            .flatten();
+        match grid {
+            Some(grid) => {
+                study.grid = grid;
+                round += 1;
+                if probes.is_empty() {
+                    probes = run
+                        .iter()
+                        .zip(&evals)
+                        .filter(|(_, e)| !e.marks.is_empty())
+                        .map(|(j, _)| *j)
+                        .collect();
+                }
             }
-            e
-        })
-        .collect();
-    #[cfg(feature = "progress")]
-    drop(bar);
-    let mut evals = evals.into_iter();
+            None if !probes.is_empty() => probes.clear(),
+            None => break evals,
+        }
+    };
+    let mut evals = evals.into_iter().map(Ok::<Eval, Error>);
     let mut points = Vec::with_capacity(values.len());
     for &v in &values {
         let (minus, mid, plus) = match (evals.next(), evals.next(), evals.next()) {
@@ -687,7 +819,8 @@ pub fn sweep(
         unit: unit.to_string(),
         nominal_min: nominal.min,
         nominal_max: nominal.max,
-        stations: study.base.stations(),
+        stations: study.stations(),
+        refinement_rounds: round,
         spans: study.base.problems.len(),
         fd_step: h,
         solver: match study.options.solver_kind {
@@ -726,9 +859,14 @@ impl fmt::Display for Sweep {
         )?;
         writeln!(
             f,
-            "stations      {} in {} span(s), fixed for every step; solver {}; finite differences at ±{} %",
+            "stations      {} in {} span(s), the same for every step{}; solver {}; finite differences at ±{} %",
             self.stations,
             self.spans,
+            match self.refinement_rounds {
+                0 => String::new(),
+                1 => " (divided once where a step exceeded a limit)".to_string(),
+                n => format!(" (divided {n} times where a step exceeded a limit)"),
+            },
             self.solver,
             100.0 * self.fd_step
         )?;
