@@ -493,6 +493,55 @@ fn a_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
     assert!(shank(12.0).is_empty());
 }
 
+/// The same with the tool tilted 30° across its slot (5-axis): material left above the
+/// flutes inside the shank is an error-level finding too, measured along the axis on the
+/// lines the flutes cross at each step's end (a tilted tool's shank was not checked: the
+/// LinuxCNC impeller on its cylinder blank, buried beyond its 12 mm flutes, had no finding).
+/// The slot runs along Y at the tip depth 10 mm; the flutes' top stands 8·cos 30° = 6.9 mm
+/// above the tip, so the top 3.1 mm of the block stand in the shank's way; with 20 mm
+/// flutes (top 17.3 mm above the tip) nothing does.
+#[test]
+fn a_tilted_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
+    use feedopt::material::check::{FindingKind, overloads};
+    let o = Vector3::new(0.5, 0.0, 0.75_f64.sqrt());
+    let pts: Vec<(Vector3<f64>, Vector3<f64>)> = [
+        [50.0, 5.0, 10.0],
+        [50.0, 5.0, 1.0],
+        [50.0, 5.0, -10.0],
+        [50.0, 35.0, -10.0],
+        [50.0, 35.0, 10.0],
+    ]
+    .iter()
+    .map(|p| (Vector3::new(p[0], p[1], p[2]), o))
+    .collect();
+    let mut tp = toolpath(&pts, Some(20.0));
+    tp.points[1].feed = Feed::Rapid;
+    let shank = |flutes: f64| -> Vec<(usize, f64)> {
+        let m = material(
+            Tool::new(10.0, 0.0, flutes, 3).unwrap(),
+            0.2,
+            ProcessLimits::default(),
+        );
+        let sim = material::simulate(&tp, &m).unwrap();
+        overloads(&sim, &m, 1.0)
+            .iter()
+            .filter(|f| f.kind == FindingKind::Shank)
+            .map(|f| (f.line, f.shank_depth))
+            .collect()
+    };
+    let found = shank(8.0);
+    eprintln!("{found:?}");
+    // The slot (line 4) at least; the depth along the axis is at least the material's top
+    // above the flutes' top at the axis (10/cos 30° − 8 = 3.55 mm), at most the top's
+    // height in the shank at its far side (+ R tan 30° = 6.43 mm).
+    let slot = found
+        .iter()
+        .find(|f| f.0 == 4)
+        .expect("the slot's shank finding");
+    assert!(slot.1 > 3.5 && slot.1 < 6.5, "{found:?}");
+    assert!(shank(20.0).is_empty());
+}
+
 /// A second identical pass cuts air: it runs at the air feed (or the machine's limits), the
 /// first at the chip load.
 #[test]

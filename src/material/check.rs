@@ -6,10 +6,11 @@
 //! second. A rapid (`G0` / `RAPID`) that removes material is an error-level finding whatever
 //! the limits, once it removes more than one cell cube (h_x·h_y·min(h_x, h_y)): less is the
 //! grid grazing a wall the tool slides along (a retract along the tool axis), not a cut.
-//! Excesses up to [`CHECK_TOLERANCE`] are not reported. A cutting move whose vertical tool
-//! leaves material standing more than a cell above its flutes' top is an error-level finding
-//! too: the shank (or the holder) runs into it (a tool whose flutes are longer than the
-//! default 2 D needs its flute length given).
+//! Excesses up to [`CHECK_TOLERANCE`] are not reported. A cutting move that leaves material
+//! standing more than a cell above its flutes' top is an error-level finding too: the shank
+//! (or the holder) runs into it (a tool whose flutes are longer than the default 2 D needs its
+//! flute length given). A vertical tool's shank is checked over each sample's whole sweep, a
+//! tilted tool's at each sample's end pose ([`super::cut::Sample::shank_depth`]).
 
 use super::cut::Sample;
 use super::{Material, ProcessLimit, Simulation};

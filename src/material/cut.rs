@@ -94,9 +94,11 @@ pub struct Sample {
     /// The move's programmed feed, mm/s (`None`: rapid, inverse-time or none).
     pub programmed_feed: Option<f64>,
     /// How far material reaches above the flutes' top where the tool passes, mm (0: nowhere):
-    /// there the shank, above the flute length, runs into it. Checked on a vertical tool's
-    /// steps, where the flutes' top is the tool's upper bound of each crossing; a tilted
-    /// step's shank is not checked.
+    /// there the shank, above the flute length, runs into it. On a vertical tool's step, the
+    /// material above the flutes' top over the step's whole sweep; on a tilted tool's, the
+    /// material inside the shank (the cylinder of radius R above the flutes, along the axis)
+    /// at the step's end pose, on the lines its flutes cross, measured along the axis
+    /// ([`Pose::shank_depth`]).
     pub shank_depth: f64,
 }
 
@@ -697,6 +699,8 @@ struct Scratch {
     starts: Vec<f64>,
     ended: Vec<(usize, usize, [f64; 2])>,
     ranges: Vec<Option<(usize, usize)>>,
+    /// The end pose's shank crossings.
+    shank: Vec<[f64; 2]>,
 }
 
 /// The plan of one step; `shared` (the previous step's last pose) is updated to this step's.
@@ -805,6 +809,7 @@ fn cut_band(
         starts,
         ended,
         ranges,
+        shank: shank_z,
     } = scratch;
     let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
     let mut acc = Acc::ZERO;
@@ -963,11 +968,22 @@ fn cut_band(
             note(cx(i), band.dexel(i, j).remove(lo, hi));
         }
         // (A cell no pose crosses has the run [∞, −∞], which removes
-        // nothing: Dexel::remove tells it without a call.)
+        // nothing: Dexel::remove tells it without a call.) Then the shank
+        // at the step's end pose, where its flutes cross a line with
+        // material left above them.
+        let end_pose = &pose_list[poses - 1].0;
+        let end_hits = &hits[(poses - 1) * width..poses * width];
+        shank_z.resize(width, NO_HIT);
+        end_pose.shank_row(y, x0, hx, ua, shank_z);
         band.each(j, ua, ub, |i, cell| {
             let [lo, hi] = run[i - ua];
             note(cx(i), cell.remove(lo, hi));
+            let (h, z) = (end_hits[i - ua], shank_z[i - ua]);
+            if h[0] <= h[1] && z[0] < z[1] && cell.extent().is_some_and(|e| e[1] > z[0]) {
+                shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
+            }
         });
+        acc.shank = acc.shank.max(shank);
     }
     acc
 }

@@ -251,6 +251,81 @@ impl<'a> Pose<'a> {
             .map(|(lo, hi)| [p.z + lo, p.z + hi])
     }
 
+    /// The interval of z (mm) where the vertical line through (x, y) crosses the shank: the
+    /// cylinder of radius R about the axis above the flutes (h ≥ L_f), unbounded, as a
+    /// vertical tool's shank is taken; its upper end may be +∞.
+    pub fn shank_span(&self, x: f64, y: f64) -> Option<[f64; 2]> {
+        let (p, o) = (&self.p, &self.o);
+        let (dx, dy) = (x - p.x, y - p.y);
+        let (r, lf) = (self.tool.radius(), self.tool.flute_length);
+        let c = dx * o.x + dy * o.y;
+        let q0 = dx * dx + dy * dy - c * c;
+        // The s (= z − P_z) where h(s) = c + s O_z ≥ L_f.
+        let (mut s0, mut s1) = if self.inv_oz.is_infinite() {
+            if c < lf {
+                return None;
+            }
+            (f64::NEG_INFINITY, f64::INFINITY)
+        } else if o.z > 0.0 {
+            ((lf - c) * self.inv_oz, f64::INFINITY)
+        } else {
+            (f64::NEG_INFINITY, (lf - c) * self.inv_oz)
+        };
+        // And ρ²(s) ≤ R².
+        let cc = q0 - r * r;
+        if self.inv_a.is_infinite() {
+            if cc > 0.0 {
+                return None;
+            }
+        } else {
+            let bh = -c * o.z;
+            let disc = bh * bh - self.a * cc;
+            if disc < 0.0 {
+                return None;
+            }
+            let sq = disc.sqrt();
+            s0 = s0.max((-bh - sq) * self.inv_a);
+            s1 = s1.min((-bh + sq) * self.inv_a);
+        }
+        (s0 < s1).then_some([p.z + s0, p.z + s1])
+    }
+
+    /// [`Pose::shank_span`] on a run of dexel lines of one grid row (as [`Pose::hits_row`]):
+    /// `out[k]` for the line through x = `x0` + (i0 + k + ½)·`hx` and `y`, [`NO_HIT`] where
+    /// the shank does not cross it. Without branches where the axis is neither vertical nor
+    /// horizontal (vector instructions, `multiversion`).
+    pub fn shank_row(&self, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 2]]) {
+        if self.inv_a.is_infinite() || self.inv_oz.is_infinite() {
+            for (k, h) in out.iter_mut().enumerate() {
+                *h = self
+                    .shank_span(x0 + ((i0 + k) as f64 + 0.5) * hx, y)
+                    .unwrap_or(NO_HIT);
+            }
+            return;
+        }
+        shank_row(self, y, x0, hx, i0, out);
+    }
+
+    /// How far material on the vertical line through (x, y) reaches into the shank
+    /// ([`Pose::shank_span`]; `span` is it), measured along the axis above the flutes' top (mm;
+    /// 0: not at all); `intervals`: the line's material. For a vertical axis it is the
+    /// material's top less the flutes' top, where the line passes within R of the axis.
+    pub fn shank_depth(&self, x: f64, y: f64, span: [f64; 2], intervals: &[[f64; 2]]) -> f64 {
+        let (p, o) = (&self.p, &self.o);
+        let c = (x - p.x) * o.x + (y - p.y) * o.y;
+        let lf = self.tool.flute_length;
+        let mut depth = 0.0_f64;
+        for iv in intervals {
+            let (a, b) = (iv[0].max(span[0]), iv[1].min(span[1]));
+            if b - a > super::dexel::MIN_CUT_MM {
+                // h is linear in z: its largest value over [a, b] at one end.
+                let h = |z: f64| c + (z - p.z) * o.z - lf;
+                depth = depth.max(h(a)).max(h(b));
+            }
+        }
+        depth
+    }
+
     /// [`Pose::hit`] on a run of dexel lines of one grid row: `out[k]` for the line through
     /// x = `x0` + (i0 + k + ½)·`hx` and `y`, [`NO_HIT`] where the tool does not cross it.
     ///
@@ -320,6 +395,37 @@ fn crossings_row(
         };
         let any = (cylinder || sphere) && lo.is_finite() && hi.is_finite();
         *h = if any { [p.z + lo, p.z + hi] } else { NO_HIT };
+    }
+}
+
+/// [`Pose::shank_row`]'s branch-free loop (an axis neither vertical nor horizontal), as
+/// [`crossings_row`].
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn shank_row(pose: &Pose, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 2]]) {
+    let tool = pose.tool;
+    let (r, lf) = (tool.radius(), tool.flute_length);
+    let (p, o, a, inv_a, inv_oz) = (pose.p, pose.o, pose.a, pose.inv_a, pose.inv_oz);
+    let up = o.z > 0.0;
+    let dy = y - p.y;
+    for (k, h) in out.iter_mut().enumerate() {
+        let dx = x0 + ((i0 + k) as f64 + 0.5) * hx - p.x;
+        let c = dx * o.x + dy * o.y;
+        let q0 = dx * dx + dy * dy - c * c;
+        let t = (lf - c) * inv_oz;
+        let (t0, t1) = if up {
+            (t, f64::INFINITY)
+        } else {
+            (f64::NEG_INFINITY, t)
+        };
+        let bh = -c * o.z;
+        let disc = bh * bh - a * (q0 - r * r);
+        let sq = disc.max(0.0).sqrt();
+        let (s0, s1) = (t0.max((-bh - sq) * inv_a), t1.min((-bh + sq) * inv_a));
+        *h = if disc >= 0.0 && s0 < s1 {
+            [p.z + s0, p.z + s1]
+        } else {
+            NO_HIT
+        };
     }
 }
 
@@ -456,6 +562,61 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The shank's depth against sampling the line: the largest h − L_f over the points of the
+    /// line's material that lie within R of the axis and above the flutes (h ≥ L_f).
+    #[test]
+    fn shank_depth_agrees_with_sampling_the_line() {
+        let mut rnd = crate::test_rng(12);
+        let tool = Tool::new(6.0, 3.0, 12.0, 2).unwrap();
+        let mut reached = 0;
+        for case in 0..600 {
+            // A sixth vertical, a sixth horizontal.
+            let o = match case % 6 {
+                0 => Vector3::z(),
+                1 => Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.0).normalize(),
+                _ => Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.2 + rnd()).normalize(),
+            };
+            let p = Vector3::new(rnd(), rnd(), rnd());
+            let pose = Pose::new(&tool, &p, &o);
+            let (x, y) = (p.x + 12.0 * (rnd() - 0.5), p.y + 12.0 * (rnd() - 0.5));
+            // Material: two intervals somewhere on z ∈ [−10, 40].
+            let mut z: Vec<f64> = (0..4).map(|_| -10.0 + 50.0 * rnd()).collect();
+            z.sort_by(f64::total_cmp);
+            let intervals = [[z[0], z[1]], [z[2], z[3]]];
+            let depth = pose
+                .shank_span(x, y)
+                .map_or(0.0, |span| pose.shank_depth(x, y, span, &intervals));
+            // The row form gives the same span, bit for bit.
+            let mut row = [NO_HIT; 1];
+            pose.shank_row(y, x - 0.5 * 0.1, 0.1, 0, &mut row);
+            assert_eq!(
+                pose.shank_span(x - 0.05 + 0.05, y).unwrap_or(NO_HIT),
+                row[0]
+            );
+            let mut sampled = 0.0_f64;
+            let n = 20_000;
+            for k in 0..=n {
+                let zz = -10.0 + 50.0 * k as f64 / n as f64;
+                if !intervals.iter().any(|iv| zz >= iv[0] && zz <= iv[1]) {
+                    continue;
+                }
+                let q = Vector3::new(x, y, zz) - p;
+                let h = q.dot(&o);
+                let rho = (q - o * h).norm();
+                if rho <= 3.0 && h >= 12.0 {
+                    sampled = sampled.max(h - 12.0);
+                }
+            }
+            // The sampling's step is 2.5e-3 mm in z.
+            assert!(
+                (depth - sampled).abs() < 5e-3,
+                "case {case}: {depth} against {sampled} (o {o:?})"
+            );
+            reached += usize::from(depth > 0.0);
+        }
+        assert!(reached > 50, "{reached}");
     }
 
     #[test]
