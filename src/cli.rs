@@ -61,7 +61,8 @@ pub enum Command {
     /// Constraint study: cycle time and its sensitivity against one axis limit.
     Sweep(SweepArgs),
     /// Overload check (needs a stock): cut the stock along the program and list every move
-    /// whose programmed feed exceeds a process limit, and every rapid through material.
+    /// whose programmed feed exceeds a process limit, every rapid through material and every
+    /// move that takes the shank into it.
     Check(CheckArgs),
 }
 
