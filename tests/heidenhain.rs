@@ -1768,6 +1768,19 @@ fn rotary_words_under_a_plane_are_programmed_positions() {
     )
     .unwrap();
     assert_eq!(tp.points.last().unwrap().rotary, Some([-90.0, 0.0, 270.0]));
+    // So after `L A+Q120 C+Q122` to the positions of a STAY SEQ-, after a TURN that left them
+    // unknown (M126 stays in force: C 270 the shorter way from −90°).
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 TURN FMAX\n\
+             6 PLANE SPATIAL SPA90 SPB0 SPC90 STAY SEQ-\n\
+             7 L A+Q120 C+Q122 R0 FMAX M126\n8 L C+270 R0 FMAX\n"
+        ),
+    )
+    .unwrap();
+    assert_eq!(tp.points.last().unwrap().rotary, Some([-90.0, 0.0, -90.0]));
 
     // Under tool-tip control (M128) the rotary axes orient the tool as they do without a
     // plane: run as programmed, no check against the plane.

@@ -881,10 +881,15 @@ impl Interpreter<'_> {
         end: &[f64; 6],
     ) -> Result<bool> {
         let words = block.axes[3..].iter().any(Option::is_some);
-        if block.plane_rotary.iter().any(|&q| q) && !self.klartext.sequence_point {
-            // `L A+Q120 C+Q122` without positions computed for SEQ: the kinematics chooses.
-            let k = self.frame_now().r * self.vector;
-            self.mark_rotary_unknown(line, &k);
+        if block.plane_rotary.iter().any(|&q| q) {
+            if self.klartext.sequence_point {
+                // `L A+Q120 C+Q122` to the positions computed for SEQ: known.
+                self.klartext.rotary_unknown = None;
+            } else {
+                // Without SEQ the kinematics chooses.
+                let k = self.frame_now().r * self.vector;
+                self.mark_rotary_unknown(line, &k);
+            }
         }
         let under_plane = self.klartext.plane.is_some();
         if !words {
