@@ -435,6 +435,15 @@ fn cycle800_swivels_a_3_plus_2_plane() {
     assert_close(tp.points[1].p, v(10.0, 0.0, -5.0), 1e-12);
     assert_eq!(tp.points[0].rotary, None);
     assert_close(tp.points[2].p, v(0.0, 0.0, 10.0), 1e-12);
+    // Rotary words under CYCLE800 still give way to the plane's tool vector: the rule that
+    // makes them programmed positions is Klartext's PLANE only (what an 840D does with them
+    // was not established).
+    let tp = gcode(
+        Dialect::Sinumerik,
+        "CYCLE800(1,\"TC1\",0,57,0,0,0,0,90,0,0,0,0,-1,100,1)\nG0 X0 Y0 Z10\nG0 X5 B0 C90\n",
+    );
+    assert_eq!(tp.points[1].rotary, None);
+    assert_close(tp.points[1].o, v(1.0, 0.0, 0.0), 1e-12);
     // TRANS and AROT: a programmable frame.
     let tp = gcode(
         Dialect::Sinumerik,

@@ -1659,3 +1659,149 @@ fn plane_seq_picks_the_master_axis_sign() {
     let e = read_on(&ctx, &seq("SEQ")).unwrap_err();
     assert!(e.contains("t.h:6:") && e.contains("SEQ+ or SEQ-"), "{e}");
 }
+
+/// `PLANE SPATIAL SPA90 SPB0 SPC90 STAY` and then the rotary axes positioned by the block's
+/// own words, `L A-90 C+270 R0 FMAX M126`: STAY moves nothing, and the control moves the axes
+/// where that block says, the tilted plane staying the plane's. Until 2026-11-27 the words
+/// were dropped for the plane's tool vector and the kinematics ran A +90°, C +90° (2.4000 s
+/// instead of 2.7817 s on this table). Now the block's point carries A −90°, C −90° (C 270°
+/// the shorter way from 0), the next point continues there, and the program times as the
+/// same moves written without the plane (the tip (10, 20, 5) of the plane is (5, 10, 20) of
+/// the workpiece): the two toolpaths have the same tips and the same axis positions at every
+/// point, so the solves are the same problem and the times agree to round-off.
+#[test]
+fn rotary_words_under_a_plane_are_programmed_positions() {
+    let (m, ctx) = ac_table(-120.0, 120.0);
+    let under_plane = |mode: &str, words: &str| {
+        format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 {mode} TABLE ROT\n\
+             6 L {words} R0 FMAX M126\n7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
+        )
+    };
+    let written = format!(
+        "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n5 L A-90 C+270 R0 FMAX M126\n\
+         6 L X+5 Y+10 Z+20 FMAX\n7 END PGM T MM\n"
+    );
+    let time = |tp: &Toolpath| {
+        let s = optimize(&m, tp, &Options::default()).unwrap();
+        assert!(s.verification.verified);
+        s.schedule.cycle_time
+    };
+    let tp = read_on(&ctx, &under_plane("STAY", "A-90 C+270")).unwrap();
+    assert_eq!(tp.points.len(), 3);
+    assert_eq!(tp.points[1].line, 7);
+    assert_eq!(tp.points[1].rotary, Some([-90.0, 0.0, -90.0]));
+    assert!(close(tp.points[1].p, v(40.0, 30.0, 50.0), 1e-12));
+    // A point under the plane without rotary words: the tool vector rules, as before.
+    assert_eq!(tp.points[2].rotary, None);
+    assert!(close(tp.points[2].p, v(5.0, 10.0, 20.0), 1e-12));
+    assert!(close(tp.points[2].o, v(1.0, 0.0, 0.0), 1e-12));
+    let got = ac_angles(&m, &tp);
+    assert!(
+        got[1..]
+            .iter()
+            .all(|a| (a[0] + 90.0).abs() < 1e-9 && (a[1] + 90.0).abs() < 1e-9),
+        "{got:?}"
+    );
+    let w = read_on(&ctx, &written).unwrap();
+    assert_eq!(ac_angles(&m, &w)[1..], got[1..]);
+    let (t, tw) = (time(&tp), time(&w));
+    assert!((t - tw).abs() <= 1e-9 * tw, "{t} s, written out {tw} s");
+    // The other solution (the kinematics' own choice from A 0) times differently here: the
+    // words decide.
+    let other = read_on(&ctx, &under_plane("STAY", "A+90 C+90")).unwrap();
+    assert_eq!(other.points[1].rotary, Some([90.0, 0.0, 90.0]));
+    let to = time(&other);
+    assert!((t - to).abs() > 0.01 * to, "A-90: {t} s, A+90: {to} s");
+
+    // Words that contradict the plane's tool axis (+X): A −90°, C 0 puts the tool along +Y
+    // of the workpiece (Rx(−90°)·Z, this table turning the part against its axes). The control would machine the part at that angle; an error naming
+    // the line, the plane's line and both directions.
+    let e = read_on(&ctx, &under_plane("STAY", "A-90 C+0")).unwrap_err();
+    assert!(e.contains("t.h:7:") && e.contains("PLANE of line 6"), "{e}");
+    assert!(e.contains("A = -90°, C = 0°"), "{e}");
+    assert!(
+        e.contains("along (0, 1, 0)") && e.contains("along (1, 0, 0)"),
+        "{e}"
+    );
+    assert!(e.contains("90.0000° apart"), "{e}");
+    // Off by less than the posts' rounding (A to 0.0001°): accepted.
+    let tp = read_on(&ctx, &under_plane("STAY", "A-90.0001 C+270")).unwrap();
+    assert_eq!(tp.points[1].rotary.map(|r| r[0]), Some(-90.0001));
+
+    // PLANE … TURN without SEQ turns the axes to a solution the kinematics chooses; a block
+    // that then positions them all is run where it says (C 270 without M126: as written)…
+    let turn = |words: &str| {
+        format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 TURN FMAX\n\
+             6 L {words} R0 FMAX\n7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
+        )
+    };
+    let tp = read_on(&ctx, &turn("A-90 C+270")).unwrap();
+    let got = ac_angles(&m, &tp);
+    assert_eq!(tp.points.last().unwrap().rotary, None);
+    assert!(
+        (got[1][0] - 90.0).abs() < 1e-9 && (got[1][1] - 90.0).abs() < 1e-9,
+        "the turn: {got:?}"
+    );
+    assert!(
+        got[2..]
+            .iter()
+            .all(|a| (a[0] + 90.0).abs() < 1e-9 && (a[1] - 270.0).abs() < 1e-9),
+        "{got:?}"
+    );
+    // … but one that positions C alone leaves A where the reader does not know it: an error.
+    let e = read_on(&ctx, &turn("C+270")).unwrap_err();
+    assert!(
+        e.contains("t.h:7:") && e.contains("where A stands") && e.contains("SEQ+ or SEQ-"),
+        "{e}"
+    );
+    // With SEQ- the reader knows the turn's positions (A −90°, C −90°): C alone is fine.
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 TURN SEQ- FMAX\n6 L C+270 R0 FMAX\n"
+        ),
+    )
+    .unwrap();
+    assert_eq!(tp.points.last().unwrap().rotary, Some([-90.0, 0.0, 270.0]));
+    // So after `L A+Q120 C+Q122` to the positions of a STAY SEQ-, after a TURN that left them
+    // unknown (M126 stays in force: C 270 the shorter way from −90°).
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 TURN FMAX\n\
+             6 PLANE SPATIAL SPA90 SPB0 SPC90 STAY SEQ-\n\
+             7 L A+Q120 C+Q122 R0 FMAX M126\n8 L C+270 R0 FMAX\n"
+        ),
+    )
+    .unwrap();
+    assert_eq!(tp.points.last().unwrap().rotary, Some([-90.0, 0.0, -90.0]));
+
+    // Under tool-tip control (M128) the rotary axes orient the tool as they do without a
+    // plane: run as programmed, no check against the plane.
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n5 FUNCTION TCPM F TCP AXIS POS\n\
+             6 PLANE SPATIAL SPA90 SPB0 SPC90 STAY\n7 L A-90 C+0 R0 FMAX\n"
+        ),
+    )
+    .unwrap();
+    assert_eq!(tp.points.last().unwrap().rotary, Some([-90.0, 0.0, 0.0]));
+
+    // Read without a machine file the check cannot be made: the words are run as
+    // programmed, with one warning.
+    let tp = read(&under_plane("STAY", "A-90 C+270"));
+    assert_eq!(tp.points[1].rotary, Some([-90.0, 0.0, -90.0]));
+    let said: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("under a PLANE"))
+        .collect();
+    assert!(said.len() == 1 && said[0].line == 7, "{:?}", tp.warnings);
+}

@@ -2614,6 +2614,9 @@ impl<'a> Interpreter<'a> {
             // Klartext PLANE … STAY: the rotary axes are positioned now.
             self.klartext.stay_orientation = None;
         }
+        // Rotary words under a Klartext PLANE are programmed positions (checked against the
+        // plane's tool axis).
+        self.klartext.programmed_rotary = self.plane_rotary_words(line, block, &end)?;
         if is_arc {
             self.arc(line, motion, block, start, end)?;
         } else {
@@ -2627,6 +2630,7 @@ impl<'a> Interpreter<'a> {
             self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
                 .then(|| (Plane::Xy, [a / len, b / len], self.points.len()));
         }
+        self.klartext.programmed_rotary = false;
         self.pos = end;
         Ok(())
     }
@@ -2693,8 +2697,11 @@ impl<'a> Interpreter<'a> {
             let p = frame.apply(&Vector3::new(q[0], q[1], q[2]));
             let o = frame.r * self.vector;
             // Under a swivel frame the control sets the rotary axes: the tool vector rules,
-            // but where they were positioned to the solution a `PLANE … SEQ±` asked for.
-            let rotary = if self.swivel.is_some() && !positioned {
+            // but where they were positioned to the solution a `PLANE … SEQ±` asked for, or
+            // where a block under a Klartext PLANE programs them (`L A-90 C+270`): the
+            // control moves them where the block says.
+            let rotary = if self.swivel.is_some() && !positioned && !self.klartext.programmed_rotary
+            {
                 None
             } else {
                 Some(q_rot)

@@ -91,8 +91,19 @@
 //!   ([`crate::kinematics::Kinematics::sequence_positions`], C the shorter way from where it
 //!   stands) and the block that positions the axes (`TURN`/`MOVE` itself, after `STAY` the
 //!   `A+Q120 C+Q122` block) carries them; outside travel that is an error naming the line and
-//!   SEQ (the control's too); read without a machine file, a warning. `PLANE RESET
-//!   TURN`/`MOVE` turns the rotary axes back to 0. A non-zero datum shift programmed while a
+//!   SEQ (the control's too); read without a machine file, a warning. A block under a plane
+//!   whose own words position rotary axes (`L A-90 C+270 R0 FMAX` after `STAY`, or after
+//!   `TURN`/`MOVE`) moves them where it says, as the control does, the working plane staying
+//!   the plane's: its points carry those positions. Outside tool-tip mode they must put the
+//!   tool along the plane's tool axis (within 1e-4 rad, the posts' rounding), by the machine
+//!   file's kinematics: otherwise the part would be machined at another angle than the plane
+//!   its coordinates are given in, an error naming the line, the plane's line and both
+//!   directions. After a `TURN`/`MOVE` or `L A+Q120 C+Q122` without SEQ the reader does not
+//!   know the kinematics' choice: a block that then positions only some of the rotary axes is
+//!   an error naming the others. Read without a machine file the words are run as programmed
+//!   with a warning. Blocks without rotary words follow the plane's tool vector; Sinumerik's
+//!   `CYCLE800` frame is not affected. `PLANE RESET TURN`/`MOVE` turns the rotary axes back
+//!   to 0. A non-zero datum shift programmed while a
 //!   plane is active is an error (feedopt reads shifts in the untilted system); `PLANE
 //!   AXIAL`, `PROJECTED`, `POINTS`, cycles 8, 10, 11, 19, 26 are errors.
 //! * **Cycles**: `CYCL DEF 200`, `201`, `202`, `203`, `207`, `209`, `241` define a drilling,

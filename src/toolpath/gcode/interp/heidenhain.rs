@@ -62,6 +62,18 @@ pub(super) struct State {
     /// them as programmed positions (elsewhere under a tilted plane the tool vector rules and
     /// the kinematics chooses).
     pub(super) sequence_point: bool,
+    /// The line of the active `PLANE` (its tool axis is the one rotary words must keep).
+    plane_line: usize,
+    /// The block being pushed programs rotary words under a `PLANE` (`L A-90 C+270` after
+    /// `STAY`): its points carry them as programmed positions, as the control moves the axes
+    /// where the block says; elsewhere under a plane the tool vector rules.
+    pub(super) programmed_rotary: bool,
+    /// The line of a `PLANE … TURN`/`MOVE` or an `L A+Q120 C+Q122` without SEQ that moved the
+    /// rotary axes to a solution the reader leaves to the kinematics: until a block programs
+    /// every rotary axis again, the reader does not know where they stand.
+    rotary_unknown: Option<usize>,
+    /// Rotary words under a plane were read without the machine's kinematics (said once).
+    unchecked_warned: bool,
     /// The preset `CYCL DEF 247` activated first (`Some(None)`: one whose Q339 is unknown).
     preset: Option<Option<f64>>,
     /// The line of a `CYCL DEF 7` that left a non-zero shift programmed while a plane was
@@ -781,6 +793,7 @@ impl Interpreter<'_> {
         }
         let before = self.orientation();
         self.klartext.plane = rotation;
+        self.klartext.plane_line = line;
         self.klartext.stay_orientation = None;
         self.set_klartext_frame();
         let after = self.frame_now().r * self.vector;
@@ -796,10 +809,15 @@ impl Interpreter<'_> {
         } else {
             if rotation.is_none() {
                 self.pos[3..].fill(0.0);
+                self.klartext.rotary_unknown = None;
+            } else if self.klartext.sequence.is_none() {
+                // TURN, MOVE without SEQ: the kinematics chooses where the axes go.
+                self.mark_rotary_unknown(line, &after);
             }
             // TURN, MOVE: the rotary axes go to the solution SEQ asked for now; the next point
             // (this turn's, where the tool turns) stands there.
             if let Some(p) = self.klartext.sequence.take() {
+                self.klartext.rotary_unknown = None;
                 let shift = self.offsets.shift();
                 for (i, v) in p.iter().enumerate() {
                     if let Some(v) = v {
@@ -816,6 +834,148 @@ impl Interpreter<'_> {
         }
         self.tangent = None;
         Ok(())
+    }
+
+    /// The tool axis (workpiece coordinates) the machine's kinematics gives at the rotary
+    /// positions `q` (`[A, B, C]`, program degrees, before the work offsets' shift).
+    fn tool_axis_at(
+        kinematics: &crate::kinematics::Kinematics,
+        q: [f64; 3],
+        shift: &[f64; 6],
+    ) -> Vector3<f64> {
+        kinematics.tool_axis(kinematics.angles_from_rotary([
+            q[0] + shift[3],
+            q[1] + shift[4],
+            q[2] + shift[5],
+        ]))
+    }
+
+    /// The rotary axes went, at `line`, to a solution for the tool axis `k` (workpiece
+    /// coordinates) that the kinematics chooses: unless the positions the reader holds already
+    /// give `k` (the kinematics then keeps them), they are unknown from here on.
+    fn mark_rotary_unknown(&mut self, line: usize, k: &Vector3<f64>) {
+        let Some((kinematics, _)) = two_rotary_kinematics(self.machine) else {
+            return;
+        };
+        let shift = self.offsets.shift();
+        let q = [self.pos[3], self.pos[4], self.pos[5]];
+        let at = Self::tool_axis_at(kinematics, q, &shift);
+        if angle_between(&at, k) > ROTARY_AXIS_TOLERANCE_RAD {
+            self.klartext.rotary_unknown = Some(line);
+        }
+    }
+
+    /// A block whose words position rotary axes (`L A-90 C+270 R0 FMAX`, its end `end`): under
+    /// a `PLANE` the control moves them where the block says, and the working plane stays the
+    /// plane's. Returns whether the block's points carry those positions for that reason
+    /// (false outside a Klartext plane: there they do or not as before, and Sinumerik's
+    /// `CYCLE800` frame keeps its own rule). With the machine's kinematics, the positions
+    /// must put the tool along the plane's tool axis (outside tool-tip mode: under `M128` the
+    /// rotary axes orient the tool as they do without a plane) and may not leave an axis the
+    /// reader does not know; an error naming the line otherwise. Without the kinematics that
+    /// cannot be checked: a warning, once.
+    pub(super) fn plane_rotary_words(
+        &mut self,
+        line: usize,
+        block: &Block,
+        end: &[f64; 6],
+    ) -> Result<bool> {
+        let words = block.axes[3..].iter().any(Option::is_some);
+        if block.plane_rotary.iter().any(|&q| q) {
+            if self.klartext.sequence_point {
+                // `L A+Q120 C+Q122` to the positions computed for SEQ: known.
+                self.klartext.rotary_unknown = None;
+            } else {
+                // Without SEQ the kinematics chooses.
+                let k = self.frame_now().r * self.vector;
+                self.mark_rotary_unknown(line, &k);
+            }
+        }
+        let under_plane = self.klartext.plane.is_some();
+        if !words {
+            return Ok(false);
+        }
+        let Some((kinematics, turned)) = two_rotary_kinematics(self.machine) else {
+            if under_plane
+                && self.machine.is_none_or(|m| m.kinematics.is_none())
+                && !self.klartext.unchecked_warned
+            {
+                self.klartext.unchecked_warned = true;
+                self.warn(
+                    line,
+                    "rotary axis words under a PLANE: the axes go where the block says; whether \
+                     that keeps the tool along the plane's tool axis depends on the machine's \
+                     kinematics, which the reader was not given (read the program with a \
+                     machine file to check it)",
+                );
+            }
+            return Ok(under_plane);
+        };
+        let letters = ["A", "B", "C"];
+        if let Some(at) = self.klartext.rotary_unknown {
+            let missing: Vec<&str> = (0..3)
+                .filter(|&i| turned[i] && block.axes[3 + i].is_none())
+                .map(|i| letters[i])
+                .collect();
+            if !missing.is_empty() {
+                if !under_plane {
+                    // Outside a plane the words are read as they always were.
+                    return Ok(false);
+                }
+                return Err(self.error(
+                    line,
+                    format!(
+                        "this block positions some of the rotary axes, but where {} stands is \
+                         not known here: line {at} moved the axes to the plane's solution, which \
+                         the control chooses (PLANE without SEQ) and feedopt leaves to the \
+                         kinematics; program {} in this block too, or give the PLANE SEQ+ or SEQ-",
+                        missing.join(" and "),
+                        missing.join(" and ")
+                    ),
+                ));
+            }
+            self.klartext.rotary_unknown = None;
+        }
+        if !under_plane || self.tcp != Tcp::Off {
+            return Ok(under_plane);
+        }
+        let shift = self.offsets.shift();
+        let q = [end[3], end[4], end[5]];
+        let k = Self::tool_axis_at(kinematics, q, &shift);
+        let plane = self.frame_now().r * self.vector;
+        let apart = angle_between(&k, &plane);
+        if apart > ROTARY_AXIS_TOLERANCE_RAD {
+            let degrees = apart.to_degrees();
+            let positions: Vec<String> = (0..3)
+                .filter(|&i| turned[i] || block.axes[3 + i].is_some())
+                .map(|i| {
+                    format!(
+                        "{} = {}°",
+                        letters[i],
+                        crate::error::number(q[i] + shift[3 + i])
+                    )
+                })
+                .collect();
+            let file = match self.machine.map(|m| m.file.display().to_string()) {
+                Some(f) if !f.is_empty() => f,
+                _ => "the machine file".to_string(),
+            };
+            return Err(self.error(
+                line,
+                format!(
+                    "the rotary axes at {} put the tool along {}, but the PLANE of line {} has \
+                     its tool axis along {} (workpiece coordinates, {degrees:.4}° apart): the part would \
+                     be machined at another angle than the plane its X Y Z are given in; program \
+                     the positions of the plane's solution (after PLANE … STAY: L A+Q120 C+Q122, \
+                     SEQ+ or SEQ- selecting which), or check the kinematics in {file}",
+                    positions.join(", "),
+                    direction(&k),
+                    self.klartext.plane_line,
+                    direction(&plane),
+                ),
+            ));
+        }
+        Ok(true)
     }
 
     /// The rotary positions the control computes for `PLANE … SEQ+` (`positive`) or `SEQ-`
@@ -1296,4 +1456,46 @@ impl Interpreter<'_> {
         self.tangent = None;
         Ok(())
     }
+}
+
+/// The largest angle (radians) between the tool axis that programmed rotary positions give
+/// and the one a `PLANE` sets that is read as the same axis: 1e-4 rad, 0.0057°. Posts print
+/// angles to 3 or 4 decimals of a degree, the plane's and the axes' each rounded on its own,
+/// which puts the two up to about 4e-5 rad apart (0.0005° on each of SPA, SPB, SPC and on each
+/// rotary word); a program that contradicts its plane is off by whole degrees.
+const ROTARY_AXIS_TOLERANCE_RAD: f64 = 1e-4;
+
+/// The kinematics of the machine the program is read for, where it has two rotary axes (the
+/// tool axis follows from their positions), and which of A, B, C it turns.
+fn two_rotary_kinematics(
+    machine: Option<&MachineContext>,
+) -> Option<(&crate::kinematics::Kinematics, [bool; 3])> {
+    let kinematics = machine?.kinematics.as_ref()?;
+    kinematics.rotary_axes()[1]?;
+    let zero = kinematics.angles_from_rotary([0.0; 3]);
+    let turned = [0, 1, 2].map(|i| {
+        let mut r = [0.0; 3];
+        r[i] = 1.0;
+        kinematics.angles_from_rotary(r) != zero
+    });
+    Some((kinematics, turned))
+}
+
+/// The angle between two unit vectors, radians (accurate near 0 and π).
+fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// A direction for a message: `(0, 1, 0)`, components to 6 decimals.
+fn direction(v: &Vector3<f64>) -> String {
+    let c = |x: f64| {
+        let t = format!("{x:.6}");
+        let t = t.trim_end_matches('0').trim_end_matches('.');
+        if t == "-0" {
+            "0".to_string()
+        } else {
+            t.to_string()
+        }
+    };
+    format!("({}, {}, {})", c(v.x), c(v.y), c(v.z))
 }
