@@ -29,8 +29,8 @@
 //! 40 % over at a tenth of its velocity limit). Each step's schedule is re-simulated at the
 //! servo period, and where one exceeds a limit, the intervals it marks are divided as `solve`'s
 //! local refinement divides them ([`optimize::local_parts`]) — *for every step* — and the steps
-//! are solved again, up to [`SWEEP_ROUNDS`] times: one station set, fine enough for every
-//! step. While the stations change only some steps run (the two ends of the range first, then
+//! are solved again, up to [`SWEEP_ROUNDS`] times and [`MAX_STATION_GROWTH`] times the
+//! baseline's stations: one station set, fine enough for every step. While the stations change only some steps run (the two ends of the range first, then
 //! those a run of all found over a limit); all run again on the final set. A step still over
 //! a limit after the last round reports `verified: false` and its worst ratio. The finite
 //! differences' solves, 1 % from their step's limit, are timed but not re-simulated.
@@ -439,7 +439,7 @@ impl Study<'_> {
 
     /// The study's stations with every interval some step marked divided as the local
     /// refinement of `solve` divides it (the most parts any step asks for); `None` where that
-    /// would pass `max_stations`.
+    /// would pass `max_stations` stations.
     fn divided(&self, evals: &[Eval], max_stations: usize) -> Option<Vec<Vec<f64>>> {
         let tolerance = self.options.verify.tolerance;
         let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.grid.len()];
@@ -511,6 +511,12 @@ impl Study<'_> {
 /// the steps still over a limit. (The LinuxCNC impeller's C-acceleration study on 8,887
 /// requested stations took 6, to 10,000 stations; `solve` allows 12.)
 pub const SWEEP_ROUNDS: usize = 8;
+
+/// The most the sweep's rounds may multiply the baseline's stations by (module doc): a step
+/// whose excess does not fall as its intervals are divided (where `solve` would slow a span
+/// down instead) stops the rounds there, not at `max_stations`. (The LinuxCNC impeller's
+/// studies grew them by 1 % and 12 %.)
+pub const MAX_STATION_GROWTH: usize = 4;
 
 /// Relative step ε of the lattice optimum's central difference (module doc).
 pub const LATTICE_EPS: f64 = 1e-6;
@@ -724,7 +730,13 @@ pub fn sweep(
             evals.iter().filter(|e| !e.marks.is_empty()).count()
         );
         let grid = (refine && round < SWEEP_ROUNDS && evals.iter().any(|e| !e.marks.is_empty()))
-            .then(|| study.divided(&evals, options.solve.max_stations))
+            .then(|| {
+                let cap = options
+                    .solve
+                    .max_stations
+                    .min(MAX_STATION_GROWTH * study.base.stations());
+                study.divided(&evals, cap)
+            })
             .flatten();
         match grid {
             Some(grid) => {
