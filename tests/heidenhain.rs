@@ -1519,6 +1519,65 @@ fn ac_angles(m: &feedopt::machine::Machine, tp: &Toolpath) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// `PLANE … SYM±` (TNC7) selects the solution whose master axis stands above (`SYM+`) or below
+/// (`SYM-`) its symmetry point, the centre of its travel, where `SEQ±` takes the sign from 0
+/// (TNC7 user's manual, "Tilting solution"). It used to be skipped, the kinematics choosing by
+/// its own rule. The plane's tool axis +X needs A ±90°.
+#[test]
+fn plane_sym_picks_the_side_of_the_master_axis_travel_centre() {
+    let program = |s: &str, spa: f64| {
+        format!(
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA{spa} SPB0 SPC90 STAY {s} TABLE ROT\n\
+             6 L A+Q120 C+Q122 R0 FMAX M126\n7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
+        )
+    };
+    // A's travel −150…120°: the symmetry point is −15°. SYM+ takes A +90°, SYM− A −90°.
+    let (m, ctx) = ac_table(-150.0, 120.0);
+    for (s, a) in [("SYM+", 90.0), ("SYM-", -90.0)] {
+        let tp = read_on(&ctx, &program(s, 90.0)).unwrap();
+        let got = ac_angles(&m, &tp);
+        assert!(
+            got[1..].iter().all(|g| (g[0] - a).abs() < 1e-9),
+            "{s}: {got:?}"
+        );
+    }
+    // A's travel −120…30°: the symmetry point is −45°. A plane tilted by 30° needs A ±30°:
+    // SEQ− takes A −30° (below 0), but no solution lies below −45°, so SYM− is refused as the
+    // control refuses it, naming the line and the symmetry point; SYM+ takes the one nearer
+    // A 0 of the two above −45°.
+    let (m2, ctx2) = ac_table(-120.0, 30.0);
+    let tp = read_on(&ctx2, &program("SEQ-", 30.0)).unwrap();
+    assert!((ac_angles(&m2, &tp)[2][0] + 30.0).abs() < 1e-9);
+    let e = read_on(&ctx2, &program("SYM-", 30.0)).unwrap_err();
+    assert!(
+        e.contains("t.h:6:") && e.contains("SYM-") && e.contains("below -45°"),
+        "{e}"
+    );
+    let tp = read_on(&ctx2, &program("SYM+", 30.0)).unwrap();
+    assert!((ac_angles(&m2, &tp)[2][0].abs() - 30.0).abs() < 1e-9);
+    // Without travel limits there is no symmetry point: an error saying so.
+    let free = common::machine(
+        r#"{"name": "A/C table", "kinematics": {"type": "table_table_ac",
+              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+              "y-offset": 0, "z-offset": 0, "conventional-directions": true},
+            "axes": {"X": {"velocity": 50, "acceleration": 500},
+                     "Y": {"velocity": 50, "acceleration": 500},
+                     "Z": {"velocity": 50, "acceleration": 500},
+                     "A": {"velocity": 60, "acceleration": 600},
+                     "C": {"velocity": 120, "acceleration": 1200}},
+            "feed": {"max": 500}}"#,
+    );
+    let ctx3 = MachineContext::new(&free, &feedopt::machine::References::default());
+    let e = read_on(&ctx3, &program("SYM+", 90.0)).unwrap_err();
+    assert!(
+        e.contains("t.h:6:") && e.contains("symmetry point of A") && e.contains("no travel"),
+        "{e}"
+    );
+    // SEQ needs none.
+    assert!(read_on(&ctx3, &program("SEQ+", 90.0)).is_ok());
+}
+
 /// `PLANE SPATIAL SPA90 SPB0 SPC90 STAY SEQ±` and `L A+Q120 C+Q122 M126`, as hyperMILL posts
 /// for a DMU 85 monoBLOCK ("A-90 C270" in its comment for SEQ-): the tool axis is
 /// Rz(90°)·Rx(90°)·Z = +X, which an A/C table reaches at A +90°, C +90° or at A −90°,

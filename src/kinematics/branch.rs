@@ -447,18 +447,23 @@ impl Walker<'_> {
 /// either); where both qualify, the nearer to `current` is taken. `Err` (a message naming the
 /// axes, without a line) when no solution with that sign lies within travel: the control
 /// reports an error there too.
+///
+/// `about` (degrees of the master axis) is the point the sign is taken from: 0 for `SEQ`, the
+/// centre of the master axis's travel for `SYM` (its "symmetry point", TNC7 user's manual,
+/// "Tilting solution").
 pub fn sequence(
     tilt: f64,
     spin: Option<f64>,
     layout: &Layout,
     positive: bool,
+    about: f64,
     current: [f64; 2],
 ) -> std::result::Result<[f64; 2], String> {
     let l = layout;
     let (pt, ps) = l.split(current);
     let master = l.names[l.tilt];
     let wanted = |x: f64| {
-        let deg = l.degrees(l.tilt, x);
+        let deg = l.degrees(l.tilt, x) - about;
         if positive { deg >= -1e-9 } else { deg <= 1e-9 }
     };
     let branches = match spin {
@@ -493,7 +498,12 @@ pub fn sequence(
     if let Some((a, _)) = best {
         return Ok(a);
     }
-    let sign = if positive { "positive" } else { "negative" };
+    let sign = match (positive, about == 0.0) {
+        (true, true) => "positive".to_string(),
+        (false, true) => "negative".to_string(),
+        (true, false) => format!("above {about}° (its symmetry point)"),
+        (false, false) => format!("below {about}° (its symmetry point)"),
+    };
     let travel = format!(
         "{} {}, {} {}",
         l.names[0],
@@ -583,12 +593,12 @@ mod tests {
         let deg = |a: [f64; 2]| a.map(|x| (x.to_degrees() * 1e9).round() / 1e9);
         let free = layout(None, 0.0);
         assert_eq!(
-            deg(sequence(t, Some(s), &free, true, [0.0, 0.0]).unwrap()),
+            deg(sequence(t, Some(s), &free, true, 0.0, [0.0, 0.0]).unwrap()),
             [60.0, 30.0]
         );
         // The other solution: tilt negated, spin turned by 180°, shifted nearest C 0.
         assert_eq!(
-            deg(sequence(t, Some(s), &free, false, [0.0, 0.0]).unwrap()),
+            deg(sequence(t, Some(s), &free, false, 0.0, [0.0, 0.0]).unwrap()),
             [-60.0, -150.0]
         );
         // B −60° outside travel [−50°, 120°]: an error naming B and its travel.
@@ -597,6 +607,7 @@ mod tests {
             Some(s),
             &layout(Some((-50f64.to_radians(), 120f64.to_radians())), 0.0),
             false,
+            0.0,
             [0.0; 2],
         )
         .unwrap_err();
@@ -605,11 +616,11 @@ mod tests {
             "{e}"
         );
         // A tilt axis offset by 90° stands at 150° or 30°: never negative.
-        let e = sequence(t, Some(s), &layout(None, FRAC_PI_2), false, [0.0; 2]).unwrap_err();
+        let e = sequence(t, Some(s), &layout(None, FRAC_PI_2), false, 0.0, [0.0; 2]).unwrap_err();
         assert!(e.contains("no solution has B negative"), "{e}");
         // At the pole both solutions are one: either sign takes it.
         assert_eq!(
-            sequence(0.0, None, &free, false, [0.0, 1.0]).unwrap(),
+            sequence(0.0, None, &free, false, 0.0, [0.0, 1.0]).unwrap(),
             [0.0, 1.0]
         );
     }

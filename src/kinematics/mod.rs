@@ -301,11 +301,13 @@ impl Kinematics {
     /// `None` for the others; `Ok(None)` where there are no two solutions to choose from: a
     /// kinematics with fewer than two rotary axes, or `k` along the C axis (tilt 0, any spin).
     /// `Err`: no solution with that sign within travel (the message names the axes, not the
-    /// line).
+    /// line). `symmetric`: `PLANE … SYM±` instead, the sign taken from the master axis's
+    /// symmetry point, the centre of its travel (an `Err` where its travel is not limited).
     pub fn sequence_positions(
         &self,
         k: &Vector3<f64>,
         positive: bool,
+        symmetric: bool,
         current: [f64; 3],
         travel: [Option<(f64, f64)>; 3],
     ) -> std::result::Result<Option<[Option<f64>; 3]>, String> {
@@ -343,11 +345,23 @@ impl Kinematics {
             // The tool along the C axis: both solutions are one (tilt 0).
             return Ok(None);
         }
+        let master = names[tilt_index];
+        let about = if symmetric {
+            let (lo, hi) = travel[letter(master)].ok_or_else(|| {
+                format!(
+                    "SYM takes its sign from the symmetry point of {master}, the centre of its                      travel, and {master} has no travel limits"
+                )
+            })?;
+            0.5 * (lo + hi)
+        } else {
+            0.0
+        };
         let angles = branch::sequence(
             tilt,
             spin,
             &layout,
             positive,
+            about,
             self.angles_from_rotary(current),
         )?;
         let mut out = [None; 3];

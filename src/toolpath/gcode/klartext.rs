@@ -87,7 +87,9 @@
 //!   rotary axes' two solutions for the plane's tool axis the kinematics chooses
 //!   ([`crate::kinematics::branch`]), but `SEQ+`/`SEQ-` selects the one whose master axis
 //!   (the tilting axis: A of an A/C table) stands at a positive or negative angle, as the
-//!   control does: with the machine file's kinematics the reader computes those positions
+//!   control does, and `SYM+`/`SYM-` (TNC7) the one whose master axis stands above or below
+//!   its symmetry point, the centre of its travel (TNC7 user's manual, "Tilting solution"; an
+//!   error where the machine file gives the master axis no travel): with the machine file's kinematics the reader computes those positions
 //!   ([`crate::kinematics::Kinematics::sequence_positions`], C the shorter way from where it
 //!   stands) and the block that positions the axes (`TURN`/`MOVE` itself, after `STAY` the
 //!   `A+Q120 C+Q122` block) carries them; outside travel that is an error naming the line and

@@ -668,7 +668,8 @@ impl Interpreter<'_> {
         let mut mode: Option<String> = None;
         let mut mb: Option<Option<f64>> = None;
         let mut values: Vec<(String, f64)> = Vec::new();
-        let mut sequence: Option<bool> = None;
+        // (positive, SYM rather than SEQ)
+        let mut sequence: Option<(bool, bool)> = None;
         let mut k = 1;
         while k < words.len() {
             let (name, text) = &words[k];
@@ -690,16 +691,19 @@ impl Interpreter<'_> {
                 ("MBMAX", "") => mb = Some(None),
                 ("MB", t) => mb = Some(Some(self.klartext_value(line, "MB", t)?)),
                 // Which of the rotary axes' two solutions: the master axis's sign.
-                ("SEQ", "+") => sequence = Some(true),
-                ("SEQ", "-") => sequence = Some(false),
-                ("SEQ", t) => {
+                ("SEQ", "+") => sequence = Some((true, false)),
+                ("SEQ", "-") => sequence = Some((false, false)),
+                // The same from the master axis's symmetry point (TNC7).
+                ("SYM", "+") => sequence = Some((true, true)),
+                ("SYM", "-") => sequence = Some((false, true)),
+                ("SEQ" | "SYM", t) => {
                     return Err(self.error(
                         line,
-                        format!("PLANE: `SEQ{t}`: the solution is SEQ+ or SEQ-"),
+                        format!("PLANE: `{name}{t}`: the solution is {name}+ or {name}-"),
                     ));
                 }
                 // The rotary axes' feed and the table's role: the machine's.
-                ("FMAX" | "TABLE" | "COORD" | "ROT" | "SYM", _) | ("F" | "ABST" | "DIST", _) => {}
+                ("FMAX" | "TABLE" | "COORD" | "ROT", _) | ("F" | "ABST" | "DIST", _) => {}
                 (n, t)
                     if !t.is_empty()
                         && n.chars().all(|c| c.is_ascii_alphabetic())
@@ -799,8 +803,8 @@ impl Interpreter<'_> {
         let after = self.frame_now().r * self.vector;
         self.klartext.sequence = None;
         self.klartext.sequence_point = false;
-        if let Some(positive) = sequence {
-            self.klartext.sequence = self.sequence_positions(line, positive, &after)?;
+        if let Some((positive, symmetric)) = sequence {
+            self.klartext.sequence = self.sequence_positions(line, positive, symmetric, &after)?;
         }
         if mode == "STAY" {
             if (after - before).norm() > 1e-12 {
@@ -987,9 +991,15 @@ impl Interpreter<'_> {
         &mut self,
         line: usize,
         positive: bool,
+        symmetric: bool,
         k: &Vector3<f64>,
     ) -> Result<Option<[Option<f64>; 3]>> {
-        let seq = if positive { "SEQ+" } else { "SEQ-" };
+        let seq = match (symmetric, positive) {
+            (false, true) => "SEQ+",
+            (false, false) => "SEQ-",
+            (true, true) => "SYM+",
+            (true, false) => "SYM-",
+        };
         let kinematics = self
             .machine
             .and_then(|m| m.kinematics.as_ref().map(|kin| (m, kin)));
@@ -1011,13 +1021,13 @@ impl Interpreter<'_> {
         let current = [3, 4, 5].map(|i| self.pos[i] + shift[i]);
         let travel = [3, 4, 5].map(|i| machine.travel[i]);
         kinematics
-            .sequence_positions(k, positive, current, travel)
+            .sequence_positions(k, positive, symmetric, current, travel)
             .map_err(|e| {
                 self.error(
                     line,
                     format!(
                         "PLANE … {seq}: {e}; the control refuses it too: program the other \
-                         SEQ, or check the travel in {}",
+                         solution, or check the travel in {}",
                         machine.file.display()
                     ),
                 )
