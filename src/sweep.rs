@@ -30,8 +30,9 @@
 //! servo period, and where one exceeds a limit, the intervals it marks are divided as `solve`'s
 //! local refinement divides them ([`optimize::local_parts`]) — *for every step* — and the steps
 //! are solved again, up to [`SWEEP_ROUNDS`] times and [`MAX_STATION_GROWTH`] times the
-//! baseline's stations: one station set, fine enough for every step. While the stations change only some steps run (the two ends of the range first, then
-//! those a run of all found over a limit); all run again on the final set. A step still over
+//! baseline's stations: one station set, fine enough for every step. While the stations
+//! change only some steps run (the two ends of the range first, then those a run of all found
+//! over a limit); all run again on the final set. A step still over
 //! a limit after the last round reports `verified: false` and its worst ratio. The finite
 //! differences' solves, 1 % from their step's limit, are timed but not re-simulated.
 //! (`refine_until_verified: false` keeps the baseline's stations.)
@@ -296,8 +297,8 @@ pub fn with_limit(machine: &Machine, axis: usize, which: SweptLimit, value: f64)
     m
 }
 
-/// What stays fixed over the sweep: the path, its kinematics and stations (from the baseline
-/// solve), and the options.
+/// What every step shares: the path and its kinematics (from the baseline solve), the
+/// stations (the baseline's, divided where a step needed it), and the options.
 struct Study<'a> {
     machine: &'a Machine,
     axis: usize,
