@@ -414,3 +414,43 @@ fn a_turn_under_a_plane_outside_tcp_carries_the_tip_with_the_table() {
     assert_eq!(tcp.points.iter().filter(|p| p.line == 7).count(), 1);
     assert_eq!(tcp.points.last().unwrap().p, Vector3::new(40.0, 30.0, 50.0));
 }
+
+/// 3+2 without a frame or TCP: at C 90° a `G1 X50` moves the X axis 50 mm, as the control
+/// does, and the tip moves 50 mm along the part's −Y (the table turned under it). On a machine
+/// whose X is slow (10 mm/s) and Y fast, the move takes X's time, 50/10 + 10/100 = 5.1 s;
+/// read as the tip (until 2026-11-27) it ran on Y at F (100 mm/s) in 0.52 s.
+#[test]
+fn a_straight_move_at_a_standing_rotary_angle_moves_the_axes_as_written() {
+    let m = common::machine(
+        r#"{"name": "A/C table, slow X", "kinematics": {"type": "table_table_ac",
+              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+              "y-offset": 0, "z-offset": 0},
+            "axes": {"X": {"velocity": 10, "acceleration": 100},
+                     "Y": {"velocity": 500, "acceleration": 5000},
+                     "Z": {"velocity": 500, "acceleration": 5000},
+                     "A": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
+                     "C": {"velocity": 120, "acceleration": 1200}},
+            "feed": {"max": 2000}}"#,
+    );
+    let ctx = MachineContext::new(&m, &feedopt::machine::References::default());
+    let tp = read(
+        Dialect::LinuxCnc,
+        Some(&ctx),
+        "G21 G90 G94\nG0 X0 Y0 Z20 A0 C90\nG1 X50 F6000\nM2\n",
+    );
+    assert_eq!(tp.points.len(), 2);
+    let axes = axes_of(&m, &tp);
+    assert!(
+        (axes[1][0] - 50.0).abs() < 1e-9 && axes[1][1].abs() < 1e-9,
+        "{axes:?}"
+    );
+    let d = tp.points[1].p - tp.points[0].p;
+    assert!((d.norm() - 50.0).abs() < 1e-9 && d.x.abs() < 1e-9, "{d}");
+    let s = solve(&m, &tp);
+    let want = rest_to_rest(50.0, 10.0, 100.0);
+    assert!(
+        (s.schedule.cycle_time - want).abs() <= 1e-6 * want,
+        "{} s, X alone {want} s",
+        s.schedule.cycle_time
+    );
+}
