@@ -1583,9 +1583,10 @@ fn plane_sym_picks_the_side_of_the_master_axis_travel_centre() {
 /// Rz(90°)·Rx(90°)·Z = +X, which an A/C table reaches at A +90°, C +90° or at A −90°,
 /// C 270°. SEQ+ takes the first (A, the master axis, positive), SEQ− the second; from C 0
 /// under M126 C goes the shorter way, to −90°. Each reads, solves and times as the same
-/// program with the positions written out (`L A-90 C+270`, the tilted plane's point
-/// (10, 20, 5) as Rz(90°)·Rx(90°)·(10, 20, 5) = (5, 10, 20)); until 2026-11-27 SEQ was skipped
-/// and SEQ− ran at A +90°, C +90°.
+/// program with the positions written out (`L A-90 C+270` under the plane; the tilted plane's
+/// point (10, 20, 5) is Rz(90°)·Rx(90°)·(10, 20, 5) = (5, 10, 20) of the workpiece); until
+/// 2026-11-27 SEQ was skipped and SEQ− ran at A +90°, C +90°. Outside M128 the table turns
+/// with X Y Z standing (at 40, 30, 50), carrying the tip with the part.
 #[test]
 fn plane_seq_picks_the_master_axis_sign() {
     let (m, ctx) = ac_table(-120.0, 120.0);
@@ -1598,8 +1599,9 @@ fn plane_seq_picks_the_master_axis_sign() {
     };
     let explicit = |a: &str, c: &str| {
         format!(
-            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n5 L A{a} C{c} R0 FMAX M126\n\
-             6 L X+5 Y+10 Z+20 FMAX\n7 END PGM T MM\n"
+            "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC90 STAY TABLE ROT\n\
+             6 L A{a} C{c} R0 FMAX M126\n7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
         )
     };
     let time = |tp: &Toolpath| {
@@ -1613,13 +1615,18 @@ fn plane_seq_picks_the_master_axis_sign() {
         ("SEQ+", "+90", "+90", [90.0, 90.0]),
     ] {
         let tp = read_on(&ctx, &seq(s)).unwrap();
-        assert_eq!(tp.points.len(), 3, "{s}");
-        // The positioning block carries the control's positions (A, B, C).
-        assert_eq!(tp.points[1].rotary, Some([want[0], 0.0, want[1]]), "{s}");
-        assert!(close(tp.points[2].p, v(5.0, 10.0, 20.0), 1e-12), "{s}");
-        assert!(close(tp.points[2].o, v(1.0, 0.0, 0.0), 1e-12), "{s}");
+        let n = tp.points.len();
+        assert!(n > 3, "{s}");
+        // The positioning block carries the control's positions (A, B, C), along the turn.
+        assert_eq!(
+            tp.points[n - 2].rotary,
+            Some([want[0], 0.0, want[1]]),
+            "{s}"
+        );
+        assert!(close(tp.points[n - 1].p, v(5.0, 10.0, 20.0), 1e-12), "{s}");
+        assert!(close(tp.points[n - 1].o, v(1.0, 0.0, 0.0), 1e-12), "{s}");
         let got = ac_angles(&m, &tp);
-        for k in 1..3 {
+        for k in n - 2..n {
             assert!(
                 (got[k][0] - want[0]).abs() < 1e-9 && (got[k][1] - want[1]).abs() < 1e-9,
                 "{s}: point {k} at A, C = {:?}, want {want:?}",
@@ -1627,8 +1634,7 @@ fn plane_seq_picks_the_master_axis_sign() {
             );
         }
         let written = read_on(&ctx, &explicit(a, c)).unwrap();
-        let wa = ac_angles(&m, &written);
-        assert!((wa[2][0] - want[0]).abs() < 1e-9 && (wa[2][1] - want[1]).abs() < 1e-9);
+        assert_eq!(written.points, tp.points, "{s}");
         let (t, tw) = (time(&tp), time(&written));
         assert!(
             (t - tw).abs() <= 1e-9 * tw,
@@ -1671,7 +1677,7 @@ fn plane_seq_picks_the_master_axis_sign() {
     );
     assert!(e.contains("A [-10, 120]°"), "{e}");
     let tp = read_on(&ctx2, &seq("SEQ+")).unwrap();
-    assert!((ac_angles(&m2, &tp)[2][0] - 90.0).abs() < 1e-9);
+    assert!((ac_angles(&m2, &tp).last().unwrap()[0] - 90.0).abs() < 1e-9);
 
     // Without SEQ the kinematics chooses, as before: the solution within travel (A −120…10°:
     // A −90°), or from A 0 the positive one.
@@ -1723,11 +1729,13 @@ fn plane_seq_picks_the_master_axis_sign() {
 /// own words, `L A-90 C+270 R0 FMAX M126`: STAY moves nothing, and the control moves the axes
 /// where that block says, the tilted plane staying the plane's. Until 2026-11-27 the words
 /// were dropped for the plane's tool vector and the kinematics ran A +90°, C +90° (2.4000 s
-/// instead of 2.7817 s on this table). Now the block's point carries A −90°, C −90° (C 270°
-/// the shorter way from 0), the next point continues there, and the program times as the
-/// same moves written without the plane (the tip (10, 20, 5) of the plane is (5, 10, 20) of
-/// the workpiece): the two toolpaths have the same tips and the same axis positions at every
-/// point, so the solves are the same problem and the times agree to round-off.
+/// instead of 2.7817 s on this table). Now the block's points end at A −90°, C −90° (C 270°
+/// the shorter way from 0), the next point continues there, and the program reads and times
+/// as the same turn written before the plane: outside M128 the table turns with X Y Z
+/// standing either way (at 40, 30, 50), carrying the tip with the part, and the plane's
+/// point (10, 20, 5) is (5, 10, 20) of the workpiece. The two toolpaths have the same tips
+/// and the same axis positions at every point, so the solves are the same problem and the
+/// times agree to round-off.
 #[test]
 fn rotary_words_under_a_plane_are_programmed_positions() {
     let (m, ctx) = ac_table(-120.0, 120.0);
@@ -1740,7 +1748,8 @@ fn rotary_words_under_a_plane_are_programmed_positions() {
     };
     let written = format!(
         "{HEADER}4 L X+40 Y+30 Z+50 A+0 C+0 FMAX\n5 L A-90 C+270 R0 FMAX M126\n\
-         6 L X+5 Y+10 Z+20 FMAX\n7 END PGM T MM\n"
+         6 PLANE SPATIAL SPA90 SPB0 SPC90 STAY TABLE ROT\n\
+         7 L X+10 Y+20 Z+5 FMAX\n8 END PGM T MM\n"
     );
     let time = |tp: &Toolpath| {
         let s = optimize(&m, tp, &Options::default()).unwrap();
@@ -1748,29 +1757,49 @@ fn rotary_words_under_a_plane_are_programmed_positions() {
         s.schedule.cycle_time
     };
     let tp = read_on(&ctx, &under_plane("STAY", "A-90 C+270")).unwrap();
-    assert_eq!(tp.points.len(), 3);
-    assert_eq!(tp.points[1].line, 7);
-    assert_eq!(tp.points[1].rotary, Some([-90.0, 0.0, -90.0]));
-    assert!(close(tp.points[1].p, v(40.0, 30.0, 50.0), 1e-12));
+    let n = tp.points.len();
+    assert!(n > 3);
+    assert_eq!(tp.points[n - 2].line, 7);
+    assert_eq!(tp.points[n - 2].rotary, Some([-90.0, 0.0, -90.0]));
+    // The tip went with the table: X Y Z stand at (40, 30, 50), so the tip is
+    // Rx(90°)·Rz(90°)·(40, 30, 50) … of the workpiece, as the kinematics gives.
+    let pose = feedopt::kinematics::Kinematics::new(&m)
+        .forward(&[40.0, 30.0, 50.0, -90.0, -90.0])
+        .unwrap();
+    assert!(close(tp.points[n - 2].p, pose.p, 1e-9));
+    assert!(!close(tp.points[n - 2].p, v(40.0, 30.0, 50.0), 1.0));
     // A point under the plane without rotary words: the tool vector rules, as before.
-    assert_eq!(tp.points[2].rotary, None);
-    assert!(close(tp.points[2].p, v(5.0, 10.0, 20.0), 1e-12));
-    assert!(close(tp.points[2].o, v(1.0, 0.0, 0.0), 1e-12));
+    assert_eq!(tp.points[n - 1].rotary, None);
+    assert!(close(tp.points[n - 1].p, v(5.0, 10.0, 20.0), 1e-12));
+    assert!(close(tp.points[n - 1].o, v(1.0, 0.0, 0.0), 1e-12));
     let got = ac_angles(&m, &tp);
     assert!(
-        got[1..]
+        got[n - 2..]
             .iter()
             .all(|a| (a[0] + 90.0).abs() < 1e-9 && (a[1] + 90.0).abs() < 1e-9),
         "{got:?}"
     );
     let w = read_on(&ctx, &written).unwrap();
-    assert_eq!(ac_angles(&m, &w)[1..], got[1..]);
+    assert_eq!(w.points.len(), n);
+    for (a, b) in w.points.iter().zip(&tp.points) {
+        assert!(
+            close(a.p, b.p, 1e-9) && close(a.o, b.o, 1e-9),
+            "{a:?} {b:?}"
+        );
+    }
+    for (a, b) in ac_angles(&m, &w).iter().zip(&got) {
+        assert!(
+            (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9,
+            "{a:?} {b:?}"
+        );
+    }
     let (t, tw) = (time(&tp), time(&w));
     assert!((t - tw).abs() <= 1e-9 * tw, "{t} s, written out {tw} s");
     // The other solution (the kinematics' own choice from A 0) times differently here: the
     // words decide.
     let other = read_on(&ctx, &under_plane("STAY", "A+90 C+90")).unwrap();
-    assert_eq!(other.points[1].rotary, Some([90.0, 0.0, 90.0]));
+    let k = other.points.len() - 2;
+    assert_eq!(other.points[k].rotary, Some([90.0, 0.0, 90.0]));
     let to = time(&other);
     assert!((t - to).abs() > 0.01 * to, "A-90: {t} s, A+90: {to} s");
 
@@ -1787,7 +1816,8 @@ fn rotary_words_under_a_plane_are_programmed_positions() {
     assert!(e.contains("90.0000° apart"), "{e}");
     // Off by less than the posts' rounding (A to 0.0001°): accepted.
     let tp = read_on(&ctx, &under_plane("STAY", "A-90.0001 C+270")).unwrap();
-    assert_eq!(tp.points[1].rotary.map(|r| r[0]), Some(-90.0001));
+    let k = tp.points.len() - 2;
+    assert_eq!(tp.points[k].rotary.map(|r| r[0]), Some(-90.0001));
 
     // PLANE … TURN without SEQ turns the axes to a solution the kinematics chooses; a block
     // that then positions them all is run where it says (C 270 without M126: as written)…

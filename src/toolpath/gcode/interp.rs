@@ -3,6 +3,7 @@
 use nalgebra::Vector3;
 use std::path::Path;
 
+mod axes;
 mod heidenhain;
 pub(super) use heidenhain::KlartextWords;
 
@@ -941,7 +942,7 @@ impl<'a> Interpreter<'a> {
                     if t != self.tcp {
                         self.non_tcp_warned = false;
                     }
-                    self.tcp = t;
+                    self.switch_tcp(t);
                 }
                 Action::MachineCoordinates => machine = true,
                 Action::BuilderDatum => {
@@ -2593,21 +2594,33 @@ impl<'a> Interpreter<'a> {
             }
         }
 
+        let vector = vector_words.iter().any(Option::is_some);
         if self.tcp == Tcp::Off
             && !self.non_tcp_warned
             && !self.machine.is_some_and(|m| m.machine_coordinates)
             && !block.plane_rotary.iter().any(|&q| q)
-            && (end[3..] != [0.0; 3]
-                || block.axes[3..].iter().any(Option::is_some)
-                || vector_words.iter().any(Option::is_some))
+            && (vector || self.axis_kinematics().is_none())
+            && (end[3..] != [0.0; 3] || block.axes[3..].iter().any(Option::is_some) || vector)
         {
             self.non_tcp_warned = true;
-            self.warn(
-                line,
+            let text = if vector {
+                "a tool vector outside tool-tip (TCP) mode: X Y Z taken as the tool tip along \
+                 it, as under tool-tip mode"
+            } else if self.machine.is_some_and(|m| m.kinematics.is_some()) {
+                // Under a frame (its X Y Z the tip in the frame's coordinates), or where the
+                // rotary positions are not known.
                 "motion with rotary axes or a tool vector outside tool-tip (TCP) mode: X Y Z \
                  taken as the tool tip (a four-axis machine's program, in machine \
-                 coordinates, needs kinematics xyza, xyzb or xyzc)",
-            );
+                 coordinates, needs kinematics xyza, xyzb or xyzc)"
+            } else {
+                "motion with rotary axes outside tool-tip (TCP) mode, read without the \
+                 machine's kinematics: X Y Z taken as the tool tip, as under tool-tip mode (a \
+                 control without it moves the axes to X Y Z A B C, which puts the tip \
+                 elsewhere once a rotary axis is off zero); give the machine file to read the \
+                 block as the control runs it (a four-axis machine's program, in machine \
+                 coordinates, needs kinematics xyza, xyzb or xyzc)"
+            };
+            self.warn(line, text);
         }
 
         if block.axes[3..].iter().any(Option::is_some) || block.plane_rotary.iter().any(|&q| q) {
@@ -2616,14 +2629,81 @@ impl<'a> Interpreter<'a> {
         }
         // Rotary words under a Klartext PLANE are programmed positions (checked against the
         // plane's tool axis).
+        // Whether the rotary axes' start positions are known (not after a Klartext PLANE …
+        // TURN that left the solution to the control, which this block may now resolve).
+        let start_rotary_known = self.klartext.rotary_unknown.is_none();
         self.klartext.programmed_rotary = self.plane_rotary_words(line, block, &end)?;
         if is_arc {
+            if self.reads_axes(&start, &end) && (3..6).any(|i| start[i] != end[i]) {
+                return Err(self.error(
+                    line,
+                    "an arc that turns a rotary axis outside tool-tip (TCP) mode: the control \
+                     moves the axes along it and the tool tip relative to the part follows a \
+                     curve feedopt does not model; program the rotary move as its own block, \
+                     or the arc under tool-tip mode",
+                ));
+            }
             self.arc(line, motion, block, start, end)?;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
             // A G53 point is a machine position: outside the work offsets' check.
             self.machine_point = machine;
-            self.push(line, &end, feed);
+            let along = if self.reads_axes(&start, &end) && !vector && start_rotary_known {
+                self.axis_motion_points(line, &start, &end)?
+            } else {
+                None
+            };
+            let turn = if along.is_none() && !vector && start_rotary_known {
+                self.frame_turn_points(line, &start, &end)?
+            } else {
+                None
+            };
+            if let Some(points) = turn {
+                // Under a frame, outside tool-tip mode, the rotary axes turn alone: the tip
+                // goes with them; the block's time is its F rule's, split evenly.
+                let n = points.len() as f64;
+                let feed = match feed {
+                    Feed::BlockTime(t) => Feed::BlockTime(t / n),
+                    other => other,
+                };
+                self.klartext.sequence_point = false;
+                for &(p, o, rotary) in &points {
+                    self.check_offsets(line);
+                    self.points.push(ClPoint {
+                        p,
+                        o,
+                        feed,
+                        rotary: Some(rotary),
+                        line,
+                    });
+                }
+                // Where the carried tip now is, in the frame's coordinates.
+                if let Some(&(p, _, _)) = points.last() {
+                    let q = self.frame_now().invert(&p);
+                    end[..3].copy_from_slice(q.as_slice());
+                }
+            } else if let Some(qs) = along {
+                // The axes move linearly; the tip follows the kinematics. The block's time is
+                // the control's F rule for the axes' motion, split evenly over the points
+                // (uniform in the axes' interpolation parameter).
+                let n = qs.len() as f64;
+                let feed = match feed {
+                    Feed::Programmed(v) => {
+                        let d = (0..3)
+                            .map(|i| (end[i] - start[i]).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        Feed::BlockTime(d / v / n)
+                    }
+                    Feed::BlockTime(t) => Feed::BlockTime(t / n),
+                    other => other,
+                };
+                for q in &qs {
+                    self.push(line, q, feed);
+                }
+            } else {
+                self.push(line, &end, feed);
+            }
             self.machine_point = false;
             let (a, b) = (end[0] - start[0], end[1] - start[1]);
             let len = a.hypot(b);
@@ -2664,7 +2744,8 @@ impl<'a> Interpreter<'a> {
         crate::toolpath::check_room(self.source, line, what, self.points.len(), more)
     }
 
-    fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
+    /// Checks that the work offsets in force agree (outside a machine-coordinate point).
+    fn check_offsets(&mut self, line: usize) {
         if !self.machine_point {
             let axes = if self.saw_rotary { 0..6 } else { 0..3 };
             if let Err(m) = self.offsets.check(axes)
@@ -2673,7 +2754,26 @@ impl<'a> Interpreter<'a> {
                 self.offset_error = Some(self.offset_mismatch(line, m));
             }
         }
+    }
+
+    fn push(&mut self, line: usize, q: &[f64; 6], feed: Feed) {
+        self.check_offsets(line);
         let frame = self.frame_now();
+        // Rotary axes shifted by their work offsets (none unless a G10 or G52 gives one).
+        let s = self.offsets.shift();
+        let q_rot = [q[3] + s[3], q[4] + s[4], q[5] + s[5]];
+        if let Some(pose) = self.axes_pose(q) {
+            // Outside tool-tip mode, a rotary axis off zero: the tip the axes give.
+            self.klartext.sequence_point = false;
+            self.points.push(ClPoint {
+                p: pose.p,
+                o: pose.k,
+                feed,
+                rotary: Some(q_rot),
+                line,
+            });
+            return;
+        }
         if let Some(o) = self.klartext.stay_orientation {
             // Klartext PLANE … STAY: the rotary axes have not moved yet; the tool keeps the
             // orientation it had (workpiece coordinates).
@@ -2687,9 +2787,6 @@ impl<'a> Interpreter<'a> {
             });
             return;
         }
-        // Rotary axes shifted by their work offsets (none unless a G10 or G52 gives one).
-        let s = self.offsets.shift();
-        let q_rot = [q[3] + s[3], q[4] + s[4], q[5] + s[5]];
         let positioned = std::mem::take(&mut self.klartext.sequence_point);
         let (p, o, rotary) = if frame.is_identity() {
             (Vector3::new(q[0], q[1], q[2]), self.vector, Some(q_rot))

@@ -97,9 +97,21 @@
 //!   the first feed move). A Fanuc F without a decimal point under G95 is an error: the control
 //!   reads it in units its parameters set (0.01 or 0.001 mm per revolution on many).
 //! * **Tool-tip mode (TCP).** The codes above switch it on and off. In TCP mode X Y Z are the
-//!   tool tip in workpiece coordinates and A B C the rotary axis positions. A motion block that
-//!   has (or keeps) a rotary position or tool vector while TCP is off gets one warning per
-//!   stretch of such blocks: its X Y Z are still taken as the tool tip.
+//!   tool tip in workpiece coordinates and A B C the rotary axis positions. Outside it, on a
+//!   five-axis machine whose kinematics the reader has ([`MachineContext::kinematics`]), X Y Z
+//!   A B C are where the control moves the axes (X Y Z as at zero rotary angles, where they
+//!   are the tip): with every rotary axis at zero nothing changes; with one off zero the CL
+//!   point is the tip the forward kinematics gives, and a block that turns a rotary axis
+//!   becomes CL points along the tip's curve as the axes move linearly (chords within
+//!   [`MAX_CHORD_ERROR_MM`], the last one the block's end), its time the F rule's above
+//!   ([`Feed::BlockTime`] split evenly; a rapid stays a rapid). Under a frame that maps X Y Z
+//!   (Klartext `PLANE`, `CYCLE800`, `G68.2`, a rotation) X Y Z stay the tip in the frame's
+//!   coordinates, but a block that turns rotary axes alone turns them with the linear axes
+//!   standing, the tip carried along. Switching TCP on or off, or a Klartext frame, keeps the
+//!   axes where they are and re-expresses the position the next block starts from. An arc
+//!   that turns a rotary axis outside TCP is an error. Without the kinematics (a library read
+//!   without a machine), or under a frame, or with a tool vector, X Y Z are taken as the tool
+//!   tip with one warning per stretch of such blocks.
 //! * **Tool vectors.** Sinumerik `A3= B3= C3=`, and Fanuc `I J K` on G0/G1 blocks under `G43.5`,
 //!   set the tool orientation: a component not written in a block that writes another is 0, a
 //!   block that writes none keeps the vector, and the vector is normalised (zero length is an

@@ -71,7 +71,7 @@ pub(super) struct State {
     /// The line of a `PLANE … TURN`/`MOVE` or an `L A+Q120 C+Q122` without SEQ that moved the
     /// rotary axes to a solution the reader leaves to the kinematics: until a block programs
     /// every rotary axis again, the reader does not know where they stand.
-    rotary_unknown: Option<usize>,
+    pub(super) rotary_unknown: Option<usize>,
     /// Rotary words under a plane were read without the machine's kinematics (said once).
     unchecked_warned: bool,
     /// The preset `CYCL DEF 247` activated first (`Some(None)`: one whose Q339 is unknown).
@@ -554,6 +554,13 @@ impl Interpreter<'_> {
 
     /// The tool axis in program coordinates.
     fn tool_axis(&self, line: usize, what: &str) -> Result<Vector3<f64>> {
+        if let Some(pose) = self.axes_pose(&self.pos) {
+            // Outside tool-tip mode, the axes read as positions: the program direction that
+            // moves the tip along the tool axis the kinematics gives.
+            let a = self.program_at(pose.p, &self.pos);
+            let b = self.program_at(pose.p + pose.k, &self.pos);
+            return Ok((b - a).normalize());
+        }
         if let Some(o) = self.klartext.stay_orientation {
             return Ok(self.frame_now().r.transpose() * o);
         }
@@ -635,9 +642,7 @@ impl Interpreter<'_> {
 
     /// Recomputes the frames from the datum shift and the plane; the tool does not move.
     fn set_klartext_frame(&mut self) {
-        let p = self
-            .frame_now()
-            .apply(&Vector3::new(self.pos[0], self.pos[1], self.pos[2]));
+        let p = self.tip_at(&self.pos);
         let t = self.klartext.datum_shift;
         match self.klartext.plane {
             Some(r) => {
@@ -649,12 +654,15 @@ impl Interpreter<'_> {
                 self.programmable = Frame::translation(t);
             }
         }
-        let q = self.frame_now().invert(&p);
+        let q = self.program_at(p, &self.pos);
         self.pos[..3].copy_from_slice(q.as_slice());
     }
 
     /// The tool's orientation now, workpiece coordinates.
     fn orientation(&self) -> Vector3<f64> {
+        if let Some(pose) = self.axes_pose(&self.pos) {
+            return pose.k;
+        }
         self.klartext
             .stay_orientation
             .unwrap_or_else(|| self.frame_now().r * self.vector)
@@ -1068,7 +1076,7 @@ impl Interpreter<'_> {
         if self.tcp != Tcp::On {
             self.non_tcp_warned = false;
         }
-        self.tcp = Tcp::On;
+        self.switch_tcp(Tcp::On);
         Ok(())
     }
 
