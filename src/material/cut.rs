@@ -699,8 +699,9 @@ struct Scratch {
     starts: Vec<f64>,
     ended: Vec<(usize, usize, [f64; 2])>,
     ranges: Vec<Option<(usize, usize)>>,
-    /// The end pose's shank crossings.
+    /// The end pose's shank crossings, and the cells where the shank may meet material.
     shank: Vec<[f64; 2]>,
+    candidates: Vec<usize>,
 }
 
 /// The plan of one step; `shared` (the previous step's last pose) is updated to this step's.
@@ -810,6 +811,7 @@ fn cut_band(
         ended,
         ranges,
         shank: shank_z,
+        candidates,
     } = scratch;
     let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
     let mut acc = Acc::ZERO;
@@ -970,19 +972,39 @@ fn cut_band(
         // (A cell no pose crosses has the run [∞, −∞], which removes
         // nothing: Dexel::remove tells it without a call.) Then the shank
         // at the step's end pose, where its flutes cross a line with
-        // material left above them.
+        // material left above them (the shank lies above the flutes).
         let end_pose = &pose_list[poses - 1].0;
         let end_hits = &hits[(poses - 1) * width..poses * width];
-        shank_z.resize(width, NO_HIT);
-        end_pose.shank_row(y, x0, hx, ua, shank_z);
+        candidates.clear();
         band.each(j, ua, ub, |i, cell| {
             let [lo, hi] = run[i - ua];
             note(cx(i), cell.remove(lo, hi));
-            let (h, z) = (end_hits[i - ua], shank_z[i - ua]);
-            if h[0] <= h[1] && z[0] < z[1] && cell.extent().is_some_and(|e| e[1] > z[0]) {
-                shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
+            let h = end_hits[i - ua];
+            if h[0] <= h[1] && cell.extent().is_some_and(|e| e[1] > h[1]) {
+                candidates.push(i);
             }
         });
+        if let (Some(&first), Some(&last)) = (candidates.first(), candidates.last()) {
+            // Many candidates (a tool buried beyond its flutes): the row's
+            // shank spans at once, with vector instructions; few: each alone
+            // (the same spans bit for bit).
+            let many = 4 * candidates.len() >= last - first + 1;
+            if many {
+                shank_z.resize(last - first + 1, NO_HIT);
+                end_pose.shank_row(y, x0, hx, first, shank_z);
+            }
+            for &i in candidates.iter() {
+                let z = if many {
+                    shank_z[i - first]
+                } else {
+                    end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT)
+                };
+                let cell = band.dexel(i, j);
+                if z[0] < z[1] && cell.extent().is_some_and(|e| e[1] > z[0]) {
+                    shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
+                }
+            }
+        }
         acc.shank = acc.shank.max(shank);
     }
     acc
