@@ -988,7 +988,7 @@ fn cut_band(
             // Many candidates (a tool buried beyond its flutes): the row's
             // shank spans at once, with vector instructions; few: each alone
             // (the same spans bit for bit).
-            let many = 4 * candidates.len() >= last - first + 1;
+            let many = 4 * candidates.len() > last - first;
             if many {
                 shank_z.resize(last - first + 1, NO_HIT);
                 end_pose.shank_row(y, x0, hx, first, shank_z);
