@@ -454,3 +454,35 @@ fn a_straight_move_at_a_standing_rotary_angle_moves_the_axes_as_written() {
         s.schedule.cycle_time
     );
 }
+
+/// A turn of whole times round (`L C+720 FMAX`, the tip 50 mm off the C axis) comes back to
+/// the same tip at every quarter of the block: sampled at its ends and quarters alone, its
+/// chords looked exact and the turn was one point, the tip held still while the table turned
+/// twice (X Y swinging round). At least one sample per 30° of the turn: the tip follows two
+/// circles, X Y Z stand.
+#[test]
+fn a_turn_of_whole_revolutions_is_followed_round() {
+    let (m, ctx) = ac_table();
+    let tp = read(
+        Dialect::Heidenhain,
+        Some(&ctx),
+        &format!("{HEADER}4 L X+50 Y+0 Z+10 A+0 C+0 FMAX\n5 L C+720 FMAX\n6 END PGM T MM\n"),
+    );
+    // 720° at ≤ 30° a step, then chords within 1 µm of a 50 mm circle (sagitta 1 µm: ≈0.36°).
+    assert!(tp.points.len() > 2 * 360, "{} points", tp.points.len());
+    for (k, q) in axes_of(&m, &tp).iter().enumerate() {
+        assert!(
+            (q[0] - 50.0).abs() < 1e-9 && q[1].abs() < 1e-9 && (q[2] - 10.0).abs() < 1e-9,
+            "point {k}: axes {q:?}"
+        );
+    }
+    let s = solve(&m, &tp);
+    // C's own time, to the chords' share: 1,400 chords within 1 µm of the circle put C
+    // within 4e-6 of it.
+    let want = rest_to_rest(720.0, 120.0, 1200.0);
+    assert!(
+        (s.schedule.cycle_time - want).abs() <= 1e-5 * want,
+        "{} s, C alone {want} s",
+        s.schedule.cycle_time
+    );
+}

@@ -30,6 +30,10 @@ pub(super) type TurnPoint = (Vector3<f64>, Vector3<f64>, [f64; 3]);
 /// At most this many CL points for one block that turns a rotary axis outside tool-tip mode.
 const MAX_SUBPOINTS: usize = 1 << 16;
 
+/// The largest rotary change, degrees, between two samples of a chord of a turn's tip curve
+/// where its error is checked (`chord_count`).
+const MAX_STEP_DEG: f64 = 30.0;
+
 impl Interpreter<'_> {
     /// The machine's kinematics where a block outside tool-tip mode is read as the axes'
     /// motion: a five-axis kinematics known to the reader, no frame mapping X Y Z (swivel,
@@ -134,7 +138,10 @@ impl Interpreter<'_> {
         }
         let at =
             |t: f64| -> [f64; 6] { std::array::from_fn(|i| start[i] + t * (end[i] - start[i])) };
-        let n = self.chord_count(line, |t| self.tip_at(&at(t)))?;
+        let turn = (3..6)
+            .map(|i| end[i] - start[i])
+            .fold(0.0, |m: f64, d| m.max(d.abs()));
+        let n = self.chord_count(line, turn, |t| self.tip_at(&at(t)))?;
         self.check_room(line, "the rotary move", n)?;
         Ok(Some(
             (1..=n)
@@ -151,14 +158,27 @@ impl Interpreter<'_> {
 
     /// How many equal steps of the parameter t ∈ [0, 1] keep the chords of the tip's curve
     /// `tip(t)` within [`MAX_CHORD_ERROR_MM`] of it (checked at each chord's midpoint and
-    /// quarter points), the CL points they make counted against the program's limit.
-    fn chord_count(&self, line: usize, tip: impl Fn(f64) -> Vector3<f64>) -> Result<usize> {
+    /// quarter points), the CL points they make counted against the program's limit. `turn`:
+    /// the largest rotary axis change, degrees: each chord is checked at least every
+    /// [`MAX_STEP_DEG`] of it too, so that the samples cannot alias a curve that turns whole
+    /// times (a table turned by 720° with the tip off its axis comes back to the same tip at
+    /// every quarter of the block).
+    fn chord_count(
+        &self,
+        line: usize,
+        turn: f64,
+        tip: impl Fn(f64) -> Vector3<f64>,
+    ) -> Result<usize> {
+        let least = (turn.abs() / MAX_STEP_DEG).ceil();
         let error = |n: usize| -> f64 {
             let mut worst: f64 = 0.0;
             let mut a = tip(0.0);
+            // Samples per chord beyond its quarters: one per MAX_STEP_DEG of it.
+            let extra = (least / n as f64).ceil() as usize;
             for k in 1..=n {
                 let b = tip(k as f64 / n as f64);
-                for f in [0.25, 0.5, 0.75] {
+                let more = (1..extra).map(|j| j as f64 / extra as f64);
+                for f in [0.25, 0.5, 0.75].into_iter().chain(more) {
                     let m = tip((k as f64 - 1.0 + f) / n as f64);
                     worst = worst.max((m - (a + (b - a) * f)).norm());
                 }
@@ -166,6 +186,17 @@ impl Interpreter<'_> {
             }
             worst
         };
+        if least.is_nan() || least > MAX_SUBPOINTS as f64 {
+            return Err(self.error(
+                line,
+                format!(
+                    "a block that turns a rotary axis outside tool-tip mode by {} degrees: split \
+                     it into shorter turns (at most {} degrees a block)",
+                    crate::error::number(turn.abs()),
+                    MAX_SUBPOINTS as f64 * MAX_STEP_DEG
+                ),
+            ));
+        }
         let mut n = 1usize;
         loop {
             let e = error(n);
@@ -253,7 +284,10 @@ impl Interpreter<'_> {
             kin.forward(&j)
         };
         let tip = |t: f64| pose(rotary_at(t)).map_or(Vector3::repeat(f64::NAN), |p| p.p);
-        let n = self.chord_count(line, tip)?;
+        let turn = (0..3)
+            .map(|i| r1[i] - r0[i])
+            .fold(0.0, |m: f64, d| m.max(d.abs()));
+        let n = self.chord_count(line, turn, tip)?;
         let mut points = Vec::with_capacity(n);
         for k in 1..=n {
             let rotary = if k == n {
