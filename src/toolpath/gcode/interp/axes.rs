@@ -99,13 +99,7 @@ impl Interpreter<'_> {
             && rotary != [0.0; 3]
             && let Some(kin) = self.axis_kinematics()
         {
-            let mut w = [0.0; PATH_DIM];
-            w[..3].copy_from_slice(tip.as_slice());
-            let a = kin.angles_from_rotary(rotary);
-            w[3] = a[0];
-            w[4] = a[1];
-            let mut j = [0.0; MAX_AXES];
-            kin.axis_positions(w, &mut j);
+            let j = inverse(kin, tip, rotary);
             if let Some(p) = linear_axes_inverse(kin, Vector3::new(j[0], j[1], j[2])) {
                 return frame.invert(&p);
             }
@@ -266,16 +260,7 @@ impl Interpreter<'_> {
         let rotary_at =
             |t: f64| -> [f64; 3] { std::array::from_fn(|i| r0[i] + t * (r1[i] - r0[i])) };
         // The axes at the block's start; the linear ones stand.
-        let j0 = {
-            let mut w = [0.0; PATH_DIM];
-            w[..3].copy_from_slice(tip0.as_slice());
-            let a = kin.angles_from_rotary(r0);
-            w[3] = a[0];
-            w[4] = a[1];
-            let mut j = [0.0; MAX_AXES];
-            kin.axis_positions(w, &mut j);
-            j
-        };
+        let j0 = inverse(kin, tip0, r0);
         let pose = |rotary: [f64; 3]| -> Option<ToolPose> {
             let turned = axis_positions(kin, tip0, rotary);
             let mut j = j0;
@@ -312,28 +297,28 @@ pub(super) fn axis_positions(
     rotary: [f64; 3],
 ) -> [f64; MAX_AXES] {
     let mut linear = linear_axes(kin, p);
-    let mut w = [0.0; PATH_DIM];
-    w[..3].copy_from_slice(p.as_slice());
-    let a = kin.angles_from_rotary(rotary);
-    w[3] = a[0];
-    w[4] = a[1];
-    let mut turned = [0.0; MAX_AXES];
-    kin.axis_positions(w, &mut turned);
+    let turned = inverse(kin, p, rotary);
     let n = kin.n_axes();
     linear[3..n].copy_from_slice(&turned[3..n]);
     linear
 }
 
-/// The axis positions at zero rotary angles that put the tip at `p`.
-fn linear_axes(kin: &Kinematics, p: Vector3<f64>) -> [f64; MAX_AXES] {
+/// The inverse kinematics: the axis positions (the kinematics' order) that put the tip at
+/// `p` (program coordinates) with the rotary axes at `rotary` (`[A, B, C]`, degrees).
+fn inverse(kin: &Kinematics, p: Vector3<f64>, rotary: [f64; 3]) -> [f64; MAX_AXES] {
     let mut w = [0.0; PATH_DIM];
     w[..3].copy_from_slice(p.as_slice());
-    let a = kin.angles_from_rotary([0.0; 3]);
+    let a = kin.angles_from_rotary(rotary);
     w[3] = a[0];
     w[4] = a[1];
     let mut out = [0.0; MAX_AXES];
     kin.axis_positions(w, &mut out);
     out
+}
+
+/// The axis positions at zero rotary angles that put the tip at `p`.
+fn linear_axes(kin: &Kinematics, p: Vector3<f64>) -> [f64; MAX_AXES] {
+    inverse(kin, p, [0.0; 3])
 }
 
 /// The tip `p` whose zero-angle linear axes are `j` (the map is affine).
