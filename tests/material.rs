@@ -452,6 +452,24 @@ fn the_overload_check_lists_exactly_the_overloads_and_the_rapid_through_stock() 
     assert_eq!(overloads(&sim, &m, 0.5).len(), 1);
 }
 
+/// The shank findings (line, depth) of `tp` cut with a 10 mm flat end mill of `flutes` mm
+/// flutes on the block at 0.2 mm; every finding there is an error (shank or rapid).
+fn shank_findings(tp: &Toolpath, flutes: f64) -> Vec<(usize, f64)> {
+    use feedopt::material::check::{FindingKind, Severity, overloads};
+    let m = material(
+        Tool::new(10.0, 0.0, flutes, 3).unwrap(),
+        0.2,
+        ProcessLimits::default(),
+    );
+    let sim = material::simulate(tp, &m).unwrap();
+    overloads(&sim, &m, 1.0)
+        .iter()
+        .inspect(|f| assert_eq!(f.severity, Severity::Error, "{f:?}"))
+        .filter(|f| f.kind == FindingKind::Shank)
+        .map(|f| (f.line, f.shank_depth))
+        .collect()
+}
+
 /// A cut deeper than the flutes are long leaves material standing above them where the shank
 /// goes: an error-level finding at each such move, with how far it reaches (10 − 8 = 2 mm
 /// here), but not at a plunge, which clears its own hole; with flutes long enough, none. (The CAMotics bear, a 17 mm relief, with the default
@@ -459,7 +477,6 @@ fn the_overload_check_lists_exactly_the_overloads_and_the_rapid_through_stock() 
 /// only its last retract showed, as a rapid through the material left above the flutes.)
 #[test]
 fn a_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
-    use feedopt::material::check::{FindingKind, Severity, overloads};
     let tp = path(&[
         [20.0, 20.0, 10.0],
         [20.0, 20.0, 1.0],
@@ -467,20 +484,7 @@ fn a_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
         [60.0, 20.0, -10.0],
         [60.0, 20.0, 10.0],
     ]);
-    let shank = |flutes: f64| -> Vec<(usize, f64)> {
-        let m = material(
-            Tool::new(10.0, 0.0, flutes, 3).unwrap(),
-            0.2,
-            ProcessLimits::default(),
-        );
-        let sim = material::simulate(&tp, &m).unwrap();
-        overloads(&sim, &m, 1.0)
-            .iter()
-            .inspect(|f| assert_eq!(f.severity, Severity::Error, "{f:?}"))
-            .filter(|f| f.kind == FindingKind::Shank)
-            .map(|f| (f.line, f.shank_depth))
-            .collect()
-    };
+    let shank = |flutes: f64| shank_findings(&tp, flutes);
     let found = shank(8.0);
     // The plunge (line 3) clears its own hole: its flutes pass through everything above them.
     // The slot (line 4) leaves the top 2 mm uncut where the shank goes; the retract (line 5)
@@ -502,7 +506,6 @@ fn a_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
 /// flutes (top 17.3 mm above the tip) nothing does.
 #[test]
 fn a_tilted_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
-    use feedopt::material::check::{FindingKind, overloads};
     let o = Vector3::new(0.5, 0.0, 0.75_f64.sqrt());
     let pts: Vec<(Vector3<f64>, Vector3<f64>)> = [
         [50.0, 5.0, 10.0],
@@ -516,19 +519,7 @@ fn a_tilted_cut_deeper_than_the_flutes_puts_the_shank_in_the_material() {
     .collect();
     let mut tp = toolpath(&pts, Some(20.0));
     tp.points[1].feed = Feed::Rapid;
-    let shank = |flutes: f64| -> Vec<(usize, f64)> {
-        let m = material(
-            Tool::new(10.0, 0.0, flutes, 3).unwrap(),
-            0.2,
-            ProcessLimits::default(),
-        );
-        let sim = material::simulate(&tp, &m).unwrap();
-        overloads(&sim, &m, 1.0)
-            .iter()
-            .filter(|f| f.kind == FindingKind::Shank)
-            .map(|f| (f.line, f.shank_depth))
-            .collect()
-    };
+    let shank = |flutes: f64| shank_findings(&tp, flutes);
     let found = shank(8.0);
     eprintln!("{found:?}");
     // The slot (line 4) at least; the depth along the axis is at least the material's top
