@@ -601,6 +601,25 @@ fn ramp_end(p: &SpanProblem, b: &[f64], k: usize) -> Option<f64> {
     (at > u0 + 1e-3 * du && at < u1 - 1e-3 * du).then_some(at)
 }
 
+/// Per span (of `spans`), the intervals `marks` name and into how many parts each is divided
+/// ([`local_parts`]): sorted, one entry per interval (its worst violation's, the most parts),
+/// as [`divide`] takes them.
+pub(crate) fn marked_parts<'a>(
+    marks: impl IntoIterator<Item = &'a Violation>,
+    spans: usize,
+    tolerance: f64,
+) -> Vec<Vec<(usize, usize)>> {
+    let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); spans];
+    for viol in marks {
+        split[viol.span].push((viol.interval, local_parts(viol.ratio, tolerance)));
+    }
+    for ks in &mut split {
+        ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+        ks.dedup_by_key(|k| k.0);
+    }
+    split
+}
+
 /// Stations `u` with every interval k of `ks` (pairs (k, m), sorted by k, distinct k) divided
 /// into m equal parts.
 pub(crate) fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
@@ -627,7 +646,7 @@ pub(crate) fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
 /// excess e to about e/m². m is chosen to bring e to a quarter of the tolerance, at least 2,
 /// at most [`MAX_LOCAL_SPLIT`]: one round usually suffices where halving took three or four
 /// (the jerk-limited impeller: excess 3.6 % at first).
-pub(crate) fn local_parts(ratio: f64, tolerance: f64) -> usize {
+fn local_parts(ratio: f64, tolerance: f64) -> usize {
     let excess = (ratio - 1.0).max(0.0);
     let m = (excess / (0.25 * tolerance.max(1e-12))).sqrt().ceil();
     if m.is_finite() {
@@ -1733,11 +1752,7 @@ impl Plan<'_> {
         options: &Options,
     ) -> Result<RefineOutcome> {
         use rayon::prelude::*;
-        let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); lv.problems.len()];
-        for viol in marks {
-            let parts = local_parts(viol.ratio, options.verify.tolerance);
-            split[viol.span].push((viol.interval, parts));
-        }
+        let split = marked_parts(marks, lv.problems.len(), options.verify.tolerance);
         // The spans concerned in parallel (each span's windows join the same pool).
         let jobs: Vec<(usize, Vec<(usize, usize)>)> = split
             .into_iter()
@@ -1746,10 +1761,7 @@ impl Plan<'_> {
             .collect();
         let solved: Vec<(usize, Option<(SpanProblem, SpanSolution)>)> = jobs
             .into_par_iter()
-            .map(|(si, mut ks)| {
-                // One entry per interval (its worst violation's, the most parts).
-                ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
-                ks.dedup_by_key(|k| k.0);
+            .map(|(si, ks)| {
                 let old = &lv.problems[si];
                 let u = divide(&old.u, &ks);
                 let mut p =

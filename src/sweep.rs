@@ -28,7 +28,7 @@
 //! 40 °/s², 3.3 % over at 31,267 stations, 3.3 times over at 8,887; a test's smooth joint path
 //! 40 % over at a tenth of its velocity limit). Each step's schedule is re-simulated at the
 //! servo period, and where one exceeds a limit, the intervals it marks are divided as `solve`'s
-//! local refinement divides them ([`optimize::local_parts`]) — *for every step* — and the steps
+//! local refinement divides them ([`optimize::marked_parts`]) — *for every step* — and the steps
 //! are solved again, up to [`SWEEP_ROUNDS`] times and [`MAX_STATION_GROWTH`] times the
 //! baseline's stations: one station set, fine enough for every step. While the stations
 //! change only some steps run (the two ends of the range first, then those a run of all found
@@ -442,19 +442,16 @@ impl Study<'_> {
     /// refinement of `solve` divides it (the most parts any step asks for); `None` where that
     /// would pass `max_stations` stations.
     fn divided(&self, evals: &[Eval], max_stations: usize) -> Option<Vec<Vec<f64>>> {
-        let tolerance = self.options.verify.tolerance;
-        let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.grid.len()];
-        for m in evals.iter().flat_map(|e| &e.marks) {
-            split[m.span].push((m.interval, optimize::local_parts(m.ratio, tolerance)));
-        }
+        let split = optimize::marked_parts(
+            evals.iter().flat_map(|e| &e.marks),
+            self.grid.len(),
+            self.options.verify.tolerance,
+        );
         let mut grid = self.grid.clone();
-        for (u, ks) in grid.iter_mut().zip(&mut split) {
-            if ks.is_empty() {
-                continue;
+        for (u, ks) in grid.iter_mut().zip(&split) {
+            if !ks.is_empty() {
+                *u = optimize::divide(u, ks);
             }
-            ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
-            ks.dedup_by_key(|k| k.0);
-            *u = optimize::divide(u, ks);
         }
         (grid.iter().map(Vec::len).sum::<usize>() <= max_stations).then_some(grid)
     }
@@ -674,12 +671,11 @@ pub fn sweep(
         .collect();
     // Every step at the study's stations; where a step's re-simulation finds a limit exceeded
     // between them, its marked intervals are divided for every step and the steps are solved
-    // again (module doc, "A common station set").
-    // Only some of the steps run while the stations change (probes): first the two ends of
-    // the range, whose limits are furthest from those the baseline's stations were refined
-    // for, then the steps a run of every solve found over a limit, each set until it
-    // verifies; every solve then runs again on the final stations. (The finite differences'
-    // solves, 1 % from their step's, are timed, not re-simulated.)
+    // again (module doc, "A common station set"). While the stations change only some steps
+    // run (probes): first the two ends of the range, whose limits are furthest from those the
+    // baseline's stations were refined for, then the steps a run of every solve found over a
+    // limit, each set until it verifies; every solve then runs again on the final stations.
+    // (The finite differences' solves, 1 % from their step's, are timed, not re-simulated.)
     let mut round = 0;
     let refine = options.solve.refine_until_verified;
     let mut probes: Vec<(usize, usize, f64)> = if refine && values.len() > 1 {
@@ -756,11 +752,11 @@ pub fn sweep(
             None => break evals,
         }
     };
-    let mut evals = evals.into_iter().map(Ok::<Eval, Error>);
+    let mut evals = evals.into_iter();
     let mut points = Vec::with_capacity(values.len());
     for &v in &values {
         let (minus, mid, plus) = match (evals.next(), evals.next(), evals.next()) {
-            (Some(a), Some(b), Some(c)) => (a?, b?, c?),
+            (Some(a), Some(b), Some(c)) => (a, b, c),
             _ => return Err(Error::Solver("a sweep step was lost".into())),
         };
         let fd = (plus.cycle_time - minus.cycle_time) / (2.0 * h * v);
