@@ -4,6 +4,12 @@
 //! the readers, the geometry and the kinematics can all name them without depending on each
 //! other (issue 15: no loop between modules).
 
+/// The angle between two unit vectors, radians, accurate near 0 and π (`atan2` of the sine
+/// and cosine, where `acos` of the dot product loses half the digits near 0).
+pub fn angle_between(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
 /// Largest number of machine axes.
 pub const MAX_AXES: usize = 8;
 

@@ -18,6 +18,7 @@ pub mod spline;
 
 use nalgebra::Vector3;
 
+pub use crate::base::angle_between;
 use crate::base::{PATH_DIM, PathJet};
 use crate::error::number;
 use crate::error::{Error, Result};
@@ -905,11 +906,6 @@ pub fn chord_deviation(
             (mm, rad)
         })
         .collect()
-}
-
-/// Angle between two unit vectors, accurate for small angles.
-pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
 }
 
 impl GeometryOptions {

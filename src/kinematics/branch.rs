@@ -33,6 +33,7 @@
 use nalgebra::Vector3;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
+use crate::base::angle_between;
 use crate::error::{Error, Result};
 
 /// Below this |sin t| the tool is parallel to the C axis and the spin angle is free.
@@ -145,10 +146,6 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
-fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
-}
-
 /// One walk along the path, or the index of the point that failed and its error.
 type Walk = std::result::Result<Vec<[f64; 2]>, (usize, Error)>;
 
@@ -169,7 +166,7 @@ impl Walker<'_> {
 
     /// Angle between a tool vector and the C axis, either way along it.
     fn pole_distance(&self, k: &Vector3<f64>) -> f64 {
-        let a = angle(k, &self.pole);
+        let a = angle_between(k, &self.pole);
         a.min(PI - a)
     }
 
@@ -356,7 +353,7 @@ impl Walker<'_> {
         }
         let mut acc = vec![0.0];
         for w in ks.windows(2) {
-            acc.push(acc.last().unwrap_or(&0.0) + angle(&w[0], &w[1]));
+            acc.push(acc.last().unwrap_or(&0.0) + angle_between(&w[0], &w[1]));
         }
         let total = *acc.last().unwrap_or(&0.0);
         let offset = usize::from(prev.is_some());
@@ -379,7 +376,9 @@ impl Walker<'_> {
                 l.travel[l.tilt],
             )?;
             let pose = l.pair(t, s);
-            if angle(&(self.axis)(pose), &k) > POLE_TOLERANCE || !within(s, l.travel[l.spin()]) {
+            if angle_between(&(self.axis)(pose), &k) > POLE_TOLERANCE
+                || !within(s, l.travel[l.spin()])
+            {
                 return None;
             }
             last_tilt = Some(t);

@@ -66,6 +66,7 @@ use rayon::prelude::*;
 
 use super::dexel::{Dexel, Dexels, TILE};
 use super::tool::{NO_HIT, Pose, Tool};
+use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
 
 /// What the tool engaged over one sample step.
@@ -143,7 +144,7 @@ impl Step {
 
     /// How far any point of the cutting part moves: |ΔP| + L_f·Δθ (an upper bound), mm.
     pub fn extent(&self, tool: &Tool) -> f64 {
-        (self.p1 - self.p0).norm() + tool.flute_length * angle(&self.o0, &self.o1)
+        (self.p1 - self.p0).norm() + tool.flute_length * angle_between(&self.o0, &self.o1)
     }
 
     /// Poses of a tilted step (at least 2), so that no point moves more than `delta` between.
@@ -194,11 +195,6 @@ impl Step {
         }
         b
     }
-}
-
-/// The angle between two unit vectors, radians.
-fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
 }
 
 /// The grid cells (i0..=i1, j0..=j1) that rectangle `b` covers, if any.

@@ -316,8 +316,7 @@ pub fn estimate_work(tp: &Toolpath, m: &Material) -> Result<f64> {
             ));
         }
         let tool = m.tool_at(k);
-        let e =
-            (b.p - a.p).norm() + tool.flute_length * a.o.cross(&b.o).norm().atan2(a.o.dot(&b.o));
+        let e = (b.p - a.p).norm() + tool.flute_length * crate::base::angle_between(&a.o, &b.o);
         samples += (e / m.step_for(tool)).ceil();
     }
     if samples > MAX_SAMPLES {

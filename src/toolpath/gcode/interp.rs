@@ -2627,11 +2627,11 @@ impl<'a> Interpreter<'a> {
             // Klartext PLANE … STAY: the rotary axes are positioned now.
             self.klartext.stay_orientation = None;
         }
-        // Rotary words under a Klartext PLANE are programmed positions (checked against the
-        // plane's tool axis).
         // Whether the rotary axes' start positions are known (not after a Klartext PLANE …
         // TURN that left the solution to the control, which this block may now resolve).
         let start_rotary_known = self.klartext.rotary_unknown.is_none();
+        // Rotary words under a Klartext PLANE are programmed positions (checked against the
+        // plane's tool axis).
         self.klartext.programmed_rotary = self.plane_rotary_words(line, block, &end)?;
         if is_arc {
             if self.reads_axes(&start, &end) && (3..6).any(|i| start[i] != end[i]) {

@@ -9,6 +9,7 @@ use super::super::dialect::{PathKind, Statement};
 use super::super::klartext;
 use super::super::lexer::Num;
 use super::*;
+use crate::base::angle_between;
 
 /// The Klartext words of a block the interpreter acts on after the modal settings.
 #[derive(Debug, Default)]
@@ -1497,11 +1498,6 @@ fn two_rotary_kinematics(
         kinematics.angles_from_rotary(r) != zero
     });
     Some((kinematics, turned))
-}
-
-/// The angle between two unit vectors, radians (accurate near 0 and π).
-fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
 }
 
 /// A direction for a message: `(0, 1, 0)`, components to 6 decimals.
