@@ -1484,6 +1484,11 @@ fn an_error_in_a_block_delete_block_names_block_delete() {
 /// while the table turns under a held tool tip (outside TCPM) differs between the two
 /// solutions and shows in the time.
 fn ac_table(a_min: f64, a_max: f64) -> (feedopt::machine::Machine, MachineContext) {
+    ac_table_travel(&format!(r#", "min": {a_min}, "max": {a_max}"#))
+}
+
+/// [`ac_table`] with A's travel given as its JSON fields (`""`: unlimited).
+fn ac_table_travel(a_travel: &str) -> (feedopt::machine::Machine, MachineContext) {
     let m = common::machine(&format!(
         r#"{{"name": "A/C table", "kinematics": {{"type": "table_table_ac",
               "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
@@ -1491,7 +1496,7 @@ fn ac_table(a_min: f64, a_max: f64) -> (feedopt::machine::Machine, MachineContex
             "axes": {{"X": {{"velocity": 50, "acceleration": 500}},
                      "Y": {{"velocity": 50, "acceleration": 500}},
                      "Z": {{"velocity": 50, "acceleration": 500}},
-                     "A": {{"velocity": 60, "acceleration": 600, "min": {a_min}, "max": {a_max}}},
+                     "A": {{"velocity": 60, "acceleration": 600{a_travel}}},
                      "C": {{"velocity": 120, "acceleration": 1200}}}},
             "feed": {{"max": 500}}}}"#
     ));
@@ -1557,18 +1562,7 @@ fn plane_sym_picks_the_side_of_the_master_axis_travel_centre() {
     let tp = read_on(&ctx2, &program("SYM+", 30.0)).unwrap();
     assert!((ac_angles(&m2, &tp).last().unwrap()[0].abs() - 30.0).abs() < 1e-9);
     // Without travel limits there is no symmetry point: an error saying so.
-    let free = common::machine(
-        r#"{"name": "A/C table", "kinematics": {"type": "table_table_ac",
-              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
-              "y-offset": 0, "z-offset": 0, "conventional-directions": true},
-            "axes": {"X": {"velocity": 50, "acceleration": 500},
-                     "Y": {"velocity": 50, "acceleration": 500},
-                     "Z": {"velocity": 50, "acceleration": 500},
-                     "A": {"velocity": 60, "acceleration": 600},
-                     "C": {"velocity": 120, "acceleration": 1200}},
-            "feed": {"max": 500}}"#,
-    );
-    let ctx3 = MachineContext::new(&free, &feedopt::machine::References::default());
+    let (_, ctx3) = ac_table_travel("");
     let e = read_on(&ctx3, &program("SYM+", 90.0)).unwrap_err();
     assert!(
         e.contains("t.h:6:") && e.contains("symmetry point of A") && e.contains("no travel"),
