@@ -39,15 +39,21 @@ impl Interpreter<'_> {
     /// motion: a five-axis kinematics known to the reader, no frame mapping X Y Z (swivel,
     /// rotation), no Klartext `PLANE … STAY` pending. `None`: X Y Z are taken as the tool tip.
     pub(super) fn axis_kinematics(&self) -> Option<&Kinematics> {
-        let kin = self.machine?.kinematics.as_ref()?;
-        let five_axis = matches!(
-            kin,
-            Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_)
-        );
-        (five_axis
-            && self.swivel.is_none()
+        let kin = self.five_axis_kinematics()?;
+        (self.swivel.is_none()
             && self.programmable.r == Matrix3::identity()
             && self.klartext.rotary_unknown.is_none())
+        .then_some(kin)
+    }
+
+    /// The machine's kinematics where it has two rotary axes and a tool tip (head–head,
+    /// table–table, head–table).
+    fn five_axis_kinematics(&self) -> Option<&Kinematics> {
+        let kin = self.machine?.kinematics.as_ref()?;
+        matches!(
+            kin,
+            Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_)
+        )
         .then_some(kin)
     }
 
@@ -244,15 +250,9 @@ impl Interpreter<'_> {
         {
             return Ok(None);
         }
-        let Some(kin) = self.machine.and_then(|m| m.kinematics.as_ref()) else {
+        let Some(kin) = self.five_axis_kinematics() else {
             return Ok(None);
         };
-        if !matches!(
-            kin,
-            Kinematics::HeadHead { .. } | Kinematics::TableTable(_) | Kinematics::HeadTable(_)
-        ) {
-            return Ok(None);
-        }
         let tip0 = self
             .frame_now()
             .apply(&Vector3::new(start[0], start[1], start[2]));
