@@ -303,6 +303,24 @@ impl SpanProblem {
         Self::at_stations(span, kin, machine, stations(span, grid))
     }
 
+    /// [`SpanProblem::at_stations`], the velocity bounds tightened by `chord` where it is given
+    /// ([`SpanProblem::apply_chord`]): the problem every solve of a path states on its stations
+    /// (the refinement's, the jerk-limited windows', the sweep's steps), so that none of them
+    /// leaves the chord bound out.
+    pub fn at_stations_within(
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        u: Vec<f64>,
+        chord: Option<&Chord>,
+    ) -> Self {
+        let mut p = Self::at_stations(span, kin, machine, u);
+        if let Some(c) = chord {
+            p.apply_chord(span, c);
+        }
+        p
+    }
+
     /// Discretises `span` at the given stations (increasing, from 0 to the span's length).
     pub fn at_stations(span: &Span, kin: &Kinematics, machine: &Machine, u: Vec<f64>) -> Self {
         let feed = station_feed_caps(span, &u);

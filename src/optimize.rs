@@ -1472,10 +1472,13 @@ impl Plan<'_> {
             return Ok(None);
         };
         let span = &self.path.spans[si];
-        let mut fine = SpanProblem::at_stations(span, &self.kin, self.machine, u);
-        if let Some(c) = &options.verify.chord {
-            fine.apply_chord(span, c);
-        }
+        let fine = SpanProblem::at_stations_within(
+            span,
+            &self.kin,
+            self.machine,
+            u,
+            options.verify.chord.as_ref(),
+        );
         self.check_travel(si, &fine)?;
         let times = self.times(si, &fine, &solution)?;
         let k = times.len();
@@ -1711,10 +1714,13 @@ impl Plan<'_> {
         u.sort_by(f64::total_cmp);
         u.dedup();
         let span = &self.path.spans[si];
-        let mut q = SpanProblem::at_stations(span, &self.kin, self.machine, u);
-        if let Some(c) = &options.verify.chord {
-            q.apply_chord(span, c);
-        }
+        let mut q = SpanProblem::at_stations_within(
+            span,
+            &self.kin,
+            self.machine,
+            u,
+            options.verify.chord.as_ref(),
+        );
         (q.b_start, q.b_end) = (p.b_start, p.b_end);
         q
     }
@@ -1764,11 +1770,13 @@ impl Plan<'_> {
             .map(|(si, ks)| {
                 let old = &lv.problems[si];
                 let u = divide(&old.u, &ks);
-                let mut p =
-                    SpanProblem::at_stations(&self.path.spans[si], &self.kin, self.machine, u);
-                if let Some(c) = &options.verify.chord {
-                    p.apply_chord(&self.path.spans[si], c);
-                }
+                let mut p = SpanProblem::at_stations_within(
+                    &self.path.spans[si],
+                    &self.kin,
+                    self.machine,
+                    u,
+                    options.verify.chord.as_ref(),
+                );
                 self.check_travel(si, &p)?;
                 (p.b_start, p.b_end) = (old.b_start, old.b_end);
                 match self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true) {

@@ -460,11 +460,13 @@ impl Study<'_> {
     /// and chord bound as the baseline's.
     fn problem(&self, si: usize, machine: &Machine) -> SpanProblem {
         let (span, old) = (&self.base.path.spans[si], &self.base.problems[si]);
-        let mut p =
-            SpanProblem::at_stations(span, &self.base.kinematics, machine, self.grid[si].clone());
-        if let Some(c) = &self.options.verify.chord {
-            p.apply_chord(span, c);
-        }
+        let mut p = SpanProblem::at_stations_within(
+            span,
+            &self.base.kinematics,
+            machine,
+            self.grid[si].clone(),
+            self.options.verify.chord.as_ref(),
+        );
         (p.b_start, p.b_end) = (old.b_start, old.b_end);
         p
     }
