@@ -60,6 +60,7 @@ fn toolpath() -> Toolpath {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     }
 }
 

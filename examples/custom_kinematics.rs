@@ -120,6 +120,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

@@ -39,6 +39,7 @@ fn groove() -> Toolpath {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     }
 }
 

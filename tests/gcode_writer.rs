@@ -243,6 +243,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     };
     (m, t)
 }

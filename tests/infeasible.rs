@@ -54,6 +54,7 @@ fn line() -> Toolpath {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     }
 }
 
@@ -266,6 +267,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

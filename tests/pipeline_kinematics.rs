@@ -27,6 +27,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     }
 }
 

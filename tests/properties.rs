@@ -220,6 +220,7 @@ fn random_cl(seed: u64) -> Case {
             dwells: Vec::new(),
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
+            switches: Vec::new(),
         },
     }
 }
@@ -591,6 +592,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             dwells: Vec::new(),
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
+            switches: Vec::new(),
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

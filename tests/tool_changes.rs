@@ -179,3 +179,73 @@ fn spindle_speeds_in_program_order() {
     .to_string();
     assert!(e.contains("t.mpf:4:") && e.contains("G4 S"), "{e}");
 }
+
+/// The spindle and coolant switches each reader records (for `feedopt gcode`, which writes
+/// them back): a start before its block's move, a stop after it (`G0 Z50 M5` retracts, then
+/// stops the spindle), with the line that makes it.
+#[test]
+fn spindle_and_coolant_switches_in_program_order() {
+    use feedopt::toolpath::Switch::*;
+    let switches = |tp: &Toolpath| -> Vec<(usize, usize, feedopt::toolpath::Switch)> {
+        tp.switches
+            .iter()
+            .map(|c| (c.point, c.line, c.switch))
+            .collect()
+    };
+    let t = "G21 G90\nT1 M6\nG0 X0 Y0 Z5 S8000 M3\nM8\nG1 Z0 F100\nG1 X10\nG0 Z5 M5 M9\n\
+             S6000 M4 M7\nG1 X20 F100\nM5\nM9\nM2\n";
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let text = match dialect {
+            Dialect::Fanuc => format!("%\nO1000\n{t}%\n"),
+            Dialect::Sinumerik => t.replace("G21", "G71"),
+            _ => t.to_string(),
+        };
+        let line = |n: usize| if dialect == Dialect::Fanuc { n + 2 } else { n };
+        let tp = gcode(dialect, &text);
+        assert_eq!(
+            switches(&tp),
+            vec![
+                (0, line(3), SpindleClockwise),
+                (1, line(4), CoolantFlood),
+                (4, line(7), SpindleStop),
+                (4, line(7), CoolantOff),
+                (4, line(8), SpindleCounterClockwise),
+                (4, line(8), CoolantMist),
+                (5, line(10), SpindleStop),
+                (5, line(11), CoolantOff),
+            ],
+            "{dialect}"
+        );
+    }
+    // Klartext (lines count from `0 BEGIN PGM`, the file's first): M13 is the spindle
+    // clockwise and the coolant, M14 counter-clockwise and it.
+    let t = "0 BEGIN PGM T MM\n1 TOOL CALL 5 Z S3000\n2 L X+0 Y+0 Z+5 FMAX M13\n\
+             3 L Z+0 F100\n4 L Z+5 FMAX M5 M9\n5 L X+5 M14\n6 END PGM T MM\n";
+    let tp = parse(Path::new("t.h"), t, Dialect::Heidenhain).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        switches(&tp),
+        vec![
+            (0, 3, SpindleClockwise),
+            (0, 3, CoolantFlood),
+            (3, 5, SpindleStop),
+            (3, 5, CoolantOff),
+            (3, 6, SpindleCounterClockwise),
+            (3, 6, CoolantFlood),
+        ]
+    );
+    // APT: `SPINDL/…,CLW|CCLW`, `SPINDL/OFF`, `COOLNT/ON|FLOOD|MIST|OFF`.
+    let t = "SPINDL/RPM,8000,CLW\nCOOLNT/MIST\nGOTO/0,0,5\nGOTO/0,0,0\nCOOLNT/OFF\n\
+             SPINDL/OFF\nSPINDL/RPM,6000,CCLW\nCOOLNT/FLOOD\nGOTO/1,0,0\n";
+    let tp = apt::parse(Path::new("a.cls"), t).unwrap();
+    assert_eq!(
+        switches(&tp),
+        vec![
+            (0, 1, SpindleClockwise),
+            (0, 2, CoolantMist),
+            (2, 5, CoolantOff),
+            (2, 6, SpindleStop),
+            (2, 7, SpindleCounterClockwise),
+            (2, 8, CoolantFlood),
+        ]
+    );
+}

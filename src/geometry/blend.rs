@@ -42,7 +42,7 @@ use nalgebra::Vector3;
 use std::borrow::Cow;
 
 use super::SAME_POSITION_MM;
-use crate::toolpath::{ClPoint, Dwell, Feed, SpindleChange, ToolChange, Toolpath};
+use crate::toolpath::{ClPoint, Dwell, Feed, MachineSwitch, SpindleChange, ToolChange, Toolpath};
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
 pub const MAX_BLEND_ANGLE_DEG: f64 = 150.0;
@@ -106,7 +106,9 @@ pub fn blend_corners(
             None => out.push(pts[k].clone()),
         }
     }
-    let moved = |i: usize| map[i.min(n - 1)];
+    // A point index past the last (a switch after the last move) stays past it.
+    let total = out.len();
+    let moved = |i: usize| if i < n { map[i] } else { total };
     let tp = Toolpath {
         source: toolpath.source.clone(),
         points: out,
@@ -125,6 +127,12 @@ pub fn blend_corners(
             .collect(),
         spindle_changes: (toolpath.spindle_changes.iter())
             .map(|c| SpindleChange {
+                point: moved(c.point),
+                ..*c
+            })
+            .collect(),
+        switches: (toolpath.switches.iter())
+            .map(|c| MachineSwitch {
                 point: moved(c.point),
                 ..*c
             })

@@ -118,7 +118,8 @@ use crate::toolpath::gcode::{
     ARC_RADIUS_MISMATCH_MM, ARC_RADIUS_MISMATCH_RELATIVE, MAX_CHORD_ERROR_MM,
 };
 use crate::toolpath::{
-    ClPoint, Dwell, Feed, MachineContext, SpindleChange, ToolChange, ToolSelect, Toolpath, Units,
+    ClPoint, Dwell, Feed, MachineContext, MachineSwitch, SpindleChange, Switch, ToolChange,
+    ToolSelect, Toolpath, Units,
 };
 
 /// Known major words that do not affect the motion and are skipped.
@@ -254,6 +255,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         dwells: reader.dwells,
         tool_changes: reader.tool_changes,
         spindle_changes: reader.spindle_changes,
+        switches: reader.switches,
     })
 }
 
@@ -282,6 +284,8 @@ struct Reader<'a> {
     tool_changes: Vec<ToolChange>,
     /// `SPINDL/` speeds, in program order.
     spindle_changes: Vec<SpindleChange>,
+    /// `SPINDL/` directions and `COOLNT/` states, in program order.
+    switches: Vec<MachineSwitch>,
 }
 
 /// An APT arc's centre, unit axis and radius (if given), in world mm.
@@ -326,6 +330,7 @@ impl<'a> Reader<'a> {
             cycle: None,
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
+            switches: Vec::new(),
         }
     }
 
@@ -338,6 +343,44 @@ impl<'a> Reader<'a> {
     fn spindle(&mut self, line: usize, args: &str) {
         if let Some(rpm) = args.split(',').find_map(|a| a.trim().parse::<f64>().ok()) {
             SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
+        }
+        // The direction (`CLW`, `CCLW`) or `OFF`, for the writer.
+        let words = || args.split(',').map(|a| a.trim().to_ascii_uppercase());
+        let switch = if words().any(|w| w == "OFF") {
+            Some(Switch::SpindleStop)
+        } else if words().any(|w| w == "CCLW") {
+            Some(Switch::SpindleCounterClockwise)
+        } else if words().any(|w| w == "CLW" || w == "ON") {
+            Some(Switch::SpindleClockwise)
+        } else {
+            None
+        };
+        self.switch(line, switch);
+    }
+
+    /// `COOLNT/ON` (or `FLOOD`), `MIST`, `OFF`: the coolant's state, for the writer (other
+    /// kinds, `THRU`, `AIR`, `TAP`, the machine's own, are not recorded).
+    fn coolant(&mut self, line: usize, args: &str) {
+        let words = || args.split(',').map(|a| a.trim().to_ascii_uppercase());
+        let switch = if words().any(|w| w == "OFF") {
+            Some(Switch::CoolantOff)
+        } else if words().any(|w| w == "MIST") {
+            Some(Switch::CoolantMist)
+        } else if words().any(|w| w == "ON" || w == "FLOOD") {
+            Some(Switch::CoolantFlood)
+        } else {
+            None
+        };
+        self.switch(line, switch);
+    }
+
+    fn switch(&mut self, line: usize, switch: Option<Switch>) {
+        if let Some(switch) = switch {
+            self.switches.push(MachineSwitch {
+                point: self.points.len(),
+                line,
+                switch,
+            });
         }
     }
 
@@ -501,6 +544,10 @@ impl<'a> Reader<'a> {
             )),
             ("SPINDL", Some(minor)) => {
                 self.spindle(line, minor);
+                Ok(())
+            }
+            ("COOLNT", Some(minor)) => {
+                self.coolant(line, minor);
                 Ok(())
             }
             ("TLDATA", Some(minor))

@@ -140,6 +140,10 @@ pub struct Toolpath {
     /// The spindle speeds the program sets, in the order it runs (G-code `S`, Klartext
     /// `TOOL CALL … S`, APT `SPINDL/`). Read by the material model's chip load.
     pub spindle_changes: Vec<SpindleChange>,
+    /// The spindle and coolant switches the program makes, in the order it runs (G-code M3,
+    /// M4, M5, M7, M8, M9, Klartext M13/M14; APT `SPINDL/…CLW`, `COOLNT/`). The motion does
+    /// not depend on them; `feedopt gcode` writes them back where the program has them.
+    pub switches: Vec<MachineSwitch>,
 }
 
 impl Toolpath {
@@ -152,6 +156,7 @@ impl Toolpath {
             dwells: Vec::new(),
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
+            switches: Vec::new(),
         }
     }
 
@@ -237,6 +242,43 @@ impl SpindleChange {
         if rpm.is_finite() && rpm > 0.0 && changes.last().is_none_or(|c| c.rpm != rpm) {
             changes.push(SpindleChange { point, line, rpm });
         }
+    }
+}
+
+/// A machine function that does not move the tool: the spindle's or the coolant's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Switch {
+    /// The spindle turns clockwise (M3, `SPINDL/…,CLW`).
+    SpindleClockwise,
+    /// The spindle turns counter-clockwise (M4, `SPINDL/…,CCLW`).
+    SpindleCounterClockwise,
+    /// The spindle stops (M5, `SPINDL/OFF`).
+    SpindleStop,
+    /// Mist coolant on (M7, `COOLNT/MIST`).
+    CoolantMist,
+    /// Flood coolant on (M8, `COOLNT/ON`, `COOLNT/FLOOD`).
+    CoolantFlood,
+    /// Coolant off (M9, `COOLNT/OFF`).
+    CoolantOff,
+}
+
+/// The program makes `switch` at `line`. A switch that starts something (the spindle, the
+/// coolant) comes before the move ending at CL point `point`; one that stops something comes
+/// after the moves of its own block, so that `point` is the number of points made by then (a
+/// control runs `G0 Z50 M5` as the retract, then the stop: the spindle does not stop in the
+/// cut).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MachineSwitch {
+    pub point: usize,
+    pub line: usize,
+    pub switch: Switch,
+}
+
+impl Switch {
+    /// Whether it stops something (M5, M9): it takes effect after its block's motion.
+    pub fn stops(self) -> bool {
+        matches!(self, Switch::SpindleStop | Switch::CoolantOff)
     }
 }
 

@@ -31,6 +31,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
         dwells: Vec::new(),
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
+        switches: Vec::new(),
     }
 }
 

@@ -4,7 +4,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::toolpath::Units;
+use crate::toolpath::{Switch, Units};
 
 // ---------------------------------------------------------------------------------------------
 // Dialects as data
@@ -246,6 +246,9 @@ pub enum Tcp {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Action {
     Motion(Motion),
+    /// Spindle or coolant switches (M3, M8; Klartext M13 is both), recorded for the writer
+    /// ([`crate::toolpath::MachineSwitch`]); they do not move the tool.
+    Switch(&'static [Switch]),
     /// Cancels the motion mode (LinuxCNC G80): axis words need a new G0–G3.
     MotionCancel,
     Plane(Plane),
@@ -704,9 +707,13 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..5", Action::Ignored),
+        ("3", Action::Switch(&[Switch::SpindleClockwise])),
+        ("4", Action::Switch(&[Switch::SpindleCounterClockwise])),
+        ("5", Action::Switch(&[Switch::SpindleStop])),
         ("6", Action::ToolChange),
-        ("7..9", Action::Ignored),
+        ("7", Action::Switch(&[Switch::CoolantMist])),
+        ("8", Action::Switch(&[Switch::CoolantFlood])),
+        ("9", Action::Switch(&[Switch::CoolantOff])),
         ("19", Action::Ignored),
         ("30", ProgramEnd),
         ("48..53", Action::Ignored),
@@ -882,9 +889,13 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..5", Action::Ignored),
+        ("3", Action::Switch(&[Switch::SpindleClockwise])),
+        ("4", Action::Switch(&[Switch::SpindleCounterClockwise])),
+        ("5", Action::Switch(&[Switch::SpindleStop])),
         ("6", Action::ToolChange),
-        ("7..9", Action::Ignored),
+        ("7", Action::Switch(&[Switch::CoolantMist])),
+        ("8", Action::Switch(&[Switch::CoolantFlood])),
+        ("9", Action::Switch(&[Switch::CoolantOff])),
         ("19", Action::Ignored),
         ("29", Action::Ignored),
         ("30", ProgramEnd),
@@ -1052,9 +1063,13 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..5", Action::Ignored),
+        ("3", Action::Switch(&[Switch::SpindleClockwise])),
+        ("4", Action::Switch(&[Switch::SpindleCounterClockwise])),
+        ("5", Action::Switch(&[Switch::SpindleStop])),
         ("6", Action::ToolChange),
-        ("7..9", Action::Ignored),
+        ("7", Action::Switch(&[Switch::CoolantMist])),
+        ("8", Action::Switch(&[Switch::CoolantFlood])),
+        ("9", Action::Switch(&[Switch::CoolantOff])),
         ("17", Return),
         ("19", Action::Ignored),
         ("30", ProgramEnd),
@@ -1206,9 +1221,20 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
         ("0", Action::Ignored),
         ("1", Action::Ignored),
         ("2", ProgramEnd),
-        ("3..9", Action::Ignored),
-        ("13", Action::Ignored),
-        ("14", Action::Ignored),
+        ("3", Action::Switch(&[Switch::SpindleClockwise])),
+        ("4", Action::Switch(&[Switch::SpindleCounterClockwise])),
+        ("5", Action::Switch(&[Switch::SpindleStop])),
+        ("6..7", Action::Ignored),
+        ("8", Action::Switch(&[Switch::CoolantFlood])),
+        ("9", Action::Switch(&[Switch::CoolantOff])),
+        (
+            "13",
+            Action::Switch(&[Switch::SpindleClockwise, Switch::CoolantFlood]),
+        ),
+        (
+            "14",
+            Action::Switch(&[Switch::SpindleCounterClockwise, Switch::CoolantFlood]),
+        ),
         ("19", Action::Ignored),
         ("30", ProgramEnd),
         ("89", Action::CycleCallAt(false)),

@@ -17,8 +17,8 @@ use super::*;
 use crate::error::{Error, Result};
 use crate::machine::DecimalPointInput;
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, SpindleChange, ToolChange,
-    ToolSelect, Toolpath, Warning,
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineSwitch, SpindleChange,
+    Switch, ToolChange, ToolSelect, Toolpath, Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -242,6 +242,10 @@ pub(super) struct Interpreter<'a> {
     pub(super) tool_changes: Vec<ToolChange>,
     /// The spindle speed changes so far.
     pub(super) spindle_changes: Vec<SpindleChange>,
+    /// The spindle and coolant switches so far.
+    pub(super) switches: Vec<MachineSwitch>,
+    /// This block's switches that stop something (M5, M9): recorded after its motion.
+    stops: Vec<Switch>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -315,6 +319,8 @@ impl<'a> Interpreter<'a> {
             offset_error: None,
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
+            switches: Vec::new(),
+            stops: Vec::new(),
             m92: false,
             m92_warned: [false; 3],
         }
@@ -464,6 +470,7 @@ impl<'a> Interpreter<'a> {
             dwells: self.dwells,
             tool_changes: self.tool_changes,
             spindle_changes: self.spindle_changes,
+            switches: self.switches,
         })
     }
 
@@ -840,6 +847,16 @@ impl<'a> Interpreter<'a> {
     /// Interprets one block.
     pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let done = self.block_words(line, items);
+        // A switch that stops the spindle or the coolant acts after the block's motion (a
+        // control runs `G0 Z50 M5` as the retract, then the stop).
+        let point = self.points.len();
+        for switch in std::mem::take(&mut self.stops) {
+            self.switches.push(MachineSwitch {
+                point,
+                line,
+                switch,
+            });
+        }
         match self.offset_error.take() {
             Some(e) => Err(e),
             None => done,
@@ -990,6 +1007,19 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::Return => end = true,
                 Action::Call => fanuc_call = true,
+                Action::Switch(list) => {
+                    for &switch in list {
+                        if switch.stops() {
+                            self.stops.push(switch);
+                        } else {
+                            self.switches.push(MachineSwitch {
+                                point: self.points.len(),
+                                line,
+                                switch,
+                            });
+                        }
+                    }
+                }
                 Action::ToolChange => tool_change = Some(text.as_str()),
                 Action::SetTool => set_tool = true,
                 Action::Path(kind) => klartext.path = Some((text.clone(), kind)),
