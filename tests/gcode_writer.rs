@@ -585,3 +585,85 @@ fn peak_feeds_hold_for_g93_blocks_and_turns_on_the_spot() {
         );
     }
 }
+
+/// The program's tool changes, spindle speeds and switches in program order, each with where
+/// the tool stands when it comes (the CL point before it; `None`: before the first).
+fn machine_words(t: &Toolpath) -> Vec<(String, Option<[f64; 3]>)> {
+    let mut v: Vec<(usize, usize, u8, String)> = Vec::new();
+    v.extend(
+        t.tool_changes
+            .iter()
+            .map(|c| (c.point, c.line, 0, format!("{:?}", c.tool))),
+    );
+    v.extend(
+        t.spindle_changes
+            .iter()
+            .map(|c| (c.point, c.line, 1, format!("S{}", c.rpm))),
+    );
+    v.extend(
+        t.switches
+            .iter()
+            .map(|c| (c.point, c.line, 2, format!("{:?}", c.switch))),
+    );
+    v.sort_by_key(|e| (e.0, e.1, e.2));
+    v.into_iter()
+        .map(|(point, _, _, what)| {
+            let at = point
+                .checked_sub(1)
+                .map(|k| t.points[k.min(t.points.len() - 1)].p)
+                .map(|p| [p.x, p.y, p.z]);
+            (what, at)
+        })
+        .collect()
+}
+
+#[test]
+fn tools_spindle_and_coolant_are_written_where_the_program_has_them() {
+    // A written program runs on the machine: its tools, spindle and coolant as the input's,
+    // at the same places (the spindle stops after the retract that carries M5, not in the cut).
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let input = toolpath::gcode::parse(
+        Path::new("two_tools.ngc"),
+        "G21 G90 G94\nT1 M6\nG43 H1\nG0 X0 Y0 Z5 S2000 M3\nM8\nG1 Z-2 F300\nG1 X20\n\
+         G0 Z5 M5 M9\nT2 M6\nG43 H2\nS3000 M4\nM7\nG0 X40\nG1 Z-2 F300\nG1 X60\nG0 Z5 M5\nM9\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    let want = machine_words(&input);
+    assert_eq!(want.len(), 12, "{want:?}");
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let (prog, _) = round_trip(&m, &input, &sol, &options.geometry, dialect);
+        let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, dialect).unwrap();
+        assert_eq!(machine_words(&back), want, "{dialect}\n{}", prog.text);
+        // A three-axis program's Z is the tool tip: the tool's length offset with each tool
+        // (LinuxCNC, Fanuc; a Sinumerik applies the tool's own with T … M6).
+        let g43 = prog.text.lines().filter(|l| l.starts_with("G43 H")).count();
+        assert_eq!(g43, if dialect == Dialect::Sinumerik { 0 } else { 2 });
+    }
+}
+
+#[test]
+fn a_tool_change_under_tool_tip_mode_leaves_it_and_comes_back_with_the_new_tool() {
+    let (m, _) = bundled("seed_head_head", "impeller_blade.cls");
+    let input = toolpath::gcode::parse(
+        Path::new("tcp.ngc"),
+        "G21 G90 G94\nT1 M6\nM428\nG0 X0 Y0 Z50 A0 C0 S10000 M3\nG1 Z10 F1000\nG1 X10 A5\n\
+         G0 Z50 M5\nT2 M6\nS12000 M3\nG1 X20 F1000\nG0 Z60 M5\nM429\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    let (prog, _) = round_trip(&m, &input, &sol, &options.geometry, Dialect::Fanuc);
+    let lines: Vec<&str> = prog.text.lines().collect();
+    let at = |s: &str| lines.iter().position(|l| *l == s).unwrap_or(usize::MAX);
+    // The first tool before tool-tip mode, with its length; the second out of it and back.
+    assert!(at("T1 M6") < at("G43.4 H1"), "{}", prog.text);
+    let t2 = at("T2 M6");
+    assert_eq!(&lines[t2 - 1..=t2 + 1], ["G49", "T2 M6", "G43.4 H2"]);
+    let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, Dialect::Fanuc).unwrap();
+    assert_eq!(machine_words(&back), machine_words(&input), "{}", prog.text);
+}

@@ -64,8 +64,29 @@
 //! the point before, at that point; one at a merged tiny block's end, at the block kept), in
 //! each dialect's word: LinuxCNC `G4 P` seconds, Fanuc `G4 X` seconds (with a decimal point,
 //! to the control's 1 ms; `P` would count milliseconds), Sinumerik `G4 F` seconds. The
-//! program's time counts them, as the cycle time does. Spindle, coolant and tool words are
-//! not written: the program is the motion, its feeds and its dwells.
+//! program's time counts them, as the cycle time does.
+//!
+//! # Tools, spindle and coolant
+//!
+//! What the program does between its moves without moving the tool is written where the
+//! program does it ([`crate::toolpath::Toolpath::tool_changes`], `spindle_changes`,
+//! `switches`), before the block that ends at the CL point it comes before (a stop, M5 or
+//! M9, comes after its own block's move, so after the retract that carries it):
+//!
+//! * a numbered tool as `T n M6`; a named one as `T="name" M6` (Sinumerik), elsewhere a
+//!   comment that says to select it (those controls number their tools); a tool given by its
+//!   geometry alone (APT `CUTTER/`, `TLDATA/`) as a comment;
+//! * the tool-tip mode switch comes after the first tool (Fanuc `G43.4 H n` with its length
+//!   offset, H1 where no numbered tool is selected); a tool change in tool-tip mode leaves it
+//!   and switches it on again with the new tool. On a machine without tool-tip mode the
+//!   written Z is the tool tip, so each numbered tool comes with its length offset, `G43 H n`
+//!   (LinuxCNC, Fanuc; a Sinumerik applies the tool's own with `T … M6`);
+//! * the spindle speed as `S` (a whole number of rpm on a Fanuc), with the direction of the
+//!   same block (`S12000 M3`); `M3`, `M4`, `M5`; the coolant `M7`, `M8`, `M9` (a Klartext
+//!   `M13` is written as M3 and M8).
+//!
+//! Work offsets, the program's own length-offset words, and any other M code are not
+//! written: the written coordinates are the program's, in its work offset.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
@@ -118,7 +139,7 @@ use crate::machine::Machine;
 use crate::optimize::Solution;
 use crate::schedule::Timeline;
 use crate::toolpath::gcode::Dialect;
-use crate::toolpath::{Feed, Toolpath};
+use crate::toolpath::{Feed, Switch, ToolSelect, Toolpath};
 use crate::validate::MIN_ROTATION_DEG;
 
 /// Blocks shorter than this (s) are merged with the next one.
@@ -217,6 +238,8 @@ struct Node {
     /// Source line of the CL point (0 for a point added by the Δθ rule or at a change of a
     /// process limit).
     line: usize,
+    /// The CL point the block ending here ends at (an added point: the block it cuts).
+    point: usize,
     /// The program's dwells here, s (written as G4 after the block that reaches the point).
     dwell: f64,
     /// The block that ends here: the fastest tool-tip feed (mm/s) and rate u̇ (span units/s)
@@ -240,6 +263,182 @@ impl Peak {
             udot: self.udot.max(o.udot),
             du: self.du + o.du,
         }
+    }
+}
+
+/// What the program does between its moves that the written program does at the same place
+/// (module doc, "Tools, spindle and coolant").
+#[derive(Debug, Clone, Copy)]
+enum Aux<'a> {
+    Tool(&'a ToolSelect),
+    Speed(f64),
+    Switch(Switch),
+}
+
+/// The toolpath's tool changes, spindle speeds and switches in the order the program makes
+/// them, each with the CL point it comes before: by that point, then by line, and in one block
+/// the tool change first, then the speed, then the switches.
+fn auxiliaries(tp: &Toolpath) -> Vec<(usize, Aux<'_>)> {
+    let mut v: Vec<(usize, usize, u8, usize, Aux)> = Vec::new();
+    v.extend(
+        tp.tool_changes
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.point, c.line, 0, i, Aux::Tool(&c.tool))),
+    );
+    v.extend(
+        tp.spindle_changes
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.point, c.line, 1, i, Aux::Speed(c.rpm))),
+    );
+    v.extend(
+        tp.switches
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.point, c.line, 2, i, Aux::Switch(c.switch))),
+    );
+    v.sort_by_key(|&(point, line, rank, i, _)| (point, line, rank, i));
+    v.into_iter()
+        .map(|(point, _, _, _, a)| (point, a))
+        .collect()
+}
+
+/// The machine's state the writer keeps between blocks: tool-tip mode and the tool, and the
+/// program's tool changes, speeds and switches still to write.
+struct Setup<'a> {
+    dialect: Dialect,
+    words: &'a Words,
+    /// The machine has a tool-tip mode (rotary axes, not programmed in machine coordinates).
+    tcp: bool,
+    tcp_active: bool,
+    /// The tool in the spindle, by number.
+    tool: Option<u32>,
+    events: Vec<(usize, Aux<'a>)>,
+    next: usize,
+}
+
+impl Setup<'_> {
+    /// Tool-tip mode on (a Fanuc's `G43.4` with the tool's length offset, H1 where the program
+    /// selects no numbered tool).
+    fn tcp_on(&mut self, text: &mut String) {
+        if self.tcp && !self.tcp_active {
+            let on = match self.dialect {
+                Dialect::Fanuc => format!("G43.4 H{}", self.tool.unwrap_or(1)),
+                _ => self.words.tcp_on.to_string(),
+            };
+            let _ = writeln!(text, "{on}");
+            self.tcp_active = true;
+        }
+    }
+
+    fn tcp_off(&mut self, text: &mut String) {
+        if self.tcp_active {
+            let _ = writeln!(text, "{}", self.words.tcp_off);
+            self.tcp_active = false;
+        }
+    }
+
+    /// Writes what the program does before the move ending at CL point `point` and has not
+    /// been written.
+    fn before(&mut self, text: &mut String, point: usize) {
+        while let Some(&(p, aux)) = self.events.get(self.next) {
+            if p > point {
+                break;
+            }
+            self.next += 1;
+            match aux {
+                Aux::Tool(tool) => self.change(text, tool),
+                Aux::Speed(rpm) => {
+                    // A direction in the same block goes with it (`S12000 M3`).
+                    let with = match self.events.get(self.next) {
+                        Some(&(q, Aux::Switch(sw)))
+                            if q == p
+                                && matches!(
+                                    sw,
+                                    Switch::SpindleClockwise | Switch::SpindleCounterClockwise
+                                ) =>
+                        {
+                            self.next += 1;
+                            format!(" {}", m_code(sw))
+                        }
+                        _ => String::new(),
+                    };
+                    let speed = if self.dialect == Dialect::Fanuc {
+                        // A Fanuc S is a whole number of rpm.
+                        format!("{}", rpm.round())
+                    } else {
+                        let s = format!("{rpm:.3}");
+                        s.trim_end_matches('0').trim_end_matches('.').to_string()
+                    };
+                    let _ = writeln!(text, "S{speed}{with}");
+                }
+                Aux::Switch(sw) => {
+                    let _ = writeln!(text, "{}", m_code(sw));
+                }
+            }
+        }
+    }
+
+    /// A tool change: out of tool-tip mode and back with the new tool; on a machine without
+    /// it, the new tool's length offset (`G43 H`) on a LinuxCNC or Fanuc control.
+    fn change(&mut self, text: &mut String, tool: &ToolSelect) {
+        let comment = |c: String| (self.words.comment)(&c);
+        let line = match (tool, self.dialect) {
+            (ToolSelect::Number(n), _) => format!("T{n} M6"),
+            (ToolSelect::Name(name), Dialect::Sinumerik) => format!("T=\"{name}\" M6"),
+            (ToolSelect::Name(name), _) => {
+                let _ = writeln!(
+                    text,
+                    "{}",
+                    comment(format!(
+                        "tool change: tool \"{name}\" (this control numbers its tools: \
+                         select it here)"
+                    ))
+                );
+                return;
+            }
+            (
+                ToolSelect::Cutter {
+                    diameter,
+                    corner_radius,
+                },
+                _,
+            ) => {
+                let _ = writeln!(
+                    text,
+                    "{}",
+                    comment(format!(
+                        "tool: diameter {diameter} mm, corner radius {corner_radius} mm"
+                    ))
+                );
+                return;
+            }
+        };
+        let was = self.tcp_active;
+        self.tcp_off(text);
+        let _ = writeln!(text, "{line}");
+        if let ToolSelect::Number(n) = tool {
+            self.tool = Some(*n);
+            if !self.tcp && self.dialect != Dialect::Sinumerik {
+                let _ = writeln!(text, "G43 H{n}");
+            }
+        }
+        if was {
+            self.tcp_on(text);
+        }
+    }
+}
+
+/// A switch's M code (the same in the three dialects written).
+fn m_code(sw: Switch) -> &'static str {
+    match sw {
+        Switch::SpindleClockwise => "M3",
+        Switch::SpindleCounterClockwise => "M4",
+        Switch::SpindleStop => "M5",
+        Switch::CoolantMist => "M7",
+        Switch::CoolantFlood => "M8",
+        Switch::CoolantOff => "M9",
     }
 }
 
@@ -372,6 +571,7 @@ fn nodes(
             angles: angles[idx[k]],
             t: tl.time_at(u),
             line: pts[idx[k]].line,
+            point: idx[k],
             dwell: 0.0,
             peak,
         };
@@ -452,6 +652,7 @@ fn nodes(
                     angles: [w[3], w[4]],
                     t: tl.time_at(u),
                     line: 0,
+                    point: idx[k],
                     dwell: 0.0,
                     peak: peak(last_u, u),
                 });
@@ -734,10 +935,20 @@ pub fn program(
     }
     // A machine programmed in machine coordinates has no tool-tip mode.
     let tcp = !rotary.is_empty() && !machine.kinematics.machine_coordinates();
-    if tcp {
-        let _ = writeln!(text, "{}", w.tcp_on);
-    }
+    let mut setup = Setup {
+        dialect: options.dialect,
+        words: &w,
+        tcp,
+        tcp_active: false,
+        tool: None,
+        events: auxiliaries(toolpath),
+        next: 0,
+    };
     let first = &nodes[keep[0]];
+    // The tool, spindle and coolant the program sets before its first move, then tool-tip
+    // mode (with the tool's length).
+    setup.before(&mut text, first.point);
+    setup.tcp_on(&mut text);
     let (words0, mut prev_p, mut prev_r) = written(first);
     let _ = writeln!(text, "G0 {}", words0.join(" "));
     let mut inverse_mode = false;
@@ -754,6 +965,7 @@ pub fn program(
     let mut prev_t = first.t;
     for (w, &i) in keep.iter().enumerate().skip(1) {
         let n = &nodes[i];
+        setup.before(&mut text, n.point);
         let (ws, p, r) = written(n);
         let dt = n.t - prev_t;
         if !(dt.is_finite() && dt > 0.0) {
@@ -802,9 +1014,9 @@ pub fn program(
     if inverse_mode {
         let _ = writeln!(text, "G94");
     }
-    if tcp {
-        let _ = writeln!(text, "{}", w.tcp_off);
-    }
+    // What the program does after its last move (M5, M9).
+    setup.before(&mut text, usize::MAX);
+    setup.tcp_off(&mut text);
     for f in w.footer {
         let _ = writeln!(text, "{f}");
     }
