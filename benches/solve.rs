@@ -61,6 +61,7 @@ fn toolpath() -> Toolpath {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     }
 }
 

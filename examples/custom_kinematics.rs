@@ -121,6 +121,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

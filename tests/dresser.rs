@@ -40,6 +40,7 @@ fn groove() -> Toolpath {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     }
 }
 

@@ -244,6 +244,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     };
     (m, t)
 }
@@ -666,4 +667,48 @@ fn a_tool_change_under_tool_tip_mode_leaves_it_and_comes_back_with_the_new_tool(
     assert_eq!(&lines[t2 - 1..=t2 + 1], ["G49", "T2 M6", "G43.4 H2"]);
     let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, Dialect::Fanuc).unwrap();
     assert_eq!(machine_words(&back), machine_words(&input), "{}", prog.text);
+}
+
+#[test]
+fn the_written_program_selects_the_work_offset_the_program_is_in() {
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let options = reach();
+    let read = |name: &str, text: &str| {
+        toolpath::gcode::parse(Path::new(name), text, Dialect::Fanuc).unwrap()
+    };
+    let body = "G0 X0 Y0 Z5\nG1 Z-1 F300\nG1 X10\nG0 Z5\nM30\n%\n";
+    // What the reader takes as the program's offset: the last one it selects before its first
+    // move; none where it selects none before it (the control's default).
+    for (head, want) in [
+        ("G55\n", Some("G55")),
+        ("G54.1 P3\n", Some("G54.1 P3")),
+        ("G54\nG56\n", Some("G56")),
+        ("", None),
+    ] {
+        let t = read("o.nc", &format!("%\nO1\nG21 G90\n{head}{body}"));
+        assert_eq!(t.work_offset.as_deref(), want, "{head}");
+    }
+    let t = read("o.nc", &format!("%\nO1\nG21 G90\nG55\n{body}"));
+    let sol = optimize(&m, &t, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, dialect);
+        let back = toolpath::gcode::parse(Path::new("b.nc"), &prog.text, dialect).unwrap();
+        assert_eq!(back.work_offset.as_deref(), Some("G55"), "{dialect}");
+    }
+    // Fanuc's extended offset: written for a Fanuc, named in a comment for a LinuxCNC.
+    let t = read("o.nc", &format!("%\nO1\nG21 G90\nG54.1 P3\n{body}"));
+    let sol = optimize(&m, &t, &options).unwrap();
+    let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::Fanuc);
+    assert!(prog.text.lines().any(|l| l == "G54.1 P3"), "{}", prog.text);
+    let (prog, _) = round_trip(&m, &t, &sol, &options.geometry, Dialect::LinuxCnc);
+    assert!(
+        prog.text
+            .lines()
+            .any(|l| l.starts_with('(') && l.contains("G54.1 P3")),
+        "{}",
+        prog.text
+    );
+    let back = toolpath::gcode::parse(Path::new("b.ngc"), &prog.text, Dialect::LinuxCnc).unwrap();
+    assert_eq!(back.work_offset, None);
 }

@@ -55,6 +55,7 @@ fn line() -> Toolpath {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     }
 }
 
@@ -268,6 +269,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -28,6 +28,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         tool_changes: Vec::new(),
         spindle_changes: Vec::new(),
         switches: Vec::new(),
+        work_offset: None,
     }
 }
 

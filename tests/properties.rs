@@ -221,6 +221,7 @@ fn random_cl(seed: u64) -> Case {
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
             switches: Vec::new(),
+            work_offset: None,
         },
     }
 }
@@ -593,6 +594,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
             switches: Vec::new(),
+            work_offset: None,
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

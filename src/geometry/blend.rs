@@ -137,6 +137,7 @@ pub fn blend_corners(
                 ..*c
             })
             .collect(),
+        work_offset: toolpath.work_offset.clone(),
     };
     (Cow::Owned(tp), blended)
 }

@@ -256,6 +256,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         tool_changes: reader.tool_changes,
         spindle_changes: reader.spindle_changes,
         switches: reader.switches,
+        work_offset: None,
     })
 }
 

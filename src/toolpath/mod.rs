@@ -144,6 +144,10 @@ pub struct Toolpath {
     /// M4, M5, M7, M8, M9, Klartext M13/M14; APT `SPINDL/…CLW`, `COOLNT/`). The motion does
     /// not depend on them; `feedopt gcode` writes them back where the program has them.
     pub switches: Vec<MachineSwitch>,
+    /// The work offset the points are in, as the program names it before its first move
+    /// (G-code `G55`, `G54.1 P3`); `None` where it names none (the control's default, an APT
+    /// or Klartext program). `feedopt gcode` selects it.
+    pub work_offset: Option<String>,
 }
 
 impl Toolpath {
@@ -157,6 +161,7 @@ impl Toolpath {
             tool_changes: Vec::new(),
             spindle_changes: Vec::new(),
             switches: Vec::new(),
+            work_offset: None,
         }
     }
 

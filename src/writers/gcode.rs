@@ -85,8 +85,13 @@
 //!   same block (`S12000 M3`); `M3`, `M4`, `M5`; the coolant `M7`, `M8`, `M9` (a Klartext
 //!   `M13` is written as M3 and M8).
 //!
-//! Work offsets, the program's own length-offset words, and any other M code are not
-//! written: the written coordinates are the program's, in its work offset.
+//! The written coordinates are the program's, in the work offset it selects before its first
+//! move ([`crate::toolpath::Toolpath::work_offset`]), which the header selects (`G55`); one
+//! the output's dialect does not have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a
+//! Sinumerik, whose G58 is a programmable shift) is named in a comment instead. A program
+//! that names none runs in the control's default, as the program did. The values a program
+//! gives its offsets (`G10 L2`), its own length-offset words and any other M code are not
+//! written.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
@@ -932,6 +937,21 @@ pub fn program(
     }
     for h in w.header {
         let _ = writeln!(text, "{h}");
+    }
+    // The work offset the program's coordinates are in, where it names one.
+    if let Some(name) = &toolpath.work_offset {
+        if crate::toolpath::gcode::is_work_offset(options.dialect, name) {
+            let _ = writeln!(text, "{name}");
+        } else {
+            let _ = writeln!(
+                text,
+                "{}",
+                comment(&format!(
+                    "the program's work offset is {name}, which this dialect does not \
+                     have: select the same origin here"
+                ))
+            );
+        }
     }
     // A machine programmed in machine coordinates has no tool-tip mode.
     let tcp = !rotary.is_empty() && !machine.kinematics.machine_coordinates();

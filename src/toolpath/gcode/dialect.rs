@@ -1418,6 +1418,29 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).
+/// Whether `name` (`G55`, `G54.1 P3`, as [`crate::toolpath::Toolpath::work_offset`] names
+/// it) selects a work offset in `dialect`.
+pub fn is_work_offset(dialect: Dialect, name: &str) -> bool {
+    let mut words = name.split_whitespace();
+    let code = words
+        .next()
+        .and_then(|w| w.strip_prefix('G'))
+        .and_then(|v| v.parse::<f64>().ok());
+    let p = match words.next() {
+        None => true,
+        Some(w) => w
+            .strip_prefix('P')
+            .is_some_and(|n| n.parse::<u32>().is_ok()),
+    };
+    p && words.next().is_none()
+        && code.is_some_and(|c| {
+            matches!(
+                lookup_code(dialect.spec().g_codes, c),
+                Some(Action::WorkOffset)
+            )
+        })
+}
+
 pub(super) fn lookup_code(table: &[(&'static str, Action)], value: f64) -> Option<Action> {
     let tenths = (value * 10.0).round();
     if value < 0.0 || (value * 10.0 - tenths).abs() > 1e-6 || tenths > 1e9 {

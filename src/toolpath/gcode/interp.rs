@@ -471,6 +471,7 @@ impl<'a> Interpreter<'a> {
             tool_changes: self.tool_changes,
             spindle_changes: self.spindle_changes,
             switches: self.switches,
+            work_offset: self.offsets.start_named().map(str::to_string),
         })
     }
 

@@ -156,6 +156,8 @@ pub(super) struct WorkOffsets {
     position: [f64; AXES],
     /// Per axis, the bases at the last point checked.
     last: [Option<Key>; AXES],
+    /// The offset the program selected last before its first point: the start, by its name.
+    start_named: Option<String>,
 }
 
 impl WorkOffsets {
@@ -171,7 +173,14 @@ impl WorkOffsets {
             local: [0.0; AXES],
             position: [0.0; AXES],
             last: std::array::from_fn(|_| None),
+            start_named: None,
         }
+    }
+
+    /// The start's name where the program selects it before its first point (`None`: the
+    /// control's default, which the program does not name).
+    pub(super) fn start_named(&self) -> Option<&str> {
+        self.start_named.as_deref()
     }
 
     /// The offset in force.
@@ -227,6 +236,9 @@ impl WorkOffsets {
         // Before the first point, a selection still names the start: nothing has been made
         // in the offset it replaces (a Sinumerik header's `G500`, then `G54`).
         let before_points = self.last.iter().all(Option::is_none);
+        if before_points {
+            self.start_named = Some(name.to_string());
+        }
         let implicit = std::mem::replace(&mut self.implicit, false) || before_points;
         if name == self.active {
             return None;
