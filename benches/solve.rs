@@ -62,6 +62,7 @@ fn toolpath() -> Toolpath {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     }
 }
 

@@ -122,6 +122,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

@@ -41,6 +41,7 @@ fn groove() -> Toolpath {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     }
 }
 

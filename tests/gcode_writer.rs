@@ -245,6 +245,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     };
     (m, t)
 }
@@ -711,4 +712,63 @@ fn the_written_program_selects_the_work_offset_the_program_is_in() {
     );
     let back = toolpath::gcode::parse(Path::new("b.ngc"), &prog.text, Dialect::LinuxCnc).unwrap();
     assert_eq!(back.work_offset, None);
+}
+
+#[test]
+fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coordinates() {
+    // Three setups: G54, then G55 (never set: the reader takes it as equal to G54), then G56
+    // set by the program at the current position (LinuxCNC G10 L20: its origin lies at X10 of
+    // G55). Each is selected where the program selects it and its coordinates are the
+    // program's own: the machine places them by its offsets, as it places the program's.
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let body = "G0 X0 Y0\nG1 Z-1 F300\nG1 X10\nG0 Z5\n";
+    let input = toolpath::gcode::parse(
+        Path::new("setups.ngc"),
+        &format!("G21 G90\nG54\nG0 Z5\n{body}G55\n{body}G10 L20 P3 X0 Y0 Z5\nG56\n{body}M2\n"),
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    let offsets: Vec<(&str, [f64; 3])> = input
+        .offset_changes
+        .iter()
+        .map(|c| (c.name.as_str(), c.origin))
+        .collect();
+    assert_eq!(
+        offsets,
+        [("G55", [0.0, 0.0, 0.0]), ("G56", [10.0, 0.0, 0.0])]
+    );
+    // The reader's points of the third setup lie 10 mm further in X.
+    assert_eq!(input.points.last().unwrap().p.x, 20.0);
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let o = GcodeOptions {
+            dialect,
+            max_rotation_deg: None,
+            block_feed: BlockFeed::Peak,
+        };
+        let prog = program(&m, &input, &sol, &options.geometry, &o).unwrap();
+        let lines: Vec<&str> = prog.text.lines().collect();
+        let at = |s: &str| lines.iter().position(|l| *l == s);
+        let (g54, g55, g56) = (at("G54"), at("G55"), at("G56"));
+        assert!(
+            g54 < g55 && g55 < g56 && g54.is_some(),
+            "{dialect}\n{}",
+            prog.text
+        );
+        // Each setup's cut from X0 to X10 at Z−1, in its own offset.
+        let cuts: Vec<usize> = lines
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.starts_with("G1 X10.000000 Y0.000000 Z-1.000000"))
+            .map(|(i, _)| i)
+            .collect();
+        assert_eq!(cuts.len(), 3, "{dialect}\n{}", prog.text);
+        assert!(cuts[0] < g55.unwrap() && cuts[1] < g56.unwrap() && cuts[2] > g56.unwrap());
+        // Read back, every point is the program's own coordinates (the reader takes G55 and
+        // G56 as equal to G54 without the G10: the offsets are the control's).
+        let back = toolpath::gcode::parse(Path::new("b.nc"), &prog.text, dialect).unwrap();
+        assert_eq!(back.points.last().unwrap().p.x, 10.0, "{dialect}");
+    }
 }

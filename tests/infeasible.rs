@@ -56,6 +56,7 @@ fn line() -> Toolpath {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     }
 }
 
@@ -270,6 +271,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

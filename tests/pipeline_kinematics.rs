@@ -29,6 +29,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         spindle_changes: Vec::new(),
         switches: Vec::new(),
         work_offset: None,
+        offset_changes: Vec::new(),
     }
 }
 

@@ -222,6 +222,7 @@ fn random_cl(seed: u64) -> Case {
             spindle_changes: Vec::new(),
             switches: Vec::new(),
             work_offset: None,
+            offset_changes: Vec::new(),
         },
     }
 }
@@ -595,6 +596,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             spindle_changes: Vec::new(),
             switches: Vec::new(),
             work_offset: None,
+            offset_changes: Vec::new(),
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

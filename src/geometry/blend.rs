@@ -42,7 +42,9 @@ use nalgebra::Vector3;
 use std::borrow::Cow;
 
 use super::SAME_POSITION_MM;
-use crate::toolpath::{ClPoint, Dwell, Feed, MachineSwitch, SpindleChange, ToolChange, Toolpath};
+use crate::toolpath::{
+    ClPoint, Dwell, Feed, MachineSwitch, OffsetChange, SpindleChange, ToolChange, Toolpath,
+};
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
 pub const MAX_BLEND_ANGLE_DEG: f64 = 150.0;
@@ -138,6 +140,12 @@ pub fn blend_corners(
             })
             .collect(),
         work_offset: toolpath.work_offset.clone(),
+        offset_changes: (toolpath.offset_changes.iter())
+            .map(|c| OffsetChange {
+                point: moved(c.point),
+                ..c.clone()
+            })
+            .collect(),
     };
     (Cow::Owned(tp), blended)
 }

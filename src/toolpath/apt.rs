@@ -257,6 +257,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         spindle_changes: reader.spindle_changes,
         switches: reader.switches,
         work_offset: None,
+        offset_changes: Vec::new(),
     })
 }
 

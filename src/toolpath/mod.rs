@@ -148,6 +148,8 @@ pub struct Toolpath {
     /// (G-code `G55`, `G54.1 P3`); `None` where it names none (the control's default, an APT
     /// or Klartext program). `feedopt gcode` selects it.
     pub work_offset: Option<String>,
+    /// The work offsets the program selects after its first move, in program order.
+    pub offset_changes: Vec<OffsetChange>,
 }
 
 impl Toolpath {
@@ -162,6 +164,7 @@ impl Toolpath {
             spindle_changes: Vec::new(),
             switches: Vec::new(),
             work_offset: None,
+            offset_changes: Vec::new(),
         }
     }
 
@@ -285,6 +288,20 @@ impl Switch {
     pub fn stops(self) -> bool {
         matches!(self, Switch::SpindleStop | Switch::CoolantOff)
     }
+}
+
+/// The program selects work offset `name` (`G55`, `G54.1 P3`) at `line`, before the move
+/// ending at CL point `point`. `origin`: where the reader takes its origin to lie, X Y Z in
+/// the toolpath's coordinates (those of [`Toolpath::work_offset`]): where the program sets it
+/// (`G10`), there; otherwise equal to the offset before it, as the reader assumes (and says).
+/// The points after it are the program's coordinates plus `origin` (and any `G52` or `G92`
+/// shift).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OffsetChange {
+    pub point: usize,
+    pub line: usize,
+    pub name: String,
+    pub origin: [f64; 3],
 }
 
 /// A reader's warning: a line and what about it. The message is shared (`Arc<str>`): a

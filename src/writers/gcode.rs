@@ -85,13 +85,18 @@
 //!   same block (`S12000 M3`); `M3`, `M4`, `M5`; the coolant `M7`, `M8`, `M9` (a Klartext
 //!   `M13` is written as M3 and M8).
 //!
-//! The written coordinates are the program's, in the work offset it selects before its first
-//! move ([`crate::toolpath::Toolpath::work_offset`]), which the header selects (`G55`); one
-//! the output's dialect does not have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a
-//! Sinumerik, whose G58 is a programmable shift) is named in a comment instead. A program
-//! that names none runs in the control's default, as the program did. The values a program
-//! gives its offsets (`G10 L2`), its own length-offset words and any other M code are not
-//! written.
+//! **Work offsets.** The header selects the work offset the program selects before its first
+//! move ([`crate::toolpath::Toolpath::work_offset`], `G55`); a program that names none runs in
+//! the control's default, as the program did. Each offset the program selects later
+//! ([`crate::toolpath::Toolpath::offset_changes`]: an NX program for a Mori machines five
+//! setups in G55, G56, G57, G54.1 P3 and G54) is selected where the program selects it, and
+//! the coordinates after it are written in it: the points less the origin the reader took
+//! for it, so the program's own coordinates where the reader took it as equal to the one
+//! before (it does not know the control's values). An offset the output's dialect does not
+//! have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a Sinumerik, whose G58 is a
+//! programmable shift) is named in a comment instead. The values a program gives its offsets
+//! (`G10 L2`) are not written: the control's own are used. Nor are `G52`/`G92` shifts (the
+//! coordinates include them), the program's own length-offset words or other M codes.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
@@ -144,7 +149,7 @@ use crate::machine::Machine;
 use crate::optimize::Solution;
 use crate::schedule::Timeline;
 use crate::toolpath::gcode::Dialect;
-use crate::toolpath::{Feed, Switch, ToolSelect, Toolpath};
+use crate::toolpath::{Feed, OffsetChange, Switch, ToolSelect, Toolpath};
 use crate::validate::MIN_ROTATION_DEG;
 
 /// Blocks shorter than this (s) are merged with the next one.
@@ -275,6 +280,7 @@ impl Peak {
 /// (module doc, "Tools, spindle and coolant").
 #[derive(Debug, Clone, Copy)]
 enum Aux<'a> {
+    Offset(&'a OffsetChange),
     Tool(&'a ToolSelect),
     Speed(f64),
     Switch(Switch),
@@ -285,6 +291,12 @@ enum Aux<'a> {
 /// the tool change first, then the speed, then the switches.
 fn auxiliaries(tp: &Toolpath) -> Vec<(usize, Aux<'_>)> {
     let mut v: Vec<(usize, usize, u8, usize, Aux)> = Vec::new();
+    v.extend(
+        tp.offset_changes
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.point, c.line, 0, i, Aux::Offset(c))),
+    );
     v.extend(
         tp.tool_changes
             .iter()
@@ -319,6 +331,9 @@ struct Setup<'a> {
     tcp_active: bool,
     /// The tool in the spindle, by number.
     tool: Option<u32>,
+    /// The origin of the work offset in force, toolpath coordinates: written coordinates are
+    /// the points less it.
+    origin: [f64; 3],
     events: Vec<(usize, Aux<'a>)>,
     next: usize,
 }
@@ -353,6 +368,22 @@ impl Setup<'_> {
             }
             self.next += 1;
             match aux {
+                Aux::Offset(change) => {
+                    if crate::toolpath::gcode::is_work_offset(self.dialect, &change.name) {
+                        let _ = writeln!(text, "{}", change.name);
+                    } else {
+                        let _ = writeln!(
+                            text,
+                            "{}",
+                            (self.words.comment)(&format!(
+                                "the program selects work offset {} here, which this dialect \
+                                 does not have: select the same origin here",
+                                change.name
+                            ))
+                        );
+                    }
+                    self.origin = change.origin;
+                }
                 Aux::Tool(tool) => self.change(text, tool),
                 Aux::Speed(rpm) => {
                     // A direction in the same block goes with it (`S12000 M3`).
@@ -819,8 +850,9 @@ pub fn program(
     let offsets = kin.angle_offsets();
     let (nodes, split, process_split) = nodes(machine, toolpath, solution, geometry, step)?;
     // Written words of each node, and the merge of tiny blocks.
-    let written = |n: &Node| -> (Vec<String>, [f64; 3], Vec<f64>) {
-        let p = n.p.map(rounded);
+    // `origin`: the work offset's in force, toolpath coordinates (module doc).
+    let written = |n: &Node, origin: [f64; 3]| -> (Vec<String>, [f64; 3], Vec<f64>) {
+        let p: [f64; 3] = std::array::from_fn(|i| rounded(n.p[i] - origin[i]));
         let r: Vec<f64> = rotary
             .iter()
             .map(|(_, a)| rounded((n.angles[*a] + offsets[*a]).to_degrees()))
@@ -845,7 +877,7 @@ pub fn program(
     let mut merged = 0usize;
     for i in 1..nodes.len() {
         let last = *keep.last().unwrap_or(&0);
-        let same = written(&nodes[i]).0 == written(&nodes[last]).0;
+        let same = written(&nodes[i], [0.0; 3]).0 == written(&nodes[last], [0.0; 3]).0;
         let tiny = nodes[i].t - nodes[last].t < MIN_BLOCK_TIME_S;
         let peak = pending.join(nodes[i].peak);
         if i == nodes.len() - 1 {
@@ -961,6 +993,7 @@ pub fn program(
         tcp,
         tcp_active: false,
         tool: None,
+        origin: [0.0; 3],
         events: auxiliaries(toolpath),
         next: 0,
     };
@@ -969,7 +1002,7 @@ pub fn program(
     // mode (with the tool's length).
     setup.before(&mut text, first.point);
     setup.tcp_on(&mut text);
-    let (words0, mut prev_p, mut prev_r) = written(first);
+    let (words0, mut prev_p, mut prev_r) = written(first, setup.origin);
     let _ = writeln!(text, "G0 {}", words0.join(" "));
     let mut inverse_mode = false;
     let (mut blocks, mut inverse_blocks, mut total) = (0usize, 0usize, 0.0f64);
@@ -986,7 +1019,7 @@ pub fn program(
     for (w, &i) in keep.iter().enumerate().skip(1) {
         let n = &nodes[i];
         setup.before(&mut text, n.point);
-        let (ws, p, r) = written(n);
+        let (ws, p, r) = written(n, setup.origin);
         let dt = n.t - prev_t;
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::Solver(format!(

@@ -17,8 +17,8 @@ use super::*;
 use crate::error::{Error, Result};
 use crate::machine::DecimalPointInput;
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineSwitch, SpindleChange,
-    Switch, ToolChange, ToolSelect, Toolpath, Warning,
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineSwitch, OffsetChange,
+    SpindleChange, Switch, ToolChange, ToolSelect, Toolpath, Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -246,6 +246,8 @@ pub(super) struct Interpreter<'a> {
     pub(super) switches: Vec<MachineSwitch>,
     /// This block's switches that stop something (M5, M9): recorded after its motion.
     stops: Vec<Switch>,
+    /// The work offsets selected after the first point.
+    offset_changes: Vec<OffsetChange>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -321,6 +323,7 @@ impl<'a> Interpreter<'a> {
             spindle_changes: Vec::new(),
             switches: Vec::new(),
             stops: Vec::new(),
+            offset_changes: Vec::new(),
             m92: false,
             m92_warned: [false; 3],
         }
@@ -472,6 +475,7 @@ impl<'a> Interpreter<'a> {
             spindle_changes: self.spindle_changes,
             switches: self.switches,
             work_offset: self.offsets.start_named().map(str::to_string),
+            offset_changes: self.offset_changes,
         })
     }
 
@@ -1044,6 +1048,14 @@ impl<'a> Interpreter<'a> {
                     let used = if self.saw_rotary { 0..6 } else { 0..3 };
                     if let Some(warning) = self.offsets.select(&name, used) {
                         self.warn(line, warning);
+                    }
+                    if !self.points.is_empty() {
+                        self.offset_changes.push(OffsetChange {
+                            point: self.points.len(),
+                            line,
+                            name: name.clone(),
+                            origin: self.offsets.origin(),
+                        });
                     }
                     self.shift_changed(before);
                 }

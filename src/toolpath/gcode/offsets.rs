@@ -209,6 +209,12 @@ impl WorkOffsets {
         })
     }
 
+    /// The origin of the offset in force (with the external offset), X Y Z, toolpath
+    /// coordinates: [`Self::shift`] without `G52` and `G92`.
+    pub(super) fn origin(&self) -> [f64; 3] {
+        std::array::from_fn(|i| self.active_origin(i).value + self.external[i].value)
+    }
+
     /// Fanuc's `G92` shift on `axis`.
     pub(super) fn position(&self, axis: usize) -> f64 {
         self.position[axis]
