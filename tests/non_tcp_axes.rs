@@ -486,3 +486,22 @@ fn a_turn_of_whole_revolutions_is_followed_round() {
         s.schedule.cycle_time
     );
 }
+
+#[test]
+fn a_block_outside_tcp_that_moves_nothing_after_a_tcp_turn_is_no_turn() {
+    // Under tool-tip mode a block's rotary words are its orientation (the reader keeps the
+    // program's tool vector, +Z, beside them); outside it the axes give the vector. A block
+    // outside TCP that moves nothing after a turn under TCP has the same angles and another
+    // vector: the geometry took it for a turn of no angle, a span of zero length, whose axes
+    // came out NaN ("axis X would be at NaN", a program feedopt gcode wrote for NX's Mori).
+    let (m, ctx) = ac_table();
+    let tp = read(
+        Dialect::Fanuc,
+        Some(&ctx),
+        "%\nO1\nG21 G90\nG43.4 H1\nG1 X10. Y10. Z10. A0 C0 F1000.\n\
+         G93 G1 X0 Y0 Z0 A-37.576 C45. F80.\nG94\nG49\nG91 G0 Z0.\nG90\nM30\n%\n",
+    );
+    assert_eq!(tp.points.len(), 3);
+    let sol = solve(&m, &tp);
+    assert!(sol.schedule.cycle_time.is_finite() && sol.verification.verified);
+}

@@ -553,8 +553,13 @@ pub fn span_points(
         let last = &pts[*keep.last().unwrap_or(&0)];
         let moved = (pts[k].p - last.p).norm() > SAME_POSITION_MM;
         let last_k = *keep.last().unwrap_or(&0);
+        // Where both points give their rotary positions, those are the orientation (the
+        // reader's tool vector is then the program's, not the one they make: a tool-tip-mode
+        // block's +Z beside a block outside it whose vector the axes give made a turn of no
+        // angle, a span of zero length, and NaN).
+        let given = pts[k].rotary.is_some() && last.rotary.is_some();
         let turned = orientation_moves_axes
-            && (angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD
+            && ((!given && angle_between(&pts[k].o, &last.o) > SAME_ORIENTATION_RAD)
                 || (0..2).any(|j| (angles[k][j] - angles[last_k][j]).abs() > SAME_ORIENTATION_RAD));
         if moved || turned {
             keep.push(k);
