@@ -63,6 +63,7 @@ fn toolpath() -> Toolpath {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     }
 }
 

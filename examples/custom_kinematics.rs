@@ -123,6 +123,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

@@ -42,6 +42,7 @@ fn groove() -> Toolpath {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     }
 }
 

@@ -246,6 +246,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     };
     (m, t)
 }
@@ -662,10 +663,15 @@ fn a_tool_change_under_tool_tip_mode_leaves_it_and_comes_back_with_the_new_tool(
     let (prog, _) = round_trip(&m, &input, &sol, &options.geometry, Dialect::Fanuc);
     let lines: Vec<&str> = prog.text.lines().collect();
     let at = |s: &str| lines.iter().position(|l| *l == s).unwrap_or(usize::MAX);
-    // The first tool before tool-tip mode, with its length; the second out of it and back.
+    // The first tool before tool-tip mode, with its length; the second out of it and back
+    // before the next move (after the spindle's words).
     assert!(at("T1 M6") < at("G43.4 H1"), "{}", prog.text);
     let t2 = at("T2 M6");
-    assert_eq!(&lines[t2 - 1..=t2 + 1], ["G49", "T2 M6", "G43.4 H2"]);
+    assert_eq!(
+        &lines[t2 - 1..=t2 + 2],
+        ["G49", "T2 M6", "S12000 M3", "G43.4 H2"]
+    );
+    assert!(lines[t2 + 3].starts_with("G1 "));
     let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, Dialect::Fanuc).unwrap();
     assert_eq!(machine_words(&back), machine_words(&input), "{}", prog.text);
 }
@@ -770,5 +776,96 @@ fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coor
         // G56 as equal to G54 without the G10: the offsets are the control's).
         let back = toolpath::gcode::parse(Path::new("b.nc"), &prog.text, dialect).unwrap();
         assert_eq!(back.points.last().unwrap().p.x, 10.0, "{dialect}");
+    }
+}
+
+#[test]
+fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
+    // `G91 G28 Z0` goes to the control's reference point, `G53 Z-10.` to a machine
+    // coordinate: the reader places both through the machine file (its reference, else
+    // machine zero, and its work offset), which the control does not read. Written as the
+    // tip position, the first went to the work origin on NX's Mori program. Written so, the
+    // control places them itself; read back with the same machine file, every point is the
+    // input's.
+    for (dir, file, tcp) in [
+        ("xyz_pocket", "machine.json", false),
+        ("seed_head_head", "machine.json", true),
+    ] {
+        let m = Machine::from_file(&root().join(format!("problems/{dir}/{file}"))).unwrap();
+        let rotary = if tcp { " A0. C0." } else { "" };
+        let on = if tcp { "G43.4 H1\n" } else { "" };
+        let text = format!(
+            "%\nO1\nG21 G90\nG91 G28 Z0.\nG28 X0. Y0.\nG90\nT1 M6\n{on}G0 X10. Y0. Z5.{rotary}\n\
+             G1 Z-1. F300.\nG1 X20.\nG53 G0 Z-10.\nG0 X0. Y0.\nG1 Z-1. F300.\nG91 G28 Z0.\n\
+             G90\nM30\n%\n"
+        );
+        let ctx = toolpath::MachineContext::new(&m, &Default::default());
+        let input =
+            toolpath::gcode::parse_for(Path::new("m.nc"), &text, Dialect::Fanuc.spec(), Some(&ctx))
+                .unwrap();
+        // (The second goes where the tool stands, by the machine file: X Y at machine zero
+        // from the unknown start taken as 0. No block of the schedule ends there; it is
+        // written all the same.)
+        assert_eq!(input.machine_points.len(), 4);
+        let options = reach();
+        let sol = optimize(&m, &input, &options).unwrap();
+        for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+            let o = GcodeOptions {
+                dialect,
+                max_rotation_deg: None,
+                block_feed: BlockFeed::Peak,
+            };
+            let prog = program(&m, &input, &sol, &options.geometry, &o).unwrap();
+            let lines: Vec<&str> = prog.text.lines().collect();
+            let count = |s: &str| lines.iter().filter(|l| **l == s).count();
+            match dialect {
+                Dialect::Sinumerik => {
+                    assert_eq!(count("G0 SUPA X0.000000 Y0.000000"), 1, "{}", prog.text);
+                    assert_eq!(count("G0 SUPA Z0.000000"), 2, "{}", prog.text);
+                    assert_eq!(count("G0 SUPA Z-10.000000"), 1, "{}", prog.text);
+                }
+                _ => {
+                    let xy = count("G91 G28 X0.000000 Y0.000000");
+                    assert_eq!(xy, 1, "{dialect}\n{}", prog.text);
+                    assert_eq!(count("G91 G28 Z0.000000"), 2, "{dialect}\n{}", prog.text);
+                    assert_eq!(count("G53 G0 Z-10.000000"), 1, "{dialect}\n{}", prog.text);
+                }
+            }
+            // Out of tool-tip mode for each.
+            if tcp {
+                for (k, l) in lines.iter().enumerate() {
+                    if l.starts_with("G53") || l.contains("G28") || l.contains("SUPA") {
+                        let off = lines[..k].iter().rev().find(|l| {
+                            ["G49", "M429", "TRAFOOF", "G43.4 H1", "M428", "TRAORI"].contains(l)
+                        });
+                        assert!(
+                            off.is_none_or(|l| ["G49", "M429", "TRAFOOF"].contains(l)),
+                            "{dialect}: line {k} under tool-tip mode\n{}",
+                            prog.text
+                        );
+                    }
+                }
+            }
+            let back = toolpath::gcode::parse_for(
+                Path::new("b.nc"),
+                &prog.text,
+                dialect.spec(),
+                Some(&ctx),
+            )
+            .unwrap();
+            let pts = |t: &Toolpath| -> Vec<[f64; 3]> {
+                let mut v: Vec<[f64; 3]> = t.points.iter().map(|p| [p.p.x, p.p.y, p.p.z]).collect();
+                v.dedup();
+                v
+            };
+            let (a, b) = (pts(&input), pts(&back));
+            assert_eq!(a.len(), b.len(), "{dialect}: {a:?}\n{b:?}\n{}", prog.text);
+            for (x, y) in a.iter().zip(&b) {
+                assert!(
+                    x.iter().zip(y).all(|(u, v)| (u - v).abs() < 1e-6),
+                    "{dialect}: {a:?}\n{b:?}"
+                );
+            }
+        }
     }
 }

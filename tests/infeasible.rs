@@ -57,6 +57,7 @@ fn line() -> Toolpath {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     }
 }
 
@@ -272,6 +273,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

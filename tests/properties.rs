@@ -223,6 +223,7 @@ fn random_cl(seed: u64) -> Case {
             switches: Vec::new(),
             work_offset: None,
             offset_changes: Vec::new(),
+            machine_points: Vec::new(),
         },
     }
 }
@@ -597,6 +598,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             switches: Vec::new(),
             work_offset: None,
             offset_changes: Vec::new(),
+            machine_points: Vec::new(),
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

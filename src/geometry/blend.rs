@@ -43,7 +43,8 @@ use std::borrow::Cow;
 
 use super::SAME_POSITION_MM;
 use crate::toolpath::{
-    ClPoint, Dwell, Feed, MachineSwitch, OffsetChange, SpindleChange, ToolChange, Toolpath,
+    ClPoint, Dwell, Feed, MachinePoint, MachineSwitch, OffsetChange, SpindleChange, ToolChange,
+    Toolpath,
 };
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
@@ -144,6 +145,12 @@ pub fn blend_corners(
             .map(|c| OffsetChange {
                 point: moved(c.point),
                 ..c.clone()
+            })
+            .collect(),
+        machine_points: (toolpath.machine_points.iter())
+            .map(|c| MachinePoint {
+                point: moved(c.point),
+                ..*c
             })
             .collect(),
     };

@@ -258,6 +258,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         switches: reader.switches,
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     })
 }
 

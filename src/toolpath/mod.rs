@@ -150,6 +150,9 @@ pub struct Toolpath {
     pub work_offset: Option<String>,
     /// The work offsets the program selects after its first move, in program order.
     pub offset_changes: Vec<OffsetChange>,
+    /// The CL points the program places in machine coordinates (`G53`, `SUPA`, `M91`, the
+    /// `G28`/`G30` reference points), in program order.
+    pub machine_points: Vec<MachinePoint>,
 }
 
 impl Toolpath {
@@ -165,6 +168,7 @@ impl Toolpath {
             switches: Vec::new(),
             work_offset: None,
             offset_changes: Vec::new(),
+            machine_points: Vec::new(),
         }
     }
 
@@ -302,6 +306,33 @@ pub struct OffsetChange {
     pub line: usize,
     pub name: String,
     pub origin: [f64; 3],
+}
+
+/// CL point `point` is where a block in machine coordinates goes (the reader places it
+/// through the machine file: its work offset, its reference points). `feedopt gcode` writes
+/// such a block in machine coordinates, as the program does, not as the tip position the
+/// machine file's values give.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MachinePoint {
+    pub point: usize,
+    pub line: usize,
+    pub kind: MachineMove,
+}
+
+/// How a block in machine coordinates names its target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MachineMove {
+    /// `G53`, `SUPA`, `M91`: the axes X Y Z A B C it names (`None`: not named) to these
+    /// machine coordinates, mm and degrees.
+    Coordinates([Option<f64>; 6]),
+    /// `G28` (`k` = 1) or `G30` (`k` = 2, or `P3`, `P4`): the named axes to reference point
+    /// `k`, the control's own; `at`: the machine coordinates the reader took for it (the
+    /// machine file's reference, else machine zero), for a dialect without the code.
+    Reference {
+        k: u8,
+        axes: [bool; 6],
+        at: [f64; 6],
+    },
 }
 
 /// A reader's warning: a line and what about it. The message is shared (`Arc<str>`): a

@@ -85,6 +85,17 @@
 //!   same block (`S12000 M3`); `M3`, `M4`, `M5`; the coolant `M7`, `M8`, `M9` (a Klartext
 //!   `M13` is written as M3 and M8).
 //!
+//! **Machine coordinates.** A move the program makes in machine coordinates (`G53`, `SUPA`,
+//! `M91`, the `G28`/`G30` reference points: [`crate::toolpath::Toolpath::machine_points`])
+//! is written so, out of tool-tip mode: the reader placed it through the machine file's work
+//! offset and reference points, which the control does not read (the NX Mori program's
+//! `G91 G28 Z0` was written as `G0 X0 Y0 Z0 B0 C0` under `G43.4`: the tip to the work
+//! origin, where the machine file gives no reference). `G53 G0` with the axes it names
+//! (Sinumerik `G0 SUPA`); a reference point as `G91 G28 Z0` then `G90` (`G30`, Fanuc's
+//! `G30 P3`), and where the dialect has no such code (Sinumerik) as `SUPA` to the machine
+//! coordinates the reader took for it. It runs at the control's rapid; the program's time
+//! counts the schedule's for it.
+//!
 //! **Work offsets.** The header selects the work offset the program selects before its first
 //! move ([`crate::toolpath::Toolpath::work_offset`], `G55`); a program that names none runs in
 //! the control's default, as the program did. Each offset the program selects later
@@ -149,7 +160,9 @@ use crate::machine::Machine;
 use crate::optimize::Solution;
 use crate::schedule::Timeline;
 use crate::toolpath::gcode::Dialect;
-use crate::toolpath::{Feed, OffsetChange, Switch, ToolSelect, Toolpath};
+use crate::toolpath::{
+    Feed, MachineMove, MachinePoint, OffsetChange, Switch, ToolSelect, Toolpath,
+};
 use crate::validate::MIN_ROTATION_DEG;
 
 /// Blocks shorter than this (s) are merged with the next one.
@@ -281,6 +294,9 @@ impl Peak {
 #[derive(Debug, Clone, Copy)]
 enum Aux<'a> {
     Offset(&'a OffsetChange),
+    /// A move in machine coordinates to a point no written block ends at (the reader put it
+    /// where the tool already stood: machine zero from an unknown start).
+    Machine(MachineMove),
     Tool(&'a ToolSelect),
     Speed(f64),
     Switch(Switch),
@@ -289,8 +305,15 @@ enum Aux<'a> {
 /// The toolpath's tool changes, spindle speeds and switches in the order the program makes
 /// them, each with the CL point it comes before: by that point, then by line, and in one block
 /// the tool change first, then the speed, then the switches.
-fn auxiliaries(tp: &Toolpath) -> Vec<(usize, Aux<'_>)> {
+fn auxiliaries<'a>(tp: &'a Toolpath, machine: &[MachinePoint]) -> Vec<(usize, Aux<'a>)> {
     let mut v: Vec<(usize, usize, u8, usize, Aux)> = Vec::new();
+    // A move is the last thing before the block after it.
+    v.extend(
+        machine
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (m.point, m.line, 3, i, Aux::Machine(m.kind))),
+    );
     v.extend(
         tp.offset_changes
             .iter()
@@ -368,6 +391,7 @@ impl Setup<'_> {
             }
             self.next += 1;
             match aux {
+                Aux::Machine(mv) => self.machine_move(text, &mv),
                 Aux::Offset(change) => {
                     if crate::toolpath::gcode::is_work_offset(self.dialect, &change.name) {
                         let _ = writeln!(text, "{}", change.name);
@@ -451,7 +475,7 @@ impl Setup<'_> {
                 return;
             }
         };
-        let was = self.tcp_active;
+        // (Tool-tip mode comes back before the next move, with the new tool's length.)
         self.tcp_off(text);
         let _ = writeln!(text, "{line}");
         if let ToolSelect::Number(n) = tool {
@@ -460,9 +484,49 @@ impl Setup<'_> {
                 let _ = writeln!(text, "G43 H{n}");
             }
         }
-        if was {
-            self.tcp_on(text);
-        }
+    }
+
+    /// The block of a move the program makes in machine coordinates (module doc, "Machine
+    /// coordinates"), out of tool-tip mode.
+    fn machine_move(&mut self, text: &mut String, mv: &MachineMove) {
+        self.tcp_off(text);
+        const NAMES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
+        let words = |values: [Option<f64>; 6]| -> String {
+            (0..6)
+                .filter_map(|i| values[i].map(|v| format!("{}{}", NAMES[i], coord(v))))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let coordinates = |values: [Option<f64>; 6]| match self.dialect {
+            Dialect::Sinumerik => format!("G0 SUPA {}", words(values)),
+            _ => format!("G53 G0 {}", words(values)),
+        };
+        let block = match (*mv, self.dialect) {
+            (MachineMove::Coordinates(values), _) => coordinates(values),
+            // The control's own reference point, reached from where the tool stands.
+            (MachineMove::Reference { k, axes, .. }, Dialect::Fanuc)
+            | (
+                MachineMove::Reference {
+                    k: k @ (1 | 2),
+                    axes,
+                    ..
+                },
+                Dialect::LinuxCnc,
+            ) => {
+                let code = match k {
+                    1 => "G28".to_string(),
+                    2 => "G30".to_string(),
+                    k => format!("G30 P{k}"),
+                };
+                let zeros = words(std::array::from_fn(|i| axes[i].then_some(0.0)));
+                format!("G91 {code} {zeros}\nG90")
+            }
+            // No such code: the machine coordinates the reader took for it.
+            (MachineMove::Reference { axes, at, .. }, _) => {
+                coordinates(std::array::from_fn(|i| axes[i].then_some(at[i])))
+            }
+        };
+        let _ = writeln!(text, "{block}");
     }
 }
 
@@ -987,6 +1051,27 @@ pub fn program(
     }
     // A machine programmed in machine coordinates has no tool-tip mode.
     let tcp = !rotary.is_empty() && !machine.kinematics.machine_coordinates();
+    // The blocks in machine coordinates, by the CL point they go to; a node that is such a
+    // block's end (not a point the writer added inside it) is written as it. Those whose
+    // points no kept node ends at are written where they come, as the program's other words.
+    let machine_moves: std::collections::HashMap<usize, MachineMove> = toolpath
+        .machine_points
+        .iter()
+        .map(|m| (m.point, m.kind))
+        .collect();
+    let machine_move = |n: &Node| (n.line != 0).then(|| machine_moves.get(&n.point)).flatten();
+    let ends: std::collections::HashSet<usize> = keep
+        .iter()
+        .map(|&i| &nodes[i])
+        .filter(|n| n.line != 0)
+        .map(|n| n.point)
+        .collect();
+    let unwritten: Vec<MachinePoint> = toolpath
+        .machine_points
+        .iter()
+        .filter(|m| !ends.contains(&m.point))
+        .copied()
+        .collect();
     let mut setup = Setup {
         dialect: options.dialect,
         words: &w,
@@ -994,16 +1079,20 @@ pub fn program(
         tcp_active: false,
         tool: None,
         origin: [0.0; 3],
-        events: auxiliaries(toolpath),
+        events: auxiliaries(toolpath, &unwritten),
         next: 0,
     };
     let first = &nodes[keep[0]];
     // The tool, spindle and coolant the program sets before its first move, then tool-tip
     // mode (with the tool's length).
     setup.before(&mut text, first.point);
-    setup.tcp_on(&mut text);
     let (words0, mut prev_p, mut prev_r) = written(first, setup.origin);
-    let _ = writeln!(text, "G0 {}", words0.join(" "));
+    if let Some(mv) = machine_move(first) {
+        setup.machine_move(&mut text, mv);
+    } else {
+        setup.tcp_on(&mut text);
+        let _ = writeln!(text, "G0 {}", words0.join(" "));
+    }
     let mut inverse_mode = false;
     let (mut blocks, mut inverse_blocks, mut total) = (0usize, 0usize, 0.0f64);
     let mut dwell_time = 0.0;
@@ -1027,6 +1116,16 @@ pub fn program(
                 n.line
             )));
         }
+        if let Some(mv) = machine_move(n) {
+            // At the control's rapid: the schedule's time stands for it.
+            setup.machine_move(&mut text, mv);
+            total += dt;
+            dwell(&mut text, dwell_after[w]);
+            blocks += 1;
+            (prev_p, prev_r, prev_t) = (p, r, n.t);
+            continue;
+        }
+        setup.tcp_on(&mut text);
         let turns = r.iter().zip(&prev_r).any(|(a, b)| a != b);
         let chord =
             ((p[0] - prev_p[0]).powi(2) + (p[1] - prev_p[1]).powi(2) + (p[2] - prev_p[2]).powi(2))

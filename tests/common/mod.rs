@@ -34,6 +34,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
         switches: Vec::new(),
         work_offset: None,
         offset_changes: Vec::new(),
+        machine_points: Vec::new(),
     }
 }
 

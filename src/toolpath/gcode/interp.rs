@@ -17,8 +17,8 @@ use super::*;
 use crate::error::{Error, Result};
 use crate::machine::DecimalPointInput;
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineSwitch, OffsetChange,
-    SpindleChange, Switch, ToolChange, ToolSelect, Toolpath, Warning,
+    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineMove, MachinePoint,
+    MachineSwitch, OffsetChange, SpindleChange, Switch, ToolChange, ToolSelect, Toolpath, Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -248,6 +248,8 @@ pub(super) struct Interpreter<'a> {
     stops: Vec<Switch>,
     /// The work offsets selected after the first point.
     offset_changes: Vec<OffsetChange>,
+    /// The points placed in machine coordinates.
+    machine_points: Vec<MachinePoint>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -324,6 +326,7 @@ impl<'a> Interpreter<'a> {
             switches: Vec::new(),
             stops: Vec::new(),
             offset_changes: Vec::new(),
+            machine_points: Vec::new(),
             m92: false,
             m92_warned: [false; 3],
         }
@@ -476,6 +479,7 @@ impl<'a> Interpreter<'a> {
             switches: self.switches,
             work_offset: self.offsets.start_named().map(str::to_string),
             offset_changes: self.offset_changes,
+            machine_points: self.machine_points,
         })
     }
 
@@ -2039,6 +2043,7 @@ impl<'a> Interpreter<'a> {
         let mut target = via;
         let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
         let mut defaulted = Vec::new();
+        let mut at = [0.0; 6];
         for &i in &named {
             // The machine file's reference, else machine zero: the controls' default (Fanuc
             // parameters 1240–1243, LinuxCNC 5161–5169 / 5181–5189 are 0 in machine
@@ -2056,6 +2061,7 @@ impl<'a> Interpreter<'a> {
                     0.0
                 }
             };
+            at[i] = r;
             if i < 3 {
                 machine_xyz[i] = r;
             } else {
@@ -2113,6 +2119,15 @@ impl<'a> Interpreter<'a> {
         self.machine_point = true;
         self.push(line, &target, Feed::Rapid);
         self.machine_point = false;
+        self.machine_points.push(MachinePoint {
+            point: self.points.len() - 1,
+            line,
+            kind: MachineMove::Reference {
+                k: k as u8,
+                axes: std::array::from_fn(|i| named.contains(&i)),
+                at,
+            },
+        });
         self.pos = target;
         Ok(())
     }
@@ -2482,6 +2497,8 @@ impl<'a> Interpreter<'a> {
         let start = self.pos;
         let mut end = start;
         let mut machine_xyz = self.to_machine(Vector3::new(start[0], start[1], start[2]));
+        // In machine coordinates, the named axes' (for the writer: [`MachinePoint`]).
+        let mut machine_words: [Option<f64>; 6] = [None; 6];
         // Whether the rotary axes stand where an earlier block put them (not at the unknown
         // start).
         let rotary_known = self.saw_rotary;
@@ -2516,8 +2533,12 @@ impl<'a> Interpreter<'a> {
                     } else {
                         0.0
                     };
+                machine_words[i] = Some(machine_xyz[i]);
                 self.known[i] = true;
                 continue;
+            }
+            if machine {
+                machine_words[i] = Some(value);
             }
             let incremental = (self.distance == Distance::Incremental || block.incremental[i])
                 && !machine
@@ -2746,6 +2767,13 @@ impl<'a> Interpreter<'a> {
                 }
             } else {
                 self.push(line, &end, feed);
+            }
+            if machine {
+                self.machine_points.push(MachinePoint {
+                    point: self.points.len() - 1,
+                    line,
+                    kind: MachineMove::Coordinates(machine_words),
+                });
             }
             self.machine_point = false;
             let (a, b) = (end[0] - start[0], end[1] - start[1]);
