@@ -164,6 +164,10 @@ pub enum Address {
     /// Klartext: the direction of a circular path, `DR+` (counter-clockwise, value +1) or
     /// `DR-` (clockwise, −1).
     ArcDirection,
+    /// A corner between this straight move and the next cut off as a chamfer or rounded:
+    /// Fanuc `,C` / `,R` (made by the lexer where [`DialectSpec::comma_corners`]), Sinumerik
+    /// `RND=`, `CHF=`, `CHR=` (and `RNDM=`, `FRC=`, `FRCM=`, read to refuse them).
+    Corner(CornerWord),
     /// Klartext: a polar angle about the pole `CC`, degrees; `true`: incremental (`IPA`).
     PolarAngle(bool),
     /// Klartext: a polar radius from the pole `CC`, mm; `true`: incremental (`IPR`).
@@ -183,6 +187,22 @@ pub enum Motion {
     Linear,
     ArcCw,
     ArcCcw,
+}
+
+/// What a corner word asks for ([`Address::Corner`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CornerWord {
+    /// A rounding arc of this radius, tangent to both moves (Fanuc `,R`, Sinumerik `RND=`).
+    Round,
+    /// Sinumerik `RNDM=`: rounding of every following corner (modal).
+    RoundModal,
+    /// A chamfer from this far before the corner to this far after it along the moves
+    /// (Fanuc `,C`, Sinumerik `CHR=`).
+    ChamferLeg,
+    /// A chamfer of this length (Sinumerik `CHF=`).
+    ChamferLength,
+    /// Sinumerik `FRC=` / `FRCM=`: the feed of a chamfer or rounding.
+    Feed,
 }
 
 /// Arc planes: XY (G17), ZX (G18), YZ (G19).
@@ -505,6 +525,9 @@ pub struct DialectSpec {
     pub cycle_repeat: &'static [char],
     /// What F means on a feed block that turns a rotary axis.
     pub rotary_feed: RotaryFeed,
+    /// `,C` and `,R` after a straight move chamfer or round the corner to the next one
+    /// (Fanuc's "chamfering and corner R", as Haas reads it too).
+    pub comma_corners: bool,
 }
 
 use Action::{
@@ -730,6 +753,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -911,6 +935,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Combined,
+    comma_corners: true,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -951,6 +976,12 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
             "AR",
             Address::Unsupported("arcs by opening angle (AR=) are not supported"),
         ),
+        ("RND", Address::Corner(CornerWord::Round)),
+        ("RNDM", Address::Corner(CornerWord::RoundModal)),
+        ("CHF", Address::Corner(CornerWord::ChamferLength)),
+        ("CHR", Address::Corner(CornerWord::ChamferLeg)),
+        ("FRC", Address::Corner(CornerWord::Feed)),
+        ("FRCM", Address::Corner(CornerWord::Feed)),
         (
             "AP",
             Address::Unsupported("polar coordinates (AP=, RP=) are not supported"),
@@ -1147,6 +1178,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1389,6 +1421,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     units_by_setting: false,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

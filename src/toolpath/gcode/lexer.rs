@@ -253,6 +253,38 @@ fn lex_letters(
             i = end;
             continue;
         }
+        if c == ',' && spec.comma_corners {
+            // Fanuc's chamfering and corner R: `G1 X50 ,C3` / `G1 X50 ,R5` (Haas too).
+            let letter = chars.get(i + 1).map(char::to_ascii_uppercase);
+            let word = match letter {
+                Some('R') => super::dialect::CornerWord::Round,
+                Some('C') => super::dialect::CornerWord::ChamferLeg,
+                _ => {
+                    return Err("`,` not followed by C or R: `,C` (a chamfer) and `,R` (a corner \
+                                rounding) are the only words written with a comma"
+                        .to_string());
+                }
+            };
+            let letter = letter.unwrap_or('R');
+            let end = scan_value(&chars, i + 2, false);
+            let text_value: String = chars[i + 2..end].iter().collect();
+            if text_value.is_empty() {
+                return Err(format!("`,{letter}` has no number"));
+            }
+            let num = if text_value.contains(['#', '[']) {
+                value(&text_value, vars).map_err(|e| format!("`,{letter}{text_value}`: {e}"))?
+            } else {
+                number(&text_value)
+                    .ok_or_else(|| format!("malformed number `{text_value}` after `,{letter}`"))?
+            };
+            items.push(Item::Word {
+                text: format!(",{letter}{text_value}"),
+                address: Address::Corner(word),
+                num,
+            });
+            i = end;
+            continue;
+        }
         if !c.is_ascii_alphabetic() {
             return Err(match c {
                 '[' | ']' => "an expression `[ … ]` must follow a letter or `=`".to_string(),
