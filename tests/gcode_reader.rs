@@ -1576,3 +1576,26 @@ fn a_chamfer_or_rounding_feedopt_cannot_make_is_an_error_naming_its_word() {
     // LinuxCNC has no such words: the comma stays an error.
     err("G21 G1 X0 Y0 Z0 F600\nG1 X50 ,R5\nG1 Y50\n", 2, &[","]);
 }
+
+#[test]
+fn sinumerik_words_that_set_an_end_point_or_the_orientation_another_way_are_errors() {
+    // Round 16: each was an unknown word skipped with a warning: `G1 X60 ANG=30` went to X60
+    // alone, and under TRAORI `A2= B2= C2=` or `LEAD= TILT=` left the tool where the last
+    // block had it, while the control turns the rotary axes to them.
+    let sin = |word: &str, needle: &str| {
+        err_in(
+            Dialect::Sinumerik,
+            &format!("G71 G94\nG1 X0 Y0 Z0 F600\nTRAORI\nG1 X50 {word}\nG1 Y50\n"),
+            4,
+            &[needle],
+        )
+    };
+    sin("ANG=30", "ANG=");
+    sin("A2=10 B2=20 C2=0", "A2=");
+    sin("LEAD=10 TILT=5", "LEAD=");
+    sin("THETA=30", "THETA=");
+    sin("PHI=10", "PHI=");
+    sin("A4=0 B4=0 C4=1", "A4=");
+    sin("A5=0", "A5=");
+    sin("XH=10 YH=0 ZH=5", "XH=");
+}

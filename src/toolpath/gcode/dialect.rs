@@ -567,6 +567,24 @@ const UVW_FANUC: &str = concat!(
     ". On a Fanuc lathe (T series) U and W are X and Z incremental: then this is a turning \
      program, which feedopt does not read (it reads milling programs)"
 );
+/// Sinumerik words that set the tool's orientation other than by the rotary axes' positions or
+/// the tool vector `A3= B3= C3=` (round 16: they were unknown words, skipped with a warning,
+/// while under TRAORI the control turns the rotary axes to them).
+const ORI_ANGLES: &str = "tool orientation by angles (A2= B2= C2=: Euler, RPY or virtual-axis \
+                          angles) is not supported: post it as the rotary axes' positions or as \
+                          a tool vector A3= B3= C3=";
+const ORI_LEAD_TILT: &str = "tool orientation by lead and tilt angles (LEAD= TILT=) is not \
+                             supported: post it as the rotary axes' positions or as a tool \
+                             vector A3= B3= C3=";
+const ORI_CONE: &str = "orientation by rotation or cone angles (THETA= PHI= PSI=) is not \
+                        supported: post it as the rotary axes' positions or as a tool vector \
+                        A3= B3= C3=";
+const ORI_NORMALS: &str = "surface normal vectors (A4= B4= C4=, A5= B5= C5=) are not supported: \
+                           they steer 3D tool compensation and path-relative orientation, \
+                           which feedopt does not model";
+const ORI_CURVE: &str = "orientation by a second contour (XH= YH= ZH=, ORICURVE) is not \
+                         supported: post it as the rotary axes' positions or as a tool vector \
+                         A3= B3= C3=";
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
 const CSS_ON: Action = Action::SurfaceSpeed {
     on: true,
@@ -976,6 +994,30 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
             "AR",
             Address::Unsupported("arcs by opening angle (AR=) are not supported"),
         ),
+        (
+            "ANG",
+            Address::Unsupported(
+                "a contour's end point by its angle (ANG=) is not supported: post the end \
+                 point's coordinates",
+            ),
+        ),
+        ("A2", Address::Unsupported(ORI_ANGLES)),
+        ("B2", Address::Unsupported(ORI_ANGLES)),
+        ("C2", Address::Unsupported(ORI_ANGLES)),
+        ("LEAD", Address::Unsupported(ORI_LEAD_TILT)),
+        ("TILT", Address::Unsupported(ORI_LEAD_TILT)),
+        ("THETA", Address::Unsupported(ORI_CONE)),
+        ("PHI", Address::Unsupported(ORI_CONE)),
+        ("PSI", Address::Unsupported(ORI_CONE)),
+        ("A4", Address::Unsupported(ORI_NORMALS)),
+        ("B4", Address::Unsupported(ORI_NORMALS)),
+        ("C4", Address::Unsupported(ORI_NORMALS)),
+        ("A5", Address::Unsupported(ORI_NORMALS)),
+        ("B5", Address::Unsupported(ORI_NORMALS)),
+        ("C5", Address::Unsupported(ORI_NORMALS)),
+        ("XH", Address::Unsupported(ORI_CURVE)),
+        ("YH", Address::Unsupported(ORI_CURVE)),
+        ("ZH", Address::Unsupported(ORI_CURVE)),
         ("RND", Address::Corner(CornerWord::Round)),
         ("RNDM", Address::Corner(CornerWord::RoundModal)),
         ("CHF", Address::Corner(CornerWord::ChamferLength)),

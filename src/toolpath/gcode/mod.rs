@@ -216,7 +216,9 @@
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
 //!   silently: the stored `G92` shift (`G92.3`), splines, threading, probing, polar coordinates, scaling,
 //!   mirroring, calls of subprograms not in the file, Haas `M97`, Sinumerik
-//!   `CYCLE76`/`CYCLE77` (spigot milling).
+//!   `CYCLE76`/`CYCLE77` (spigot milling), and the Sinumerik words that give an end point or
+//!   the tool's orientation another way (`ANG=`; `A2= B2= C2=`, `LEAD= TILT=`, `THETA= PHI=
+//!   PSI=`, `A4=`…`C5=`, `XH= YH= ZH=`: under TRAORI the control turns the rotary axes to them).
 
 pub mod cycles;
 mod dialect;
