@@ -1599,3 +1599,22 @@ fn sinumerik_words_that_set_an_end_point_or_the_orientation_another_way_are_erro
     sin("A5=0", "A5=");
     sin("XH=10 YH=0 ZH=5", "XH=");
 }
+
+#[test]
+fn a_macro_call_is_named_not_its_u_v_w_arguments() {
+    // Round 16: a Haas program's `G65 P9001 A.125 C.625 V10100.` was refused at `V10100.`
+    // as a parallel axis; the letters are the macro's arguments (V is #22).
+    err_in(
+        Dialect::Fanuc,
+        "O2001\nG90 G20 G94\nG1 X0. Y0. Z0. F10.\nG65 P9001 A.125 C.625 V10100.\nM30\n",
+        4,
+        &["G65", "macro call", "V10100."],
+    );
+    // Outside a macro call, V is still a parallel axis.
+    err_in(
+        Dialect::Fanuc,
+        "O2001\nG90 G20 G94\nG1 X0. Y0. Z0. F10.\nG1 V1.\nM30\n",
+        4,
+        &["V1.", "U, V or W"],
+    );
+}

@@ -2056,8 +2056,9 @@ impl<'a> Interpreter<'a> {
             return Err(self.error(
                 line,
                 format!(
-                    "{code} without axis words (all axes to the reference point) is not \
-                     supported: name the axes (`G91 {code} Z0`)"
+                    "{code} without axis words is read differently by the controls of this \
+                     dialect: a Haas returns every axis to its reference point, a Fanuc none; \
+                     name the axes the control returns (a Haas: `G91 {code} X0 Y0 Z0`)"
                 ),
             ));
         }

@@ -357,6 +357,13 @@ fn lex_letters(
             // An O word after other words (NX's DeVlieg post: `T00O00`) is no O-word statement,
             // whose `o…` starts its block: say so rather than naming control flow.
             let before: String = chars[..i].iter().collect::<String>().trim().to_string();
+            // A Fanuc macro call's arguments are letters A–Z (`G65 P9001 A.125 V10100.`:
+            // V is #22, no axis): name the call, which is what feedopt does not read.
+            if let Some(call) = macro_call(&before) {
+                return Err(format!(
+                    "{call}: a macro call (its letters are the macro's arguments:                      `{letter}{text_value}` is no axis word here); macro calls (G65/G66) are                      not supported: post the program with the macro's moves written out"
+                ));
+            }
             let numbered = before.strip_prefix(['N', 'n']).is_some_and(|rest| {
                 rest.trim().chars().all(|c| c.is_ascii_digit()) && !rest.trim().is_empty()
             });
@@ -405,6 +412,23 @@ fn lex_letters(
         i = end;
     }
     Ok(())
+}
+
+/// The `G65`/`G66` word (a Fanuc macro call) among the compacted words `before`, if any.
+fn macro_call(before: &str) -> Option<String> {
+    let upper = before.to_ascii_uppercase();
+    let chars: Vec<char> = upper.chars().collect();
+    (0..chars.len()).find_map(|k| {
+        if chars[k] != 'G' || (k > 0 && chars[k - 1].is_ascii_digit()) {
+            return None;
+        }
+        let digits: String = chars[k + 1..]
+            .iter()
+            .take_while(|c| c.is_ascii_digit() || **c == '.')
+            .collect();
+        let n: f64 = digits.parse().ok()?;
+        (n == 65.0 || n == 66.0).then(|| format!("G{digits}"))
+    })
 }
 
 /// End of a parameter name after `#`: digits, `<name>` or `[ … ]`.
