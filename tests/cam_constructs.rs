@@ -1888,7 +1888,9 @@ fn a_three_axis_machine_file_gives_the_work_offset_that_machine_positions_need()
     // G53 Z0 and the G28 reference (machine Z 0) are 400 mm above the program's Z0.
     assert_eq!(zs, vec![5.0, 400.0, 400.0, 400.0], "{zs:?}");
     assert!(
-        !tp.warnings.iter().any(|w| w.message.contains("work_offset")),
+        !tp.warnings
+            .iter()
+            .any(|w| w.message.contains("work_offset")),
         "{:?}",
         tp.warnings
     );

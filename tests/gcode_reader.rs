@@ -1496,7 +1496,11 @@ fn fanuc_comma_r_and_comma_c_cut_the_corner_to_the_next_move() {
     let arc: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 4).collect();
     assert!(arc.len() > 10, "{} points on the rounding", arc.len());
     for p in &arc {
-        assert!(((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9, "{:?}", p.p);
+        assert!(
+            ((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9,
+            "{:?}",
+            p.p
+        );
         assert!((programmed(p.feed) - 10.0).abs() < 1e-12);
     }
     assert_close(arc.last().unwrap().p, v(50.0, 5.0, 0.0), 1e-9);
@@ -1514,7 +1518,10 @@ fn fanuc_comma_r_and_comma_c_cut_the_corner_to_the_next_move() {
     // 150 mm less 10 − 5π/2 at the rounding (its chords a little shorter) and 6 − 3√2.
     let expected = 150.0 - (10.0 - 5.0 * std::f64::consts::FRAC_PI_2) - (6.0 - 3.0 * 2f64.sqrt());
     let got = polyline_length(&tp);
-    assert!(got < expected && got > expected - 1e-3, "{got} vs {expected}");
+    assert!(
+        got < expected && got > expected - 1e-3,
+        "{got} vs {expected}"
+    );
 }
 
 #[test]
@@ -1531,50 +1538,104 @@ fn sinumerik_rnd_chf_and_chr_cut_the_corner_to_the_next_move() {
         tp.warnings
     );
     for p in tp.points.iter().filter(|p| p.line == 3).skip(1) {
-        assert!(((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9, "{:?}", p.p);
+        assert!(
+            ((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9,
+            "{:?}",
+            p.p
+        );
     }
     // CHF=3 is the chamfer's own length: at a right angle it starts 3/√2 before the corner.
     let leg = 3.0 / 2f64.sqrt();
-    let chf: Vec<Vector3<f64>> = tp.points.iter().filter(|p| p.line == 4).map(|p| p.p).collect();
+    let chf: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.line == 4)
+        .map(|p| p.p)
+        .collect();
     assert_eq!(chf.len(), 2, "{chf:?}");
     assert_close(chf[0], v(50.0, 50.0 - leg, 0.0), 1e-12);
     assert_close(chf[1], v(50.0 - leg, 50.0, 0.0), 1e-12);
     assert!(((chf[1] - chf[0]).norm() - 3.0).abs() < 1e-12);
     // CHR=2 is the leg.
-    let chr: Vec<Vector3<f64>> = tp.points.iter().filter(|p| p.line == 5).map(|p| p.p).collect();
+    let chr: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.line == 5)
+        .map(|p| p.p)
+        .collect();
     assert_close(chr[0], v(2.0, 50.0, 0.0), 1e-12);
     assert_close(chr[1], v(0.0, 48.0, 0.0), 1e-12);
 }
 
 #[test]
 fn a_chamfer_or_rounding_feedopt_cannot_make_is_an_error_naming_its_word() {
-    let fanuc = |text: &str, line: usize, needles: &[&str]| err_in(Dialect::Fanuc, text, line, needles);
+    let fanuc =
+        |text: &str, line: usize, needles: &[&str]| err_in(Dialect::Fanuc, text, line, needles);
     let head = "O1000\nG90 G21 G94\nG1 X0. Y0. Z0. F600.\n";
     // Into an arc (round 16's college program), a rapid, or nothing.
-    fanuc(&format!("{head}G1 X50. ,R5.\nG3 X60. Y10. R10.\nM30\n"), 4, &[",R5.", "line 5", "arc"]);
-    fanuc(&format!("{head}G1 X50. ,C2.\nG0 Y50.\nM30\n"), 4, &[",C2.", "rapid"]);
+    fanuc(
+        &format!("{head}G1 X50. ,R5.\nG3 X60. Y10. R10.\nM30\n"),
+        4,
+        &[",R5.", "line 5", "arc"],
+    );
+    fanuc(
+        &format!("{head}G1 X50. ,C2.\nG0 Y50.\nM30\n"),
+        4,
+        &[",C2.", "rapid"],
+    );
     fanuc(&format!("{head}G1 X50. ,R5.\nM30\n"), 4, &[",R5.", "ends"]);
     // Larger than the moves allow (Fanuc alarms), or with a dwell between.
-    fanuc(&format!("{head}G1 X50. ,R60.\nG1 Y50.\nM30\n"), 4, &[",R60.", "too short"]);
-    fanuc(&format!("{head}G1 X50. ,R5.\nG4 X1.\nG1 Y50.\nM30\n"), 4, &[",R5.", "dwell"]);
+    fanuc(
+        &format!("{head}G1 X50. ,R60.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R60.", "too short"],
+    );
+    fanuc(
+        &format!("{head}G1 X50. ,R5.\nG4 X1.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R5.", "dwell"],
+    );
     // In line with the next move: no corner.
-    fanuc(&format!("{head}G1 X50. ,C2.\nG1 X80.\nM30\n"), 4, &[",C2.", "no corner"]);
+    fanuc(
+        &format!("{head}G1 X50. ,C2.\nG1 X80.\nM30\n"),
+        4,
+        &[",C2.", "no corner"],
+    );
     // On an arc, or a block that moves nothing.
-    fanuc(&format!("{head}G2 X20. Y0. R10. ,R2.\nG1 Y50.\nM30\n"), 4, &[",R2.", "straight"]);
-    fanuc(&format!("{head}G1 X50.\nM8 ,R2.\nG1 Y50.\nM30\n"), 5, &[",R2.", "straight move"]);
+    fanuc(
+        &format!("{head}G2 X20. Y0. R10. ,R2.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R2.", "straight"],
+    );
+    fanuc(
+        &format!("{head}G1 X50.\nM8 ,R2.\nG1 Y50.\nM30\n"),
+        5,
+        &[",R2.", "straight move"],
+    );
     // Sinumerik: modal rounding and a corner feed of its own are refused where they act.
-    let sin = |text: &str, line: usize, needles: &[&str]| {
-        err_in(Dialect::Sinumerik, text, line, needles)
-    };
-    sin("G71 G94\nG1 X0 Y0 Z0 F600\nRNDM=2\nG1 X50\nG1 Y50\n", 3, &["RNDM=", "modal"]);
-    sin("G71 G94\nG1 X0 Y0 Z0 F600\nG1 X50 RND=2 FRC=100\nG1 Y50\n", 3, &["FRC=", "feed"]);
+    let sin =
+        |text: &str, line: usize, needles: &[&str]| err_in(Dialect::Sinumerik, text, line, needles);
+    sin(
+        "G71 G94\nG1 X0 Y0 Z0 F600\nRNDM=2\nG1 X50\nG1 Y50\n",
+        3,
+        &["RNDM=", "modal"],
+    );
+    sin(
+        "G71 G94\nG1 X0 Y0 Z0 F600\nG1 X50 RND=2 FRC=100\nG1 Y50\n",
+        3,
+        &["FRC=", "feed"],
+    );
     let tp = ok_in(
         Dialect::Sinumerik,
         "G71 G94\nG1 X0 Y0 Z0 F600\nRNDM=0 FRC=0\nG1 X50\nG1 Y50\n",
     );
     assert_eq!(tp.points.len(), 3);
-    // LinuxCNC has no such words: the comma stays an error.
-    err("G21 G1 X0 Y0 Z0 F600\nG1 X50 ,R5\nG1 Y50\n", 2, &[","]);
+    // LinuxCNC has no such words: the comma stays an error, which names the Fanuc dialect.
+    err(
+        "G21 G1 X0 Y0 Z0 F600\nG1 X50 ,R5\nG1 Y50\n",
+        2,
+        &[",R", "--dialect fanuc"],
+    );
 }
 
 #[test]

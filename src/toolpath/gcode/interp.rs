@@ -2519,7 +2519,9 @@ impl<'a> Interpreter<'a> {
             let what = if is_arc {
                 Some("an arc: a chamfer or rounding into an arc is not modelled")
             } else if motion == Motion::Rapid {
-                Some("a rapid (G0): the control makes a chamfer or rounding between feed moves only")
+                Some(
+                    "a rapid (G0): the control makes a chamfer or rounding between feed moves only",
+                )
             } else if machine {
                 Some("a machine-coordinate move")
             } else if between {

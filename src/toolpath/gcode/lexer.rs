@@ -260,9 +260,11 @@ fn lex_letters(
                 Some('R') => super::dialect::CornerWord::Round,
                 Some('C') => super::dialect::CornerWord::ChamferLeg,
                 _ => {
-                    return Err("`,` not followed by C or R: `,C` (a chamfer) and `,R` (a corner \
+                    return Err(
+                        "`,` not followed by C or R: `,C` (a chamfer) and `,R` (a corner \
                                 rounding) are the only words written with a comma"
-                        .to_string());
+                            .to_string(),
+                    );
                 }
             };
             let letter = letter.unwrap_or('R');
@@ -288,6 +290,19 @@ fn lex_letters(
         if !c.is_ascii_alphabetic() {
             return Err(match c {
                 '[' | ']' => "an expression `[ … ]` must follow a letter or `=`".to_string(),
+                // Fanuc's chamfer and corner rounding in a dialect that has none.
+                ',' if chars
+                    .get(i + 1)
+                    .is_some_and(|n| matches!(n.to_ascii_uppercase(), 'C' | 'R')) =>
+                {
+                    format!(
+                        "`,{}`: {} has no comma words; `,C` (a chamfer) and `,R` (a corner \
+                         rounding) are Fanuc's and Haas': if this is their program, read it \
+                         with --dialect fanuc",
+                        chars[i + 1].to_ascii_uppercase(),
+                        spec.name
+                    )
+                }
                 // Block delete `/` is read at the start of a block (`super::interp`); a second
                 // one or one further in is not G-code (MillMaster Pro programs comment with
                 // `//`).
