@@ -71,7 +71,7 @@ struct Block {
 /// A chamfer or rounding asked for at the end of a straight move, made when the next move is
 /// read ([`Interpreter::corner_to`]).
 #[derive(Debug, Clone)]
-struct PendingCorner {
+pub(super) struct PendingCorner {
     line: usize,
     text: String,
     word: CornerWord,
@@ -81,6 +81,8 @@ struct PendingCorner {
     /// may come between the two moves.
     at: usize,
     counts: [usize; 3],
+    /// The corner's own feed, mm/s (Klartext `RND R5 F300`); `None`: the first move's.
+    feed: Option<f64>,
 }
 
 /// Where a Klartext arc's centre comes from.
@@ -227,7 +229,10 @@ pub(super) struct Interpreter<'a> {
     /// Klartext `M126`: rotary axes take the shorter way to an absolute position.
     shortest_path: bool,
     /// A corner the last straight move asked to chamfer or round, made by the next move.
-    corner: Option<PendingCorner>,
+    pub(super) corner: Option<PendingCorner>,
+    /// Where the last straight feed move of X Y Z ended (the point count then) and the dwell,
+    /// tool and spindle counts: a Klartext `RND`/`CHF` must follow it directly.
+    pub(super) straight_end: Option<(usize, [usize; 3])>,
     /// The Klartext state ([`heidenhain`]).
     klartext: heidenhain::State,
     /// What the reader assumed where the machine file is silent.
@@ -320,6 +325,7 @@ impl<'a> Interpreter<'a> {
             tangent: None,
             shortest_path: false,
             corner: None,
+            straight_end: None,
             klartext: heidenhain::State::default(),
             assumed: Assumed::default(),
             cycle_aliases: Vec::new(),
@@ -2510,12 +2516,7 @@ impl<'a> Interpreter<'a> {
         // be a straight feed move right after it.
         let corner = self.corner.take();
         if let Some(c) = &corner {
-            let between = self.points.len() != c.at + 1
-                || [
-                    self.dwells.len(),
-                    self.tool_changes.len(),
-                    self.spindle_changes.len(),
-                ] != c.counts;
+            let between = self.points.len() != c.at + 1 || self.event_counts() != c.counts;
             let what = if is_arc {
                 Some("an arc: a chamfer or rounding into an arc is not modelled")
             } else if motion == Motion::Rapid {
@@ -2781,6 +2782,7 @@ impl<'a> Interpreter<'a> {
                 ));
             }
             self.arc(line, motion, block, start, end)?;
+            self.straight_end = None;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
             // A G53 point is a machine position: outside the work offsets' check.
@@ -2849,6 +2851,8 @@ impl<'a> Interpreter<'a> {
             if let Some((text, word, num)) = &block.corner {
                 self.corner_from(line, text, *word, *num, pushed)?;
             }
+            self.straight_end = (motion == Motion::Linear && pushed == 1 && !machine)
+                .then(|| (self.points.len(), self.event_counts()));
             let (a, b) = (end[0] - start[0], end[1] - start[1]);
             let len = a.hypot(b);
             self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
@@ -2905,13 +2909,20 @@ impl<'a> Interpreter<'a> {
             word,
             size,
             at: self.points.len() - 1,
-            counts: [
-                self.dwells.len(),
-                self.tool_changes.len(),
-                self.spindle_changes.len(),
-            ],
+            counts: self.event_counts(),
+            feed: None,
         });
         Ok(())
+    }
+
+    /// The dwells, tool changes and spindle changes so far: a chamfer or rounding is made
+    /// only where none comes between its two moves.
+    pub(super) fn event_counts(&self) -> [usize; 3] {
+        [
+            self.dwells.len(),
+            self.tool_changes.len(),
+            self.spindle_changes.len(),
+        ]
     }
 
     /// Makes the chamfer or rounding `c` between the move that asked for it and the straight
@@ -2952,7 +2963,7 @@ impl<'a> Interpreter<'a> {
                 "a move that changes the tool's orientation: not modelled",
             ));
         }
-        let Feed::Programmed(feed) = p.feed else {
+        let Feed::Programmed(first) = p.feed else {
             return Err(self.corner_error(
                 &c,
                 line,
@@ -2963,6 +2974,7 @@ impl<'a> Interpreter<'a> {
         if !matches!(b.feed, Feed::Programmed(_)) {
             return Err(self.corner_error(&c, line, "not a feed move at a programmed feed"));
         }
+        let feed = c.feed.unwrap_or(first);
         let (d1, d2) = (p.p - a.p, b.p - p.p);
         let (l1, l2) = (d1.norm(), d2.norm());
         if l1 <= XYZ_MOVE_THRESHOLD_MM || l2 <= XYZ_MOVE_THRESHOLD_MM {
