@@ -406,6 +406,10 @@ pub struct References {
     /// The readers need it where a program moves in machine coordinates (`G53`, `G28`/`G30`
     /// to the reference point, `SUPA`, `M91`).
     pub work_offset: Option<[f64; 3]>,
+    /// `"g28_without_axes": "all"`: a `G28`/`G30` without axis words returns every axis to its
+    /// reference point, as a Haas does (a Fanuc returns none); without it such a block is an
+    /// error in the dialects that do not say (Fanuc).
+    pub g28_all_axes: bool,
 }
 
 /// How a Fanuc control reads an axis word written without a decimal point (`X100`):
@@ -636,6 +640,19 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             ));
         }
     };
+    let g28_all_axes = match value.get("g28_without_axes") {
+        None => false,
+        Some(Value::String(u)) if u == "all" => true,
+        Some(v) => {
+            return Err(parser.err(
+                "g28_without_axes",
+                format!(
+                    "expected \"all\" (a G28 or G30 without axis words returns every axis to \
+                     its reference point, as a Haas does), found {v}"
+                ),
+            ));
+        }
+    };
     Ok(References {
         file: source.to_path_buf(),
         axes,
@@ -645,6 +662,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         feed_diameter,
         shortest_way,
         work_offset,
+        g28_all_axes,
     })
 }
 
@@ -865,6 +883,7 @@ impl Parser {
                 "program_units",
                 "decimal_point_input",
                 "work_offset",
+                "g28_without_axes",
             ],
         )?;
         let name = match obj.get("name") {

@@ -123,6 +123,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         reference,
         work_offset,
         work_offset_given: true,
+        g28_all_axes: false,
         travel: Default::default(),
         m92: [None; 3],
         program_units: None,
@@ -306,6 +307,21 @@ fn bare_g28_and_g30_send_every_axis_home_on_linuxcnc() {
         text.contains("Haas") && text.contains("`G91 G28 X0 Y0 Z0`"),
         "{text}"
     );
+    // A Haas's machine file says so: every axis goes straight to its reference point.
+    let haas = MachineContext {
+        g28_all_axes: true,
+        ..m.clone()
+    };
+    let tp = parse_for(
+        Path::new("t.nc"),
+        "G90 G0 X10. Y10. Z5.\nG28\n",
+        Dialect::Fanuc.spec(),
+        Some(&haas),
+    )
+    .unwrap();
+    let last = tp.points.last().unwrap();
+    assert_eq!(last.feed, Feed::Rapid);
+    assert_eq!(last.p, v(-200.0, 0.0, 50.0));
 }
 
 #[test]
@@ -1911,6 +1927,7 @@ fn a_three_axis_machine_file_gives_the_work_offset_that_machine_positions_need()
     for (extra, says) in [
         (r#", "work_offset": [0, 0]"#, "work_offset"),
         (r#", "work_offset": [0, 0, 1e9]"#, "work_offset[2]"),
+        (r#", "g28_without_axes": "none""#, "g28_without_axes"),
     ] {
         let text = json(extra);
         let m = Machine::from_json(Path::new("m.json"), &text).unwrap();

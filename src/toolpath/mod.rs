@@ -316,6 +316,9 @@ pub struct MachineContext {
     /// The machine file gives the work offset (a trunnion's `kinematics.work-offset`, which
     /// defaults to zero, counts as given; else the file's `work_offset`).
     pub work_offset_given: bool,
+    /// A `G28`/`G30` without axis words returns every axis (the machine file's
+    /// `"g28_without_axes": "all"`, a Haas), in every dialect.
+    pub g28_all_axes: bool,
     /// Travel `(min, max)` per axis X Y Z A B C, machine coordinates (mm, degrees), where the
     /// machine file gives it (Heidenhain `M140 MB MAX` retracts Z to its max).
     pub travel: [Option<(f64, f64)>; 6],
@@ -384,6 +387,7 @@ impl MachineContext {
             reference,
             work_offset,
             work_offset_given,
+            g28_all_axes: references.g28_all_axes,
             travel,
             m92: std::array::from_fn(|i| {
                 references

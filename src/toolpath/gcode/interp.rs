@@ -2050,7 +2050,9 @@ impl<'a> Interpreter<'a> {
         };
         let code = if k == 1 { "G28" } else { "G30" };
         let mut named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
-        if named.is_empty() && self.spec.bare_reference_moves_all {
+        if named.is_empty()
+            && (self.spec.bare_reference_moves_all || self.machine.is_some_and(|m| m.g28_all_axes))
+        {
             // LinuxCNC: straight to the stored position, every axis the machine has (X Y Z
             // where the machine file is not known).
             named = match self.machine.and_then(|m| m.axes.as_ref()) {
@@ -2064,7 +2066,8 @@ impl<'a> Interpreter<'a> {
                 format!(
                     "{code} without axis words is read differently by the controls of this \
                      dialect: a Haas returns every axis to its reference point, a Fanuc none; \
-                     name the axes the control returns (a Haas: `G91 {code} X0 Y0 Z0`)"
+                     name the axes the control returns (a Haas: `G91 {code} X0 Y0 Z0`), or set \
+                     \"g28_without_axes\": \"all\" in the machine file of a Haas"
                 ),
             ));
         }
