@@ -29,8 +29,11 @@
 //! coordinates until set, and a Fanuc's machine zero is set at its reference position; they
 //! say so (a warning naming `axes.Z.reference`, the summary's `reference` line). Machine
 //! coordinates (`G28`, `G53`, Sinumerik `SUPA`, Heidenhain `M91`) are program coordinates plus
-//! the kinematics' `work-offset` (trunnion tables) or, for every other kinematics, the program
-//! coordinates themselves. X, Y and Z may give Heidenhain's **M92 datum**, `"m92": 180.0`
+//! the kinematics' `work-offset` (trunnion tables) or, for every other kinematics, the file's
+//! top-level `"work_offset": [x, y, z]` (mm: the machine coordinates of the program's origin,
+//! the G54 offset; [`References::work_offset`]); where a program moves in machine coordinates
+//! and the file gives neither, they are the program coordinates themselves, with a warning
+//! naming `work_offset` (`G53 Z0`, the top of Z's travel, is otherwise the part's Z0). X, Y and Z may give Heidenhain's **M92 datum**, `"m92": 180.0`
 //! (machine coordinates, mm), the machine builder's: an `M92` block's coordinates are relative
 //! to it (machine zero, with a warning, where the file gives none). A rotary axis may give the
 //! **diameter its feed is taken at**, `"feed_diameter": 50.0` (mm; Haas settings 34 and 79, the
@@ -397,6 +400,16 @@ pub struct References {
     /// that reaches an absolute position the shorter way, modulo 360° (Sinumerik MD30455 bit
     /// 2, Fanuc parameter 1008 ROA with RAB = 0, LinuxCNC `WRAPPED_ROTARY`).
     pub shortest_way: Vec<String>,
+    /// `"work_offset"` [x, y, z]: where the program's origin lies in machine coordinates, mm
+    /// (the work offset in force, G54's: machine coordinates minus program coordinates), for
+    /// the kinematics that have no `work-offset` of their own; `None`: the file does not say.
+    /// The readers need it where a program moves in machine coordinates (`G53`, `G28`/`G30`
+    /// to the reference point, `SUPA`, `M91`).
+    pub work_offset: Option<[f64; 3]>,
+    /// `"g28_without_axes": "all"`: a `G28`/`G30` without axis words returns every axis to its
+    /// reference point, as a Haas does (a Fanuc returns none); without it such a block is an
+    /// error in the dialects that do not say (Fanuc).
+    pub g28_all_axes: bool,
 }
 
 /// How a Fanuc control reads an axis word written without a decimal point (`X100`):
@@ -585,6 +598,61 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             ));
         }
     };
+    let work_offset = match value.get("work_offset") {
+        None => None,
+        Some(_) if matches!(machine.kinematics, KinematicsSpec::TableTable { .. }) => {
+            return Err(parser.err(
+                "work_offset",
+                "a trunnion table gives its work offset as kinematics.work-offset: give it there",
+            ));
+        }
+        Some(_) if machine.kinematics == KinematicsSpec::Joint => {
+            return Err(parser.err(
+                "work_offset",
+                "a joint-space path has no program coordinates: remove it",
+            ));
+        }
+        Some(Value::Array(items)) if items.len() == 3 => {
+            let mut w = [0.0; 3];
+            for (k, v) in items.iter().enumerate() {
+                let field = format!("work_offset[{k}]");
+                let d = parser.number(Some(v), &field)?;
+                if d.abs() > MAX_LENGTH {
+                    return Err(parser.err(
+                        &field,
+                        format!(
+                            "{} mm is beyond ±{MAX_LENGTH:e} mm",
+                            crate::error::number(d)
+                        ),
+                    ));
+                }
+                w[k] = d;
+            }
+            Some(w)
+        }
+        Some(v) => {
+            return Err(parser.err(
+                "work_offset",
+                format!(
+                    "expected [x, y, z]: the machine coordinates of the program's origin (the \
+                     G54 offset), mm, found {v}"
+                ),
+            ));
+        }
+    };
+    let g28_all_axes = match value.get("g28_without_axes") {
+        None => false,
+        Some(Value::String(u)) if u == "all" => true,
+        Some(v) => {
+            return Err(parser.err(
+                "g28_without_axes",
+                format!(
+                    "expected \"all\" (a G28 or G30 without axis words returns every axis to \
+                     its reference point, as a Haas does), found {v}"
+                ),
+            ));
+        }
+    };
     Ok(References {
         file: source.to_path_buf(),
         axes,
@@ -593,6 +661,8 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
         decimal_point_input,
         feed_diameter,
         shortest_way,
+        work_offset,
+        g28_all_axes,
     })
 }
 
@@ -812,6 +882,8 @@ impl Parser {
                 "process",
                 "program_units",
                 "decimal_point_input",
+                "work_offset",
+                "g28_without_axes",
             ],
         )?;
         let name = match obj.get("name") {

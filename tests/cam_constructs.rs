@@ -122,6 +122,8 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         axes: Some(axes.chars().collect()),
         reference,
         work_offset,
+        work_offset_given: true,
+        g28_all_axes: false,
         travel: Default::default(),
         m92: [None; 3],
         program_units: None,
@@ -297,7 +299,29 @@ fn bare_g28_and_g30_send_every_axis_home_on_linuxcnc() {
         Some(&m),
     )
     .unwrap_err();
-    assert!(message(e).contains("t.nc:2: G28 without axis words"));
+    let text = message(e);
+    assert!(text.contains("t.nc:2: G28 without axis words"), "{text}");
+    // Round 16: three Haas student programs start with a bare `G28`, which a Haas reads as
+    // every axis home; the message said to name Z alone.
+    assert!(
+        text.contains("Haas") && text.contains("`G91 G28 X0 Y0 Z0`"),
+        "{text}"
+    );
+    // A Haas's machine file says so: every axis goes straight to its reference point.
+    let haas = MachineContext {
+        g28_all_axes: true,
+        ..m.clone()
+    };
+    let tp = parse_for(
+        Path::new("t.nc"),
+        "G90 G0 X10. Y10. Z5.\nG28\n",
+        Dialect::Fanuc.spec(),
+        Some(&haas),
+    )
+    .unwrap();
+    let last = tp.points.last().unwrap();
+    assert_eq!(last.feed, Feed::Rapid);
+    assert_eq!(last.p, v(-200.0, 0.0, 50.0));
 }
 
 #[test]
@@ -1841,4 +1865,88 @@ fn a_fanuc_g50_spindle_limit_names_a_turning_program() {
         "G21 G90 G17 G40 G49 G50 G80\nG0 X1. Y2. Z3.\n",
     );
     assert_eq!(tp.points.last().unwrap().p.x, 1.0);
+}
+
+/// Round 16: a Haas/Mastercam 3-axis program retracts with `G53 G0 Z0.` (the top of Z's
+/// travel) and `G28 G91 Z0.`; on a three-axis machine file the machine position was read as
+/// the same program position, Z0 on the part's top face, with a warning that named no way to
+/// say otherwise: the retracts (2.5 m of 8.6 m in a 767-line program) were lost. The machine
+/// file's `work_offset` [x, y, z] (the program origin's machine coordinates, the G54 offset)
+/// now places them, and where it is missing the warning names it.
+#[test]
+fn a_three_axis_machine_file_gives_the_work_offset_that_machine_positions_need() {
+    use feedopt::machine::{Machine, references_from_json};
+    use feedopt::toolpath::MachineContext;
+    use feedopt::toolpath::gcode::{Dialect, parse_for};
+    use std::path::Path;
+    let json = |extra: &str| {
+        format!(
+            r#"{{"name": "vmc", "kinematics": {{"type": "xyz"}}{extra},
+                "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
+                         "Y": {{"velocity": 500, "acceleration": 3000}},
+                         "Z": {{"velocity": 500, "acceleration": 3000, "reference": 0}}}}}}"#
+        )
+    };
+    let read = |text: &str| {
+        let m = Machine::from_json(Path::new("m.json"), text).unwrap();
+        let refs = references_from_json(Path::new("m.json"), text, &m).unwrap();
+        let ctx = MachineContext::new(&m, &refs);
+        parse_for(
+            Path::new("p.nc"),
+            "O1000\nG90 G21 G94\nG0 X10. Y20. Z5.\nG53 G0 Z0.\nG0 X30.\nG91 G28 Z0.\nM30\n",
+            Dialect::Fanuc.spec(),
+            Some(&ctx),
+        )
+        .unwrap()
+    };
+    let tp = read(&json(r#", "work_offset": [-250, -200, -400]"#));
+    let zs: Vec<f64> = tp.points.iter().map(|p| p.p.z).collect();
+    // G53 Z0 and the G28 reference (machine Z 0) are 400 mm above the program's Z0.
+    assert_eq!(zs, vec![5.0, 400.0, 400.0, 400.0], "{zs:?}");
+    assert!(
+        !tp.warnings
+            .iter()
+            .any(|w| w.message.contains("work_offset")),
+        "{:?}",
+        tp.warnings
+    );
+    // Without it: read as before (program Z0), and said, naming the field.
+    let tp = read(&json(""));
+    let zs: Vec<f64> = tp.points.iter().map(|p| p.p.z).collect();
+    assert_eq!(zs, vec![5.0, 0.0, 0.0, 0.0], "{zs:?}");
+    for line in [4, 6] {
+        assert!(
+            tp.warnings
+                .iter()
+                .any(|w| w.line == line && w.message.contains("\"work_offset\"")),
+            "line {line}: {:?}",
+            tp.warnings
+        );
+    }
+    // A bad value names the field; a trunnion gives its own.
+    for (extra, says) in [
+        (r#", "work_offset": [0, 0]"#, "work_offset"),
+        (r#", "work_offset": [0, 0, 1e9]"#, "work_offset[2]"),
+        (r#", "g28_without_axes": "none""#, "g28_without_axes"),
+    ] {
+        let text = json(extra);
+        let m = Machine::from_json(Path::new("m.json"), &text).unwrap();
+        let e = references_from_json(Path::new("m.json"), &text, &m)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e}");
+    }
+    let trt = r#"{"name": "trt", "kinematics": {"type": "table_table_ac", "x-rot-point": 0,
+        "y-rot-point": 0, "z-rot-point": 0, "y-offset": 0, "z-offset": 0},
+        "work_offset": [0, 0, -400],
+        "axes": {"X": {"velocity": 100, "acceleration": 1000},
+                 "Y": {"velocity": 100, "acceleration": 1000},
+                 "Z": {"velocity": 100, "acceleration": 1000},
+                 "A": {"velocity": 100, "acceleration": 1000},
+                 "C": {"velocity": 100, "acceleration": 1000}}}"#;
+    let m = Machine::from_json(Path::new("m.json"), trt).unwrap();
+    let e = references_from_json(Path::new("m.json"), trt, &m)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("kinematics.work-offset"), "{e}");
 }

@@ -1470,3 +1470,212 @@ fn an_o_word_after_other_words_is_named_as_such() {
     );
     err("G21 G90\nN8 O00\n", 2, &["O-word control flow"]);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Chamfers and roundings between straight moves (Fanuc `,C` `,R`, Sinumerik `CHR=` `CHF=` `RND=`)
+// ---------------------------------------------------------------------------------------------
+
+/// The length of the polyline through the points.
+fn polyline_length(tp: &Toolpath) -> f64 {
+    tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum()
+}
+
+#[test]
+fn fanuc_comma_r_and_comma_c_cut_the_corner_to_the_next_move() {
+    // Round 16: a hand-written Fanuc program (`G01 X 92 Y 50, R 15;`) was refused at the comma
+    // ("unexpected character"); Haas and Fanuc round the corner with an arc of radius R tangent
+    // to both moves, and `,C` chamfers it from C before to C after the corner.
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "O1000\nG90 G21 G94\nG1 X0. Y0. Z0. F600.\nG1 X50. , R 5.\nG1 Y50. ,C3.\nG1 X0.\nM30\n",
+    );
+    let ps: Vec<Vector3<f64>> = tp.points.iter().map(|p| p.p).collect();
+    // The first move stops 5 mm short of the corner; the arc about (45, 5) ends 5 mm up the
+    // second, every chord end on the circle.
+    assert_close(ps[1], v(45.0, 0.0, 0.0), 1e-12);
+    let arc: Vec<&ClPoint> = tp.points.iter().filter(|p| p.line == 4).collect();
+    assert!(arc.len() > 10, "{} points on the rounding", arc.len());
+    for p in &arc {
+        assert!(
+            ((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9,
+            "{:?}",
+            p.p
+        );
+        assert!((programmed(p.feed) - 10.0).abs() < 1e-12);
+    }
+    assert_close(arc.last().unwrap().p, v(50.0, 5.0, 0.0), 1e-9);
+    // The chamfer: from 3 mm before (50, 50) to 3 mm after it.
+    let chamfer: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.line == 5)
+        .map(|p| p.p)
+        .collect();
+    assert_eq!(chamfer.len(), 2, "{chamfer:?}");
+    assert_close(chamfer[0], v(50.0, 47.0, 0.0), 1e-12);
+    assert_close(chamfer[1], v(47.0, 50.0, 0.0), 1e-12);
+    assert_close(*ps.last().unwrap(), v(0.0, 50.0, 0.0), 1e-12);
+    // 150 mm less 10 − 5π/2 at the rounding (its chords a little shorter) and 6 − 3√2.
+    let expected = 150.0 - (10.0 - 5.0 * std::f64::consts::FRAC_PI_2) - (6.0 - 3.0 * 2f64.sqrt());
+    let got = polyline_length(&tp);
+    assert!(
+        got < expected && got > expected - 1e-3,
+        "{got} vs {expected}"
+    );
+}
+
+#[test]
+fn sinumerik_rnd_chf_and_chr_cut_the_corner_to_the_next_move() {
+    // They were unknown words skipped with a warning: the corners stayed sharp, a path the
+    // control does not run.
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G90 G71 G94\nG1 X0 Y0 Z0 F600\nG1 X50 RND=5\nG1 Y50 CHF=3\nG1 X0 CHR=2\nG1 Y0\nM30\n",
+    );
+    assert!(
+        !tp.warnings.iter().any(|w| w.message.contains("unknown")),
+        "{:?}",
+        tp.warnings
+    );
+    for p in tp.points.iter().filter(|p| p.line == 3).skip(1) {
+        assert!(
+            ((p.p - v(45.0, 5.0, 0.0)).norm() - 5.0).abs() < 1e-9,
+            "{:?}",
+            p.p
+        );
+    }
+    // CHF=3 is the chamfer's own length: at a right angle it starts 3/√2 before the corner.
+    let leg = 3.0 / 2f64.sqrt();
+    let chf: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.line == 4)
+        .map(|p| p.p)
+        .collect();
+    assert_eq!(chf.len(), 2, "{chf:?}");
+    assert_close(chf[0], v(50.0, 50.0 - leg, 0.0), 1e-12);
+    assert_close(chf[1], v(50.0 - leg, 50.0, 0.0), 1e-12);
+    assert!(((chf[1] - chf[0]).norm() - 3.0).abs() < 1e-12);
+    // CHR=2 is the leg.
+    let chr: Vec<Vector3<f64>> = tp
+        .points
+        .iter()
+        .filter(|p| p.line == 5)
+        .map(|p| p.p)
+        .collect();
+    assert_close(chr[0], v(2.0, 50.0, 0.0), 1e-12);
+    assert_close(chr[1], v(0.0, 48.0, 0.0), 1e-12);
+}
+
+#[test]
+fn a_chamfer_or_rounding_feedopt_cannot_make_is_an_error_naming_its_word() {
+    let fanuc =
+        |text: &str, line: usize, needles: &[&str]| err_in(Dialect::Fanuc, text, line, needles);
+    let head = "O1000\nG90 G21 G94\nG1 X0. Y0. Z0. F600.\n";
+    // Into an arc (round 16's college program), a rapid, or nothing.
+    fanuc(
+        &format!("{head}G1 X50. ,R5.\nG3 X60. Y10. R10.\nM30\n"),
+        4,
+        &[",R5.", "line 5", "arc"],
+    );
+    fanuc(
+        &format!("{head}G1 X50. ,C2.\nG0 Y50.\nM30\n"),
+        4,
+        &[",C2.", "rapid"],
+    );
+    fanuc(&format!("{head}G1 X50. ,R5.\nM30\n"), 4, &[",R5.", "ends"]);
+    // Larger than the moves allow (Fanuc alarms), or with a dwell between.
+    fanuc(
+        &format!("{head}G1 X50. ,R60.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R60.", "too short"],
+    );
+    fanuc(
+        &format!("{head}G1 X50. ,R5.\nG4 X1.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R5.", "dwell"],
+    );
+    // In line with the next move: no corner.
+    fanuc(
+        &format!("{head}G1 X50. ,C2.\nG1 X80.\nM30\n"),
+        4,
+        &[",C2.", "no corner"],
+    );
+    // On an arc, or a block that moves nothing.
+    fanuc(
+        &format!("{head}G2 X20. Y0. R10. ,R2.\nG1 Y50.\nM30\n"),
+        4,
+        &[",R2.", "straight"],
+    );
+    fanuc(
+        &format!("{head}G1 X50.\nM8 ,R2.\nG1 Y50.\nM30\n"),
+        5,
+        &[",R2.", "straight move"],
+    );
+    // Sinumerik: modal rounding and a corner feed of its own are refused where they act.
+    let sin =
+        |text: &str, line: usize, needles: &[&str]| err_in(Dialect::Sinumerik, text, line, needles);
+    sin(
+        "G71 G94\nG1 X0 Y0 Z0 F600\nRNDM=2\nG1 X50\nG1 Y50\n",
+        3,
+        &["RNDM=", "modal"],
+    );
+    sin(
+        "G71 G94\nG1 X0 Y0 Z0 F600\nG1 X50 RND=2 FRC=100\nG1 Y50\n",
+        3,
+        &["FRC=", "feed"],
+    );
+    let tp = ok_in(
+        Dialect::Sinumerik,
+        "G71 G94\nG1 X0 Y0 Z0 F600\nRNDM=0 FRC=0\nG1 X50\nG1 Y50\n",
+    );
+    assert_eq!(tp.points.len(), 3);
+    // LinuxCNC has no such words: the comma stays an error, which names the Fanuc dialect.
+    err(
+        "G21 G1 X0 Y0 Z0 F600\nG1 X50 ,R5\nG1 Y50\n",
+        2,
+        &[",R", "--dialect fanuc"],
+    );
+}
+
+#[test]
+fn sinumerik_words_that_set_an_end_point_or_the_orientation_another_way_are_errors() {
+    // Round 16: each was an unknown word skipped with a warning: `G1 X60 ANG=30` went to X60
+    // alone, and under TRAORI `A2= B2= C2=` or `LEAD= TILT=` left the tool where the last
+    // block had it, while the control turns the rotary axes to them.
+    let sin = |word: &str, needle: &str| {
+        err_in(
+            Dialect::Sinumerik,
+            &format!("G71 G94\nG1 X0 Y0 Z0 F600\nTRAORI\nG1 X50 {word}\nG1 Y50\n"),
+            4,
+            &[needle],
+        )
+    };
+    sin("ANG=30", "ANG=");
+    sin("A2=10 B2=20 C2=0", "A2=");
+    sin("LEAD=10 TILT=5", "LEAD=");
+    sin("THETA=30", "THETA=");
+    sin("PHI=10", "PHI=");
+    sin("A4=0 B4=0 C4=1", "A4=");
+    sin("A5=0", "A5=");
+    sin("XH=10 YH=0 ZH=5", "XH=");
+}
+
+#[test]
+fn a_macro_call_is_named_not_its_u_v_w_arguments() {
+    // Round 16: a Haas program's `G65 P9001 A.125 C.625 V10100.` was refused at `V10100.`
+    // as a parallel axis; the letters are the macro's arguments (V is #22).
+    err_in(
+        Dialect::Fanuc,
+        "O2001\nG90 G20 G94\nG1 X0. Y0. Z0. F10.\nG65 P9001 A.125 C.625 V10100.\nM30\n",
+        4,
+        &["G65", "macro call", "V10100."],
+    );
+    // Outside a macro call, V is still a parallel axis.
+    err_in(
+        Dialect::Fanuc,
+        "O2001\nG90 G20 G94\nG1 X0. Y0. Z0. F10.\nG1 V1.\nM30\n",
+        4,
+        &["V1.", "U, V or W"],
+    );
+}

@@ -406,8 +406,14 @@ pub struct MachineContext {
     /// is `G28`'s, the second `G30`'s, … (empty: the file gives none).
     pub reference: [Vec<f64>; 6],
     /// Machine coordinates minus program coordinates, X Y Z, mm (the trunnion kinematics'
-    /// `work-offset`; zero for every other kinematics).
+    /// `work-offset`, else the machine file's `work_offset`; zero where neither is given).
     pub work_offset: [f64; 3],
+    /// The machine file gives the work offset (a trunnion's `kinematics.work-offset`, which
+    /// defaults to zero, counts as given; else the file's `work_offset`).
+    pub work_offset_given: bool,
+    /// A `G28`/`G30` without axis words returns every axis (the machine file's
+    /// `"g28_without_axes": "all"`, a Haas), in every dialect.
+    pub g28_all_axes: bool,
     /// Travel `(min, max)` per axis X Y Z A B C, machine coordinates (mm, degrees), where the
     /// machine file gives it (Heidenhain `M140 MB MAX` retracts Z to its max).
     pub travel: [Option<(f64, f64)>; 6],
@@ -456,9 +462,12 @@ impl MachineContext {
                 .map(|(_, r)| r.clone())
                 .unwrap_or_default()
         });
-        let work_offset = match &machine.kinematics {
-            KinematicsSpec::TableTable { params, .. } => params.work_offset,
-            _ => [0.0; 3],
+        let (work_offset, work_offset_given) = match &machine.kinematics {
+            KinematicsSpec::TableTable { params, .. } => (params.work_offset, true),
+            _ => match references.work_offset {
+                Some(w) => (w, true),
+                None => ([0.0; 3], false),
+            },
         };
         let travel = std::array::from_fn(|i| {
             machine
@@ -472,6 +481,8 @@ impl MachineContext {
             axes,
             reference,
             work_offset,
+            work_offset_given,
+            g28_all_axes: references.g28_all_axes,
             travel,
             m92: std::array::from_fn(|i| {
                 references

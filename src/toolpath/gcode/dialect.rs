@@ -164,6 +164,10 @@ pub enum Address {
     /// Klartext: the direction of a circular path, `DR+` (counter-clockwise, value +1) or
     /// `DR-` (clockwise, −1).
     ArcDirection,
+    /// A corner between this straight move and the next cut off as a chamfer or rounded:
+    /// Fanuc `,C` / `,R` (made by the lexer where [`DialectSpec::comma_corners`]), Sinumerik
+    /// `RND=`, `CHF=`, `CHR=` (and `RNDM=`, `FRC=`, `FRCM=`, read to refuse them).
+    Corner(CornerWord),
     /// Klartext: a polar angle about the pole `CC`, degrees; `true`: incremental (`IPA`).
     PolarAngle(bool),
     /// Klartext: a polar radius from the pole `CC`, mm; `true`: incremental (`IPR`).
@@ -183,6 +187,22 @@ pub enum Motion {
     Linear,
     ArcCw,
     ArcCcw,
+}
+
+/// What a corner word asks for ([`Address::Corner`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CornerWord {
+    /// A rounding arc of this radius, tangent to both moves (Fanuc `,R`, Sinumerik `RND=`).
+    Round,
+    /// Sinumerik `RNDM=`: rounding of every following corner (modal).
+    RoundModal,
+    /// A chamfer from this far before the corner to this far after it along the moves
+    /// (Fanuc `,C`, Sinumerik `CHR=`).
+    ChamferLeg,
+    /// A chamfer of this length (Sinumerik `CHF=`).
+    ChamferLength,
+    /// Sinumerik `FRC=` / `FRCM=`: the feed of a chamfer or rounding.
+    Feed,
 }
 
 /// Arc planes: XY (G17), ZX (G18), YZ (G19).
@@ -508,6 +528,9 @@ pub struct DialectSpec {
     pub cycle_repeat: &'static [char],
     /// What F means on a feed block that turns a rotary axis.
     pub rotary_feed: RotaryFeed,
+    /// `,C` and `,R` after a straight move chamfer or round the corner to the next one
+    /// (Fanuc's "chamfering and corner R", as Haas reads it too).
+    pub comma_corners: bool,
 }
 
 use Action::{
@@ -547,6 +570,24 @@ const UVW_FANUC: &str = concat!(
     ". On a Fanuc lathe (T series) U and W are X and Z incremental: then this is a turning \
      program, which feedopt does not read (it reads milling programs)"
 );
+/// Sinumerik words that set the tool's orientation other than by the rotary axes' positions or
+/// the tool vector `A3= B3= C3=` (round 16: they were unknown words, skipped with a warning,
+/// while under TRAORI the control turns the rotary axes to them).
+const ORI_ANGLES: &str = "tool orientation by angles (A2= B2= C2=: Euler, RPY or virtual-axis \
+                          angles) is not supported: post it as the rotary axes' positions or as \
+                          a tool vector A3= B3= C3=";
+const ORI_LEAD_TILT: &str = "tool orientation by lead and tilt angles (LEAD= TILT=) is not \
+                             supported: post it as the rotary axes' positions or as a tool \
+                             vector A3= B3= C3=";
+const ORI_CONE: &str = "orientation by rotation or cone angles (THETA= PHI= PSI=) is not \
+                        supported: post it as the rotary axes' positions or as a tool vector \
+                        A3= B3= C3=";
+const ORI_NORMALS: &str = "surface normal vectors (A4= B4= C4=, A5= B5= C5=) are not supported: \
+                           they steer 3D tool compensation and path-relative orientation, \
+                           which feedopt does not model";
+const ORI_CURVE: &str = "orientation by a second contour (XH= YH= ZH=, ORICURVE) is not \
+                         supported: post it as the rotary axes' positions or as a tool vector \
+                         A3= B3= C3=";
 /// Fanuc and LinuxCNC `G96`/`G97`: the spindle-speed mode only (feed mode is G94/G95's).
 const CSS_ON: Action = Action::SurfaceSpeed {
     on: true,
@@ -737,6 +778,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -922,6 +964,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Combined,
+    comma_corners: true,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -962,6 +1005,36 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
             "AR",
             Address::Unsupported("arcs by opening angle (AR=) are not supported"),
         ),
+        (
+            "ANG",
+            Address::Unsupported(
+                "a contour's end point by its angle (ANG=) is not supported: post the end \
+                 point's coordinates",
+            ),
+        ),
+        ("A2", Address::Unsupported(ORI_ANGLES)),
+        ("B2", Address::Unsupported(ORI_ANGLES)),
+        ("C2", Address::Unsupported(ORI_ANGLES)),
+        ("LEAD", Address::Unsupported(ORI_LEAD_TILT)),
+        ("TILT", Address::Unsupported(ORI_LEAD_TILT)),
+        ("THETA", Address::Unsupported(ORI_CONE)),
+        ("PHI", Address::Unsupported(ORI_CONE)),
+        ("PSI", Address::Unsupported(ORI_CONE)),
+        ("A4", Address::Unsupported(ORI_NORMALS)),
+        ("B4", Address::Unsupported(ORI_NORMALS)),
+        ("C4", Address::Unsupported(ORI_NORMALS)),
+        ("A5", Address::Unsupported(ORI_NORMALS)),
+        ("B5", Address::Unsupported(ORI_NORMALS)),
+        ("C5", Address::Unsupported(ORI_NORMALS)),
+        ("XH", Address::Unsupported(ORI_CURVE)),
+        ("YH", Address::Unsupported(ORI_CURVE)),
+        ("ZH", Address::Unsupported(ORI_CURVE)),
+        ("RND", Address::Corner(CornerWord::Round)),
+        ("RNDM", Address::Corner(CornerWord::RoundModal)),
+        ("CHF", Address::Corner(CornerWord::ChamferLength)),
+        ("CHR", Address::Corner(CornerWord::ChamferLeg)),
+        ("FRC", Address::Corner(CornerWord::Feed)),
+        ("FRCM", Address::Corner(CornerWord::Feed)),
         (
             "AP",
             Address::Unsupported("polar coordinates (AP=, RP=) are not supported"),
@@ -1162,6 +1235,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     units_by_setting: true,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1415,6 +1489,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     units_by_setting: false,
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
+    comma_corners: false,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

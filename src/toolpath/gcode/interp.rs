@@ -64,6 +64,25 @@ struct Block {
     arc_sweep: Option<f64>,
     /// Sinumerik `T="name"`.
     tool_name: Option<String>,
+    /// A corner word (Fanuc `,R5` / `,C3`, Sinumerik `RND=5`, `CHF=`, `CHR=`) as written.
+    corner: Option<(String, CornerWord, Num)>,
+}
+
+/// A chamfer or rounding asked for at the end of a straight move, made when the next move is
+/// read ([`Interpreter::corner_to`]).
+#[derive(Debug, Clone)]
+pub(super) struct PendingCorner {
+    line: usize,
+    text: String,
+    word: CornerWord,
+    /// Its size, mm (a radius, a chamfer's leg or its length).
+    size: f64,
+    /// The corner's index in the points, and the dwell, tool and spindle counts then: nothing
+    /// may come between the two moves.
+    at: usize,
+    counts: [usize; 3],
+    /// The corner's own feed, mm/s (Klartext `RND R5 F300`); `None`: the first move's.
+    feed: Option<f64>,
 }
 
 /// Where a Klartext arc's centre comes from.
@@ -209,6 +228,11 @@ pub(super) struct Interpreter<'a> {
     tangent: Option<(Plane, [f64; 2], usize)>,
     /// Klartext `M126`: rotary axes take the shorter way to an absolute position.
     shortest_path: bool,
+    /// A corner the last straight move asked to chamfer or round, made by the next move.
+    pub(super) corner: Option<PendingCorner>,
+    /// Where the last straight feed move of X Y Z ended (the point count then) and the dwell,
+    /// tool and spindle counts: a Klartext `RND`/`CHF` must follow it directly.
+    pub(super) straight_end: Option<(usize, [usize; 3])>,
     /// The Klartext state ([`heidenhain`]).
     klartext: heidenhain::State,
     /// What the reader assumed where the machine file is silent.
@@ -308,6 +332,8 @@ impl<'a> Interpreter<'a> {
             dwells: Vec::new(),
             tangent: None,
             shortest_path: false,
+            corner: None,
+            straight_end: None,
             klartext: heidenhain::State::default(),
             assumed: Assumed::default(),
             cycle_aliases: Vec::new(),
@@ -463,6 +489,16 @@ impl<'a> Interpreter<'a> {
     pub(super) fn finish(mut self, last_line: usize) -> Result<Toolpath> {
         if self.points.is_empty() {
             return Err(self.error(last_line.max(1), "no motion blocks"));
+        }
+        if let Some(c) = self.corner.take() {
+            return Err(self.error(
+                c.line,
+                format!(
+                    "`{}`: a chamfer or rounding needs a next move to meet, and the program \
+                     ends without one",
+                    c.text
+                ),
+            ));
         }
         if !self.saw_rotary {
             for p in &mut self.points {
@@ -697,6 +733,33 @@ impl<'a> Interpreter<'a> {
                             format!("unknown word `{text}` (not a {name} code): ignored"),
                         ),
                     }
+                }
+                Address::Corner(CornerWord::Feed) => {
+                    if num.value != 0.0 {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}`: a feed of its own for chamfers and roundings is not \
+                                 modelled (feedopt runs them at the F of the move that asks \
+                                 for them): remove it"
+                            ),
+                        ));
+                    }
+                }
+                Address::Corner(CornerWord::RoundModal) => {
+                    if num.value != 0.0 {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "`{text}`: modal rounding of every following corner is not \
+                                 supported: write RND= on the moves whose corners are rounded"
+                            ),
+                        ));
+                    }
+                }
+                Address::Corner(word) => {
+                    duplicate(block.corner.is_some())?;
+                    block.corner = Some((text, word, num));
                 }
                 Address::Ignored => {}
                 Address::Call => {
@@ -1351,6 +1414,17 @@ impl<'a> Interpreter<'a> {
         let has_axes = block.axes.iter().any(Option::is_some);
         let has_vector = block.vector.iter().any(Option::is_some);
         let has_centre = block.centre.iter().any(Option::is_some);
+        if let Some((text, ..)) = &block.corner
+            && (no_motion.is_some() || !has_axes || self.cycle.is_some())
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}`: a chamfer or rounding is written on a straight move (G1 with axis \
+                     words), where it cuts the corner to the next move; this block makes none"
+                ),
+            ));
+        }
         if self.cycle.is_some() && no_motion.is_none() && !machine {
             if new_cycle.is_some() || has_axes || block.radius.is_some() {
                 self.hole(line, &block)?;
@@ -1979,6 +2053,21 @@ impl<'a> Interpreter<'a> {
         0.0
     }
 
+    /// Where the machine file does not give the work offset a machine-coordinate move needs:
+    /// what that means and the field to set (else empty).
+    fn unknown_work_offset(&self) -> String {
+        match self.machine {
+            Some(c) if !c.work_offset_given => format!(
+                ": {} gives no work offset, so a machine position is read as the same position \
+                 in program coordinates (G53 Z0, the top of Z's travel, as the part's Z0); set \
+                 \"work_offset\": [x, y, z], the machine coordinates of the program's origin \
+                 (its G54 offset), mm",
+                c.file.display()
+            ),
+            _ => String::new(),
+        }
+    }
+
     /// Machine coordinates → program (frame) coordinates, X Y Z.
     fn machine_to_program(&self, m: Vector3<f64>) -> Vector3<f64> {
         let offset = self.machine.map_or([0.0; 3], |c| c.work_offset);
@@ -2008,7 +2097,9 @@ impl<'a> Interpreter<'a> {
         };
         let code = if k == 1 { "G28" } else { "G30" };
         let mut named: Vec<usize> = (0..6).filter(|&i| block.axes[i].is_some()).collect();
-        if named.is_empty() && self.spec.bare_reference_moves_all {
+        if named.is_empty()
+            && (self.spec.bare_reference_moves_all || self.machine.is_some_and(|m| m.g28_all_axes))
+        {
             // LinuxCNC: straight to the stored position, every axis the machine has (X Y Z
             // where the machine file is not known).
             named = match self.machine.and_then(|m| m.axes.as_ref()) {
@@ -2020,8 +2111,10 @@ impl<'a> Interpreter<'a> {
             return Err(self.error(
                 line,
                 format!(
-                    "{code} without axis words (all axes to the reference point) is not \
-                     supported: name the axes (`G91 {code} Z0`)"
+                    "{code} without axis words is read differently by the controls of this \
+                     dialect: a Haas returns every axis to its reference point, a Fanuc none; \
+                     name the axes the control returns (a Haas: `G91 {code} X0 Y0 Z0`), or set \
+                     \"g28_without_axes\": \"all\" in the machine file of a Haas"
                 ),
             ));
         }
@@ -2067,6 +2160,15 @@ impl<'a> Interpreter<'a> {
             } else {
                 // A machine coordinate, as the program coordinate the offsets take to it.
                 target[i] = r - self.offsets.shift()[i];
+            }
+        }
+        if named.iter().any(|&i| i < 3) {
+            let unknown = self.unknown_work_offset();
+            if !unknown.is_empty() {
+                self.warn(
+                    line,
+                    format!("{code}: the reference point is a machine position{unknown}"),
+                );
             }
         }
         if !defaulted.is_empty() {
@@ -2471,6 +2573,44 @@ impl<'a> Interpreter<'a> {
         if machine && is_arc {
             return Err(self.error(line, "G53/SUPA/M91 (machine coordinates) with an arc"));
         }
+        // A chamfer or rounding asked for by the last move is made with this one, which must
+        // be a straight feed move right after it.
+        let corner = self.corner.take();
+        if let Some(c) = &corner {
+            let between = self.points.len() != c.at + 1 || self.event_counts() != c.counts;
+            let what = if is_arc {
+                Some("an arc: a chamfer or rounding into an arc is not modelled")
+            } else if motion == Motion::Rapid {
+                Some(
+                    "a rapid (G0): the control makes a chamfer or rounding between feed moves only",
+                )
+            } else if machine {
+                Some("a machine-coordinate move")
+            } else if between {
+                Some(
+                    "a move that does not follow it directly (a dwell, a cycle, a reference \
+                     move, a tool or spindle change between): not modelled",
+                )
+            } else {
+                None
+            };
+            if let Some(what) = what {
+                return Err(self.corner_error(&c.clone(), line, what));
+            }
+        }
+        if let Some((text, ..)) = &block.corner
+            && (is_arc || motion != Motion::Linear || machine)
+        {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}`: a chamfer or rounding is read after a straight feed move (G1) \
+                     only; on an arc, a rapid or a machine-coordinate move it is not modelled: \
+                     post the corner as its own move"
+                ),
+            ));
+        }
+        let points_before = self.points.len();
         if block.plane_rotary.iter().any(|&q| q) {
             if self.swivel.is_none() {
                 return Err(self.error(
@@ -2608,10 +2748,11 @@ impl<'a> Interpreter<'a> {
             } else {
                 "G53/SUPA/M91: machine-coordinate move, taken as"
             };
+            let unknown = self.unknown_work_offset();
             self.warn(
                 line,
                 format!(
-                    "{what} program coordinates + the work offset ({}, {}, {}) mm",
+                    "{what} program coordinates + the work offset ({}, {}, {}) mm{unknown}",
                     offset[0], offset[1], offset[2]
                 ),
             );
@@ -2708,6 +2849,7 @@ impl<'a> Interpreter<'a> {
                 ));
             }
             self.arc(line, motion, block, start, end)?;
+            self.straight_end = None;
         } else {
             let feed = self.linear_feed(line, motion, block, &start, &end)?;
             // A G53 point is a machine position: outside the work offsets' check.
@@ -2776,6 +2918,15 @@ impl<'a> Interpreter<'a> {
                 });
             }
             self.machine_point = false;
+            let pushed = self.points.len() - points_before;
+            if let Some(c) = corner {
+                self.corner_to(line, c, pushed)?;
+            }
+            if let Some((text, word, num)) = &block.corner {
+                self.corner_from(line, text, *word, *num, pushed)?;
+            }
+            self.straight_end = (motion == Motion::Linear && pushed == 1 && !machine)
+                .then(|| (self.points.len(), self.event_counts()));
             let (a, b) = (end[0] - start[0], end[1] - start[1]);
             let len = a.hypot(b);
             self.tangent = (len > XYZ_MOVE_THRESHOLD_MM)
@@ -2783,6 +2934,189 @@ impl<'a> Interpreter<'a> {
         }
         self.klartext.programmed_rotary = false;
         self.pos = end;
+        Ok(())
+    }
+
+    /// The error of a corner word (`c`, asked for at its line) that the move at `line` cannot
+    /// make, and why.
+    fn corner_error(&self, c: &PendingCorner, line: usize, why: &str) -> Error {
+        self.error(
+            c.line,
+            format!(
+                "`{}`: the chamfer or rounding of the corner after this move cannot be made: the \
+                 next move (line {line}) is {why}; post the corner as a move of its own",
+                c.text
+            ),
+        )
+    }
+
+    /// Records the corner word of the straight move just made (`pushed`: its points), to be
+    /// made by the next move.
+    fn corner_from(
+        &mut self,
+        line: usize,
+        text: &str,
+        word: CornerWord,
+        num: Num,
+        pushed: usize,
+    ) -> Result<()> {
+        let size = self.length(num);
+        if size <= 0.0 {
+            return Err(self.error(
+                line,
+                format!("`{text}`: a chamfer or rounding must be larger than 0"),
+            ));
+        }
+        if pushed != 1 {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}`: a chamfer or rounding is modelled between two straight moves of \
+                     X, Y and Z only; this move turns a rotary axis: post the corner as its own \
+                     move"
+                ),
+            ));
+        }
+        self.corner = Some(PendingCorner {
+            line,
+            text: text.to_string(),
+            word,
+            size,
+            at: self.points.len() - 1,
+            counts: self.event_counts(),
+            feed: None,
+        });
+        Ok(())
+    }
+
+    /// The dwells, tool changes and spindle changes so far: a chamfer or rounding is made
+    /// only where none comes between its two moves.
+    pub(super) fn event_counts(&self) -> [usize; 3] {
+        [
+            self.dwells.len(),
+            self.tool_changes.len(),
+            self.spindle_changes.len(),
+        ]
+    }
+
+    /// Makes the chamfer or rounding `c` between the move that asked for it and the straight
+    /// move just made (`pushed`: its points; the last point is its end). The corner point
+    /// becomes the point `t` before it on the first move, then the chamfer's end or the
+    /// rounding arc's chords (within [`MAX_CHORD_ERROR_MM`]) to the point `t` after it on the
+    /// second: t = the chamfer's leg (Fanuc `,C`, Sinumerik `CHR=`), L / (2 cos(θ/2)) for a
+    /// chamfer of length L (`CHF=`), R tan(θ/2) for a rounding of radius R (`,R`, `RND=`), θ
+    /// the turn between the moves. The inserted points keep the first move's line and feed
+    /// (Sinumerik: `FRC=0`, the chamfer or rounding at the F in force; Fanuc and Haas run the
+    /// inserted block at the modal F).
+    fn corner_to(&mut self, line: usize, c: PendingCorner, pushed: usize) -> Result<()> {
+        if pushed != 1 {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "a move that turns a rotary axis: a chamfer or rounding is modelled between two \
+                 straight moves of X, Y and Z only",
+            ));
+        }
+        let k = c.at;
+        if k == 0 {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "after a first move from where the program has not placed the tool",
+            ));
+        }
+        let (a, p, b) = (
+            self.points[k - 1].clone(),
+            self.points[k].clone(),
+            self.points[k + 1].clone(),
+        );
+        if a.o != p.o || p.o != b.o || a.rotary != p.rotary || p.rotary != b.rotary {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "a move that changes the tool's orientation: not modelled",
+            ));
+        }
+        let Feed::Programmed(first) = p.feed else {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "read under inverse time (G93): a chamfer or rounding is modelled under a feed \
+                 per minute or per revolution only",
+            ));
+        };
+        if !matches!(b.feed, Feed::Programmed(_)) {
+            return Err(self.corner_error(&c, line, "not a feed move at a programmed feed"));
+        }
+        let feed = c.feed.unwrap_or(first);
+        let (d1, d2) = (p.p - a.p, b.p - p.p);
+        let (l1, l2) = (d1.norm(), d2.norm());
+        if l1 <= XYZ_MOVE_THRESHOLD_MM || l2 <= XYZ_MOVE_THRESHOLD_MM {
+            return Err(self.corner_error(&c, line, "a move of no length: there is no corner"));
+        }
+        let (u1, u2) = (d1 / l1, d2 / l2);
+        let turn = crate::base::angle_between(&u1, &u2);
+        if turn < 1e-9 {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "in line with it: there is no corner to cut (the control alarms)",
+            ));
+        }
+        if turn > std::f64::consts::PI - 1e-9 {
+            return Err(self.corner_error(
+                &c,
+                line,
+                "straight back along it: the corner cannot be cut (the control alarms)",
+            ));
+        }
+        let t = match c.word {
+            CornerWord::Round => c.size * (turn / 2.0).tan(),
+            CornerWord::ChamferLength => c.size / (2.0 * (turn / 2.0).cos()),
+            _ => c.size,
+        };
+        // Within rounding of the numbers written (a chamfer as long as the move).
+        let slack = 1e-9 * (1.0 + l1.max(l2));
+        if t > l1 + slack || t > l2 + slack {
+            return Err(self.corner_error(
+                &c,
+                line,
+                &format!(
+                    "too short for it: it takes {t:.6} mm of each move, and the moves are \
+                     {l1:.6} mm and {l2:.6} mm long (the control alarms)"
+                ),
+            ));
+        }
+        let at = |q: Vector3<f64>| ClPoint {
+            p: q,
+            feed: Feed::Programmed(feed),
+            line: c.line,
+            ..p.clone()
+        };
+        let s = p.p - u1 * t;
+        let mut made = vec![at(s)];
+        if c.word == CornerWord::Round {
+            let r = c.size;
+            // Towards the inside of the turn, square to the first move.
+            let inward = (u2 - u1 * u1.dot(&u2)).normalize();
+            let centre = s + inward * r;
+            let step = if r > MAX_CHORD_ERROR_MM {
+                2.0 * (1.0 - MAX_CHORD_ERROR_MM / r).acos()
+            } else {
+                turn
+            };
+            let n = (turn / step).ceil().max(1.0) as usize;
+            self.check_room(line, "a rounding", n)?;
+            for i in 1..=n {
+                let phi = turn * i as f64 / n as f64;
+                made.push(at(centre + (s - centre) * phi.cos() + u1 * (r * phi.sin())));
+            }
+        } else {
+            made.push(at(p.p + u2 * t));
+        }
+        self.points.truncate(k);
+        self.points.extend(made);
+        self.points.push(b);
         Ok(())
     }
 

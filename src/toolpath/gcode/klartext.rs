@@ -131,8 +131,11 @@
 //!   cycles may be defined (a warning); calling one is an error naming it.
 //! * `BEGIN PGM … MM` (`INCH` is an error), `TOOL CALL n Z S… F…` (S and F remembered; a
 //!   tool axis X or Y is an error), `BLK FORM`, `TOOL DEF`, `STOP` move nothing.
-//! * `RND` and `CHF` (rounding and chamfer between two contour elements) are errors naming
-//!   the line: post the contour with the arc or chamfer written out.
+//! * `RND R…` and `CHF …` right after a straight feed move (`L`) round or chamfer the corner
+//!   to the next move (the chamfer side length cut off each move; an F in the block is the
+//!   corner's own feed), as G-code's `,R`/`,C` ([`super`]'s chamfers and roundings); after an
+//!   arc or FMAX, before an arc or FMAX, or with no next move they are errors naming the line:
+//!   post the contour with the arc or chamfer written out.
 
 use super::dialect::{Action, Address, DialectSpec, Statement};
 use super::expr::{self, Variables};

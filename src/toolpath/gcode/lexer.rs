@@ -253,9 +253,56 @@ fn lex_letters(
             i = end;
             continue;
         }
+        if c == ',' && spec.comma_corners {
+            // Fanuc's chamfering and corner R: `G1 X50 ,C3` / `G1 X50 ,R5` (Haas too).
+            let letter = chars.get(i + 1).map(char::to_ascii_uppercase);
+            let word = match letter {
+                Some('R') => super::dialect::CornerWord::Round,
+                Some('C') => super::dialect::CornerWord::ChamferLeg,
+                _ => {
+                    return Err(
+                        "`,` not followed by C or R: `,C` (a chamfer) and `,R` (a corner \
+                                rounding) are the only words written with a comma"
+                            .to_string(),
+                    );
+                }
+            };
+            let letter = letter.unwrap_or('R');
+            let end = scan_value(&chars, i + 2, false);
+            let text_value: String = chars[i + 2..end].iter().collect();
+            if text_value.is_empty() {
+                return Err(format!("`,{letter}` has no number"));
+            }
+            let num = if text_value.contains(['#', '[']) {
+                value(&text_value, vars).map_err(|e| format!("`,{letter}{text_value}`: {e}"))?
+            } else {
+                number(&text_value)
+                    .ok_or_else(|| format!("malformed number `{text_value}` after `,{letter}`"))?
+            };
+            items.push(Item::Word {
+                text: format!(",{letter}{text_value}"),
+                address: Address::Corner(word),
+                num,
+            });
+            i = end;
+            continue;
+        }
         if !c.is_ascii_alphabetic() {
             return Err(match c {
                 '[' | ']' => "an expression `[ … ]` must follow a letter or `=`".to_string(),
+                // Fanuc's chamfer and corner rounding in a dialect that has none.
+                ',' if chars
+                    .get(i + 1)
+                    .is_some_and(|n| matches!(n.to_ascii_uppercase(), 'C' | 'R')) =>
+                {
+                    format!(
+                        "`,{}`: {} has no comma words; `,C` (a chamfer) and `,R` (a corner \
+                         rounding) are Fanuc's and Haas': if this is their program, read it \
+                         with --dialect fanuc",
+                        chars[i + 1].to_ascii_uppercase(),
+                        spec.name
+                    )
+                }
                 // Block delete `/` is read at the start of a block (`super::interp`); a second
                 // one or one further in is not G-code (MillMaster Pro programs comment with
                 // `//`).
@@ -325,6 +372,13 @@ fn lex_letters(
             // An O word after other words (NX's DeVlieg post: `T00O00`) is no O-word statement,
             // whose `o…` starts its block: say so rather than naming control flow.
             let before: String = chars[..i].iter().collect::<String>().trim().to_string();
+            // A Fanuc macro call's arguments are letters A–Z (`G65 P9001 A.125 V10100.`:
+            // V is #22, no axis): name the call, which is what feedopt does not read.
+            if let Some(call) = macro_call(&before) {
+                return Err(format!(
+                    "{call}: a macro call (its letters are the macro's arguments:                      `{letter}{text_value}` is no axis word here); macro calls (G65/G66) are                      not supported: post the program with the macro's moves written out"
+                ));
+            }
             let numbered = before.strip_prefix(['N', 'n']).is_some_and(|rest| {
                 rest.trim().chars().all(|c| c.is_ascii_digit()) && !rest.trim().is_empty()
             });
@@ -373,6 +427,23 @@ fn lex_letters(
         i = end;
     }
     Ok(())
+}
+
+/// The `G65`/`G66` word (a Fanuc macro call) among the compacted words `before`, if any.
+fn macro_call(before: &str) -> Option<String> {
+    let upper = before.to_ascii_uppercase();
+    let chars: Vec<char> = upper.chars().collect();
+    (0..chars.len()).find_map(|k| {
+        if chars[k] != 'G' || (k > 0 && chars[k - 1].is_ascii_digit()) {
+            return None;
+        }
+        let digits: String = chars[k + 1..]
+            .iter()
+            .take_while(|c| c.is_ascii_digit() || **c == '.')
+            .collect();
+        let n: f64 = digits.parse().ok()?;
+        (n == 65.0 || n == 66.0).then(|| format!("G{digits}"))
+    })
 }
 
 /// End of a parameter name after `#`: digits, `<name>` or `[ … ]`.

@@ -125,7 +125,9 @@
 //!   motion block are taken as 0 with a warning (the machine's start position is unknown).
 //! * **G53**, Sinumerik **SUPA** (machine coordinates, one block): the move is included, its
 //!   words read as machine coordinates = program coordinates + the machine's work offset
-//!   ([`MachineContext::work_offset`]; zero without a machine), with a warning saying so.
+//!   ([`MachineContext::work_offset`]: a trunnion's `kinematics.work-offset`, else the machine
+//!   file's `work_offset`; zero without either), with a warning saying so, which names
+//!   `work_offset` where the file gives none (so does a G28/G30 of X, Y or Z).
 //! * **G28/G30** (`G91 G28 Z0`, `G28 X0 Y0 B0`, `G30 P3 …`): a rapid to the intermediate point
 //!   the words give, then a rapid of the named axes to their reference point, read from the
 //!   machine file's `reference`. Where the file gives none, machine zero (machine coordinate
@@ -138,6 +140,17 @@
 //!   [`crate::toolpath::Dwell`]s: the tool stops there and the time counts.
 //! * **Variables and expressions**: see [`expr`] (Sinumerik `DEF`, R parameters, Fanuc `#n`).
 //! * **Frames**: see [`frames`] (`TRANS`/`ROT`/`ATRANS`/`AROT`, `CYCLE800`, `G68.2`).
+//! * **Chamfers and roundings** between two straight feed moves: Fanuc's (and Haas')
+//!   `,C` / `,R` on a G1 block (`G1 X50. ,R5.`: blanks between are ignored, and a number
+//!   without a decimal point is a length like X's), Sinumerik `CHR=` (the chamfer's leg, as
+//!   `,C`), `CHF=` (its length) and `RND=` (as `,R`). The corner at the end of the move is cut
+//!   from t before it to t after it along the two moves (t the leg, L / (2 cos(θ/2)) for a
+//!   chamfer of length L, R tan(θ/2) for a rounding, θ the turn), the rounding an arc of radius
+//!   R in chords within [`MAX_CHORD_ERROR_MM`], at the first move's line and feed. What is not
+//!   modelled is an error naming the word: the next move an arc, a rapid, after a dwell, a
+//!   cycle, a tool or spindle change, or turning a rotary axis; no next move; moves too short
+//!   for it, in line or reversed (the controls alarm there too); Sinumerik `RNDM=` (modal) and
+//!   `FRC=`/`FRCM=` (a feed of the corner's own) other than 0.
 //! * **Work offsets**: see [`offsets`]. `G54`–`G59` (LinuxCNC `G59.1`–`G59.3`, Fanuc
 //!   `G54.1 P…`, Sinumerik `G500` and `G505`–`G599`) select one; `G10 L2` / `L20` set one (LinuxCNC P0–P9,
 //!   Fanuc P0 the external offset, P1–P6, and `L20` the extended offsets), `G52` shifts
@@ -203,7 +216,9 @@
 //!   impossible arcs, and codes that move the tool in ways a list of CL points cannot follow
 //!   silently: the stored `G92` shift (`G92.3`), splines, threading, probing, polar coordinates, scaling,
 //!   mirroring, calls of subprograms not in the file, Haas `M97`, Sinumerik
-//!   `CYCLE76`/`CYCLE77` (spigot milling).
+//!   `CYCLE76`/`CYCLE77` (spigot milling), and the Sinumerik words that give an end point or
+//!   the tool's orientation another way (`ANG=`; `A2= B2= C2=`, `LEAD= TILT=`, `THETA= PHI=
+//!   PSI=`, `A4=`…`C5=`, `XH= YH= ZH=`: under TRAORI the control turns the rotary axes to them).
 
 pub mod cycles;
 mod dialect;

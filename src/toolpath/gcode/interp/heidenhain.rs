@@ -194,26 +194,88 @@ impl Interpreter<'_> {
             Statement::Tcpm => self.tcpm(line, args),
             // Read by the lexer.
             Statement::Fn => Ok(()),
-            Statement::Corner(chamfer) => {
-                let what = if chamfer {
-                    "CHF (a chamfer between two contour elements)"
-                } else {
-                    "RND (a rounding arc between two contour elements)"
-                };
-                Err(self.error(
-                    line,
-                    format!(
-                        "{text}: {what} is not supported: post the contour with the {} written \
-                         out as its own block",
-                        if chamfer {
-                            "chamfer line (L)"
-                        } else {
-                            "arc (CC/C or CR)"
-                        }
-                    ),
-                ))
+            Statement::Corner(chamfer) => self.klartext_corner(line, text, chamfer, args),
+        }
+    }
+
+    /// `RND R5 [F…]` / `CHF 2 [F…]` right after a straight feed move (`L`): the corner to the
+    /// next move rounded with radius R, or chamfered from the chamfer side length before the
+    /// corner to as far after it (TNC 640 Klartext manual, "Path contours — Cartesian
+    /// coordinates": RND, CHF); an F is the corner's own feed (mm/min). Made by the next move
+    /// as G-code's `,R`/`,C` are ([`Interpreter::corner_to`]): what that cannot make is an
+    /// error naming the block.
+    fn klartext_corner(
+        &mut self,
+        line: usize,
+        text: &str,
+        chamfer: bool,
+        args: &str,
+    ) -> Result<()> {
+        let written = format!("{text} {}", args.trim());
+        let (mut size, mut feed) = (None, None);
+        for w in klartext::words(args) {
+            let upper = w.to_ascii_uppercase();
+            if let Some(v) = upper.strip_prefix('F') {
+                if v.is_empty() || v == "MAX" || v == "AUTO" || v == "U" || v == "Z" {
+                    return Err(self.error(
+                        line,
+                        format!(
+                            "`{written}`: `{w}` on a rounding or chamfer is not read: give its \
+                             feed as a number, or none (the contour's feed)"
+                        ),
+                    ));
+                }
+                feed = Some(self.klartext_value(line, &w, v)?);
+            } else if !chamfer && let Some(v) = upper.strip_prefix('R') {
+                size = Some(self.klartext_value(line, &w, v)?);
+            } else if chamfer && size.is_none() {
+                size = Some(self.klartext_value(line, &w, &w)?);
+            } else {
+                return Err(self.error(line, format!("`{written}`: unexpected `{w}`")));
             }
         }
+        let Some(size) = size.filter(|s| *s > 0.0) else {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{written}`: {} larger than 0 is needed",
+                    if chamfer {
+                        "a chamfer side length"
+                    } else {
+                        "a rounding radius R"
+                    }
+                ),
+            ));
+        };
+        if feed.is_some_and(|f| f <= 0.0) {
+            return Err(self.error(line, format!("`{written}`: the feed must be above 0")));
+        }
+        let after_straight = self.corner.is_none()
+            && self.straight_end == Some((self.points.len(), self.event_counts()));
+        if !after_straight {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{written}`: a rounding or chamfer is modelled right after a straight feed \
+                     move (L) only, not after an arc, a rapid (FMAX), a dwell or another RND/CHF: \
+                     post the corner as a move of its own"
+                ),
+            ));
+        }
+        self.corner = Some(PendingCorner {
+            line,
+            text: written,
+            word: if chamfer {
+                CornerWord::ChamferLeg
+            } else {
+                CornerWord::Round
+            },
+            size,
+            at: self.points.len() - 1,
+            counts: self.event_counts(),
+            feed: feed.map(|f| f / 60.0),
+        });
+        Ok(())
     }
 
     /// A value of a statement's word.
