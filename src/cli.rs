@@ -137,6 +137,10 @@ pub struct CheckArgs {
     /// default: run them).
     #[arg(long)]
     pub block_delete: bool,
+    /// The program's G41/G42 (Klartext RL/RR) offset only the tool's wear: its path is the
+    /// tool centre's (CAM wear compensation). Without it such a block is an error.
+    #[arg(long)]
+    pub wear_compensation: bool,
     #[command(flatten)]
     /// Stock, tool and process limits beyond the machine file.
     pub material: MaterialArgs,
@@ -268,6 +272,12 @@ pub struct SolveOptions {
     /// delete) switch on does (default: run them, the program as posted).
     #[arg(long)]
     pub block_delete: bool,
+    /// The program's G41/G42 (Klartext RL/RR) offset only the tool's wear: its path is the
+    /// tool centre's (CAM wear compensation), read as programmed. Without it such a block is
+    /// an error: the control offsets the path by the tool's radius, which feedopt does not
+    /// model.
+    #[arg(long)]
+    pub wear_compensation: bool,
     /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
     /// parameter 3401#0 DPI = 0) or `calculator` (100 mm, DPI = 1); default: the machine
     /// file's `decimal_point_input`, else increment with a warning.
@@ -609,6 +619,7 @@ pub fn check(args: &CheckArgs) -> Result<String> {
             fallback_dialect: None,
             cycle_alias: &[],
             block_delete: args.block_delete,
+            wear_compensation: args.wear_compensation,
             tool_diameter: args.material.tool_diameter,
             decimal_point_input: args.decimal_point_input,
         },
@@ -699,6 +710,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
             fallback_dialect: args.fallback_dialect,
             cycle_alias: &args.opts.cycle_alias,
             block_delete: args.opts.block_delete,
+            wear_compensation: args.opts.wear_compensation,
             tool_diameter: args.opts.material.tool_diameter,
             decimal_point_input: args.opts.decimal_point_input,
         },
@@ -712,6 +724,7 @@ struct Reading<'a> {
     fallback_dialect: Option<crate::toolpath::gcode::Dialect>,
     cycle_alias: &'a [String],
     block_delete: bool,
+    wear_compensation: bool,
     tool_diameter: Option<f64>,
     decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
@@ -729,6 +742,7 @@ fn read_input_from(
         fallback_dialect,
         cycle_alias,
         block_delete,
+        wear_compensation,
         tool_diameter,
         decimal_point_input,
     } = reading;
@@ -755,7 +769,10 @@ fn read_input_from(
     let options = toolpath::ReadOptions {
         format,
         dialect,
-        machine: Some(toolpath::MachineContext::new(&machine, &references)),
+        machine: Some(toolpath::MachineContext {
+            wear_compensation,
+            ..toolpath::MachineContext::new(&machine, &references)
+        }),
         cycle_aliases,
         block_delete,
         // The tool's diameter for the cycles whose path needs it: the option, else the machine

@@ -131,6 +131,7 @@ fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> Machi
         feed_diameter: [None; 3],
         shortest_way: [false; 3],
         machine_coordinates: false,
+        wear_compensation: false,
         kinematics: None,
     }
 }

@@ -1679,3 +1679,57 @@ fn a_macro_call_is_named_not_its_u_v_w_arguments() {
         &["V1.", "U, V or W"],
     );
 }
+
+/// G41/G42 (Klartext RL/RR) move the tool off the programmed path by its radius, which
+/// feedopt does not model: an error naming the line and word, unless the user says the path
+/// is the tool centre's and the offset only wear (`--wear-compensation`; the reader then reads
+/// it as programmed, and says so). It was a warning, while a hand-written program's part
+/// contour was run as the tool centre (round 16: a ½ in end mill "engaging" 27.9 mm).
+#[test]
+fn cutter_radius_compensation_is_an_error_unless_it_is_wear_only() {
+    let g = "G21 G90 G94\nG0 X0 Y0 Z5\nG1 Z-1 F300\nG41 D1 G1 X10\nG1 Y10\nG40 G1 X0\nM2\n";
+    err_in(Dialect::LinuxCnc, g, 4, &["G41", "--wear-compensation"]);
+    err_in(Dialect::Fanuc, &g.replace("G41", "G42"), 4, &["G42"]);
+    err_in(Dialect::Sinumerik, &g.replace("G21", "G71"), 4, &["G41"]);
+    let h = "0 BEGIN PGM T MM\n1 TOOL CALL 1 Z S5000\n2 L X+0 Y+0 Z+5 R0 FMAX\n\
+             3 L Z-1 F300\n4 L X+10 RL\n5 L Y+10\n6 L X+0 R0\n7 END PGM T MM\n";
+    err_in(Dialect::Heidenhain, h, 5, &["RL", "--wear-compensation"]);
+    // Wear only: read as programmed, said once per block.
+    let m = feedopt::machine::Machine::from_json(
+        Path::new("m.json"),
+        r#"{"kinematics": {"type": "xyz"},
+            "axes": {"X": {"velocity": 100, "acceleration": 1000},
+                     "Y": {"velocity": 100, "acceleration": 1000},
+                     "Z": {"velocity": 100, "acceleration": 1000}}}"#,
+    )
+    .unwrap();
+    let ctx = feedopt::toolpath::MachineContext {
+        wear_compensation: true,
+        ..feedopt::toolpath::MachineContext::new(&m, &Default::default())
+    };
+    let tp = feedopt::toolpath::gcode::parse_for(
+        Path::new("t.ngc"),
+        g,
+        Dialect::LinuxCnc.spec(),
+        Some(&ctx),
+    )
+    .unwrap();
+    let xs: Vec<[f64; 3]> = tp.points.iter().map(|p| [p.p.x, p.p.y, p.p.z]).collect();
+    assert_eq!(
+        xs,
+        [
+            [0.0, 0.0, 5.0],
+            [0.0, 0.0, -1.0],
+            [10.0, 0.0, -1.0],
+            [10.0, 10.0, -1.0],
+            [0.0, 10.0, -1.0]
+        ]
+    );
+    let said: Vec<usize> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("wear only"))
+        .map(|w| w.line)
+        .collect();
+    assert_eq!(said, [4]);
+}

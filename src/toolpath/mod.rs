@@ -437,6 +437,11 @@ pub struct MachineContext {
     /// [`KinematicsSpec::FourthAxis`]): X Y Z and the angle are the axes' positions, not a tool
     /// tip, and it has no tool-tip mode.
     pub machine_coordinates: bool,
+    /// The program's G41/G42 (Klartext RL/RR) offset only the tool's wear: its path is the
+    /// tool centre's, and a reader takes it as programmed (the command line's
+    /// `--wear-compensation`). Otherwise such a block is an error: the control moves the tool
+    /// off the programmed path by the tool's radius, which feedopt does not model.
+    pub wear_compensation: bool,
     /// The machine's kinematics, where the reader computes what a control computes from it
     /// (Klartext `PLANE … SEQ±`: which of the rotary axes' two solutions, Q120–Q122); `None`:
     /// the reader leaves that to the kinematics' own choice.
@@ -494,6 +499,7 @@ impl MachineContext {
             program_units: references.program_units,
             decimal_point_input: references.decimal_point_input,
             machine_coordinates: machine.kinematics.machine_coordinates(),
+            wear_compensation: false,
             feed_diameter: std::array::from_fn(|i| {
                 references
                     .feed_diameter

@@ -266,6 +266,9 @@ pub enum Tcp {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Action {
     Motion(Motion),
+    /// Cutter radius compensation on (G41, G42; Klartext RL, RR): an error unless the
+    /// program's path is the tool centre's ([`crate::toolpath::MachineContext::wear_compensation`]).
+    CutterCompensation,
     /// Spindle or coolant switches (M3, M8; Klartext M13 is both), recorded for the writer
     /// ([`crate::toolpath::MachineSwitch`]); they do not move the tool.
     Switch(&'static [Switch]),
@@ -551,7 +554,6 @@ const G70_71: &str = "not a unit on this control: G70/G71 are lathe cycles here 
 const SPLINES: &str = "spline and polynomial interpolation is not supported";
 const THREADS: &str = "spindle-synchronised motion (threading, tapping) is not supported";
 const PER_REV: &str = "feed per revolution is not supported";
-const COMP: &str = "cutter radius compensation is not applied: the programmed path is used";
 const G60: &str = "single-direction positioning approaches the end point from one side, past \
                    it by an amount the control's parameters set; that approach is not modelled: \
                    the move goes straight to its end point";
@@ -686,10 +688,10 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("38.4", Unsup("probing moves are not supported")),
         ("38.5", Unsup("probing moves are not supported")),
         ("40", Action::Ignored),
-        ("41", Note(COMP)),
-        ("41.1", Note(COMP)),
-        ("42", Note(COMP)),
-        ("42.1", Note(COMP)),
+        ("41", Action::CutterCompensation),
+        ("41.1", Action::CutterCompensation),
+        ("42", Action::CutterCompensation),
+        ("42.1", Action::CutterCompensation),
         ("43", Action::Ignored),
         ("43.1", Action::Ignored),
         ("43.2", Action::Ignored),
@@ -870,8 +872,8 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("30", Action::Reference(2)),
         ("33", Unsup(THREADS)),
         ("40", Action::Ignored),
-        ("41", Note(COMP)),
-        ("42", Note(COMP)),
+        ("41", Action::CutterCompensation),
+        ("42", Action::CutterCompensation),
         ("43", Action::Tcp(Tcp::Off)),
         ("44", Action::Tcp(Tcp::Off)),
         ("43.4", Action::Tcp(Tcp::On)),
@@ -1064,8 +1066,8 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
         ),
         ("33", Unsup(THREADS)),
         ("40", Action::Ignored),
-        ("41", Note(COMP)),
-        ("42", Note(COMP)),
+        ("41", Action::CutterCompensation),
+        ("42", Action::CutterCompensation),
         ("53", MachineCoordinates),
         ("60", Action::Ignored),
         ("62", Action::Ignored),
@@ -1383,8 +1385,8 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
         ("FMAX", Action::RapidBlock),
         ("FAUTO", Action::ToolCallFeed),
         ("R0", Action::Ignored),
-        ("RL", Note(COMP)),
-        ("RR", Note(COMP)),
+        ("RL", Action::CutterCompensation),
+        ("RR", Action::CutterCompensation),
         (
             "R+",
             Unsup(

@@ -1255,6 +1255,29 @@ impl<'a> Interpreter<'a> {
                 }
                 Action::Ignored => {}
                 Action::Note(message) => self.warn(line, format!("{text}: {message}")),
+                Action::CutterCompensation => {
+                    if self.machine.is_some_and(|m| m.wear_compensation) {
+                        self.warn(
+                            line,
+                            format!(
+                                "{text}: cutter radius compensation taken as wear only \
+                                 (--wear-compensation): the programmed path is the tool centre's"
+                            ),
+                        );
+                    } else {
+                        return Err(self.error(
+                            line,
+                            format!(
+                                "{text}: cutter radius compensation moves the tool off the \
+                                 programmed path by the tool's radius, which feedopt does not \
+                                 model: post the program with the tool centre's path (CAM \
+                                 compensation in the computer), or, where its path already is \
+                                 the tool centre's and the offset register holds only wear (CAM \
+                                 wear compensation), pass --wear-compensation"
+                            ),
+                        ));
+                    }
+                }
                 Action::Unsupported(message) => {
                     return Err(self.error(line, format!("{text}: {message}")));
                 }

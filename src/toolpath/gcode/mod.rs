@@ -193,8 +193,10 @@
 //! `G61`/`G64`; Haas `G254`/`G255` (dynamic work offset: the program is read in workpiece
 //! coordinates either way; `G234` is TCP on); `%` lines; blank lines; nested `(( ))` comments. Program
 //! end (`M2`, `M30`; in the main program also Sinumerik `M17`, `RET`, Fanuc `M99`) stops
-//! reading: later lines are not parsed. These codes are accepted with a warning because the toolpath does not carry them:
-//! cutter radius compensation `G41`/`G42` (the programmed path is used). A block starting with `/` (block delete, or `/1` … `/9`)
+//! reading: later lines are not parsed. Cutter radius compensation `G41`/`G42` (Klartext
+//! `RL`/`RR`) is an error, as it moves the tool off the programmed path, unless the machine
+//! context says the path is the tool centre's with wear-only offsets
+//! ([`crate::toolpath::MachineContext::wear_compensation`]): then a warning. A block starting with `/` (block delete, or `/1` … `/9`)
 //! runs, as on a control whose block-skip switch is off, or is skipped under
 //! [`Settings::block_delete`]; either way with a warning. I J K or R on a straight move (outside G43.5) or without a
 //! move are skipped with a warning. U V W axis words are errors: they move an axis feedopt
