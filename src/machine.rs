@@ -541,16 +541,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             if !matches!(axis.name.as_str(), "X" | "Y" | "Z") {
                 return Err(parser.err(&field, "only X, Y and Z have an M92 datum"));
             }
-            let d = parser.number(Some(v), &field)?;
-            if d.abs() > MAX_LENGTH {
-                return Err(parser.err(
-                    &field,
-                    format!(
-                        "{} mm is beyond ±{MAX_LENGTH:e} mm",
-                        crate::error::number(d)
-                    ),
-                ));
-            }
+            let d = parser.coordinate(v, &field)?;
             m92.push((axis.name.clone(), d));
         }
         let field = format!("axes.{}.reference", axis.name);
@@ -616,17 +607,7 @@ pub fn references_from_json(source: &Path, text: &str, machine: &Machine) -> Res
             let mut w = [0.0; 3];
             for (k, v) in items.iter().enumerate() {
                 let field = format!("work_offset[{k}]");
-                let d = parser.number(Some(v), &field)?;
-                if d.abs() > MAX_LENGTH {
-                    return Err(parser.err(
-                        &field,
-                        format!(
-                            "{} mm is beyond ±{MAX_LENGTH:e} mm",
-                            crate::error::number(d)
-                        ),
-                    ));
-                }
-                w[k] = d;
+                w[k] = parser.coordinate(v, &field)?;
             }
             Some(w)
         }
@@ -835,6 +816,21 @@ impl Parser {
     /// A limit's size `x` (> 0) must lie within [[`MIN_LIMIT`], `max`] of its `unit`.
     fn plausible_limit(&self, x: f64, field: &str, unit: &str, max: f64) -> Result<()> {
         plausible_limit(x, unit, max).map_err(|reason| self.err(field, reason))
+    }
+
+    /// A machine coordinate (mm) within ±[`MAX_LENGTH`] (an M92 datum, a work offset).
+    fn coordinate(&self, v: &Value, field: &str) -> Result<f64> {
+        let d = self.number(Some(v), field)?;
+        if d.abs() > MAX_LENGTH {
+            return Err(self.err(
+                field,
+                format!(
+                    "{} mm is beyond ±{MAX_LENGTH:e} mm",
+                    crate::error::number(d)
+                ),
+            ));
+        }
+        Ok(d)
     }
 
     /// A length (mm, or degrees for a rotary travel) within ±[`MAX_LENGTH`].

@@ -589,6 +589,15 @@ fn peak_feeds_hold_for_g93_blocks_and_turns_on_the_spot() {
     }
 }
 
+/// The command line's default: each block's F at its peak, no Δθ rule.
+fn peak(dialect: Dialect) -> GcodeOptions {
+    GcodeOptions {
+        dialect,
+        max_rotation_deg: None,
+        block_feed: BlockFeed::Peak,
+    }
+}
+
 /// The program's tool changes, spindle speeds and switches in program order, each with where
 /// the tool stands when it comes (the CL point before it; `None`: before the first).
 fn machine_words(t: &Toolpath) -> Vec<(String, Option<[f64; 3]>)> {
@@ -749,12 +758,7 @@ fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coor
     let options = reach();
     let sol = optimize(&m, &input, &options).unwrap();
     for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
-        let o = GcodeOptions {
-            dialect,
-            max_rotation_deg: None,
-            block_feed: BlockFeed::Peak,
-        };
-        let prog = program(&m, &input, &sol, &options.geometry, &o).unwrap();
+        let prog = program(&m, &input, &sol, &options.geometry, &peak(dialect)).unwrap();
         let lines: Vec<&str> = prog.text.lines().collect();
         let at = |s: &str| lines.iter().position(|l| *l == s);
         let (g54, g55, g56) = (at("G54"), at("G55"), at("G56"));
@@ -810,12 +814,7 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
         let options = reach();
         let sol = optimize(&m, &input, &options).unwrap();
         for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
-            let o = GcodeOptions {
-                dialect,
-                max_rotation_deg: None,
-                block_feed: BlockFeed::Peak,
-            };
-            let prog = program(&m, &input, &sol, &options.geometry, &o).unwrap();
+            let prog = program(&m, &input, &sol, &options.geometry, &peak(dialect)).unwrap();
             let lines: Vec<&str> = prog.text.lines().collect();
             let count = |s: &str| lines.iter().filter(|l| **l == s).count();
             match dialect {
