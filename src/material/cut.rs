@@ -64,7 +64,7 @@ use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexel, Dexels, TILE};
+use super::dexel::{Dexels, TILE};
 use super::tool::{NO_HIT, Pose, Tool};
 use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
@@ -842,7 +842,7 @@ fn cut_band(
                 ramp_row(tool, &step.p0, &step.p1, y, (x0, hx), ia, run);
             }
             band.each(j, ia, ib, |i, cell| {
-                if matches!(cell, Dexel::Empty) {
+                if cell.is_empty() {
                     return;
                 }
                 let x = cx(i);
@@ -976,7 +976,7 @@ fn cut_band(
             let [lo, hi] = run[i - ua];
             note(cx(i), cell.remove(lo, hi));
             let h = end_hits[i - ua];
-            if h[0] <= h[1] && cell.extent().is_some_and(|e| e[1] > h[1]) {
+            if h[0] <= h[1] && cell.top() > h[1] {
                 candidates.push(i);
             }
         });
@@ -996,7 +996,7 @@ fn cut_band(
                     end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT)
                 };
                 let cell = band.dexel(i, j);
-                if z[0] < z[1] && cell.extent().is_some_and(|e| e[1] > z[0]) {
+                if z[0] < z[1] && cell.top() > z[0] {
                     shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
                 }
             }
