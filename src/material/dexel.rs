@@ -483,8 +483,27 @@ impl Dexels {
 
     /// The material volume, mm³ (summed row by row).
     pub fn volume(&self) -> f64 {
+        // As `each_row_major` with `len += d.length()`, the stock's columns added as they
+        // are, without a dexel made of each: a column's length is the one its dexel would
+        // give (the sum of one term, c₁ − c₀ ≥ 0), and where there is none, adding nothing
+        // leaves `len` (never −0) as adding that empty dexel's 0 does.
         let mut len = 0.0;
-        self.each_row_major(|d| len += d.length());
+        for j in 0..self.ny {
+            for ti in 0..self.tx {
+                let is = ti * TILE..((ti + 1) * TILE).min(self.nx);
+                match &self.tiles[(j / TILE) * self.tx + ti] {
+                    Some(t) => {
+                        let row = (j % TILE) * TILE;
+                        is.for_each(|i| len += t[row + i % TILE].length());
+                    }
+                    None => is.for_each(|i| {
+                        if let Some(c) = self.grid.column(i, j) {
+                            len += c[1] - c[0];
+                        }
+                    }),
+                }
+            }
+        }
         len * self.hx * self.hy
     }
 
