@@ -641,11 +641,12 @@ pub(crate) struct SharedPose {
 }
 
 /// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, [`NO_HIT`] where the
-/// tool does not cross.
+/// tool does not cross, on the cells `valid` (the pose's, those it was computed on).
 #[derive(Debug, Clone, Default)]
 struct SharedRow {
     step: u64,
     start: usize,
+    valid: (usize, usize),
     hits: Vec<[f64; 2]>,
 }
 
@@ -691,6 +692,9 @@ struct StepPlan<'t> {
 #[derive(Default)]
 struct Scratch {
     hits: Vec<[f64; 2]>,
+    /// The last pose's line, apart: it becomes the row's shared crossings by a swap of
+    /// buffers, not a copy.
+    last_line: Vec<[f64; 2]>,
     run: Vec<[f64; 2]>,
     starts: Vec<f64>,
     ended: Vec<(usize, usize, [f64; 2])>,
@@ -802,6 +806,7 @@ fn cut_band(
     let step = &step;
     let Scratch {
         hits,
+        last_line,
         run,
         starts,
         ended,
@@ -818,10 +823,12 @@ fn cut_band(
         }
         let y = y0 + (j as f64 + 0.5) * hy;
         let mut shank = 0.0_f64;
-        let mut note = |x: f64, c: super::dexel::Cut| {
+        // (The cell's x only where it cut: most removals take nothing.)
+        let mut note = |i: usize, c: super::dexel::Cut| {
             if c.length <= 0.0 {
                 return;
             }
+            let x = cx(i);
             let top = Vector3::new(x, y, c.z_hi) - pe;
             let bottom = Vector3::new(x, y, c.z_lo) - pe;
             acc.length += c.length;
@@ -856,7 +863,7 @@ fn cut_band(
                     vertical_sweep(tool, &step.p0, &step.p1, x, y)
                 };
                 if let Some([lo, hi]) = swept {
-                    note(x, cell.remove(lo, hi));
+                    note(i, cell.remove(lo, hi));
                     // [lo, hi] reaches the flutes' top: what stands
                     // above it is in the shank's way.
                     if let Some([_, top]) = cell.extent() {
@@ -883,11 +890,18 @@ fn cut_band(
             continue;
         }
         let width = ub - ua + 1;
-        // Each pose's line of `hits`: its crossings on its cells, misses
-        // on the others (every entry written once).
-        hits.resize(poses * width, NO_HIT);
+        // Each pose's line of `hits` (the last pose's: `last_line`): its
+        // crossings on its cells, misses on the others (every entry written
+        // once).
+        hits.resize((poses - 1) * width, NO_HIT);
+        last_line.resize(width, NO_HIT);
+        let mut share = None;
         for k in 0..poses {
-            let line = &mut hits[k * width..(k + 1) * width];
+            let line = if k + 1 < poses {
+                &mut hits[k * width..(k + 1) * width]
+            } else {
+                &mut last_line[..width]
+            };
             let Some((ia, ib)) = ranges[k] else {
                 line.fill(NO_HIT);
                 continue;
@@ -897,10 +911,10 @@ fn cut_band(
             let pose = &pose_list[k].0;
             let row = &mut line[ia - ua..=ib - ua];
             // k = 0 reads the shared row where it has the cells, k = poses − 1
-            // ≥ 1 writes it.
-            let s0 = row_shared.start;
+            // ≥ 1 becomes it (below).
+            let (s0, (v0, v1)) = (row_shared.start, row_shared.valid);
             let known = if k == 0 && reuse && row_shared.step == prev {
-                s0.max(ia)..(s0 + row_shared.hits.len()).min(ib + 1)
+                v0.max(ia)..v1.min(ib + 1)
             } else {
                 0..0
             };
@@ -914,12 +928,16 @@ fn cut_band(
                 pose.hits_row(y, x0, hx, known.end, after);
             }
             if k == poses - 1 {
-                row_shared.step = this;
-                row_shared.start = ia;
-                row_shared.hits.clear();
-                row_shared.hits.extend_from_slice(row);
+                share = Some((ia, ib + 1));
             }
         }
+        let line = |k: usize| -> &[[f64; 2]] {
+            if k + 1 < poses {
+                &hits[k * width..(k + 1) * width]
+            } else {
+                &last_line[..width]
+            }
+        };
         // The runs of consecutive poses that cross each cell, each joined
         // into [min lo, max hi]. First, without branches, every cell's
         // crossings joined and its runs counted (`starts`: the poses that
@@ -928,22 +946,26 @@ fn cut_band(
         // cell below, the ones a miss ended kept aside. (A miss is
         // [∞, −∞], which min and max leave out exactly.)
         run.clear();
-        run.extend_from_slice(&hits[..width]);
+        run.extend_from_slice(line(0));
         starts.clear();
         starts.extend(run.iter().map(|h| f64::from(u8::from(h[0] <= h[1]))));
         for k in 1..poses {
-            let (before, row) = hits[(k - 1) * width..(k + 1) * width].split_at(width);
-            join_row(run, starts, before, row);
+            join_row(run, starts, line(k - 1), line(k));
         }
         ended.clear();
-        for (c, run) in run.iter_mut().enumerate() {
+        // (Two poses make one run at most.)
+        for (c, run) in run
+            .iter_mut()
+            .enumerate()
+            .take(if poses > 2 { width } else { 0 })
+        {
             if starts[c] < 2.0 {
                 continue;
             }
             *run = NO_HIT;
             let mut open = false;
             for k in 0..poses {
-                let h = hits[k * width + c];
+                let h = line(k)[c];
                 if h[0] > h[1] {
                     open = false;
                     continue;
@@ -963,18 +985,18 @@ fn cut_band(
         // order whatever the grid).
         ended.sort_unstable_by_key(|&(k, i, _)| (k, i));
         for &(_, i, [lo, hi]) in ended.iter() {
-            note(cx(i), band.dexel(i, j).remove(lo, hi));
+            note(i, band.dexel(i, j).remove(lo, hi));
         }
         // (A cell no pose crosses has the run [∞, −∞], which removes
         // nothing: Dexel::remove tells it without a call.) Then the shank
         // at the step's end pose, where its flutes cross a line with
         // material left above them (the shank lies above the flutes).
         let end_pose = &pose_list[poses - 1].0;
-        let end_hits = &hits[(poses - 1) * width..poses * width];
+        let end_hits = &last_line[..width];
         candidates.clear();
         band.each(j, ua, ub, |i, cell| {
             let [lo, hi] = run[i - ua];
-            note(cx(i), cell.remove(lo, hi));
+            note(i, cell.remove(lo, hi));
             let h = end_hits[i - ua];
             if h[0] <= h[1] && cell.top() > h[1] {
                 candidates.push(i);
@@ -985,21 +1007,35 @@ fn cut_band(
             // shank spans at once, with vector instructions; few: each alone
             // (the same spans bit for bit).
             let many = 4 * candidates.len() > last - first;
-            if many {
-                shank_z.resize(last - first + 1, NO_HIT);
-                end_pose.shank_row(y, x0, hx, first, shank_z);
-            }
-            for &i in candidates.iter() {
-                let z = if many {
-                    shank_z[i - first]
-                } else {
-                    end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT)
-                };
-                let cell = band.dexel(i, j);
+            let mut depth = |i: usize, z: [f64; 2], cell: &super::dexel::Dexel| {
                 if z[0] < z[1] && cell.top() > z[0] {
                     shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
                 }
+            };
+            if many {
+                // The candidates told again as above, on the dexels in order
+                // rather than each looked up.
+                shank_z.resize(last - first + 1, NO_HIT);
+                end_pose.shank_row(y, x0, hx, first, shank_z);
+                band.each(j, first, last, |i, cell| {
+                    let h = end_hits[i - ua];
+                    if h[0] <= h[1] && cell.top() > h[1] {
+                        depth(i, shank_z[i - first], cell);
+                    }
+                });
+            } else {
+                for &i in candidates.iter() {
+                    let z = end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT);
+                    depth(i, z, band.dexel(i, j));
+                }
             }
+        }
+        // The last pose's crossings become the row's shared ones.
+        if let Some(valid) = share {
+            std::mem::swap(last_line, &mut row_shared.hits);
+            row_shared.step = this;
+            row_shared.start = ua;
+            row_shared.valid = valid;
         }
         acc.shank = acc.shank.max(shank);
     }
