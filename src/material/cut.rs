@@ -64,7 +64,7 @@ use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexels, TILE};
+use super::dexel::{Dexels, TILE, index_f64};
 use super::tool::{NO_HIT, Pose, Tool};
 use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
@@ -274,7 +274,7 @@ fn level_row(
     let ay = p0.y - y;
     let qa = dx * dx + dy * dy;
     for (k, o) in out.iter_mut().enumerate() {
-        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let x = x0 + (index_f64(ia + k) + 0.5) * hx;
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
@@ -312,7 +312,7 @@ fn ramp_row(
     let qa = dx * dx + dy * dy;
     let capsule = Capsule::of_ball(p0, p1, r);
     for (k, o) in out.iter_mut().enumerate() {
-        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let x = x0 + (index_f64(ia + k) + 0.5) * hx;
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
@@ -814,14 +814,14 @@ fn cut_band(
         shank: shank_z,
         candidates,
     } = scratch;
-    let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
+    let cx = |i: usize| x0 + (index_f64(i) + 0.5) * hx;
     let mut acc = Acc::ZERO;
     let rows = band.rows();
     for (j, row_shared) in rows.zip(shared_rows) {
         if j < j0 || j > j1 {
             continue;
         }
-        let y = y0 + (j as f64 + 0.5) * hy;
+        let y = y0 + (index_f64(j) + 0.5) * hy;
         let mut shank = 0.0_f64;
         // (The cell's x only where it cut: most removals take nothing.)
         let mut note = |i: usize, c: super::dexel::Cut| {
