@@ -600,15 +600,29 @@ impl Footprint {
     /// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule and the
     /// rectangle, on a grid of cells `d` = (x of cell 0's edge, cell width).
     fn cells(&self, d: (f64, f64), y: f64, range: (usize, usize)) -> Option<(usize, usize)> {
+        clip_span(self.span(d, y)?, range)
+    }
+
+    /// [`Footprint::cells`] before the clipping: the first and last cell as floats (not
+    /// rounded to the grid's range).
+    fn span(&self, d: (f64, f64), y: f64) -> Option<(f64, f64)> {
         let [mut x0, mut x1] = self.capsule_row(y)?;
         if let Some([u0, u1]) = self.axis_row(y) {
             (x0, x1) = (x0.max(u0), x1.min(u1));
         }
         let (ox, hx) = d;
-        let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
-        let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
-        (i0 <= i1).then_some((i0 as usize, i1 as usize))
+        Some((
+            ((x0 - ox) / hx - 0.5).ceil(),
+            ((x1 - ox) / hx - 0.5).floor(),
+        ))
     }
+}
+
+/// A [`Footprint::span`] clipped to the cells `range` ([`Footprint::cells`]).
+fn clip_span((i0, i1): (f64, f64), range: (usize, usize)) -> Option<(usize, usize)> {
+    let i0 = i0.max(index_f64(range.0));
+    let i1 = i1.min(index_f64(range.1));
+    (i0 <= i1).then_some((i0 as usize, i1 as usize))
 }
 
 /// One pose's crossings `row` (the previous pose's `before`) joined into each cell's `run`,
@@ -648,6 +662,9 @@ struct SharedRow {
     start: usize,
     valid: (usize, usize),
     hits: Vec<[f64; 2]>,
+    /// The pose's [`Footprint::span`] on this row, and the step that found it.
+    span: Option<(f64, f64)>,
+    span_step: u64,
 }
 
 impl SharedPose {
@@ -876,12 +893,24 @@ fn cut_band(
         }
         // Pose by pose over the cells of its capsule: each pose's crossings
         // (no dexel is read), joined into runs; then the runs are removed.
+        // (The first pose's span is the previous step's last's where it
+        // is that pose, on this row: the same footprint.)
+        let first = if reuse && row_shared.span_step == prev {
+            row_shared.span
+        } else {
+            pose_list[0].1.span((x0, hx), y)
+        };
+        let end = pose_list[poses - 1].1.span((x0, hx), y);
+        (row_shared.span, row_shared.span_step) = (end, this);
         ranges.clear();
-        ranges.extend(
-            pose_list
-                .iter()
-                .map(|(_, foot)| foot.cells((x0, hx), y, (i0, i1))),
-        );
+        ranges.extend(pose_list.iter().enumerate().map(|(k, (_, foot))| {
+            let span = match k {
+                0 => first,
+                _ if k == poses - 1 => end,
+                _ => foot.span((x0, hx), y),
+            };
+            span.and_then(|s| clip_span(s, (i0, i1)))
+        }));
         let (mut ua, mut ub) = (usize::MAX, 0);
         for &(ia, ib) in ranges.iter().flatten() {
             (ua, ub) = (ua.min(ia), ub.max(ib));
