@@ -64,7 +64,7 @@ use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexel, Dexels, TILE};
+use super::dexel::{Dexels, TILE, index_f64};
 use super::tool::{NO_HIT, Pose, Tool};
 use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
@@ -274,7 +274,7 @@ fn level_row(
     let ay = p0.y - y;
     let qa = dx * dx + dy * dy;
     for (k, o) in out.iter_mut().enumerate() {
-        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let x = x0 + (index_f64(ia + k) + 0.5) * hx;
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
@@ -312,7 +312,7 @@ fn ramp_row(
     let qa = dx * dx + dy * dy;
     let capsule = Capsule::of_ball(p0, p1, r);
     for (k, o) in out.iter_mut().enumerate() {
-        let x = x0 + ((ia + k) as f64 + 0.5) * hx;
+        let x = x0 + (index_f64(ia + k) + 0.5) * hx;
         let ax = p0.x - x;
         let qb = ax * dx + ay * dy;
         let qc = ax * ax + ay * ay;
@@ -600,15 +600,29 @@ impl Footprint {
     /// The cells `i0..=i1` of row `y` (clipped to `[i_min, i_max]`) inside the capsule and the
     /// rectangle, on a grid of cells `d` = (x of cell 0's edge, cell width).
     fn cells(&self, d: (f64, f64), y: f64, range: (usize, usize)) -> Option<(usize, usize)> {
+        clip_span(self.span(d, y)?, range)
+    }
+
+    /// [`Footprint::cells`] before the clipping: the first and last cell as floats (not
+    /// rounded to the grid's range).
+    fn span(&self, d: (f64, f64), y: f64) -> Option<(f64, f64)> {
         let [mut x0, mut x1] = self.capsule_row(y)?;
         if let Some([u0, u1]) = self.axis_row(y) {
             (x0, x1) = (x0.max(u0), x1.min(u1));
         }
         let (ox, hx) = d;
-        let i0 = ((x0 - ox) / hx - 0.5).ceil().max(range.0 as f64);
-        let i1 = ((x1 - ox) / hx - 0.5).floor().min(range.1 as f64);
-        (i0 <= i1).then_some((i0 as usize, i1 as usize))
+        Some((
+            ((x0 - ox) / hx - 0.5).ceil(),
+            ((x1 - ox) / hx - 0.5).floor(),
+        ))
     }
+}
+
+/// A [`Footprint::span`] clipped to the cells `range` ([`Footprint::cells`]).
+fn clip_span((i0, i1): (f64, f64), range: (usize, usize)) -> Option<(usize, usize)> {
+    let i0 = i0.max(index_f64(range.0));
+    let i1 = i1.min(index_f64(range.1));
+    (i0 <= i1).then_some((i0 as usize, i1 as usize))
 }
 
 /// One pose's crossings `row` (the previous pose's `before`) joined into each cell's `run`,
@@ -641,12 +655,16 @@ pub(crate) struct SharedPose {
 }
 
 /// One grid row's crossings with a pose: `hits[k]` for cell `start + k`, [`NO_HIT`] where the
-/// tool does not cross.
+/// tool does not cross, on the cells `valid` (the pose's, those it was computed on).
 #[derive(Debug, Clone, Default)]
 struct SharedRow {
     step: u64,
     start: usize,
+    valid: (usize, usize),
     hits: Vec<[f64; 2]>,
+    /// The pose's [`Footprint::span`] on this row, and the step that found it.
+    span: Option<(f64, f64)>,
+    span_step: u64,
 }
 
 impl SharedPose {
@@ -691,6 +709,9 @@ struct StepPlan<'t> {
 #[derive(Default)]
 struct Scratch {
     hits: Vec<[f64; 2]>,
+    /// The last pose's line, apart: it becomes the row's shared crossings by a swap of
+    /// buffers, not a copy.
+    last_line: Vec<[f64; 2]>,
     run: Vec<[f64; 2]>,
     starts: Vec<f64>,
     ended: Vec<(usize, usize, [f64; 2])>,
@@ -802,6 +823,7 @@ fn cut_band(
     let step = &step;
     let Scratch {
         hits,
+        last_line,
         run,
         starts,
         ended,
@@ -809,19 +831,21 @@ fn cut_band(
         shank: shank_z,
         candidates,
     } = scratch;
-    let cx = |i: usize| x0 + (i as f64 + 0.5) * hx;
+    let cx = |i: usize| x0 + (index_f64(i) + 0.5) * hx;
     let mut acc = Acc::ZERO;
     let rows = band.rows();
     for (j, row_shared) in rows.zip(shared_rows) {
         if j < j0 || j > j1 {
             continue;
         }
-        let y = y0 + (j as f64 + 0.5) * hy;
+        let y = y0 + (index_f64(j) + 0.5) * hy;
         let mut shank = 0.0_f64;
-        let mut note = |x: f64, c: super::dexel::Cut| {
+        // (The cell's x only where it cut: most removals take nothing.)
+        let mut note = |i: usize, c: super::dexel::Cut| {
             if c.length <= 0.0 {
                 return;
             }
+            let x = cx(i);
             let top = Vector3::new(x, y, c.z_hi) - pe;
             let bottom = Vector3::new(x, y, c.z_lo) - pe;
             acc.length += c.length;
@@ -842,7 +866,7 @@ fn cut_band(
                 ramp_row(tool, &step.p0, &step.p1, y, (x0, hx), ia, run);
             }
             band.each(j, ia, ib, |i, cell| {
-                if matches!(cell, Dexel::Empty) {
+                if cell.is_empty() {
                     return;
                 }
                 let x = cx(i);
@@ -856,7 +880,7 @@ fn cut_band(
                     vertical_sweep(tool, &step.p0, &step.p1, x, y)
                 };
                 if let Some([lo, hi]) = swept {
-                    note(x, cell.remove(lo, hi));
+                    note(i, cell.remove(lo, hi));
                     // [lo, hi] reaches the flutes' top: what stands
                     // above it is in the shank's way.
                     if let Some([_, top]) = cell.extent() {
@@ -869,12 +893,24 @@ fn cut_band(
         }
         // Pose by pose over the cells of its capsule: each pose's crossings
         // (no dexel is read), joined into runs; then the runs are removed.
+        // (The first pose's span is the previous step's last's where it
+        // is that pose, on this row: the same footprint.)
+        let first = if reuse && row_shared.span_step == prev {
+            row_shared.span
+        } else {
+            pose_list[0].1.span((x0, hx), y)
+        };
+        let end = pose_list[poses - 1].1.span((x0, hx), y);
+        (row_shared.span, row_shared.span_step) = (end, this);
         ranges.clear();
-        ranges.extend(
-            pose_list
-                .iter()
-                .map(|(_, foot)| foot.cells((x0, hx), y, (i0, i1))),
-        );
+        ranges.extend(pose_list.iter().enumerate().map(|(k, (_, foot))| {
+            let span = match k {
+                0 => first,
+                _ if k == poses - 1 => end,
+                _ => foot.span((x0, hx), y),
+            };
+            span.and_then(|s| clip_span(s, (i0, i1)))
+        }));
         let (mut ua, mut ub) = (usize::MAX, 0);
         for &(ia, ib) in ranges.iter().flatten() {
             (ua, ub) = (ua.min(ia), ub.max(ib));
@@ -883,11 +919,18 @@ fn cut_band(
             continue;
         }
         let width = ub - ua + 1;
-        // Each pose's line of `hits`: its crossings on its cells, misses
-        // on the others (every entry written once).
-        hits.resize(poses * width, NO_HIT);
+        // Each pose's line of `hits` (the last pose's: `last_line`): its
+        // crossings on its cells, misses on the others (every entry written
+        // once).
+        hits.resize((poses - 1) * width, NO_HIT);
+        last_line.resize(width, NO_HIT);
+        let mut share = None;
         for k in 0..poses {
-            let line = &mut hits[k * width..(k + 1) * width];
+            let line = if k + 1 < poses {
+                &mut hits[k * width..(k + 1) * width]
+            } else {
+                &mut last_line[..width]
+            };
             let Some((ia, ib)) = ranges[k] else {
                 line.fill(NO_HIT);
                 continue;
@@ -897,10 +940,10 @@ fn cut_band(
             let pose = &pose_list[k].0;
             let row = &mut line[ia - ua..=ib - ua];
             // k = 0 reads the shared row where it has the cells, k = poses − 1
-            // ≥ 1 writes it.
-            let s0 = row_shared.start;
+            // ≥ 1 becomes it (below).
+            let (s0, (v0, v1)) = (row_shared.start, row_shared.valid);
             let known = if k == 0 && reuse && row_shared.step == prev {
-                s0.max(ia)..(s0 + row_shared.hits.len()).min(ib + 1)
+                v0.max(ia)..v1.min(ib + 1)
             } else {
                 0..0
             };
@@ -914,12 +957,16 @@ fn cut_band(
                 pose.hits_row(y, x0, hx, known.end, after);
             }
             if k == poses - 1 {
-                row_shared.step = this;
-                row_shared.start = ia;
-                row_shared.hits.clear();
-                row_shared.hits.extend_from_slice(row);
+                share = Some((ia, ib + 1));
             }
         }
+        let line = |k: usize| -> &[[f64; 2]] {
+            if k + 1 < poses {
+                &hits[k * width..(k + 1) * width]
+            } else {
+                &last_line[..width]
+            }
+        };
         // The runs of consecutive poses that cross each cell, each joined
         // into [min lo, max hi]. First, without branches, every cell's
         // crossings joined and its runs counted (`starts`: the poses that
@@ -928,22 +975,26 @@ fn cut_band(
         // cell below, the ones a miss ended kept aside. (A miss is
         // [∞, −∞], which min and max leave out exactly.)
         run.clear();
-        run.extend_from_slice(&hits[..width]);
+        run.extend_from_slice(line(0));
         starts.clear();
         starts.extend(run.iter().map(|h| f64::from(u8::from(h[0] <= h[1]))));
         for k in 1..poses {
-            let (before, row) = hits[(k - 1) * width..(k + 1) * width].split_at(width);
-            join_row(run, starts, before, row);
+            join_row(run, starts, line(k - 1), line(k));
         }
         ended.clear();
-        for (c, run) in run.iter_mut().enumerate() {
+        // (Two poses make one run at most.)
+        for (c, run) in run
+            .iter_mut()
+            .enumerate()
+            .take(if poses > 2 { width } else { 0 })
+        {
             if starts[c] < 2.0 {
                 continue;
             }
             *run = NO_HIT;
             let mut open = false;
             for k in 0..poses {
-                let h = hits[k * width + c];
+                let h = line(k)[c];
                 if h[0] > h[1] {
                     open = false;
                     continue;
@@ -963,20 +1014,20 @@ fn cut_band(
         // order whatever the grid).
         ended.sort_unstable_by_key(|&(k, i, _)| (k, i));
         for &(_, i, [lo, hi]) in ended.iter() {
-            note(cx(i), band.dexel(i, j).remove(lo, hi));
+            note(i, band.dexel(i, j).remove(lo, hi));
         }
         // (A cell no pose crosses has the run [∞, −∞], which removes
         // nothing: Dexel::remove tells it without a call.) Then the shank
         // at the step's end pose, where its flutes cross a line with
         // material left above them (the shank lies above the flutes).
         let end_pose = &pose_list[poses - 1].0;
-        let end_hits = &hits[(poses - 1) * width..poses * width];
+        let end_hits = &last_line[..width];
         candidates.clear();
         band.each(j, ua, ub, |i, cell| {
             let [lo, hi] = run[i - ua];
-            note(cx(i), cell.remove(lo, hi));
+            note(i, cell.remove(lo, hi));
             let h = end_hits[i - ua];
-            if h[0] <= h[1] && cell.extent().is_some_and(|e| e[1] > h[1]) {
+            if h[0] <= h[1] && cell.top() > h[1] {
                 candidates.push(i);
             }
         });
@@ -985,21 +1036,35 @@ fn cut_band(
             // shank spans at once, with vector instructions; few: each alone
             // (the same spans bit for bit).
             let many = 4 * candidates.len() > last - first;
-            if many {
-                shank_z.resize(last - first + 1, NO_HIT);
-                end_pose.shank_row(y, x0, hx, first, shank_z);
-            }
-            for &i in candidates.iter() {
-                let z = if many {
-                    shank_z[i - first]
-                } else {
-                    end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT)
-                };
-                let cell = band.dexel(i, j);
-                if z[0] < z[1] && cell.extent().is_some_and(|e| e[1] > z[0]) {
+            let mut depth = |i: usize, z: [f64; 2], cell: &super::dexel::Dexel| {
+                if z[0] < z[1] && cell.top() > z[0] {
                     shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
                 }
+            };
+            if many {
+                // The candidates told again as above, on the dexels in order
+                // rather than each looked up.
+                shank_z.resize(last - first + 1, NO_HIT);
+                end_pose.shank_row(y, x0, hx, first, shank_z);
+                band.each(j, first, last, |i, cell| {
+                    let h = end_hits[i - ua];
+                    if h[0] <= h[1] && cell.top() > h[1] {
+                        depth(i, shank_z[i - first], cell);
+                    }
+                });
+            } else {
+                for &i in candidates.iter() {
+                    let z = end_pose.shank_span(cx(i), y).unwrap_or(NO_HIT);
+                    depth(i, z, band.dexel(i, j));
+                }
             }
+        }
+        // The last pose's crossings become the row's shared ones.
+        if let Some(valid) = share {
+            std::mem::swap(last_line, &mut row_shared.hits);
+            row_shared.step = this;
+            row_shared.start = ua;
+            row_shared.valid = valid;
         }
         acc.shank = acc.shank.max(shank);
     }

@@ -10,9 +10,11 @@
 //! **Storage** (issue 13: memory and set-up no more than the cut needs). The grid is stored in
 //! tiles of [`TILE`] × [`TILE`] dexels, each made from the stock ([`Stock::column`]) the first
 //! time a cut reaches it; a tile never cut costs one null pointer, and reading it gives the
-//! stock's column. A dexel holds one or two intervals inline ([`Dexel::One`], [`Dexel::Two`]:
-//! a tilted tool's undercut leaves material below it and above its flutes) and goes to the
-//! heap only for three or more ([`Dexel::Many`]).
+//! stock's column. A dexel holds one or two intervals inline (a tilted tool's undercut leaves
+//! material below it and above its flutes) and goes to the heap only for three or more; in
+//! every form it keeps, in the same four numbers, its lowest and highest material and a range
+//! of z holding none ([`Dexel`]), so that a removal that misses is told without asking which
+//! form the dexel has.
 
 use super::stock::Stock;
 
@@ -22,55 +24,127 @@ pub const MIN_CUT_MM: f64 = 1e-9;
 /// Dexels along each side of a tile (module doc).
 pub const TILE: usize = 16;
 
+const INF: f64 = f64::INFINITY;
+
+/// Cell index `i` as a float: `i as f64`, by way of `i32`, whose conversion is one instruction
+/// and vectorises, where `u64`'s is not on x86-64 without AVX-512DQ (a dozen instructions per
+/// cell in the rows' loops); the same value for `i` < 2³¹, which [`Dexels::new`] holds.
+#[inline(always)]
+pub(crate) fn index_f64(i: usize) -> f64 {
+    i as i32 as f64
+}
+
 /// One dexel's material: sorted, disjoint intervals `[z0, z1]` (40 bytes; the heap only for
 /// three or more intervals).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub enum Dexel {
-    /// No material.
-    #[default]
-    Empty,
-    /// One interval (the stock's column, or what stays of it after cuts from above or below).
-    One([f64; 2]),
-    /// Two intervals (a tilted tool's undercut: material below it and above its flutes).
-    Two([[f64; 2]; 2]),
-    /// Three or more intervals.
-    Many(Vec<[f64; 2]>),
+///
+/// `iv` is `[[z0, g0], [g1, z1]]` in every form: z0 the lowest material (∞: none), z1 the
+/// highest (−∞: none) and [g0, g1] a range of z without material (or g0 > g1):
+/// - no interval: `[[∞, −∞], [∞, −∞]]` (the gap [−∞, ∞]);
+/// - one, `[a, b]`: `[[a, b], [∞, b]]` (the gap: everything above b);
+/// - two, `[a, b]` and `[c, d]`: `[[a, b], [c, d]]` (the gap between them);
+/// - three or more (`many`): `[[first a, g0], [g1, last b]]` with [g0, g1] the widest gap
+///   between two of them.
+///
+/// Inline (`many` is `None`), the intervals are `iv`'s first zero, one or two; on the heap,
+/// `many`'s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dexel {
+    iv: [[f64; 2]; 2],
+    /// A thin pointer (a `Vec` or a boxed slice would make a dexel 48 or 56 bytes: a fifth
+    /// more memory for the few dexels of three intervals or more).
+    #[allow(clippy::box_collection)]
+    many: Option<Box<Vec<[f64; 2]>>>,
+}
+
+impl Default for Dexel {
+    fn default() -> Dexel {
+        Dexel::EMPTY
+    }
 }
 
 impl Dexel {
+    /// No material.
+    pub const EMPTY: Dexel = Dexel {
+        iv: [[INF, -INF], [INF, -INF]],
+        many: None,
+    };
+
+    /// One interval (the stock's column, or what stays of it after cuts from above or below).
+    pub fn one(iv: [f64; 2]) -> Dexel {
+        Dexel {
+            iv: [iv, [INF, iv[1]]],
+            many: None,
+        }
+    }
+
+    /// Two intervals, in order (a tilted tool's undercut: material below it and above its
+    /// flutes).
+    pub fn two(a: [f64; 2], b: [f64; 2]) -> Dexel {
+        Dexel {
+            iv: [a, b],
+            many: None,
+        }
+    }
+
+    /// Three or more sorted, disjoint intervals, on the heap.
+    fn many(v: Vec<[f64; 2]>) -> Dexel {
+        Dexel {
+            iv: summary(&v),
+            many: Some(Box::new(v)),
+        }
+    }
+
     /// The dexel of a stock column.
     pub fn from_column(column: Option<[f64; 2]>) -> Dexel {
-        column.map_or(Dexel::Empty, Dexel::One)
+        column.map_or(Dexel::EMPTY, Dexel::one)
     }
 
     /// The dexel of sorted, disjoint intervals, in its inline form where it has one.
     fn from_intervals(v: Vec<[f64; 2]>) -> Dexel {
         match v.len() {
-            0 => Dexel::Empty,
-            1 => Dexel::One(v[0]),
-            2 => Dexel::Two([v[0], v[1]]),
-            _ => Dexel::Many(v),
+            0 => Dexel::EMPTY,
+            1 => Dexel::one(v[0]),
+            2 => Dexel::two(v[0], v[1]),
+            _ => Dexel::many(v),
         }
     }
 
     /// The intervals, sorted and disjoint.
     pub fn intervals(&self) -> &[[f64; 2]] {
-        match self {
-            Dexel::Empty => &[],
-            Dexel::One(iv) => std::slice::from_ref(iv),
-            Dexel::Two(v) => v,
-            Dexel::Many(v) => v,
+        match &self.many {
+            Some(v) => v,
+            None => {
+                let n = if self.iv[1][0] != INF {
+                    2
+                } else if self.iv[0][0] != INF {
+                    1
+                } else {
+                    0
+                };
+                &self.iv[..n]
+            }
         }
+    }
+
+    /// No material.
+    pub fn is_empty(&self) -> bool {
+        self.iv[0][0] == INF
+    }
+
+    /// The highest material (−∞: none).
+    #[inline]
+    pub fn top(&self) -> f64 {
+        self.iv[1][1]
+    }
+
+    /// Three or more intervals, held on the heap.
+    pub fn on_heap(&self) -> bool {
+        self.many.is_some()
     }
 
     /// The lowest and the highest material, if any.
     pub fn extent(&self) -> Option<[f64; 2]> {
-        match self {
-            Dexel::Empty => None,
-            Dexel::One(iv) => Some(*iv),
-            Dexel::Two(v) => Some([v[0][0], v[1][1]]),
-            Dexel::Many(v) => Some([v[0][0], v[v.len() - 1][1]]),
-        }
+        (!self.is_empty()).then_some([self.iv[0][0], self.iv[1][1]])
     }
 
     /// The material's total length, mm.
@@ -78,36 +152,29 @@ impl Dexel {
         self.intervals().iter().map(|iv| iv[1] - iv[0]).sum()
     }
 
+    /// Whether removing `[lo, hi]` may take material: false where it certainly takes none
+    /// (then [`Dexel::remove`] returns [`Cut::NONE`] and leaves the dexel unchanged). All
+    /// material lies in [z0, z1] and none in the gap [g0, g1] (`iv`), so where z1 ≤ lo,
+    /// z0 ≥ hi or g0 ≤ lo, hi ≤ g1 every overlap max(`iv[0]`, lo) … min(`iv[1]`, hi) is empty
+    /// and the removal would return [`Cut::NONE`] unchanged; so it does where lo > hi
+    /// (shorter than [`MIN_CUT_MM`]: a miss, [∞, −∞], too). The same four numbers in every
+    /// form and the tests joined without short-circuit: no branch but the answer's.
+    #[inline]
+    pub fn cuts(&self, lo: f64, hi: f64) -> bool {
+        let [[z0, g0], [g1, z1]] = self.iv;
+        let in_gap = (g0 <= lo) & (hi <= g1);
+        (lo <= hi) & (z1 > lo) & (z0 < hi) & !in_gap
+    }
+
     /// Removes `[lo, hi]`; returns what was removed (length 0: nothing). As [`remove`] on
     /// the intervals.
     ///
-    /// Inline where `[lo, hi]` misses the material (most of a cut's removals: the tool's back
-    /// passes through what the step before left), the rest out of line: all material lies in
-    /// the extent [z0, z1], so where z1 ≤ lo or z0 ≥ hi every overlap max(`iv[0]`, lo) …
-    /// min(`iv[1]`, hi) is empty and the removal would return [`Cut::NONE`] unchanged;
-    /// so it does where lo > hi (shorter than [`MIN_CUT_MM`]: a miss, [∞, −∞], too), and where
-    /// `[lo, hi]` lies in the gap [g0, g1] between the two intervals of a [`Dexel::Two`]
-    /// (g0 ≤ lo, hi ≤ g1: both overlaps empty, the same way; a tilted tool passing again
-    /// through the tunnel it cut). The tests are joined without short-circuit, one branch
-    /// whose outcome the data decide instead of several.
+    /// Inline where `[lo, hi]` misses the material ([`Dexel::cuts`]: most of a cut's
+    /// removals, the tool's back passing through what the step before left, or through the
+    /// tunnel it cut), the rest out of line.
     #[inline]
     pub fn remove(&mut self, lo: f64, hi: f64) -> Cut {
-        // (No gap: [∞, −∞].)
-        let ((z0, z1), (g0, g1)) = match self {
-            Dexel::Empty => (
-                (f64::INFINITY, f64::NEG_INFINITY),
-                (f64::INFINITY, f64::NEG_INFINITY),
-            ),
-            Dexel::One(iv) => ((iv[0], iv[1]), (f64::INFINITY, f64::NEG_INFINITY)),
-            Dexel::Two(v) => ((v[0][0], v[1][1]), (v[0][1], v[1][0])),
-            // Three or more intervals (a Many of two or fewer becomes Two, One or Empty).
-            Dexel::Many(v) => (
-                (v[0][0], v[v.len() - 1][1]),
-                (f64::INFINITY, f64::NEG_INFINITY),
-            ),
-        };
-        let in_gap = (g0 <= lo) & (hi <= g1);
-        if (lo <= hi) & (z1 > lo) & (z0 < hi) & !in_gap {
+        if self.cuts(lo, hi) {
             self.remove_any(lo, hi)
         } else {
             Cut::NONE
@@ -117,87 +184,106 @@ impl Dexel {
     /// [`Dexel::remove`] on any dexel.
     #[inline(never)]
     fn remove_any(&mut self, lo: f64, hi: f64) -> Cut {
-        match self {
-            Dexel::Empty => Cut::NONE,
-            Dexel::One(iv) => {
-                let [a0, b0] = *iv;
-                // `remove`'s steps for one interval: the overlap, then what stays.
-                if hi - lo < MIN_CUT_MM || b0 <= lo || a0 >= hi {
-                    return Cut::NONE;
-                }
-                let (a, b) = (larger(a0, lo), smaller(b0, hi));
-                if b - a < MIN_CUT_MM {
-                    return Cut::NONE;
-                }
-                *self = match (a0 < lo, b0 > hi) {
-                    (false, false) => Dexel::Empty,
-                    (true, false) => Dexel::One([a0, lo]),
-                    (false, true) => Dexel::One([hi, b0]),
-                    (true, true) => Dexel::Two([[a0, lo], [hi, b0]]),
-                };
-                Cut {
-                    length: b - a,
-                    z_lo: a,
-                    z_hi: b,
-                }
+        if self.many.is_some() {
+            return self.remove_many(lo, hi);
+        }
+        let [f, l] = self.iv;
+        if l[0] != INF {
+            // Two intervals: `remove`'s steps, without the heap unless a split makes three.
+            let v = [f, l];
+            if hi - lo < MIN_CUT_MM {
+                return Cut::NONE;
             }
-            Dexel::Two(v) => {
-                // `remove`'s steps on two intervals, without the heap unless a split makes three.
-                let [f, l] = *v;
-                if hi - lo < MIN_CUT_MM {
-                    return Cut::NONE;
-                }
-                let cut = overlap(v, lo, hi);
-                if cut.length == 0.0 {
-                    return cut;
-                }
-                // What stays of each interval: its parts below lo and above hi (either the
-                // whole interval where [lo, hi] misses it, the other empty: f[1] ≤ lo gives
-                // [f[0], f[1]] and [hi, f[1]], hi > lo ≥ f[1]), those not empty kept in order
-                // (three at most: a split leaves the other interval whole). Built in registers
-                // (`put`), not in an array indexed by a count, whose reads the processor cannot
-                // take from the writes just before.
-                let mut kept = (0, [[0.0; 2]; 3]);
-                let mut put = |a: f64, b: f64| {
-                    if a < b {
-                        match kept.0 {
-                            0 => kept.1[0] = [a, b],
-                            1 => kept.1[1] = [a, b],
-                            _ => kept.1[2] = [a, b],
-                        }
-                        kept.0 += 1;
+            let cut = overlap(&v, lo, hi);
+            if cut.length == 0.0 {
+                return cut;
+            }
+            // What stays of each interval: its parts below lo and above hi (either the
+            // whole interval where [lo, hi] misses it, the other empty: f[1] ≤ lo gives
+            // [f[0], f[1]] and [hi, f[1]], hi > lo ≥ f[1]), those not empty kept in order
+            // (three at most: a split leaves the other interval whole). Built in registers
+            // (`put`), not in an array indexed by a count, whose reads the processor cannot
+            // take from the writes just before.
+            let mut kept = (0, [[0.0; 2]; 3]);
+            let mut put = |a: f64, b: f64| {
+                if a < b {
+                    match kept.0 {
+                        0 => kept.1[0] = [a, b],
+                        1 => kept.1[1] = [a, b],
+                        _ => kept.1[2] = [a, b],
                     }
-                };
-                put(f[0], smaller(f[1], lo));
-                put(larger(f[0], hi), f[1]);
-                put(l[0], smaller(l[1], lo));
-                put(larger(l[0], hi), l[1]);
-                let (n, [x, y, z]) = kept;
-                *self = match n {
-                    0 => Dexel::Empty,
-                    1 => Dexel::One(x),
-                    2 => Dexel::Two([x, y]),
-                    _ => three(x, y, z),
-                };
-                cut
+                    kept.0 += 1;
+                }
+            };
+            put(f[0], smaller(f[1], lo));
+            put(larger(f[0], hi), f[1]);
+            put(l[0], smaller(l[1], lo));
+            put(larger(l[0], hi), l[1]);
+            let (n, [x, y, z]) = kept;
+            *self = match n {
+                0 => Dexel::EMPTY,
+                1 => Dexel::one(x),
+                2 => Dexel::two(x, y),
+                _ => three(x, y, z),
+            };
+            cut
+        } else if f[0] != INF {
+            // One interval: `remove`'s steps, the overlap, then what stays.
+            let [a0, b0] = f;
+            if hi - lo < MIN_CUT_MM || b0 <= lo || a0 >= hi {
+                return Cut::NONE;
             }
-            Dexel::Many(_) => self.remove_many(lo, hi),
+            let (a, b) = (larger(a0, lo), smaller(b0, hi));
+            if b - a < MIN_CUT_MM {
+                return Cut::NONE;
+            }
+            *self = match (a0 < lo, b0 > hi) {
+                (false, false) => Dexel::EMPTY,
+                (true, false) => Dexel::one([a0, lo]),
+                (false, true) => Dexel::one([hi, b0]),
+                (true, true) => Dexel::two([a0, lo], [hi, b0]),
+            };
+            Cut {
+                length: b - a,
+                z_lo: a,
+                z_hi: b,
+            }
+        } else {
+            Cut::NONE
         }
     }
 
-    /// [`Dexel::remove`] on a [`Dexel::Many`]: out of line, so that the heap's work does not
-    /// weigh on every call of the inline forms' [`Dexel::remove_any`].
+    /// [`Dexel::remove`] on three or more intervals: out of line, so that the heap's work does
+    /// not weigh on every call of the inline forms' [`Dexel::remove_any`].
     #[inline(never)]
     fn remove_many(&mut self, lo: f64, hi: f64) -> Cut {
-        let Dexel::Many(v) = self else {
+        let Some(v) = self.many.as_deref_mut() else {
             return self.remove_any(lo, hi);
         };
         let cut = remove(v, lo, hi);
+        if cut.length == 0.0 {
+            // (`remove` changed nothing.)
+            return cut;
+        }
         if v.len() <= 2 {
             *self = Dexel::from_intervals(std::mem::take(v));
+        } else {
+            self.iv = summary(v);
         }
         cut
     }
+}
+
+/// `Dexel::iv` of three or more intervals: the lowest and highest material and the widest gap
+/// (the first of equal ones).
+fn summary(v: &[[f64; 2]]) -> [[f64; 2]; 2] {
+    let mut gap = [v[0][1], v[1][0]];
+    for w in v[1..].windows(2) {
+        if w[1][0] - w[0][1] > gap[1] - gap[0] {
+            gap = [w[0][1], w[1][0]];
+        }
+    }
+    [[v[0][0], gap[0]], [gap[1], v[v.len() - 1][1]]]
 }
 
 /// Three intervals on the heap (a split of one of two), out of line as
@@ -205,7 +291,7 @@ impl Dexel {
 #[inline(never)]
 #[cold]
 fn three(x: [f64; 2], y: [f64; 2], z: [f64; 2]) -> Dexel {
-    Dexel::Many(vec![x, y, z])
+    Dexel::many(vec![x, y, z])
 }
 
 /// The tiles of one row of tiles (its [`TILE`] grid rows), for a cut that changes them; the
@@ -266,15 +352,15 @@ struct Grid {
 impl Grid {
     fn column(&self, i: usize, j: usize) -> Option<[f64; 2]> {
         let (x, y) = (
-            self.x0 + (i as f64 + 0.5) * self.hx,
-            self.y0 + (j as f64 + 0.5) * self.hy,
+            self.x0 + (index_f64(i) + 0.5) * self.hx,
+            self.y0 + (index_f64(j) + 0.5) * self.hy,
         );
         self.stock.column(x, y)
     }
 
     /// Tile (ti, tj) as the stock gives it (cells past the grid's edge empty).
     fn make_tile(&self, ti: usize, tj: usize) -> Box<[Dexel]> {
-        let mut t = vec![Dexel::Empty; TILE * TILE].into_boxed_slice();
+        let mut t = vec![Dexel::EMPTY; TILE * TILE].into_boxed_slice();
         for j in tj * TILE..((tj + 1) * TILE).min(self.ny) {
             for i in ti * TILE..((ti + 1) * TILE).min(self.nx) {
                 t[(j % TILE) * TILE + i % TILE] = Dexel::from_column(self.column(i, j));
@@ -334,6 +420,10 @@ impl Dexels {
         let [x0, y0, x1, y1] = stock.xy_bounds();
         let nx = ((x1 - x0) / cell).round().max(1.0) as usize;
         let ny = ((y1 - y0) / cell).round().max(1.0) as usize;
+        assert!(
+            nx < 1 << 31 && ny < 1 << 31,
+            "{nx} x {ny} dexels: at most 2^31 - 1 along a side (index_f64)"
+        );
         let (hx, hy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
         let (tx, ty) = (nx.div_ceil(TILE), ny.div_ceil(TILE));
         Dexels {
@@ -368,12 +458,12 @@ impl Dexels {
 
     /// Centre of column `i` (x), mm.
     pub fn x(&self, i: usize) -> f64 {
-        self.x0 + (i as f64 + 0.5) * self.hx
+        self.x0 + (index_f64(i) + 0.5) * self.hx
     }
 
     /// Centre of row `j` (y), mm.
     pub fn y(&self, j: usize) -> f64 {
-        self.y0 + (j as f64 + 0.5) * self.hy
+        self.y0 + (index_f64(j) + 0.5) * self.hy
     }
 
     /// Dexel (i, j) (i < nx, j < ny): its tile's, or the stock's column where no cut has
@@ -408,8 +498,27 @@ impl Dexels {
 
     /// The material volume, mm³ (summed row by row).
     pub fn volume(&self) -> f64 {
+        // As `each_row_major` with `len += d.length()`, the stock's columns added as they
+        // are, without a dexel made of each: a column's length is the one its dexel would
+        // give (the sum of one term, c₁ − c₀ ≥ 0), and where there is none, adding nothing
+        // leaves `len` (never −0) as adding that empty dexel's 0 does.
         let mut len = 0.0;
-        self.each_row_major(|d| len += d.length());
+        for j in 0..self.ny {
+            for ti in 0..self.tx {
+                let is = ti * TILE..((ti + 1) * TILE).min(self.nx);
+                match &self.tiles[(j / TILE) * self.tx + ti] {
+                    Some(t) => {
+                        let row = (j % TILE) * TILE;
+                        is.for_each(|i| len += t[row + i % TILE].length());
+                    }
+                    None => is.for_each(|i| {
+                        if let Some(c) = self.grid.column(i, j) {
+                            len += c[1] - c[0];
+                        }
+                    }),
+                }
+            }
+        }
         len * self.hx * self.hy
     }
 
@@ -556,7 +665,7 @@ mod tests {
         for j in 0..d.ny {
             for i in 0..d.nx {
                 let want = if (i, j) == (ci, cj) {
-                    Dexel::One([-1.0, 0.0])
+                    Dexel::one([-1.0, 0.0])
                 } else {
                     column(&d, i, j)
                 };
@@ -626,7 +735,7 @@ mod tests {
         let mut r = rng(5);
         let mut forms = [0usize; 4];
         for _ in 0..200 {
-            let mut d = Dexel::One([0.0, 10.0]);
+            let mut d = Dexel::one([0.0, 10.0]);
             let mut list = vec![[0.0, 10.0]];
             for _ in 0..12 {
                 let a = 12.0 * r() - 1.0;
@@ -648,13 +757,22 @@ mod tests {
                     (got.length, got.z_lo, got.z_hi),
                     (want.length, want.z_lo, want.z_hi)
                 );
-                let form = match (&d, list.len()) {
-                    (Dexel::Empty, 0) => 0,
-                    (Dexel::One(_), 1) => 1,
-                    (Dexel::Two(_), 2) => 2,
-                    (Dexel::Many(_), 3..) => 3,
-                    (d, n) => panic!("{n} intervals held as {d:?}"),
+                let form = match (d.on_heap(), list.len()) {
+                    (false, n @ 0..=2) => n,
+                    (true, 3..) => 3,
+                    (_, n) => panic!("{n} intervals held as {d:?}"),
                 };
+                // The four numbers every form keeps: the lowest and highest material and a
+                // range without any.
+                let [[z0, g0], [g1, z1]] = d.iv;
+                match (list.first(), list.last()) {
+                    (Some(f), Some(l)) => assert_eq!((z0, z1), (f[0], l[1]), "{d:?}"),
+                    _ => assert!(z0 == f64::INFINITY && z1 == f64::NEG_INFINITY, "{d:?}"),
+                }
+                assert!(
+                    list.iter().all(|iv| iv[1] <= g0 || iv[0] >= g1),
+                    "material in the gap of {d:?}"
+                );
                 forms[form] += 1;
             }
         }

@@ -17,6 +17,8 @@
 use multiversion::multiversion;
 use nalgebra::Vector3;
 
+use super::dexel::index_f64;
+
 /// The largest tool diameter (mm) feedopt accepts: 1 m.
 pub const MAX_TOOL_DIAMETER_MM: f64 = 1000.0;
 
@@ -298,7 +300,7 @@ impl<'a> Pose<'a> {
         if self.inv_a.is_infinite() || self.inv_oz.is_infinite() {
             for (k, h) in out.iter_mut().enumerate() {
                 *h = self
-                    .shank_span(x0 + ((i0 + k) as f64 + 0.5) * hx, y)
+                    .shank_span(x0 + (index_f64(i0 + k) + 0.5) * hx, y)
                     .unwrap_or(NO_HIT);
             }
             return;
@@ -341,7 +343,7 @@ impl<'a> Pose<'a> {
         if !(ball || rc == 0.0) || self.inv_a.is_infinite() || self.inv_oz.is_infinite() {
             for (k, h) in out.iter_mut().enumerate() {
                 *h = self
-                    .hit(x0 + ((i0 + k) as f64 + 0.5) * hx, y)
+                    .hit(x0 + (index_f64(i0 + k) + 0.5) * hx, y)
                     .unwrap_or(NO_HIT);
             }
             return;
@@ -369,7 +371,7 @@ fn crossings_row(
     let (p, o, a, inv_a, inv_oz) = (pose.p, pose.o, pose.a, pose.inv_a, pose.inv_oz);
     let dy = y - p.y;
     for (k, h) in out.iter_mut().enumerate() {
-        let dx = x0 + ((i0 + k) as f64 + 0.5) * hx - p.x;
+        let dx = x0 + (index_f64(i0 + k) + 0.5) * hx - p.x;
         let c = dx * o.x + dy * o.y;
         let q0 = dx * dx + dy * dy - c * c;
         // The cylinder h ∈ [r_c, L_f], ρ ≤ R: the slab, the disc, their meet.
@@ -408,7 +410,7 @@ fn shank_row(pose: &Pose, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 
     let up = o.z > 0.0;
     let dy = y - p.y;
     for (k, h) in out.iter_mut().enumerate() {
-        let dx = x0 + ((i0 + k) as f64 + 0.5) * hx - p.x;
+        let dx = x0 + (index_f64(i0 + k) + 0.5) * hx - p.x;
         let c = dx * o.x + dy * o.y;
         let q0 = dx * dx + dy * dy - c * c;
         let t = (lf - c) * inv_oz;
