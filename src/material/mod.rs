@@ -1175,6 +1175,13 @@ impl MaterialReport {
     }
 }
 
+/// A tool's dimension for the report, mm: to 0.1 µm, without trailing zeros (a table's
+/// `1.5 * 25.4` flutes are 38.1 mm, not 38.099999999999994).
+fn mm(x: f64) -> String {
+    let s = format!("{x:.4}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 impl std::fmt::Display for MaterialReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.tools.len() > 1 {
@@ -1188,10 +1195,10 @@ impl std::fmt::Display for MaterialReport {
                     u.select.as_deref().unwrap_or("(no selection)"),
                     u.line,
                     u.kind,
-                    t.diameter,
-                    t.corner_radius,
+                    mm(t.diameter),
+                    mm(t.corner_radius),
                     t.flutes,
-                    t.flute_length,
+                    mm(t.flute_length),
                     u.first_move_line,
                     u.removed_volume_mm3,
                     u.peak_area_mm2
@@ -1202,7 +1209,11 @@ impl std::fmt::Display for MaterialReport {
             writeln!(
                 f,
                 "tool          {:?} end mill D {} mm, r {} mm, {} flutes, flute length {} mm",
-                self.tool_kind, t.diameter, t.corner_radius, t.flutes, t.flute_length
+                self.tool_kind,
+                mm(t.diameter),
+                mm(t.corner_radius),
+                t.flutes,
+                mm(t.flute_length)
             )?;
         }
         writeln!(
@@ -1245,5 +1256,16 @@ impl std::fmt::Display for MaterialReport {
             writeln!(f, "spindle       {n} rpm")?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod report_tests {
+    #[test]
+    fn a_tools_dimensions_are_reported_without_rounding_noise() {
+        assert_eq!(super::mm(1.5 * 25.4), "38.1");
+        assert_eq!(super::mm(6.0), "6");
+        assert_eq!(super::mm(3.175), "3.175");
+        assert_eq!(super::mm(0.0), "0");
     }
 }
