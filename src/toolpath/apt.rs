@@ -348,36 +348,44 @@ impl<'a> Reader<'a> {
             SpindleChange::record(&mut self.spindle_changes, self.points.len(), line, rpm);
         }
         // The direction (`CLW`, `CCLW`) or `OFF`, for the writer.
-        let words = || args.split(',').map(|a| a.trim().to_ascii_uppercase());
-        let switch = if words().any(|w| w == "OFF") {
-            Some(Switch::SpindleStop)
-        } else if words().any(|w| w == "CCLW") {
-            Some(Switch::SpindleCounterClockwise)
-        } else if words().any(|w| w == "CLW" || w == "ON") {
-            Some(Switch::SpindleClockwise)
-        } else {
-            None
-        };
-        self.switch(line, switch);
+        self.switch(
+            line,
+            args,
+            &[
+                ("OFF", Switch::SpindleStop),
+                ("CCLW", Switch::SpindleCounterClockwise),
+                ("CLW", Switch::SpindleClockwise),
+                ("ON", Switch::SpindleClockwise),
+            ],
+        );
     }
 
     /// `COOLNT/ON` (or `FLOOD`), `MIST`, `OFF`: the coolant's state, for the writer (other
     /// kinds, `THRU`, `AIR`, `TAP`, the machine's own, are not recorded).
     fn coolant(&mut self, line: usize, args: &str) {
-        let words = || args.split(',').map(|a| a.trim().to_ascii_uppercase());
-        let switch = if words().any(|w| w == "OFF") {
-            Some(Switch::CoolantOff)
-        } else if words().any(|w| w == "MIST") {
-            Some(Switch::CoolantMist)
-        } else if words().any(|w| w == "ON" || w == "FLOOD") {
-            Some(Switch::CoolantFlood)
-        } else {
-            None
-        };
-        self.switch(line, switch);
+        self.switch(
+            line,
+            args,
+            &[
+                ("OFF", Switch::CoolantOff),
+                ("MIST", Switch::CoolantMist),
+                ("ON", Switch::CoolantFlood),
+                ("FLOOD", Switch::CoolantFlood),
+            ],
+        );
     }
 
-    fn switch(&mut self, line: usize, switch: Option<Switch>) {
+    /// Records the switch of the first entry of `table` whose word is one of the record's
+    /// comma-separated `args` (none where no word is).
+    fn switch(&mut self, line: usize, args: &str, table: &[(&str, Switch)]) {
+        let words: Vec<String> = args
+            .split(',')
+            .map(|a| a.trim().to_ascii_uppercase())
+            .collect();
+        let switch = table
+            .iter()
+            .find(|(w, _)| words.iter().any(|a| a == w))
+            .map(|&(_, s)| s);
         if let Some(switch) = switch {
             self.switches.push(MachineSwitch {
                 point: self.points.len(),
