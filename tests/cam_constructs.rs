@@ -1951,3 +1951,25 @@ fn a_three_axis_machine_file_gives_the_work_offset_that_machine_positions_need()
         .to_string();
     assert!(e.contains("kinematics.work-offset"), "{e}");
 }
+
+/// `G5.1 Q1` switches a Fanuc's AI contour control on (NX's Mori posts write it): its Q is no
+/// length, so it is no word read in increments and says nothing; a peck's `Q2` is one.
+#[test]
+fn the_q_of_g5_1_is_no_length_in_increments() {
+    let said = |text: &str| -> Vec<usize> {
+        let m = context("XYZ", Default::default(), [0.0; 3]);
+        parse_for(Path::new("t.nc"), text, Dialect::Fanuc.spec(), Some(&m))
+            .unwrap()
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("decimal point"))
+            .map(|w| w.line)
+            .collect()
+    };
+    let head = "O0001\nG21 G90 G94\nG0 X0. Y0. Z5.\n";
+    assert!(said(&format!("{head}G05.1 Q1\nG1 Z-1. F100\nM30\n")).is_empty());
+    assert_eq!(
+        said(&format!("{head}G99 G83 Z-3. R3. Q2 F100\nG80\nM30\n")),
+        [4]
+    );
+}

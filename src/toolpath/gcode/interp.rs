@@ -626,7 +626,12 @@ impl<'a> Interpreter<'a> {
                     );
                     self.note_increments(line, &block, &text, num, degrees);
                 }
-                Address::Ignored if text.starts_with('Q') => {
+                // A Q is a length (a peck), but not `G5.1 Q1`'s, which switches a Fanuc's AI
+                // contour control on (NX's Mori posts write it): no increments there.
+                Address::Ignored
+                    if text.starts_with('Q')
+                        && !block.actions.iter().any(|(t, _, _)| code_name(t) == "G5.1") =>
+                {
                     self.note_increments(line, &block, &text, num, false);
                 }
                 _ => {}
