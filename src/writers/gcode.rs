@@ -112,7 +112,8 @@
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
 //! the schedule's. Only the first point is reached by a G0, as every program starts: that move
-//! comes before the schedule's t = 0 and is not part of its time.
+//! comes before the schedule's t = 0 and is not part of its time. (A move in machine
+//! coordinates is a G0 too: "Machine coordinates" above.)
 //!
 //! # Dialect
 //!
