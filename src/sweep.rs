@@ -28,7 +28,7 @@
 //! 40 °/s², 3.3 % over at 31,267 stations, 3.3 times over at 8,887; a test's smooth joint path
 //! 40 % over at a tenth of its velocity limit). Each step's schedule is re-simulated at the
 //! servo period, and where one exceeds a limit, the intervals it marks are divided as `solve`'s
-//! local refinement divides them ([`optimize::marked_parts`]) — *for every step* — and the steps
+//! local refinement divides them (`optimize::marked_parts`) — *for every step* — and the steps
 //! are solved again, up to [`SWEEP_ROUNDS`] times and [`MAX_STATION_GROWTH`] times the
 //! baseline's stations: one station set, fine enough for every step. While the stations
 //! change only some steps run (the two ends of the range first, then those a run of all found
