@@ -10,6 +10,18 @@ pub fn angle_between(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> 
     a.cross(b).norm().atan2(a.dot(b))
 }
 
+/// `x` to `places` decimals without trailing zeros, for a message or a written word: `38.1`
+/// for 1.5 × 25.4 to 4 places, `6` for 6.0, `0` for −0.0 and for what rounds to it.
+pub fn trimmed(x: f64, places: usize) -> String {
+    let s = format!("{x:.places$}");
+    let t = s.trim_end_matches('0').trim_end_matches('.');
+    if t == "-0" {
+        "0".to_string()
+    } else {
+        t.to_string()
+    }
+}
+
 /// Largest number of machine axes.
 pub const MAX_AXES: usize = 8;
 

@@ -1178,8 +1178,7 @@ impl MaterialReport {
 /// A tool's dimension for the report, mm: to 0.1 µm, without trailing zeros (a table's
 /// `1.5 * 25.4` flutes are 38.1 mm, not 38.099999999999994).
 fn mm(x: f64) -> String {
-    let s = format!("{x:.4}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
+    crate::base::trimmed(x, 4)
 }
 
 impl std::fmt::Display for MaterialReport {

@@ -429,8 +429,7 @@ impl Setup<'_> {
                         // A Fanuc S is a whole number of rpm.
                         format!("{}", rpm.round())
                     } else {
-                        let s = format!("{rpm:.3}");
-                        s.trim_end_matches('0').trim_end_matches('.').to_string()
+                        crate::base::trimmed(rpm, 3)
                     };
                     let _ = writeln!(text, "S{speed}{with}");
                 }

@@ -1564,14 +1564,6 @@ fn two_rotary_kinematics(
 
 /// A direction for a message: `(0, 1, 0)`, components to 6 decimals.
 fn direction(v: &Vector3<f64>) -> String {
-    let c = |x: f64| {
-        let t = format!("{x:.6}");
-        let t = t.trim_end_matches('0').trim_end_matches('.');
-        if t == "-0" {
-            "0".to_string()
-        } else {
-            t.to_string()
-        }
-    };
+    let c = |x: f64| crate::base::trimmed(x, 6);
     format!("({}, {}, {})", c(v.x), c(v.y), c(v.z))
 }
