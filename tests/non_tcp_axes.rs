@@ -78,6 +78,14 @@ fn solve(m: &Machine, tp: &Toolpath) -> feedopt::optimize::Solution {
     s
 }
 
+/// The cycle time `t` is the closed form `want` of axis `axis` moving alone, within `rel`.
+fn assert_time(t: f64, want: f64, rel: f64, axis: &str) {
+    assert!(
+        (t - want).abs() <= rel * want,
+        "{t} s, {axis} alone {want} s"
+    );
+}
+
 /// Rest to rest over `d` at velocity `v` and acceleration `a`: bang-bang or trapezoid.
 fn rest_to_rest(d: f64, v: f64, a: f64) -> f64 {
     if d >= v * v / a {
@@ -134,11 +142,7 @@ fn a_table_turning_outside_tcp_leaves_x_y_z_standing() {
 
     let s = solve(&m, &tp);
     let want = rest_to_rest(60.0, 60.0, 600.0);
-    assert!(
-        (s.schedule.cycle_time - want).abs() <= 1e-6 * want,
-        "{} s, A alone {want} s",
-        s.schedule.cycle_time
-    );
+    assert_time(s.schedule.cycle_time, want, 1e-6, "A");
     // The schedule's X Y Z stand still from start to end.
     let x = s.schedule.axes.iter().position(|a| a == "X").unwrap();
     let mut worst: f64 = 0.0;
@@ -232,11 +236,7 @@ fn a_head_tilting_outside_tcp_swings_the_tip_about_its_pivot() {
     );
     let s = solve(&m, &turn_only);
     let want = rest_to_rest(30.0, 45.0, 450.0);
-    assert!(
-        (s.schedule.cycle_time - want).abs() <= 1e-6 * want,
-        "{} s, A alone {want} s",
-        s.schedule.cycle_time
-    );
+    assert_time(s.schedule.cycle_time, want, 1e-6, "A");
 }
 
 /// Feeds keep each control's rule for the axes' motion, split over the block's points: a
@@ -404,11 +404,7 @@ fn a_turn_under_a_plane_outside_tcp_carries_the_tip_with_the_table() {
     let s = optimize(&m, &turn_only, &options).unwrap();
     assert!(s.verification.verified);
     let want = rest_to_rest(90.0, 60.0, 600.0);
-    assert!(
-        (s.schedule.cycle_time - want).abs() <= 1e-6 * want,
-        "{} s, A alone {want} s",
-        s.schedule.cycle_time
-    );
+    assert_time(s.schedule.cycle_time, want, 1e-6, "A");
 
     let tcp = read(Dialect::Heidenhain, Some(&ctx), &program(" M128", ""));
     assert_eq!(tcp.points.iter().filter(|p| p.line == 7).count(), 1);
@@ -448,11 +444,7 @@ fn a_straight_move_at_a_standing_rotary_angle_moves_the_axes_as_written() {
     assert!((d.norm() - 50.0).abs() < 1e-9 && d.x.abs() < 1e-9, "{d}");
     let s = solve(&m, &tp);
     let want = rest_to_rest(50.0, 10.0, 100.0);
-    assert!(
-        (s.schedule.cycle_time - want).abs() <= 1e-6 * want,
-        "{} s, X alone {want} s",
-        s.schedule.cycle_time
-    );
+    assert_time(s.schedule.cycle_time, want, 1e-6, "X");
 }
 
 /// A turn of whole times round (`L C+720 FMAX`, the tip 50 mm off the C axis) comes back to
@@ -480,11 +472,7 @@ fn a_turn_of_whole_revolutions_is_followed_round() {
     // C's own time, to the chords' share: 1,400 chords within 1 µm of the circle put C
     // within 4e-6 of it.
     let want = rest_to_rest(720.0, 120.0, 1200.0);
-    assert!(
-        (s.schedule.cycle_time - want).abs() <= 1e-5 * want,
-        "{} s, C alone {want} s",
-        s.schedule.cycle_time
-    );
+    assert_time(s.schedule.cycle_time, want, 1e-5, "C");
 }
 
 #[test]
