@@ -64,6 +64,7 @@ fn toolpath() -> Toolpath {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     }
 }
 

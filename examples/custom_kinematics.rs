@@ -124,6 +124,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

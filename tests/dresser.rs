@@ -43,6 +43,7 @@ fn groove() -> Toolpath {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     }
 }
 

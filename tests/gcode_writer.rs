@@ -247,6 +247,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     };
     (m, t)
 }
@@ -655,6 +656,127 @@ fn tools_spindle_and_coolant_are_written_where_the_program_has_them() {
         let g43 = prog.text.lines().filter(|l| l.starts_with("G43 H")).count();
         assert_eq!(g43, if dialect == Dialect::Sinumerik { 0 } else { 2 });
     }
+}
+
+/// The program's length offsets in program order, each with where the tool stands when it
+/// comes (as [`machine_words`]).
+fn length_words(t: &Toolpath) -> Vec<(String, Option<[f64; 3]>)> {
+    t.length_offsets
+        .iter()
+        .flatten()
+        .map(|c| {
+            let at = c
+                .point
+                .checked_sub(1)
+                .map(|k| t.points[k.min(t.points.len() - 1)].p)
+                .map(|p| [p.x, p.y, p.z]);
+            (format!("{:?}", c.offset), at)
+        })
+        .collect()
+}
+
+#[test]
+fn the_programs_own_length_offsets_are_written_rather_than_one_with_each_tool() {
+    // A LinuxCNC program without G43 (CAMotics writes `T1M6` and no G43: the operator's touch
+    // off holds the tool's length) runs with its Z at the spindle's gauge line. Written with
+    // `G43 H1`, a control whose table gives T1 a length would run it that much higher.
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let options = reach();
+    let lines = |prog: &str| prog.lines().map(str::to_string).collect::<Vec<_>>();
+    let plain = toolpath::gcode::parse(
+        Path::new("plain.ngc"),
+        "G21 G90 G94\nT1 M6\nG0 X0 Y0 Z5 S2000 M3\nG1 Z-2 F300\nG1 X20\nG0 Z5 M5\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    assert_eq!(plain.length_offsets, Some(vec![]));
+    let sol = optimize(&m, &plain, &options).unwrap();
+    for dialect in Dialect::GCODE {
+        let (prog, _) = round_trip(&m, &plain, &sol, &options.geometry, dialect);
+        let l = lines(&prog.text);
+        assert!(
+            !l.iter().any(|l| l.starts_with("G43")),
+            "{dialect}\n{}",
+            prog.text
+        );
+        // A Sinumerik applies the tool's length with `T… M6`: off again, as in the program.
+        if dialect == Dialect::Sinumerik {
+            let t = l.iter().position(|l| l == "T1 M6").unwrap();
+            assert_eq!(l[t + 1], "D0", "{}", prog.text);
+        }
+    }
+    // Its own offsets, where it switches them: a bare G43 (LinuxCNC: the tool in the
+    // spindle's), G49, and an H of another number than the tool's.
+    let own = toolpath::gcode::parse(
+        Path::new("own.ngc"),
+        "G21 G90 G94\nT1 M6\nG43\nG0 X0 Y0 Z5 S2000 M3\nG1 Z-2 F300\nG1 X20\nG0 Z5 M5\n\
+         G49\nG0 X30\nT2 M6 G43 H12\nG0 X40\nG1 Z-2 F300\nG1 X60\nG0 Z5\nM2\n",
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    let want = length_words(&own);
+    assert_eq!(
+        want.iter().map(|w| w.0.as_str()).collect::<Vec<_>>(),
+        ["Plus(Some(1))", "Cancel", "Plus(Some(12))"]
+    );
+    let sol = optimize(&m, &own, &options).unwrap();
+    for dialect in Dialect::GCODE {
+        let (prog, _) = round_trip(&m, &own, &sol, &options.geometry, dialect);
+        let l = lines(&prog.text);
+        let at = |s: &str| l.iter().position(|l| l == s).unwrap_or(usize::MAX);
+        if dialect == Dialect::Sinumerik {
+            // D1 for the offset on, D0 for G49, D1 for G43 H12 (T2's change applies T2's
+            // length, as the program's G43 H12 in its block does).
+            let d: Vec<&String> = l.iter().filter(|l| l.starts_with('D')).collect();
+            assert_eq!(d, ["D1", "D0", "D1"], "{}", prog.text);
+            continue;
+        }
+        assert!(
+            at("T1 M6") < at("G43 H1") && at("G43 H1") < at("G49"),
+            "{}",
+            prog.text
+        );
+        assert_eq!(l[at("T2 M6") + 1], "G43 H12", "{}", prog.text);
+        assert_eq!(l.iter().filter(|l| l.starts_with("G43")).count(), 2);
+        let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, dialect).unwrap();
+        assert_eq!(length_words(&back), want, "{dialect}\n{}", prog.text);
+    }
+    // A program whose language has no length offsets (Sinumerik: `T… M6` applies the
+    // tool's): written for a LinuxCNC or Fanuc control, each numbered tool comes with its own.
+    let sinumerik = toolpath::gcode::parse(
+        Path::new("s.mpf"),
+        "G71 G90\nT1 M6\nG0 X0 Y0 Z5 S2000 M3\nG1 Z-2 F300\nG1 X20\nG0 Z5 M5\nM30\n",
+        Dialect::Sinumerik,
+    )
+    .unwrap();
+    assert_eq!(sinumerik.length_offsets, None);
+    let sol = optimize(&m, &sinumerik, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+        let (prog, _) = round_trip(&m, &sinumerik, &sol, &options.geometry, dialect);
+        let l = lines(&prog.text);
+        let t = l.iter().position(|l| l == "T1 M6").unwrap();
+        assert_eq!(l[t + 1], "G43 H1", "{dialect}\n{}", prog.text);
+    }
+}
+
+#[test]
+fn tool_tip_mode_takes_the_programs_length_offset_number() {
+    // NX's Fanuc posts give the length offset in the G43.4 block; it need not be the tool's
+    // number.
+    let (m, _) = bundled("seed_head_head", "impeller_blade.cls");
+    let input = toolpath::gcode::parse(
+        Path::new("tcp.nc"),
+        "%\nO1\nG21 G90 G94\nT5 M6\nG43.4 H25\nG0 X0 Y0 Z50 A0 C0 S10000 M3\nG1 Z10 F1000\n\
+         G1 X10 A5\nG0 Z50 M5\nG49\nM30\n%\n",
+        Dialect::Fanuc,
+    )
+    .unwrap();
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    let (prog, _) = round_trip(&m, &input, &sol, &options.geometry, Dialect::Fanuc);
+    assert!(prog.text.lines().any(|l| l == "G43.4 H25"), "{}", prog.text);
+    assert!(!prog.text.lines().any(|l| l == "G43.4 H5"), "{}", prog.text);
 }
 
 #[test]

@@ -58,6 +58,7 @@ fn line() -> Toolpath {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     }
 }
 
@@ -274,6 +275,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

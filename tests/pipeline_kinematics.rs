@@ -31,6 +31,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     }
 }
 

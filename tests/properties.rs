@@ -224,6 +224,7 @@ fn random_cl(seed: u64) -> Case {
             work_offset: None,
             offset_changes: Vec::new(),
             machine_points: Vec::new(),
+            length_offsets: None,
         },
     }
 }
@@ -599,6 +600,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             work_offset: None,
             offset_changes: Vec::new(),
             machine_points: Vec::new(),
+            length_offsets: None,
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

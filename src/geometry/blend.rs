@@ -43,8 +43,8 @@ use std::borrow::Cow;
 
 use super::SAME_POSITION_MM;
 use crate::toolpath::{
-    ClPoint, Dwell, Feed, MachinePoint, MachineSwitch, OffsetChange, SpindleChange, ToolChange,
-    Toolpath,
+    ClPoint, Dwell, Feed, LengthOffsetChange, MachinePoint, MachineSwitch, OffsetChange,
+    SpindleChange, ToolChange, Toolpath,
 };
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
@@ -153,6 +153,14 @@ pub fn blend_corners(
                 ..*c
             })
             .collect(),
+        length_offsets: toolpath.length_offsets.as_ref().map(|list| {
+            list.iter()
+                .map(|c| LengthOffsetChange {
+                    point: moved(c.point),
+                    ..*c
+                })
+                .collect()
+        }),
     };
     (Cow::Owned(tp), blended)
 }

@@ -259,6 +259,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         work_offset: None,
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
+        length_offsets: None,
     })
 }
 

@@ -153,6 +153,14 @@ pub struct Toolpath {
     /// The CL points the program places in machine coordinates (`G53`, `SUPA`, `M91`, the
     /// `G28`/`G30` reference points), in program order.
     pub machine_points: Vec<MachinePoint>,
+    /// The tool length offsets the program switches, in program order, where its language
+    /// has them (LinuxCNC and Fanuc G-code: `G43 H…`, `G44`, `G49`, and the `H` of tool-tip
+    /// mode `G43.4`/`G43.5`/`G234`); `None` where it has none (APT, Sinumerik, Klartext: the
+    /// control applies the tool's length with the tool). The motion does not depend on them
+    /// (a 3-axis program without `G43` is the same path with Z shifted by the tool's
+    /// length); `feedopt gcode` writes them back as the program has them, so that the
+    /// written Z means what the program's meant.
+    pub length_offsets: Option<Vec<LengthOffsetChange>>,
 }
 
 impl Toolpath {
@@ -169,6 +177,7 @@ impl Toolpath {
             work_offset: None,
             offset_changes: Vec::new(),
             machine_points: Vec::new(),
+            length_offsets: None,
         }
     }
 
@@ -306,6 +315,28 @@ pub struct OffsetChange {
     pub line: usize,
     pub name: String,
     pub origin: [f64; 3],
+}
+
+/// A tool length offset switched by the program ([`Toolpath::length_offsets`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LengthOffset {
+    /// `G43` (and tool-tip mode's `G43.4`, `G43.5`, Haas `G234`) with offset number H
+    /// (`None`: no H in the block and none the control would take: LinuxCNC takes the tool
+    /// in the spindle, a Fanuc the last H given).
+    Plus(Option<u32>),
+    /// `G44 H…`: the offset subtracted.
+    Minus(Option<u32>),
+    /// `G49`: no length offset.
+    Cancel,
+}
+
+/// The program switches `offset` at `line`, before the move ending at CL point `point` (a
+/// control applies it with the block's own motion).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LengthOffsetChange {
+    pub point: usize,
+    pub line: usize,
+    pub offset: LengthOffset,
 }
 
 /// CL point `point` is where a block in machine coordinates goes (the reader places it

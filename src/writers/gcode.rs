@@ -76,11 +76,18 @@
 //! * a numbered tool as `T n M6`; a named one as `T="name" M6` (Sinumerik), elsewhere a
 //!   comment that says to select it (those controls number their tools); a tool given by its
 //!   geometry alone (APT `CUTTER/`, `TLDATA/`) as a comment;
-//! * the tool-tip mode switch comes after the first tool (Fanuc `G43.4 H n` with its length
-//!   offset, H1 where no numbered tool is selected); a tool change in tool-tip mode leaves it
-//!   and switches it on again with the new tool. On a machine without tool-tip mode the
-//!   written Z is the tool tip, so each numbered tool comes with its length offset, `G43 H n`
-//!   (LinuxCNC, Fanuc; a Sinumerik applies the tool's own with `T … M6`);
+//! * the tool-tip mode switch comes after the first tool (Fanuc `G43.4 H n` with the length
+//!   offset the program gives, else the tool's number, H1 where no numbered tool is
+//!   selected); a tool change in tool-tip mode leaves it and switches it on again with the
+//!   new tool;
+//! * on a machine without tool-tip mode, the program's own length offsets where its
+//!   language has them ([`crate::toolpath::Toolpath::length_offsets`]: LinuxCNC and Fanuc
+//!   `G43 H n`, `G44`, `G49`) where it switches them: a LinuxCNC program without `G43` (the
+//!   CAMotics bear) has its Z at the gauge line and is written so; on a Sinumerik, whose
+//!   `T … M6` applies the tool's length, as `D1` and `D0`, and `D0` after a tool change
+//!   where the program's offset is off. Where the language has none (APT, Sinumerik,
+//!   Klartext: the tool tip is programmed), each numbered tool comes with its length offset,
+//!   `G43 H n` (LinuxCNC, Fanuc);
 //! * the spindle speed as `S` (a whole number of rpm on a Fanuc), with the direction of the
 //!   same block (`S12000 M3`); `M3`, `M4`, `M5`; the coolant `M7`, `M8`, `M9` (a Klartext
 //!   `M13` is written as M3 and M8).
@@ -107,7 +114,7 @@
 //! have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a Sinumerik, whose G58 is a
 //! programmable shift) is named in a comment instead. The values a program gives its offsets
 //! (`G10 L2`) are not written: the control's own are used. Nor are `G52`/`G92` shifts (the
-//! coordinates include them), the program's own length-offset words or other M codes.
+//! coordinates include them), LinuxCNC's `G43.1`/`G43.2` or other M codes.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
@@ -162,7 +169,7 @@ use crate::optimize::Solution;
 use crate::schedule::Timeline;
 use crate::toolpath::gcode::Dialect;
 use crate::toolpath::{
-    Feed, MachineMove, MachinePoint, OffsetChange, Switch, ToolSelect, Toolpath,
+    Feed, LengthOffset, MachineMove, MachinePoint, OffsetChange, Switch, ToolSelect, Toolpath,
 };
 use crate::validate::MIN_ROTATION_DEG;
 
@@ -301,6 +308,7 @@ enum Aux<'a> {
     Tool(&'a ToolSelect),
     Speed(f64),
     Switch(Switch),
+    Length(LengthOffset),
 }
 
 /// The toolpath's tool changes, spindle speeds and switches in the order the program makes
@@ -339,6 +347,14 @@ fn auxiliaries<'a>(tp: &'a Toolpath, machine: &[MachinePoint]) -> Vec<(usize, Au
             .enumerate()
             .map(|(i, c)| (c.point, c.line, 2, i, Aux::Switch(c.switch))),
     );
+    // (A length offset in a tool change's block comes after the change.)
+    v.extend(
+        tp.length_offsets
+            .iter()
+            .flatten()
+            .enumerate()
+            .map(|(i, c)| (c.point, c.line, 1, i, Aux::Length(c.offset))),
+    );
     v.sort_by_key(|&(point, line, rank, i, _)| (point, line, rank, i));
     v.into_iter()
         .map(|(point, _, _, _, a)| (point, a))
@@ -355,6 +371,13 @@ struct Setup<'a> {
     tcp_active: bool,
     /// The tool in the spindle, by number.
     tool: Option<u32>,
+    /// The program's own length offsets are written ([`Toolpath::length_offsets`]: its
+    /// language has them), rather than one with each numbered tool.
+    mirror_length: bool,
+    /// The program's length offset is on (mirrored).
+    length_on: bool,
+    /// The last H the program gives a length offset (tool-tip mode's too).
+    h: Option<u32>,
     /// The origin of the work offset in force, toolpath coordinates: written coordinates are
     /// the points less it.
     origin: [f64; 3],
@@ -368,7 +391,7 @@ impl Setup<'_> {
     fn tcp_on(&mut self, text: &mut String) {
         if self.tcp && !self.tcp_active {
             let on = match self.dialect {
-                Dialect::Fanuc => format!("G43.4 H{}", self.tool.unwrap_or(1)),
+                Dialect::Fanuc => format!("G43.4 H{}", self.h.or(self.tool).unwrap_or(1)),
                 _ => self.words.tcp_on.to_string(),
             };
             let _ = writeln!(text, "{on}");
@@ -409,7 +432,14 @@ impl Setup<'_> {
                     }
                     self.origin = change.origin;
                 }
-                Aux::Tool(tool) => self.change(text, tool),
+                Aux::Tool(tool) => {
+                    // (A length offset the program switches on before the next move.)
+                    let offset_follows = self.events[self.next..]
+                        .iter()
+                        .take_while(|&&(q, _)| q == p)
+                        .any(|(_, a)| matches!(a, Aux::Length(o) if *o != LengthOffset::Cancel));
+                    self.change(text, tool, offset_follows);
+                }
                 Aux::Speed(rpm) => {
                     // A direction in the same block goes with it (`S12000 M3`).
                     let with = match self.events.get(self.next) {
@@ -436,13 +466,43 @@ impl Setup<'_> {
                 Aux::Switch(sw) => {
                     let _ = writeln!(text, "{}", m_code(sw));
                 }
+                Aux::Length(offset) => self.length(text, offset),
             }
         }
     }
 
+    /// The program's length offset `offset` (module doc, "Tools, spindle and coolant"):
+    /// under tool-tip mode only its H, which `G43.4` takes.
+    fn length(&mut self, text: &mut String, offset: LengthOffset) {
+        if let LengthOffset::Plus(Some(h)) | LengthOffset::Minus(Some(h)) = offset {
+            self.h = Some(h);
+        }
+        if self.tcp {
+            return;
+        }
+        let h = |h: Option<u32>| h.map(|h| format!(" H{h}")).unwrap_or_default();
+        let block = match (offset, self.dialect) {
+            (LengthOffset::Plus(_), Dialect::Sinumerik) => "D1".to_string(),
+            (LengthOffset::Cancel, Dialect::Sinumerik) => "D0".to_string(),
+            (LengthOffset::Plus(n), _) => format!("G43{}", h(n)),
+            (LengthOffset::Cancel, _) => "G49".to_string(),
+            (LengthOffset::Minus(n), Dialect::Fanuc) => format!("G44{}", h(n)),
+            (LengthOffset::Minus(n), _) => (self.words.comment)(&format!(
+                "the program subtracts tool length offset{} here (G44), which this dialect does \
+                 not have: set the same length here",
+                h(n)
+            )),
+        };
+        self.length_on = offset != LengthOffset::Cancel;
+        let _ = writeln!(text, "{block}");
+    }
+
     /// A tool change: out of tool-tip mode and back with the new tool; on a machine without
-    /// it, the new tool's length offset (`G43 H`) on a LinuxCNC or Fanuc control.
-    fn change(&mut self, text: &mut String, tool: &ToolSelect) {
+    /// it, the new tool's length offset (`G43 H`) on a LinuxCNC or Fanuc control, unless the
+    /// program's own are written (and on a Sinumerik, where `T… M6` applies the tool's
+    /// length, `D0` where the program's length offset is off and is not switched on before
+    /// the next move).
+    fn change(&mut self, text: &mut String, tool: &ToolSelect, offset_follows: bool) {
         let comment = |c: String| (self.words.comment)(&c);
         let line = match (tool, self.dialect) {
             (ToolSelect::Number(n), _) => format!("T{n} M6"),
@@ -478,9 +538,19 @@ impl Setup<'_> {
         // (Tool-tip mode comes back before the next move, with the new tool's length.)
         self.tcp_off(text);
         let _ = writeln!(text, "{line}");
+        if self.dialect == Dialect::Sinumerik
+            && self.mirror_length
+            && !self.tcp
+            && !self.length_on
+            && !offset_follows
+        {
+            let _ = writeln!(text, "D0");
+        }
+        // (Tool-tip mode takes the new tool's number until the program gives its H.)
+        self.h = None;
         if let ToolSelect::Number(n) = tool {
             self.tool = Some(*n);
-            if !self.tcp && self.dialect != Dialect::Sinumerik {
+            if !self.tcp && self.dialect != Dialect::Sinumerik && !self.mirror_length {
                 let _ = writeln!(text, "G43 H{n}");
             }
         }
@@ -1078,6 +1148,9 @@ pub fn program(
         tcp,
         tcp_active: false,
         tool: None,
+        mirror_length: toolpath.length_offsets.is_some(),
+        length_on: false,
+        h: None,
         origin: [0.0; 3],
         events: auxiliaries(toolpath, &unwritten),
         next: 0,

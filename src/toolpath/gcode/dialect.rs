@@ -534,6 +534,21 @@ pub struct DialectSpec {
     /// `,C` and `,R` after a straight move chamfer or round the corner to the next one
     /// (Fanuc's "chamfering and corner R", as Haas reads it too).
     pub comma_corners: bool,
+    /// Tool length offsets (`G43 H…`, `G44`, `G49`), recorded for the writer
+    /// ([`crate::toolpath::Toolpath::length_offsets`]).
+    pub length_offsets: LengthOffsets,
+}
+
+/// Whether a dialect has tool length offset words, and the offset a `G43` without H takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LengthOffsets {
+    /// None (Sinumerik and Klartext apply the tool's length with the tool).
+    Absent,
+    /// The tool in the spindle's (LinuxCNC: "G43 without an H word uses the currently loaded
+    /// tool").
+    BareTakesTool,
+    /// The last H given (Fanuc: H is modal; a program gives it with its first G43).
+    BareTakesLastH,
 }
 
 use Action::{
@@ -781,6 +796,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
     cycle_repeat: &['L'],
     rotary_feed: RotaryFeed::Xyz,
     comma_corners: false,
+    length_offsets: LengthOffsets::BareTakesTool,
 };
 
 /// Fanuc (M series). G43.4 = TCP with rotary words, G43.5 = TCP with tool vector I J K; any
@@ -967,6 +983,7 @@ pub static FANUC: DialectSpec = DialectSpec {
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Combined,
     comma_corners: true,
+    length_offsets: LengthOffsets::BareTakesLastH,
 };
 
 /// Siemens Sinumerik 840D. TRAORI = TCP (rotary words or tool vector `A3= B3= C3=`),
@@ -1238,6 +1255,7 @@ pub static SINUMERIK: DialectSpec = DialectSpec {
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
     comma_corners: false,
+    length_offsets: LengthOffsets::Absent,
 };
 
 /// Heidenhain TNC 640 Klartext. The path functions `L`, `LN`, `C`, `CC`, `CR`, `CT`, `CP`,
@@ -1492,6 +1510,7 @@ pub static HEIDENHAIN: DialectSpec = DialectSpec {
     cycle_repeat: &['K', 'L'],
     rotary_feed: RotaryFeed::Xyz,
     comma_corners: false,
+    length_offsets: LengthOffsets::Absent,
 };
 
 /// Looks a G or M code up: `code` is the value as written (`1`, `01`, `43.4`).

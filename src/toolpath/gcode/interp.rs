@@ -17,8 +17,9 @@ use super::*;
 use crate::error::{Error, Result};
 use crate::machine::DecimalPointInput;
 use crate::toolpath::{
-    Assumed, ClPoint, Dwell, Feed, MM_PER_INCH, MachineContext, MachineMove, MachinePoint,
-    MachineSwitch, OffsetChange, SpindleChange, Switch, ToolChange, ToolSelect, Toolpath, Warning,
+    Assumed, ClPoint, Dwell, Feed, LengthOffset, LengthOffsetChange, MM_PER_INCH, MachineContext,
+    MachineMove, MachinePoint, MachineSwitch, OffsetChange, SpindleChange, Switch, ToolChange,
+    ToolSelect, Toolpath, Warning,
 };
 
 /// The words of one block, sorted by meaning.
@@ -274,6 +275,10 @@ pub(super) struct Interpreter<'a> {
     offset_changes: Vec<OffsetChange>,
     /// The points placed in machine coordinates.
     machine_points: Vec<MachinePoint>,
+    /// The tool length offsets switched so far.
+    length_offsets: Vec<LengthOffsetChange>,
+    /// The last H word given with a length offset code (a Fanuc's H is modal).
+    last_h: Option<u32>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -353,6 +358,8 @@ impl<'a> Interpreter<'a> {
             stops: Vec::new(),
             offset_changes: Vec::new(),
             machine_points: Vec::new(),
+            length_offsets: Vec::new(),
+            last_h: None,
             m92: false,
             m92_warned: [false; 3],
         }
@@ -516,6 +523,8 @@ impl<'a> Interpreter<'a> {
             work_offset: self.offsets.start_named().map(str::to_string),
             offset_changes: self.offset_changes,
             machine_points: self.machine_points,
+            length_offsets: (self.spec.length_offsets != LengthOffsets::Absent)
+                .then_some(self.length_offsets),
         })
     }
 
@@ -945,6 +954,7 @@ impl<'a> Interpreter<'a> {
     fn block_words(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let block = self.collect(line, items)?;
         self.m92 = false;
+        self.length_offset(line, &block)?;
 
         // Modal settings first (feed mode, F, units, plane, distance, TCP), then the motion.
         let mut motion_code: Option<(&str, Motion)> = None;
@@ -1479,6 +1489,56 @@ impl<'a> Interpreter<'a> {
             self.warn(line, "I/J/K or R without a move: ignored");
         }
         self.end_if(end);
+        Ok(())
+    }
+
+    /// Records the block's tool length offset code (`G43`, `G44`, `G49`; tool-tip mode's
+    /// `G43.4`, `G43.5`, Haas `G234` for their H) where the dialect has them, before the
+    /// block's motion, which the control runs with it.
+    fn length_offset(&mut self, line: usize, block: &Block) -> Result<()> {
+        if self.spec.length_offsets == LengthOffsets::Absent {
+            return Ok(());
+        }
+        for (text, _, _) in &block.actions {
+            let code = code_name(text);
+            let sign = match code.as_str() {
+                "G43" | "G43.4" | "G43.5" | "G234" => Some(true),
+                "G44" => Some(false),
+                "G49" => None,
+                _ => continue,
+            };
+            let offset = match sign {
+                None => LengthOffset::Cancel,
+                Some(plus) => {
+                    let h = match block.letter('H') {
+                        Some(h) => {
+                            let n = self.tool_number(line, &format!("{code} H"), h.value)?;
+                            self.last_h = Some(n);
+                            Some(n)
+                        }
+                        None => match self.spec.length_offsets {
+                            LengthOffsets::BareTakesTool => {
+                                self.tool_changes.last().and_then(|c| match c.tool {
+                                    ToolSelect::Number(n) => Some(n),
+                                    _ => None,
+                                })
+                            }
+                            _ => self.last_h,
+                        },
+                    };
+                    if plus {
+                        LengthOffset::Plus(h)
+                    } else {
+                        LengthOffset::Minus(h)
+                    }
+                }
+            };
+            self.length_offsets.push(LengthOffsetChange {
+                point: self.points.len(),
+                line,
+                offset,
+            });
+        }
         Ok(())
     }
 
