@@ -758,6 +758,9 @@ fn dresser_profile(
     }
 }
 
+/// Most steps of [`smooth_within`]'s descent.
+const SMOOTH_ITERATIONS: usize = 500;
+
 /// Smooths a span's points within a tolerance tube: projected gradient descent on the bending
 /// energy Σ|D²w|² (second differences over the programmed spacing, per coordinate), every step
 /// followed by a projection back into the tube — a ball of radius `tol_mm` around each
@@ -768,7 +771,6 @@ fn dresser_profile(
 /// converge to a taut string with kinks at the tube's wall, the opposite of smooth.) Returns
 /// the largest deviation (mm, rad). Zero tolerances leave the points as they are.
 pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) -> (f64, f64) {
-    const ITERATIONS: usize = 500;
     let n = values.len();
     if n < 4 || (tol_mm <= 0.0 && tol_rad <= 0.0) {
         return (0.0, 0.0);
@@ -813,50 +815,27 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
     } else {
         5
     };
-    let mut d2 = vec![[0.0; 5]; n];
-    for _ in 0..ITERATIONS {
-        for i in 1..n - 1 {
-            let r = row(i);
-            for j in 0..dims {
-                d2[i][j] = r[0] * values[i - 1][j] + r[1] * values[i][j] + r[2] * values[i + 1][j];
-            }
-        }
-        let mut moved = 0.0f64;
-        for k in 1..n - 1 {
-            let mut w = values[k];
-            let (before, here, after) = (row(k - 1)[2], row(k)[1], row(k + 1)[0]);
-            for j in 0..dims {
-                // (D²ᵀ D² w)_k = Σ_i D²[i][k] · (D² w)_i over the rows i = k−1, k, k+1 (the
-                // end rows, 0 and n−1, are zero in both).
-                let mut g = 0.0;
-                g += before * d2[k - 1][j];
-                g += here * d2[k][j];
-                g += after * d2[k + 1][j];
-                w[j] -= step * g;
-            }
-            if tol_mm > 0.0 {
-                let d = dist(&w, &orig[k]);
-                if d > tol_mm {
-                    for j in 0..3 {
-                        w[j] = orig[k][j] + (w[j] - orig[k][j]) * tol_mm / d;
-                    }
-                }
+    // Per point k, the coefficients of the rows k − 1, k, k + 1 on it (D² is tridiagonal).
+    let cols: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            if k == 0 || k + 1 == n {
+                [0.0; 3]
             } else {
-                w[..3].copy_from_slice(&orig[k][..3]);
+                [row(k - 1)[2], row(k)[1], row(k + 1)[0]]
             }
-            for j in 3..5 {
-                w[j] = w[j].clamp(orig[k][j] - tol_rad, orig[k][j] + tol_rad);
-            }
-            moved = moved.max(
-                (0..5)
-                    .map(|j| (w[j] - values[k][j]).abs())
-                    .fold(0.0, f64::max),
-            );
-            values[k] = w;
-        }
-        if moved < 1e-12 {
-            break;
-        }
+        })
+        .collect();
+    let tube = Tube {
+        orig: &orig,
+        rows: &rows,
+        cols: &cols,
+        step,
+        tol_mm,
+        tol_rad,
+    };
+    match dims {
+        3 => tube.descend::<3>(values),
+        _ => tube.descend::<5>(values),
     }
     let dev_mm = (0..n)
         .map(|i| dist(&values[i], &orig[i]))
@@ -866,6 +845,95 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
         .map(|(i, j)| (values[i][j] - orig[i][j]).abs())
         .fold(0.0, f64::max);
     (dev_mm, dev_rad)
+}
+
+/// The projected gradient descent of [`smooth_within`]: the tube about the programmed points
+/// `orig`, the rows of D² and their coefficients per point, the step.
+struct Tube<'a> {
+    orig: &'a [[f64; PATH_DIM]],
+    rows: &'a [[f64; 3]],
+    cols: &'a [[f64; 3]],
+    step: f64,
+    tol_mm: f64,
+    tol_rad: f64,
+}
+
+impl Tube<'_> {
+    /// (D² w)_i over the first `D` coordinates (1 ≤ i ≤ n − 2).
+    #[inline(always)]
+    fn second<const D: usize>(&self, v: &[[f64; PATH_DIM]], i: usize) -> [f64; D] {
+        let r = self.rows[i];
+        std::array::from_fn(|j| r[0] * v[i - 1][j] + r[1] * v[i][j] + r[2] * v[i + 1][j])
+    }
+
+    /// Up to [`SMOOTH_ITERATIONS`] steps on the first `D` coordinates (3: the tip; 5: and the
+    /// rotary angles), each followed by the projection into the tube. One pass a step: the
+    /// rows of D² w a point's gradient reads are computed from the step's starting values
+    /// just before that point moves (row k + 1 reads w[k], which has not moved yet), so the
+    /// step is the same as computing them all first.
+    fn descend<const D: usize>(&self, values: &mut [[f64; PATH_DIM]]) {
+        let n = values.len();
+        let squared = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
+            (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>()
+        };
+        // A squared distance below `inside` has its root below tol_mm, one above `outside`
+        // above it, whatever the roundings (1e-12 is far above them): the root, whose
+        // latency held the loop up, is taken only to project or where it decides.
+        let tol2 = self.tol_mm * self.tol_mm;
+        let (inside, outside) = (tol2 * (1.0 - 1e-12), tol2 * (1.0 + 1e-12));
+        for _ in 0..SMOOTH_ITERATIONS {
+            // (D² w)_{k−1}, (D² w)_k; the end rows are zero.
+            let mut before = [0.0; D];
+            let mut here = self.second::<D>(values, 1);
+            let mut moved = 0.0f64;
+            for k in 1..n - 1 {
+                let after = if k + 2 < n {
+                    self.second::<D>(values, k + 1)
+                } else {
+                    [0.0; D]
+                };
+                let mut w = values[k];
+                let [cb, ch, ca] = self.cols[k];
+                for j in 0..D {
+                    // (D²ᵀ D² w)_k = Σ_i D²[i][k] · (D² w)_i over the rows i = k−1, k, k+1.
+                    let mut g = 0.0;
+                    g += cb * before[j];
+                    g += ch * here[j];
+                    g += ca * after[j];
+                    w[j] -= self.step * g;
+                }
+                let o = &self.orig[k];
+                if self.tol_mm > 0.0 {
+                    let s = squared(&w, o);
+                    if s > inside {
+                        let d = s.sqrt();
+                        if s > outside || d > self.tol_mm {
+                            for j in 0..3 {
+                                w[j] = o[j] + (w[j] - o[j]) * self.tol_mm / d;
+                            }
+                        }
+                    }
+                } else {
+                    w[..3].copy_from_slice(&o[..3]);
+                }
+                // (With D = 3 the angles stay as programmed: the clamp keeps them, and they
+                // do not move.)
+                for j in 3..D {
+                    w[j] = w[j].clamp(o[j] - self.tol_rad, o[j] + self.tol_rad);
+                }
+                moved = moved.max(
+                    (0..D)
+                        .map(|j| (w[j] - values[k][j]).abs())
+                        .fold(0.0, f64::max),
+                );
+                values[k] = w;
+                (before, here) = (here, after);
+            }
+            if moved < 1e-12 {
+                break;
+            }
+        }
+    }
 }
 
 /// Interior samples per interval at which [`chord_deviation`] compares the curve with the
