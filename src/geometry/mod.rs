@@ -16,6 +16,7 @@ pub mod biarc;
 pub mod blend;
 pub mod spline;
 
+use multiversion::multiversion;
 use nalgebra::Vector3;
 
 pub use crate::base::angle_between;
@@ -859,81 +860,129 @@ struct Tube<'a> {
 }
 
 impl Tube<'_> {
-    /// (D² w)_i over the first `D` coordinates (1 ≤ i ≤ n − 2).
-    #[inline(always)]
-    fn second<const D: usize>(&self, v: &[[f64; PATH_DIM]], i: usize) -> [f64; D] {
-        let r = self.rows[i];
-        std::array::from_fn(|j| r[0] * v[i - 1][j] + r[1] * v[i][j] + r[2] * v[i + 1][j])
-    }
-
     /// Up to [`SMOOTH_ITERATIONS`] steps on the first `D` coordinates (3: the tip; 5: and the
-    /// rotary angles), each followed by the projection into the tube. One pass a step: the
-    /// rows of D² w a point's gradient reads are computed from the step's starting values
-    /// just before that point moves (row k + 1 reads w[k], which has not moved yet), so the
-    /// step is the same as computing them all first.
+    /// rotary angles), each followed by the projection into the tube. The coordinates are
+    /// held one array each (so that a step runs along them with vector instructions: the same
+    /// operations in the same order per point, so the same bits as point by point).
     fn descend<const D: usize>(&self, values: &mut [[f64; PATH_DIM]]) {
         let n = values.len();
-        let squared = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
-            (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>()
-        };
-        // A squared distance below `inside` has its root below tol_mm, one above `outside`
-        // above it, whatever the roundings (1e-12 is far above them): the root, whose
-        // latency held the loop up, is taken only to project or where it decides.
-        let tol2 = self.tol_mm * self.tol_mm;
-        let (inside, outside) = (tol2 * (1.0 - 1e-12), tol2 * (1.0 + 1e-12));
+        let column = |v: &[[f64; PATH_DIM]], j: usize| v.iter().map(|p| p[j]).collect::<Vec<f64>>();
+        let mut w: [Vec<f64>; D] = std::array::from_fn(|j| column(values, j));
+        let o: [Vec<f64>; D] = std::array::from_fn(|j| column(self.orig, j));
+        let r: [Vec<f64>; 3] = std::array::from_fn(|c| self.rows.iter().map(|x| x[c]).collect());
+        let c: [Vec<f64>; 3] = std::array::from_fn(|k| self.cols.iter().map(|x| x[k]).collect());
+        let mut d2: [Vec<f64>; D] = std::array::from_fn(|_| vec![0.0; n]);
+        let mut g: [Vec<f64>; D] = std::array::from_fn(|_| vec![0.0; n]);
         for _ in 0..SMOOTH_ITERATIONS {
-            // (D² w)_{k−1}, (D² w)_k; the end rows are zero.
-            let mut before = [0.0; D];
-            let mut here = self.second::<D>(values, 1);
-            let mut moved = 0.0f64;
-            for k in 1..n - 1 {
-                let after = if k + 2 < n {
-                    self.second::<D>(values, k + 1)
-                } else {
-                    [0.0; D]
-                };
-                let mut w = values[k];
-                let [cb, ch, ca] = self.cols[k];
-                for j in 0..D {
-                    // (D²ᵀ D² w)_k = Σ_i D²[i][k] · (D² w)_i over the rows i = k−1, k, k+1.
-                    let mut g = 0.0;
-                    g += cb * before[j];
-                    g += ch * here[j];
-                    g += ca * after[j];
-                    w[j] -= self.step * g;
-                }
-                let o = &self.orig[k];
-                if self.tol_mm > 0.0 {
-                    let s = squared(&w, o);
-                    if s > inside {
-                        let d = s.sqrt();
-                        if s > outside || d > self.tol_mm {
-                            for j in 0..3 {
-                                w[j] = o[j] + (w[j] - o[j]) * self.tol_mm / d;
-                            }
-                        }
-                    }
-                } else {
-                    w[..3].copy_from_slice(&o[..3]);
-                }
-                // (With D = 3 the angles stay as programmed: the clamp keeps them, and they
-                // do not move.)
-                for j in 3..D {
-                    w[j] = w[j].clamp(o[j] - self.tol_rad, o[j] + self.tol_rad);
-                }
-                moved = moved.max(
-                    (0..D)
-                        .map(|j| (w[j] - values[k][j]).abs())
-                        .fold(0.0, f64::max),
-                );
-                values[k] = w;
-                (before, here) = (here, after);
-            }
+            let moved = tube_step::<D>(self, &mut w, &o, &r, &c, &mut d2, &mut g);
             if moved < 1e-12 {
                 break;
             }
         }
+        for (k, p) in values.iter_mut().enumerate() {
+            for j in 0..D {
+                p[j] = w[j][k];
+            }
+        }
     }
+}
+
+/// One step of [`Tube::descend`] on the coordinate arrays `w` (`o`: the programmed ones;
+/// `r`, `c`: D²'s rows and their coefficients per point, by column; `d2`, `g`: scratch of the
+/// points' length): the gradient step, then the projection into the tube. Returns the largest
+/// move of a coordinate.
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn tube_step<const D: usize>(
+    tube: &Tube,
+    w: &mut [Vec<f64>; D],
+    o: &[Vec<f64>; D],
+    r: &[Vec<f64>; 3],
+    c: &[Vec<f64>; 3],
+    d2: &mut [Vec<f64>; D],
+    g: &mut [Vec<f64>; D],
+) -> f64 {
+    let n = w[0].len();
+    // (D² w)_i, 1 ≤ i ≤ n − 2 (the end rows stay zero).
+    for j in 0..D {
+        let (x, d) = (&w[j][..n], &mut d2[j][..n]);
+        for i in 1..n - 1 {
+            d[i] = r[0][i] * x[i - 1] + r[1][i] * x[i] + r[2][i] * x[i + 1];
+        }
+    }
+    // (D²ᵀ D² w)_k = Σ_i D²[i][k] · (D² w)_i over the rows i = k−1, k, k+1; the step.
+    for j in 0..D {
+        let (d, x, gj) = (&d2[j][..n], &w[j][..n], &mut g[j][..n]);
+        for k in 1..n - 1 {
+            let mut s = 0.0;
+            s += c[0][k] * d[k - 1];
+            s += c[1][k] * d[k];
+            s += c[2][k] * d[k + 1];
+            gj[k] = x[k] - tube.step * s;
+        }
+    }
+    // The projection: onto the ball of radius tol_mm about the programmed tip, the angles
+    // clamped.
+    let tol = tube.tol_mm;
+    {
+        let [ox, oy, oz] = [&o[0][..n], &o[1][..n], &o[2][..n]];
+        let [gx, gy, gz] = g.split_first_chunk_mut::<3>().expect("D ≥ 3").0;
+        let (gx, gy, gz) = (&mut gx[..n], &mut gy[..n], &mut gz[..n]);
+        for k in 1..n - 1 {
+            let (a, b, e) = (gx[k], gy[k], gz[k]);
+            if tol > 0.0 {
+                let s = (a - ox[k]).powi(2) + (b - oy[k]).powi(2) + (e - oz[k]).powi(2);
+                let d = s.sqrt();
+                // (Without branches, so that it runs along the arrays.)
+                let out = d > tol;
+                gx[k] = if out {
+                    ox[k] + (a - ox[k]) * tol / d
+                } else {
+                    a
+                };
+                gy[k] = if out {
+                    oy[k] + (b - oy[k]) * tol / d
+                } else {
+                    b
+                };
+                gz[k] = if out {
+                    oz[k] + (e - oz[k]) * tol / d
+                } else {
+                    e
+                };
+            } else {
+                (gx[k], gy[k], gz[k]) = (ox[k], oy[k], oz[k]);
+            }
+        }
+    }
+    for j in 3..D {
+        let (gj, oj) = (&mut g[j][..n], &o[j][..n]);
+        for k in 1..n - 1 {
+            gj[k] = gj[k].clamp(oj[k] - tube.tol_rad, oj[k] + tube.tol_rad);
+        }
+    }
+    // The largest move, in eight lanes (a maximum is the same in any order; `>` rather than
+    // f64::max, which does not run along the arrays: both leave a NaN out), and the new
+    // values.
+    const LANES: usize = 8;
+    let mut lanes = [0.0f64; LANES];
+    for j in 0..D {
+        let (gj, wj) = (&g[j][1..n - 1], &mut w[j][1..n - 1]);
+        let mut wc = wj.chunks_exact_mut(LANES);
+        let mut gc = gj.chunks_exact(LANES);
+        for (wk, gk) in (&mut wc).zip(&mut gc) {
+            for l in 0..LANES {
+                let m = (gk[l] - wk[l]).abs();
+                lanes[l] = if m > lanes[l] { m } else { lanes[l] };
+                wk[l] = gk[l];
+            }
+        }
+        for (wk, gk) in wc.into_remainder().iter_mut().zip(gc.remainder()) {
+            let m = (gk - *wk).abs();
+            lanes[0] = if m > lanes[0] { m } else { lanes[0] };
+            *wk = *gk;
+        }
+    }
+    lanes.iter().fold(0.0f64, |a, &m| if m > a { m } else { a })
 }
 
 /// Interior samples per interval at which [`chord_deviation`] compares the curve with the
@@ -1065,6 +1114,134 @@ mod tests {
         assert!(before > 0.08, "noisy curvature {before}");
         assert!(after < 0.06, "smoothed curvature {after} (circle: 0.05)");
         assert_eq!((w[0], w[299]), (orig[0], orig[299]), "ends stay");
+    }
+
+    /// [`smooth_within`]'s descent written point by point, as it was before it ran along
+    /// coordinate arrays: each step's rows of D² w first, then every point's gradient step and
+    /// projection.
+    fn descend_point_by_point(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) {
+        let n = values.len();
+        let orig = values.to_vec();
+        let dist = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
+            (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt()
+        };
+        let h: Vec<f64> = orig
+            .windows(2)
+            .map(|w| {
+                let d = dist(&w[0], &w[1]);
+                let a = ((w[1][3] - w[0][3]).powi(2) + (w[1][4] - w[0][4]).powi(2)).sqrt();
+                if d > 0.0 { d } else { a.max(f64::MIN_POSITIVE) }
+            })
+            .collect();
+        let row = |i: usize| -> [f64; 3] {
+            if i == 0 || i + 1 == n {
+                return [0.0; 3];
+            }
+            let (a, b) = (h[i - 1], h[i]);
+            [2.0 / (a * (a + b)), -2.0 / (a * b), 2.0 / (b * (a + b))]
+        };
+        let l = (1..n - 1)
+            .map(|i| row(i).iter().map(|c| c.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+            .powi(2);
+        let step = 1.0 / l;
+        let dims = if orig.iter().all(|w| w[3..5] == orig[0][3..5]) {
+            3
+        } else {
+            5
+        };
+        let mut d2 = vec![[0.0; 5]; n];
+        for _ in 0..SMOOTH_ITERATIONS {
+            for i in 1..n - 1 {
+                let r = row(i);
+                for j in 0..dims {
+                    d2[i][j] =
+                        r[0] * values[i - 1][j] + r[1] * values[i][j] + r[2] * values[i + 1][j];
+                }
+            }
+            let mut moved = 0.0f64;
+            for k in 1..n - 1 {
+                let mut w = values[k];
+                let (before, here, after) = (row(k - 1)[2], row(k)[1], row(k + 1)[0]);
+                for j in 0..dims {
+                    let mut g = 0.0;
+                    g += before * d2[k - 1][j];
+                    g += here * d2[k][j];
+                    g += after * d2[k + 1][j];
+                    w[j] -= step * g;
+                }
+                if tol_mm > 0.0 {
+                    let d = dist(&w, &orig[k]);
+                    if d > tol_mm {
+                        for j in 0..3 {
+                            w[j] = orig[k][j] + (w[j] - orig[k][j]) * tol_mm / d;
+                        }
+                    }
+                } else {
+                    w[..3].copy_from_slice(&orig[k][..3]);
+                }
+                for j in 3..5 {
+                    w[j] = w[j].clamp(orig[k][j] - tol_rad, orig[k][j] + tol_rad);
+                }
+                moved = moved.max(
+                    (0..5)
+                        .map(|j| (w[j] - values[k][j]).abs())
+                        .fold(0.0, f64::max),
+                );
+                values[k] = w;
+            }
+            if moved < 1e-12 {
+                break;
+            }
+        }
+    }
+
+    #[test]
+    fn the_descent_along_coordinate_arrays_is_the_point_by_point_one_to_the_bit() {
+        // Noisy circles of many lengths (the vector loops' remainders), a tip that stands
+        // still for a step, and five-axis points whose angles move.
+        // (Rounded to 0.02 mm, most points reach the tube's wall: the projection acts.)
+        let mut cases: Vec<Vec<[f64; PATH_DIM]>> = [4, 5, 9, 17, 64, 100, 301]
+            .iter()
+            .flat_map(|&n| [circle(n, 0.001), circle(n, 0.02)])
+            .collect();
+        let mut standing = circle(40, 0.001);
+        standing[20] = standing[19];
+        cases.push(standing);
+        let mut turning = circle(90, 0.02);
+        for (k, w) in turning.iter_mut().enumerate() {
+            w[3] = ((k as f64 * 0.013).sin() * 1e3).round() / 1e3;
+            w[4] = ((k as f64 * 0.007).cos() * 1e3).round() / 1e3;
+        }
+        cases.push(turning);
+        let mut on_the_wall = 0;
+        for (c, case) in cases.iter().enumerate() {
+            for (tol_mm, tol_rad) in [(0.005, 0.0), (0.02, 1e-3), (0.0, 2e-3)] {
+                let (mut a, mut b) = (case.clone(), case.clone());
+                smooth_within(&mut a, tol_mm, tol_rad);
+                descend_point_by_point(&mut b, tol_mm, tol_rad);
+                let bits = |v: &[[f64; PATH_DIM]]| -> Vec<u64> {
+                    v.iter().flatten().map(|x| x.to_bits()).collect()
+                };
+                assert_eq!(
+                    bits(&a),
+                    bits(&b),
+                    "case {c}, tolerances {tol_mm} mm {tol_rad} rad"
+                );
+                // (Four or five rounded points may lie on a line: nothing to smooth.)
+                assert!(
+                    !(tol_mm > 0.0 && case.len() > 8 && a == *case),
+                    "case {c}: nothing moved"
+                );
+                on_the_wall += (a.iter().zip(case))
+                    .filter(|(p, q)| {
+                        let d = (0..3).map(|j| (p[j] - q[j]).powi(2)).sum::<f64>().sqrt();
+                        tol_mm > 0.0 && (d - tol_mm).abs() < 1e-9 * tol_mm
+                    })
+                    .count();
+            }
+        }
+        assert!(on_the_wall > 100, "{on_the_wall} points projected");
     }
 
     #[test]
