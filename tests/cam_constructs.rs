@@ -70,6 +70,38 @@ fn g83_peck_cycle_moves_and_time() {
     assert_eq!(tp.points.last().map(|p| p.p), Some(v(6.0, 0.0, 2.0)));
 }
 
+/// A peck cycle (G83, G73) without a peck depth Q, or with Q ≤ 0, is an error naming the
+/// block, as on the controls (Fanuc alarm PS0045 "address Q not found", LinuxCNC "Q must be
+/// positive"). Until round 17 it drilled in one pass with a warning: an NX post for a Haas
+/// wrote `G83 … Q0.0`, which no control drills so.
+#[test]
+fn a_peck_cycle_without_a_positive_peck_depth_is_refused() {
+    for (dialect, cycle) in [
+        (Dialect::Fanuc, "G83 X5. Y0 Z-10. R2. Q0.0 F100."),
+        (Dialect::Fanuc, "G73 X5. Y0 Z-10. R2. F100."),
+        (Dialect::LinuxCnc, "G83 X5 Y0 Z-10 R2 Q0 F100"),
+    ] {
+        let e = parse(
+            Path::new("t.nc"),
+            &format!("G21 G90 G0 X0 Y0 Z10.\nG99 {cycle}\nG80\n"),
+            dialect,
+        )
+        .map(|tp| tp.points.len())
+        .expect_err(cycle);
+        let e = message(e);
+        assert!(
+            e.contains("t.nc:2:") && e.contains("peck depth Q") && e.contains("G81"),
+            "{cycle}: {e}"
+        );
+    }
+    // With Q > 0 it pecks (see g83_peck_cycle_moves_and_time).
+    let tp = gcode(
+        Dialect::Fanuc,
+        "G21 G90 G0 X0 Y0 Z10.\nG99 G83 X5. Y0 Z-10. R2. Q4. F100.\nG80\n",
+    );
+    assert!(tp.warnings.is_empty(), "{:?}", tp.warnings);
+}
+
 /// A peck cycle repeated 1000 times (`L1000`), 5000 pecks a hole: 15 million moves from one
 /// block, more than a toolpath may hold (`toolpath::MAX_POINTS`). Refused before a move is
 /// made, naming the block and the repeat count.

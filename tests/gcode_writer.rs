@@ -248,6 +248,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     };
     (m, t)
 }
@@ -989,4 +990,82 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
             }
         }
     }
+}
+
+/// A tapping cycle is refused by the writer, naming the block that runs it: its moves are
+/// read as feeds at the tap's pitch × speed (the solve times them right), but written back as
+/// G1 blocks they would feed the tap in and out with the spindle turning forward, neither
+/// synchronised nor reversed, which strips the thread or breaks the tap. Round 17: a
+/// hyperMILL DMU 85 program's eight M14 holes (`CYCL DEF 207`, called by `M99`) and an NX Haas
+/// program's `G84` holes were written so. Every reader's tapping cycle is refused; a drilling
+/// cycle is still written.
+#[test]
+fn tapping_cycles_are_refused_not_written_as_feed_moves() {
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let options = reach();
+    let fanuc = |cycle: &str| {
+        toolpath::gcode::parse(
+            Path::new("tap.nc"),
+            &format!(
+                "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\n\
+                 G99 {cycle} X5. Y0 Z-10. R2. F750.\nX15.\nG80\nM30\n%\n"
+            ),
+            Dialect::Fanuc,
+        )
+        .unwrap()
+    };
+    let written = |t: &Toolpath| {
+        let sol = optimize(&m, t, &options).unwrap();
+        program(&m, t, &sol, &options.geometry, &peak(Dialect::Fanuc)).map(|p| p.text)
+    };
+    // Drilling (G81) is written; tapping (G84, left-hand G74) is not.
+    assert!(written(&fanuc("G81")).is_ok());
+    for (cycle, name) in [("G84", "G84"), ("G74", "G74")] {
+        let e = written(&fanuc(cycle)).unwrap_err().to_string();
+        assert!(
+            e.contains("tap.nc:5:")
+                && e.contains(&format!("{name}: a tapping cycle (and 1 more)"))
+                && e.contains("feedopt solve"),
+            "{e}"
+        );
+    }
+    // Sinumerik CYCLE84 (called and modal), Klartext 207 (by M99), APT CYCLE/TAP.
+    let sinumerik = |call: &str| {
+        toolpath::gcode::parse(
+            Path::new("tap.mpf"),
+            &format!("G71 G90 G17 G94\nS500 M3\nG0 X0 Y0 Z50\nF60\n{call}\nM30\n"),
+            Dialect::Sinumerik,
+        )
+        .unwrap()
+    };
+    let called = sinumerik("CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)");
+    let e = written(&called).unwrap_err().to_string();
+    assert!(e.contains("tap.mpf:5:") && e.contains("CYCLE84"), "{e}");
+    let modal = sinumerik("MCALL CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)\nX10\nMCALL");
+    let e = written(&modal).unwrap_err().to_string();
+    assert!(
+        e.contains("tap.mpf:6:") && e.contains("MCALL CYCLE84"),
+        "{e}"
+    );
+    let text = "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
+                3 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3 ;SET-UP CLEARANCE~\n\
+                Q201=-12 ;DEPTH~\n Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n\
+                Q204=5 ;2ND SET-UP CLEARANCE\n4 L X+0 Y+0 R0 F MAX M99\n5 END PGM T MM\n";
+    let call = 1 + text.lines().position(|l| l.contains("M99")).unwrap();
+    let klartext = toolpath::gcode::parse(Path::new("tap.h"), text, Dialect::Heidenhain).unwrap();
+    let e = written(&klartext).unwrap_err().to_string();
+    assert!(
+        e.contains(&format!("tap.h:{call}:"))
+            && e.contains("CYCL DEF 207 (at line 4): a tapping cycle;"),
+        "{e}"
+    );
+    let apt = toolpath::apt::parse(
+        Path::new("tap.cls"),
+        "FEDRAT/MMPM,300\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0\n\
+         CYCLE/OFF\nGOTO/5,0,20\n",
+    )
+    .unwrap();
+    let e = written(&apt).unwrap_err().to_string();
+    assert!(e.contains("tap.cls:4:") && e.contains("CYCLE/TAP"), "{e}");
 }

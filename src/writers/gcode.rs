@@ -937,6 +937,34 @@ fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<V
     Ok(us)
 }
 
+/// A tapping cycle's moves cannot be written as the G1 blocks this writer writes: on the
+/// control the cycle feeds the tap at the spindle's pitch, synchronised with its rotation
+/// (Fanuc `M29` rigid tapping, LinuxCNC `G33.1`, Sinumerik `CYCLE84`, Heidenhain 207), and
+/// reverses the spindle at the bottom; a G1 into the hole and back with the spindle running
+/// forward strips the thread or breaks the tap. An error names the first such cycle.
+pub fn refuse_tapping(toolpath: &Toolpath) -> Result<()> {
+    match toolpath.taps.first() {
+        None => Ok(()),
+        Some(tap) => {
+            let more = match toolpath.taps.len() {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            };
+            Err(Error::parse(
+                &toolpath.source,
+                tap.line,
+                format!(
+                    "{}: a tapping cycle{more}; feedopt gcode writes plain feed moves, which \
+                     would feed the tap in and out without the spindle synchronised or \
+                     reversed: it does not write tapping cycles yet. `feedopt solve` times \
+                     them; to write the other operations, post the tapping separately",
+                    tap.name
+                ),
+            ))
+        }
+    }
+}
+
 /// Writes the toolpath back as G-code with the schedule's feed per block (see the module doc).
 /// `geometry` must be the options the solution was computed with. Corners blended under
 /// `geometry.corner_tolerance_mm` are written as the blends the schedule runs (G1 blocks
@@ -948,6 +976,7 @@ pub fn program(
     geometry: &GeometryOptions,
     options: &GcodeOptions,
 ) -> Result<Program> {
+    refuse_tapping(toolpath)?;
     let (blended, _) = crate::geometry::blend::blend_corners(
         toolpath,
         geometry.corner_tolerance_mm,

@@ -279,6 +279,8 @@ pub(super) struct Interpreter<'a> {
     length_offsets: Vec<LengthOffsetChange>,
     /// The last H word given with a length offset code (a Fanuc's H is modal).
     last_h: Option<u32>,
+    /// The tapping cycles run so far.
+    pub(super) taps: Vec<crate::toolpath::TapCycle>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -335,6 +337,7 @@ impl<'a> Interpreter<'a> {
             warnings: Vec::new(),
             warning_texts: std::collections::HashSet::new(),
             dwells: Vec::new(),
+            taps: Vec::new(),
             tangent: None,
             shortest_path: false,
             corner: None,
@@ -525,6 +528,7 @@ impl<'a> Interpreter<'a> {
             machine_points: self.machine_points,
             length_offsets: (self.spec.length_offsets != LengthOffsets::Absent)
                 .then_some(self.length_offsets),
+            taps: self.taps,
         })
     }
 
@@ -1479,6 +1483,9 @@ impl<'a> Interpreter<'a> {
             if let Some(call) = self.mcall.take()
                 && block.axes[..2].iter().any(Option::is_some)
             {
+                if call.number == 84 {
+                    self.tapping(line, "MCALL CYCLE84".into());
+                }
                 let run = self
                     .cycle_plane(line, &format!("MCALL CYCLE{}", call.number))
                     .and_then(|()| self.run_steps(line, &call.steps));
@@ -2445,6 +2452,9 @@ impl<'a> Interpreter<'a> {
         if let Some(note) = note {
             self.warn(line, format!("G{}: {note}", c.code));
         }
+        if matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84) {
+            self.tapping(line, format!("G{}", c.code));
+        }
         // Each repeat: up to R, over the hole, and the cycle's moves.
         self.check_room(
             line,
@@ -2635,7 +2645,15 @@ impl<'a> Interpreter<'a> {
         for n in notes {
             self.warn(line, format!("{text}: {n}"));
         }
+        if number == 84 {
+            self.tapping(line, text.to_string());
+        }
         self.run_steps(line, &steps)
+    }
+
+    /// Records a tapping cycle run at `line` ([`Toolpath::taps`]).
+    pub(super) fn tapping(&mut self, line: usize, name: String) {
+        self.taps.push(crate::toolpath::TapCycle { line, name });
     }
 
     /// Cycles are read in the XY plane only.
