@@ -330,6 +330,11 @@ pub struct OffsetChange {
     pub line: usize,
     pub name: String,
     pub origin: [f64; 3],
+    /// The program gave this offset's origin (`G10 L2`, `L20`) rather than the reader taking
+    /// it as equal to the one before: the control's stored offset is then not the one the
+    /// program ran in, and `feedopt gcode`, which writes no `G10`, writes the points on in the
+    /// offset in force, their coordinates carrying the difference.
+    pub given: bool,
 }
 
 /// A tool length offset switched by the program ([`Toolpath::length_offsets`]).

@@ -113,7 +113,13 @@
 //! before (it does not know the control's values). An offset the output's dialect does not
 //! have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a Sinumerik, whose G58 is a
 //! programmable shift) is named in a comment instead. The values a program gives its offsets
-//! (`G10 L2`) are not written: the control's own are used. Nor are `G52`/`G92` shifts (the
+//! (`G10 L2`) are not written: the control's own are used for the offset the program starts
+//! in. An offset selected later whose values the program gave itself
+//! ([`crate::toolpath::OffsetChange::given`]) is not selected: the control's stored values
+//! are not the program's, so the points go on in the offset in force, the difference in
+//! their coordinates, and a comment names the selection (round 17: a CAMotics example sets
+//! `G10 L2 P2 Y-101.6` and selects G55 again to cut a second part 101.6 mm over; written as a
+//! bare `G55`, the second part was cut on the first). Nor are `G52`/`G92` shifts (the
 //! coordinates include them), LinuxCNC's `G43.1`/`G43.2` or other M codes.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
@@ -416,6 +422,21 @@ impl Setup<'_> {
             self.next += 1;
             match aux {
                 Aux::Machine(mv) => self.machine_move(text, &mv),
+                Aux::Offset(change) if change.given => {
+                    // The program set this offset's values itself (G10), which the written
+                    // program does not: the control's stored values are not those. The
+                    // points go on in the offset in force, with the difference in them.
+                    let _ = writeln!(
+                        text,
+                        "{}",
+                        (self.words.comment)(&format!(
+                            "the program selects work offset {} here with the values it gives \
+                             it (line {}): written in the offset in force, the shift in the \
+                             coordinates",
+                            change.name, change.line
+                        ))
+                    );
+                }
                 Aux::Offset(change) => {
                     if crate::toolpath::gcode::is_work_offset(self.dialect, &change.name) {
                         let _ = writeln!(text, "{}", change.name);

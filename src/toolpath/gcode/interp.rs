@@ -1141,6 +1141,7 @@ impl<'a> Interpreter<'a> {
                             line,
                             name: name.clone(),
                             origin: self.offsets.origin(),
+                            given: self.offsets.origin_given(),
                         });
                     }
                     self.shift_changed(before);
