@@ -1401,9 +1401,13 @@ fn fanuc_g05_high_precision_contour_control_moves_nothing() {
 /// An arc whose end is off its circle says what the block shows the program meant. A lathe
 /// program (NX's Giddings & Lewis 802L post, round 10) writes `G02 X… Z… I… K…` with no G18:
 /// read in G17, K is not a centre word and the radius check fails, which named neither. NX's
-/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines, gives I J from the
-/// end point (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: 0.2756 from the end,
-/// 0.4541 from the start).
+/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines (and, round 17,
+/// Burgmaster, Fadal, Yama Seiki, Makino V33 and Mori SH8000), writes a lead-out arc whose J
+/// has the wrong sign (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: the end is
+/// 0.4541 from that centre). Its Klartext twin (the Bridgeport 412 post) puts the centre at
+/// J −0.2756 (`CC X1.8701 Y-.6693`), tangent to the cut before it; I J measured from the end
+/// point fit the radius too, and the message said only that (until round 17), naming the
+/// wrong reading. Both are named now, the sign first.
 #[test]
 fn an_arc_off_its_circle_names_what_the_block_shows() {
     err_in(
@@ -1423,8 +1427,9 @@ fn an_arc_off_its_circle_names_what_the_block_shows() {
         4,
         &[
             "not on the circle",
-            "I J measured from the end point",
-            "wrong point",
+            "these would fit: I0 J-7.0002 mm (the sign reversed), centre (47.5005, -17.0002) mm",
+            "; or I J measured from the end point, centre (41.7551, -5.9995) mm",
+            "the post wrote them wrong",
         ],
     );
     // An arc that fits neither way keeps the plain message.

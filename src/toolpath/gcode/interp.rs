@@ -3534,13 +3534,53 @@ impl<'a> Interpreter<'a> {
                 && !block.centre_as[b].unwrap_or(self.arc_distance == Distance::Absolute)
             {
                 let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
+                let fits = |f0: f64, f1: f64| {
+                    !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1))
+                };
+                // The centre with one or both signs reversed (a post that writes I J
+                // unsigned, or with the wrong sign: the NX sample posts' lead-out arcs, whose
+                // Klartext twin puts CC there), or measured from the end point.
+                let mm = |x: f64| crate::base::trimmed(x, 4);
+                let mut readings = Vec::new();
+                for (k0, k1) in [(1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                    let (w0, w1) = (k0 * word(a), k1 * word(b));
+                    // A zero word's sign changes nothing: each centre once.
+                    let same = |(v0, v1): (f64, f64)| v0 == w0 && v1 == w1;
+                    let tried = [(1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                        .iter()
+                        .take_while(|k| **k != (k0, k1))
+                        .any(|(j0, j1)| same((j0 * word(a), j1 * word(b))));
+                    if !tried && !same((word(a), word(b))) && fits(s0 + w0, s1 + w1) {
+                        readings.push(format!(
+                            "{}{} {}{} mm (the sign reversed), centre ({}, {}) mm",
+                            centre_names[a],
+                            mm(w0),
+                            centre_names[b],
+                            mm(w1),
+                            mm(s0 + w0),
+                            mm(s1 + w1)
+                        ));
+                    }
+                }
                 let (f0, f1) = (e0 + word(a), e1 + word(b));
-                if !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1)) {
+                if fits(f0, f1) {
+                    readings.push(format!(
+                        "{} {} measured from the end point, centre ({}, {}) mm",
+                        centre_names[a],
+                        centre_names[b],
+                        mm(f0),
+                        mm(f1)
+                    ));
+                }
+                if !readings.is_empty() {
                     hint = format!(
-                        "; {} {} measured from the end point instead would fit, but they are the \
-                         centre's offset from the start point: the post wrote them from the \
-                         wrong point",
-                        centre_names[a], centre_names[b]
+                        "; these would fit: {}. {} {} are the centre's offset from the start \
+                         point, with its sign: the post wrote them wrong; post the program \
+                         again (the arc ends where the next move starts, so each reading \
+                         gives another path)",
+                        readings.join("; or "),
+                        centre_names[a],
+                        centre_names[b]
                     );
                 }
             }
