@@ -1035,8 +1035,9 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
 }
 
 /// Fanuc programs are told by their Fanuc-only words: besides TCP, tilted planes and M98, the
-/// look-ahead `G08 P1`, macro calls `G65 P…` and Haas `G187`, and an `O` number as the first
-/// block after a tool-list comment (NX's Mori SH8000 and Haas posts; read as LinuxCNC before,
+/// look-ahead `G08 P1`, high-precision contour control `G05 P10000`, macro calls `G65 P…` and
+/// Haas `G187`, and an `O` number as the first block after a tool-list comment (NX's Mori
+/// SH8000 and Haas posts; read as LinuxCNC before,
 /// where their G87 is an error).
 #[test]
 fn fanuc_only_words_tell_the_dialect() {
@@ -1048,6 +1049,9 @@ fn fanuc_only_words_tell_the_dialect() {
         "(TOOL LIST)\n(T1 D10)\nO1234\nG0 X0\n",
         // Round 8: a Fadal program numbers its first block, `N1 O3 ( … )`.
         "N1 O3 ( ZAMEK-INTERP )\nN2 ( UWAGA )\nN3 L900\n",
+        // Round 17: NX's Makino E33 post, no O number, switches the Fanuc's high-precision
+        // contour control on and off (read as LinuxCNC, `G05 P10000` was a cubic spline).
+        "(Start of Program Event)\nG91 G28 Z0.0\nG05 P10000\nZ3.937\nG05 P0\n",
     ] {
         assert_eq!(detect_dialect(text), Some(Dialect::Fanuc), "{text}");
     }
