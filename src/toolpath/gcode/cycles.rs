@@ -26,9 +26,10 @@
 //! | G89 | feed to Z, dwell P, feed back to R |
 //!
 //! P is seconds on LinuxCNC and milliseconds on Fanuc. A peck cycle with Q ≤ 0 or without Q
-//! is an error, as on the controls (Fanuc alarm PS0045, LinuxCNC's "Q must be positive"):
-//! until 2026-11-27 it drilled in one pass with a warning, but the control runs no such
-//! hole. A hole needs at most [`MAX_PECKS`] pecks, else it is an
+//! drills in one pass, with a warning that says the controls refuse it (Fanuc alarm PS0045,
+//! LinuxCNC's "Q must be positive"): NX posts write `G83 … Q0.0` where the operation has no
+//! peck step (the Mori NMV5000 program of `../shared`, a Haas and a Makino program), and
+//! an error would refuse those programs whole. A hole needs at most [`MAX_PECKS`] pecks, else it is an
 //! error. Repeats `L` (LinuxCNC) / `K` or `L` (Fanuc) drill the hole again, under G91 each one
 //! shifted by the X Y increment, at most [`MAX_REPEATS`] (the letters are the dialect's
 //! [`super::dialect::DialectSpec::cycle_repeat`]). On LinuxCNC, `K` in a cycle block and
@@ -262,15 +263,13 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
         Kind::G82 => s.extend([Feed(h.bottom, None), Dwell(h.dwell), Rapid(h.clear)]),
         Kind::G83 | Kind::G73 => match peck(h.q) {
             None => {
-                return Err(format!(
-                    "peck depth Q {}: the control refuses the block (Fanuc alarm PS0045 \
-                     \"address Q not found\", LinuxCNC \"Q must be positive\"); give the \
-                     peck depth Q > 0, or drill in one pass with G81",
-                    match h.q {
-                        None => "missing".to_string(),
-                        Some(q) => format!("{q} mm (≤ 0)"),
-                    }
-                ));
+                note = Some(
+                    "peck depth Q missing or ≤ 0: a Fanuc control stops here (alarm PS0045, \
+                     address Q not found) and LinuxCNC refuses the block (Q must be \
+                     positive); feedopt drills the hole in one pass, as G81 does: give the \
+                     peck depth Q > 0 for the pecks",
+                );
+                s.extend([Feed(h.bottom, None), Rapid(h.clear)]);
             }
             Some(q) => {
                 let depths = pecks(h.r, h.bottom, q)?;
