@@ -65,6 +65,7 @@ fn toolpath() -> Toolpath {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     }
 }
 

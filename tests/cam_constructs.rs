@@ -70,6 +70,41 @@ fn g83_peck_cycle_moves_and_time() {
     assert_eq!(tp.points.last().map(|p| p.p), Some(v(6.0, 0.0, 2.0)));
 }
 
+/// A peck cycle (G83, G73) without a peck depth Q, or with Q ≤ 0, is drilled in one pass
+/// with a warning naming the block and saying that the controls refuse it (Fanuc alarm
+/// PS0045 "address Q not found", LinuxCNC "Q must be positive") and what to write. Until
+/// round 17 the warning said only "drilled in one pass", as if a control did that: NX posts
+/// write `G83 … Q0.0` (a Haas program, and the Mori NMV5000 program of ../shared).
+#[test]
+fn a_peck_cycle_without_a_positive_peck_depth_says_the_control_refuses_it() {
+    for (dialect, cycle) in [
+        (Dialect::Fanuc, "G83 X5. Y0 Z-10. R2. Q0.0 F100."),
+        (Dialect::Fanuc, "G73 X5. Y0 Z-10. R2. F100."),
+        (Dialect::LinuxCnc, "G83 X5 Y0 Z-10 R2 Q0 F100"),
+    ] {
+        let tp = gcode(
+            dialect,
+            &format!("G21 G90 G0 X0 Y0 Z10.\nG99 {cycle}\nG80\n"),
+        );
+        let said: Vec<&Warning> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("peck depth Q"))
+            .collect();
+        assert!(
+            said.len() == 1
+                && said[0].line == 2
+                && said[0].message.contains("alarm PS0045")
+                && said[0].message.contains("Q must be positive")
+                && said[0].message.contains("give the peck depth Q > 0"),
+            "{cycle}: {:?}",
+            tp.warnings
+        );
+        // One pass: feed from R 2 to −10 (12 mm at 100 mm/min), no pecks.
+        assert!((feed_time(&tp) - 7.2).abs() < 1e-9, "{}", feed_time(&tp));
+    }
+}
+
 /// A peck cycle repeated 1000 times (`L1000`), 5000 pecks a hole: 15 million moves from one
 /// block, more than a toolpath may hold (`toolpath::MAX_POINTS`). Refused before a move is
 /// made, naming the block and the repeat count.

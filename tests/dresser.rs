@@ -44,6 +44,7 @@ fn groove() -> Toolpath {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     }
 }
 

@@ -1035,8 +1035,9 @@ fn a_change_of_work_offset_is_a_warning_naming_both() {
 }
 
 /// Fanuc programs are told by their Fanuc-only words: besides TCP, tilted planes and M98, the
-/// look-ahead `G08 P1`, macro calls `G65 P…` and Haas `G187`, and an `O` number as the first
-/// block after a tool-list comment (NX's Mori SH8000 and Haas posts; read as LinuxCNC before,
+/// look-ahead `G08 P1`, high-precision contour control `G05 P10000`, macro calls `G65 P…` and
+/// Haas `G187`, and an `O` number as the first block after a tool-list comment (NX's Mori
+/// SH8000 and Haas posts; read as LinuxCNC before,
 /// where their G87 is an error).
 #[test]
 fn fanuc_only_words_tell_the_dialect() {
@@ -1048,6 +1049,9 @@ fn fanuc_only_words_tell_the_dialect() {
         "(TOOL LIST)\n(T1 D10)\nO1234\nG0 X0\n",
         // Round 8: a Fadal program numbers its first block, `N1 O3 ( … )`.
         "N1 O3 ( ZAMEK-INTERP )\nN2 ( UWAGA )\nN3 L900\n",
+        // Round 17: NX's Makino E33 post, no O number, switches the Fanuc's high-precision
+        // contour control on and off (read as LinuxCNC, `G05 P10000` was a cubic spline).
+        "(Start of Program Event)\nG91 G28 Z0.0\nG05 P10000\nZ3.937\nG05 P0\n",
     ] {
         assert_eq!(detect_dialect(text), Some(Dialect::Fanuc), "{text}");
     }
@@ -1401,9 +1405,13 @@ fn fanuc_g05_high_precision_contour_control_moves_nothing() {
 /// An arc whose end is off its circle says what the block shows the program meant. A lathe
 /// program (NX's Giddings & Lewis 802L post, round 10) writes `G02 X… Z… I… K…` with no G18:
 /// read in G17, K is not a centre word and the radius check fails, which named neither. NX's
-/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines, gives I J from the
-/// end point (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: 0.2756 from the end,
-/// 0.4541 from the start).
+/// sample part, posted for Toyoda, Mazak, Makino and Mighty Viper machines (and, round 17,
+/// Burgmaster, Fadal, Yama Seiki, Makino V33 and Mori SH8000), writes a lead-out arc whose J
+/// has the wrong sign (start (1.8701, −0.3937), end (1.6439, −0.5118), J 0.2756: the end is
+/// 0.4541 from that centre). Its Klartext twin (the Bridgeport 412 post) puts the centre at
+/// J −0.2756 (`CC X1.8701 Y-.6693`), tangent to the cut before it; I J measured from the end
+/// point fit the radius too, and the message said only that (until round 17), naming the
+/// wrong reading. Both are named now, the sign first.
 #[test]
 fn an_arc_off_its_circle_names_what_the_block_shows() {
     err_in(
@@ -1423,8 +1431,9 @@ fn an_arc_off_its_circle_names_what_the_block_shows() {
         4,
         &[
             "not on the circle",
-            "I J measured from the end point",
-            "wrong point",
+            "these would fit: I0 J-7.0002 mm (the sign reversed), centre (47.5005, -17.0002) mm",
+            "; or I J measured from the end point, centre (41.7551, -5.9995) mm",
+            "the post wrote them wrong",
         ],
     );
     // An arc that fits neither way keeps the plain message.

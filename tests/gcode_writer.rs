@@ -248,6 +248,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     };
     (m, t)
 }
@@ -855,8 +856,12 @@ fn the_written_program_selects_the_work_offset_the_program_is_in() {
 fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coordinates() {
     // Three setups: G54, then G55 (never set: the reader takes it as equal to G54), then G56
     // set by the program at the current position (LinuxCNC G10 L20: its origin lies at X10 of
-    // G55). Each is selected where the program selects it and its coordinates are the
-    // program's own: the machine places them by its offsets, as it places the program's.
+    // G55). G55 is selected where the program selects it and its coordinates are the
+    // program's own: the machine places them by its offsets, as it places the program's. G56
+    // is not: the program gave its values itself, and the written program, which writes no
+    // G10, would run in whatever the control holds for G56 (until round 17 it did, the third
+    // setup written at X0..X10 of that G56). It is written on in G55 at X10..X20, the G10's
+    // shift in its coordinates, with a comment where the program selects G56.
     let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
     let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
     let body = "G0 X0 Y0\nG1 Z-1 F300\nG1 X10\nG0 Z5\n";
@@ -866,14 +871,17 @@ fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coor
         Dialect::LinuxCnc,
     )
     .unwrap();
-    let offsets: Vec<(&str, [f64; 3])> = input
+    let offsets: Vec<(&str, [f64; 3], bool)> = input
         .offset_changes
         .iter()
-        .map(|c| (c.name.as_str(), c.origin))
+        .map(|c| (c.name.as_str(), c.origin, c.given))
         .collect();
     assert_eq!(
         offsets,
-        [("G55", [0.0, 0.0, 0.0]), ("G56", [10.0, 0.0, 0.0])]
+        [
+            ("G55", [0.0, 0.0, 0.0], false),
+            ("G56", [10.0, 0.0, 0.0], true)
+        ]
     );
     // The reader's points of the third setup lie 10 mm further in X.
     assert_eq!(input.points.last().unwrap().p.x, 20.0);
@@ -883,25 +891,67 @@ fn work_offsets_selected_after_the_first_move_are_written_with_the_programs_coor
         let prog = program(&m, &input, &sol, &options.geometry, &peak(dialect)).unwrap();
         let lines: Vec<&str> = prog.text.lines().collect();
         let at = |s: &str| lines.iter().position(|l| *l == s);
-        let (g54, g55, g56) = (at("G54"), at("G55"), at("G56"));
-        assert!(
-            g54 < g55 && g55 < g56 && g54.is_some(),
+        let (g54, g55) = (at("G54"), at("G55"));
+        assert!(g54 < g55 && g54.is_some(), "{dialect}\n{}", prog.text);
+        assert_eq!(at("G56"), None, "{dialect}\n{}", prog.text);
+        let g56 = lines
+            .iter()
+            .position(|l| l.contains("selects work offset G56 here with the values it gives"))
+            .unwrap_or_else(|| panic!("{dialect}\n{}", prog.text));
+        // The first two setups cut from X0 to X10 at Z−1, the third from X10 to X20.
+        let cuts = |x: &str| -> Vec<usize> {
+            let cut = format!("G1 X{x} Y0.000000 Z-1.000000");
+            (lines.iter().enumerate())
+                .filter(|(_, l)| l.starts_with(&cut))
+                .map(|(i, _)| i)
+                .collect()
+        };
+        let (tens, twenties) = (cuts("10.000000"), cuts("20.000000"));
+        assert_eq!(tens.len(), 3, "{dialect}\n{}", prog.text);
+        assert_eq!(twenties.len(), 1, "{dialect}\n{}", prog.text);
+        assert!(tens[0] < g55.unwrap() && tens[1] < g56 && tens[2] > g56 && twenties[0] > g56);
+        // Read back, the points are the input's: the third setup 10 mm further in X.
+        let back = toolpath::gcode::parse(Path::new("b.nc"), &prog.text, dialect).unwrap();
+        assert_eq!(back.points.last().unwrap().p.x, 20.0, "{dialect}");
+    }
+}
+
+/// A program that gives the offset it works in new values (`G10 L2 P2 Y-101.6`) and selects
+/// it again, to cut a second part 101.6 mm over (a CAMotics example, round 17): the written
+/// program, which writes no G10, selected G55 again with the second part's own coordinates,
+/// so the control cut it on the first. The second part is now written on in the offset in
+/// force, 101.6 mm over.
+#[test]
+fn an_offset_the_program_sets_again_is_written_as_its_shift() {
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let body = "G0 X0 Y0 Z2\nG1 Z-1 F300\nG1 X10\nG0 Z2\n";
+    let input = toolpath::gcode::parse(
+        Path::new("two.ngc"),
+        &format!(
+            "G21 G90\nG10 L2 P2 X0 Y0 Z0\nG55\n{body}G10 L2 P2 X0 Y-101.6 Z0\nG55\n{body}M2\n"
+        ),
+        Dialect::LinuxCnc,
+    )
+    .unwrap();
+    assert_eq!(input.points.last().unwrap().p.y, -101.6);
+    let options = reach();
+    let sol = optimize(&m, &input, &options).unwrap();
+    for dialect in [Dialect::LinuxCnc, Dialect::Fanuc, Dialect::Sinumerik] {
+        let prog = program(&m, &input, &sol, &options.geometry, &peak(dialect)).unwrap();
+        assert_eq!(
+            prog.text.lines().filter(|l| *l == "G55").count(),
+            1,
             "{dialect}\n{}",
             prog.text
         );
-        // Each setup's cut from X0 to X10 at Z−1, in its own offset.
-        let cuts: Vec<usize> = lines
-            .iter()
-            .enumerate()
-            .filter(|(_, l)| l.starts_with("G1 X10.000000 Y0.000000 Z-1.000000"))
-            .map(|(i, _)| i)
-            .collect();
-        assert_eq!(cuts.len(), 3, "{dialect}\n{}", prog.text);
-        assert!(cuts[0] < g55.unwrap() && cuts[1] < g56.unwrap() && cuts[2] > g56.unwrap());
-        // Read back, every point is the program's own coordinates (the reader takes G55 and
-        // G56 as equal to G54 without the G10: the offsets are the control's).
+        assert!(
+            prog.text.contains("G1 X10.000000 Y-101.600000 Z-1.000000"),
+            "{dialect}\n{}",
+            prog.text
+        );
         let back = toolpath::gcode::parse(Path::new("b.nc"), &prog.text, dialect).unwrap();
-        assert_eq!(back.points.last().unwrap().p.x, 10.0, "{dialect}");
+        assert_eq!(back.points.last().unwrap().p.y, -101.6, "{dialect}");
     }
 }
 
@@ -989,4 +1039,82 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
             }
         }
     }
+}
+
+/// A tapping cycle is refused by the writer, naming the block that runs it: its moves are
+/// read as feeds at the tap's pitch × speed (the solve times them right), but written back as
+/// G1 blocks they would feed the tap in and out with the spindle turning forward, neither
+/// synchronised nor reversed, which strips the thread or breaks the tap. Round 17: a
+/// hyperMILL DMU 85 program's eight M14 holes (`CYCL DEF 207`, called by `M99`) and an NX Haas
+/// program's `G84` holes were written so. Every reader's tapping cycle is refused; a drilling
+/// cycle is still written.
+#[test]
+fn tapping_cycles_are_refused_not_written_as_feed_moves() {
+    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+    let options = reach();
+    let fanuc = |cycle: &str| {
+        toolpath::gcode::parse(
+            Path::new("tap.nc"),
+            &format!(
+                "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\n\
+                 G99 {cycle} X5. Y0 Z-10. R2. F750.\nX15.\nG80\nM30\n%\n"
+            ),
+            Dialect::Fanuc,
+        )
+        .unwrap()
+    };
+    let written = |t: &Toolpath| {
+        let sol = optimize(&m, t, &options).unwrap();
+        program(&m, t, &sol, &options.geometry, &peak(Dialect::Fanuc)).map(|p| p.text)
+    };
+    // Drilling (G81) is written; tapping (G84, left-hand G74) is not.
+    assert!(written(&fanuc("G81")).is_ok());
+    for (cycle, name) in [("G84", "G84"), ("G74", "G74")] {
+        let e = written(&fanuc(cycle)).unwrap_err().to_string();
+        assert!(
+            e.contains("tap.nc:5:")
+                && e.contains(&format!("{name}: a tapping cycle (and 1 more)"))
+                && e.contains("feedopt solve"),
+            "{e}"
+        );
+    }
+    // Sinumerik CYCLE84 (called and modal), Klartext 207 (by M99), APT CYCLE/TAP.
+    let sinumerik = |call: &str| {
+        toolpath::gcode::parse(
+            Path::new("tap.mpf"),
+            &format!("G71 G90 G17 G94\nS500 M3\nG0 X0 Y0 Z50\nF60\n{call}\nM30\n"),
+            Dialect::Sinumerik,
+        )
+        .unwrap()
+    };
+    let called = sinumerik("CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)");
+    let e = written(&called).unwrap_err().to_string();
+    assert!(e.contains("tap.mpf:5:") && e.contains("CYCLE84"), "{e}");
+    let modal = sinumerik("MCALL CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)\nX10\nMCALL");
+    let e = written(&modal).unwrap_err().to_string();
+    assert!(
+        e.contains("tap.mpf:6:") && e.contains("MCALL CYCLE84"),
+        "{e}"
+    );
+    let text = "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
+                3 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3 ;SET-UP CLEARANCE~\n\
+                Q201=-12 ;DEPTH~\n Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n\
+                Q204=5 ;2ND SET-UP CLEARANCE\n4 L X+0 Y+0 R0 F MAX M99\n5 END PGM T MM\n";
+    let call = 1 + text.lines().position(|l| l.contains("M99")).unwrap();
+    let klartext = toolpath::gcode::parse(Path::new("tap.h"), text, Dialect::Heidenhain).unwrap();
+    let e = written(&klartext).unwrap_err().to_string();
+    assert!(
+        e.contains(&format!("tap.h:{call}:"))
+            && e.contains("CYCL DEF 207 (at line 4): a tapping cycle;"),
+        "{e}"
+    );
+    let apt = toolpath::apt::parse(
+        Path::new("tap.cls"),
+        "FEDRAT/MMPM,300\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0\n\
+         CYCLE/OFF\nGOTO/5,0,20\n",
+    )
+    .unwrap();
+    let e = written(&apt).unwrap_err().to_string();
+    assert!(e.contains("tap.cls:4:") && e.contains("CYCLE/TAP"), "{e}");
 }

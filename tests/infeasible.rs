@@ -59,6 +59,7 @@ fn line() -> Toolpath {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     }
 }
 
@@ -276,6 +277,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

@@ -32,6 +32,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: Vec::new(),
     }
 }
 

@@ -161,6 +161,7 @@ pub fn blend_corners(
                 })
                 .collect()
         }),
+        taps: toolpath.taps.clone(),
     };
     (Cow::Owned(tp), blended)
 }

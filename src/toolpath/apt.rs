@@ -260,6 +260,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         offset_changes: Vec::new(),
         machine_points: Vec::new(),
         length_offsets: None,
+        taps: reader.taps,
     })
 }
 
@@ -290,6 +291,8 @@ struct Reader<'a> {
     spindle_changes: Vec<SpindleChange>,
     /// `SPINDL/` directions and `COOLNT/` states, in program order.
     switches: Vec<MachineSwitch>,
+    /// `CYCLE/TAP` holes, in program order.
+    taps: Vec<crate::toolpath::TapCycle>,
 }
 
 /// An APT arc's centre, unit axis and radius (if given), in world mm.
@@ -328,6 +331,7 @@ impl<'a> Reader<'a> {
             points: Vec::new(),
             warnings: Vec::new(),
             dwells: Vec::new(),
+            taps: Vec::new(),
             msys: None,
             arc: None,
             nurbs: None,
@@ -1181,6 +1185,12 @@ impl<'a> Reader<'a> {
                 point: self.points.len() - 1,
                 seconds: c.dwell,
                 line,
+            });
+        }
+        if c.kind == "TAP" {
+            self.taps.push(crate::toolpath::TapCycle {
+                line,
+                name: "CYCLE/TAP".into(),
             });
         }
         let out = if matches!(c.kind, "TAP" | "BORE" | "REAM") {

@@ -161,6 +161,11 @@ pub struct Toolpath {
     /// length); `feedopt gcode` writes them back as the program has them, so that the
     /// written Z means what the program's meant.
     pub length_offsets: Option<Vec<LengthOffsetChange>>,
+    /// The tapping cycles the program runs, in program order. Their moves are timed as
+    /// feeds at the tap's pitch × spindle speed, but on the control the cycle synchronises
+    /// the spindle with the feed and reverses it at the bottom: `feedopt gcode`, which writes
+    /// plain feed moves, refuses such a program.
+    pub taps: Vec<TapCycle>,
 }
 
 impl Toolpath {
@@ -178,6 +183,7 @@ impl Toolpath {
             offset_changes: Vec::new(),
             machine_points: Vec::new(),
             length_offsets: None,
+            taps: Vec::new(),
         }
     }
 
@@ -192,6 +198,15 @@ impl Toolpath {
             .iter()
             .any(|d| d.point == index && d.seconds > 0.0)
     }
+}
+
+/// A tapping cycle the program runs (Fanuc/LinuxCNC `G84`/`G74`, Sinumerik `CYCLE84`,
+/// Klartext cycles 207/209, APT `CYCLE/TAP`): `line` is the block that runs it (a hole of a
+/// modal cycle, an `M99`, a `CYCL CALL`), `name` the cycle as the program writes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TapCycle {
+    pub line: usize,
+    pub name: String,
 }
 
 /// The tool stands still at CL point `point` (an index into [`Toolpath::points`]) for
@@ -315,6 +330,11 @@ pub struct OffsetChange {
     pub line: usize,
     pub name: String,
     pub origin: [f64; 3],
+    /// The program gave this offset's origin (`G10 L2`, `L20`) rather than the reader taking
+    /// it as equal to the one before: the control's stored offset is then not the one the
+    /// program ran in, and `feedopt gcode`, which writes no `G10`, writes the points on in the
+    /// offset in force, their coordinates carrying the difference.
+    pub given: bool,
 }
 
 /// A tool length offset switched by the program ([`Toolpath::length_offsets`]).

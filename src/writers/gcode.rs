@@ -113,7 +113,13 @@
 //! before (it does not know the control's values). An offset the output's dialect does not
 //! have (Fanuc `G54.1 P3` written for LinuxCNC, `G58` for a Sinumerik, whose G58 is a
 //! programmable shift) is named in a comment instead. The values a program gives its offsets
-//! (`G10 L2`) are not written: the control's own are used. Nor are `G52`/`G92` shifts (the
+//! (`G10 L2`) are not written: the control's own are used for the offset the program starts
+//! in. An offset selected later whose values the program gave itself
+//! ([`crate::toolpath::OffsetChange::given`]) is not selected: the control's stored values
+//! are not the program's, so the points go on in the offset in force, the difference in
+//! their coordinates, and a comment names the selection (round 17: a CAMotics example sets
+//! `G10 L2 P2 Y-101.6` and selects G55 again to cut a second part 101.6 mm over; written as a
+//! bare `G55`, the second part was cut on the first). Nor are `G52`/`G92` shifts (the
 //! coordinates include them), LinuxCNC's `G43.1`/`G43.2` or other M codes.
 //!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
@@ -416,6 +422,21 @@ impl Setup<'_> {
             self.next += 1;
             match aux {
                 Aux::Machine(mv) => self.machine_move(text, &mv),
+                Aux::Offset(change) if change.given => {
+                    // The program set this offset's values itself (G10), which the written
+                    // program does not: the control's stored values are not those. The
+                    // points go on in the offset in force, with the difference in them.
+                    let _ = writeln!(
+                        text,
+                        "{}",
+                        (self.words.comment)(&format!(
+                            "the program selects work offset {} here with the values it gives \
+                             it (line {}): written in the offset in force, the shift in the \
+                             coordinates",
+                            change.name, change.line
+                        ))
+                    );
+                }
                 Aux::Offset(change) => {
                     if crate::toolpath::gcode::is_work_offset(self.dialect, &change.name) {
                         let _ = writeln!(text, "{}", change.name);
@@ -937,6 +958,34 @@ fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<V
     Ok(us)
 }
 
+/// A tapping cycle's moves cannot be written as the G1 blocks this writer writes: on the
+/// control the cycle feeds the tap at the spindle's pitch, synchronised with its rotation
+/// (Fanuc `M29` rigid tapping, LinuxCNC `G33.1`, Sinumerik `CYCLE84`, Heidenhain 207), and
+/// reverses the spindle at the bottom; a G1 into the hole and back with the spindle running
+/// forward strips the thread or breaks the tap. An error names the first such cycle.
+pub fn refuse_tapping(toolpath: &Toolpath) -> Result<()> {
+    match toolpath.taps.first() {
+        None => Ok(()),
+        Some(tap) => {
+            let more = match toolpath.taps.len() {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            };
+            Err(Error::parse(
+                &toolpath.source,
+                tap.line,
+                format!(
+                    "{}: a tapping cycle{more}; feedopt gcode writes plain feed moves, which \
+                     would feed the tap in and out without the spindle synchronised or \
+                     reversed: it does not write tapping cycles yet. `feedopt solve` times \
+                     them; to write the other operations, post the tapping separately",
+                    tap.name
+                ),
+            ))
+        }
+    }
+}
+
 /// Writes the toolpath back as G-code with the schedule's feed per block (see the module doc).
 /// `geometry` must be the options the solution was computed with. Corners blended under
 /// `geometry.corner_tolerance_mm` are written as the blends the schedule runs (G1 blocks
@@ -948,6 +997,7 @@ pub fn program(
     geometry: &GeometryOptions,
     options: &GcodeOptions,
 ) -> Result<Program> {
+    refuse_tapping(toolpath)?;
     let (blended, _) = crate::geometry::blend::blend_corners(
         toolpath,
         geometry.corner_tolerance_mm,

@@ -26,7 +26,10 @@
 //! | G89 | feed to Z, dwell P, feed back to R |
 //!
 //! P is seconds on LinuxCNC and milliseconds on Fanuc. A peck cycle with Q ≤ 0 or without Q
-//! drills in one pass, with a warning. A hole needs at most [`MAX_PECKS`] pecks, else it is an
+//! drills in one pass, with a warning that says the controls refuse it (Fanuc alarm PS0045,
+//! LinuxCNC's "Q must be positive"): NX posts write `G83 … Q0.0` where the operation has no
+//! peck step (the Mori NMV5000 program of `../shared`, a Haas and a Makino program), and
+//! an error would refuse those programs whole. A hole needs at most [`MAX_PECKS`] pecks, else it is an
 //! error. Repeats `L` (LinuxCNC) / `K` or `L` (Fanuc) drill the hole again, under G91 each one
 //! shifted by the X Y increment, at most [`MAX_REPEATS`] (the letters are the dialect's
 //! [`super::dialect::DialectSpec::cycle_repeat`]). On LinuxCNC, `K` in a cycle block and
@@ -260,7 +263,12 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
         Kind::G82 => s.extend([Feed(h.bottom, None), Dwell(h.dwell), Rapid(h.clear)]),
         Kind::G83 | Kind::G73 => match peck(h.q) {
             None => {
-                note = Some("peck depth Q missing or ≤ 0: the hole is drilled in one pass");
+                note = Some(
+                    "peck depth Q missing or ≤ 0: a Fanuc control stops here (alarm PS0045, \
+                     address Q not found) and LinuxCNC refuses the block (Q must be \
+                     positive); feedopt drills the hole in one pass, as G81 does: give the \
+                     peck depth Q > 0 for the pecks",
+                );
                 s.extend([Feed(h.bottom, None), Rapid(h.clear)]);
             }
             Some(q) => {

@@ -279,6 +279,8 @@ pub(super) struct Interpreter<'a> {
     length_offsets: Vec<LengthOffsetChange>,
     /// The last H word given with a length offset code (a Fanuc's H is modal).
     last_h: Option<u32>,
+    /// The tapping cycles run so far.
+    pub(super) taps: Vec<crate::toolpath::TapCycle>,
     /// This block's machine coordinates are M92's (relative to the builder's datum).
     m92: bool,
     /// Axes X Y Z whose missing M92 datum a warning has named.
@@ -335,6 +337,7 @@ impl<'a> Interpreter<'a> {
             warnings: Vec::new(),
             warning_texts: std::collections::HashSet::new(),
             dwells: Vec::new(),
+            taps: Vec::new(),
             tangent: None,
             shortest_path: false,
             corner: None,
@@ -525,6 +528,7 @@ impl<'a> Interpreter<'a> {
             machine_points: self.machine_points,
             length_offsets: (self.spec.length_offsets != LengthOffsets::Absent)
                 .then_some(self.length_offsets),
+            taps: self.taps,
         })
     }
 
@@ -1137,6 +1141,7 @@ impl<'a> Interpreter<'a> {
                             line,
                             name: name.clone(),
                             origin: self.offsets.origin(),
+                            given: self.offsets.origin_given(),
                         });
                     }
                     self.shift_changed(before);
@@ -1479,6 +1484,9 @@ impl<'a> Interpreter<'a> {
             if let Some(call) = self.mcall.take()
                 && block.axes[..2].iter().any(Option::is_some)
             {
+                if call.number == 84 {
+                    self.tapping(line, "MCALL CYCLE84".into());
+                }
                 let run = self
                     .cycle_plane(line, &format!("MCALL CYCLE{}", call.number))
                     .and_then(|()| self.run_steps(line, &call.steps));
@@ -2445,6 +2453,9 @@ impl<'a> Interpreter<'a> {
         if let Some(note) = note {
             self.warn(line, format!("G{}: {note}", c.code));
         }
+        if matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84) {
+            self.tapping(line, format!("G{}", c.code));
+        }
         // Each repeat: up to R, over the hole, and the cycle's moves.
         self.check_room(
             line,
@@ -2635,7 +2646,15 @@ impl<'a> Interpreter<'a> {
         for n in notes {
             self.warn(line, format!("{text}: {n}"));
         }
+        if number == 84 {
+            self.tapping(line, text.to_string());
+        }
         self.run_steps(line, &steps)
+    }
+
+    /// Records a tapping cycle run at `line` ([`Toolpath::taps`]).
+    pub(super) fn tapping(&mut self, line: usize, name: String) {
+        self.taps.push(crate::toolpath::TapCycle { line, name });
     }
 
     /// Cycles are read in the XY plane only.
@@ -3515,13 +3534,53 @@ impl<'a> Interpreter<'a> {
                 && !block.centre_as[b].unwrap_or(self.arc_distance == Distance::Absolute)
             {
                 let word = |i: usize| block.centre[i].map_or(0.0, |num| self.length(num));
+                let fits = |f0: f64, f1: f64| {
+                    !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1))
+                };
+                // The centre with one or both signs reversed (a post that writes I J
+                // unsigned, or with the wrong sign: the NX sample posts' lead-out arcs, whose
+                // Klartext twin puts CC there), or measured from the end point.
+                let mm = |x: f64| crate::base::trimmed(x, 4);
+                let mut readings = Vec::new();
+                for (k0, k1) in [(1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                    let (w0, w1) = (k0 * word(a), k1 * word(b));
+                    // A zero word's sign changes nothing: each centre once.
+                    let same = |(v0, v1): (f64, f64)| v0 == w0 && v1 == w1;
+                    let tried = [(1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                        .iter()
+                        .take_while(|k| **k != (k0, k1))
+                        .any(|(j0, j1)| same((j0 * word(a), j1 * word(b))));
+                    if !tried && !same((word(a), word(b))) && fits(s0 + w0, s1 + w1) {
+                        readings.push(format!(
+                            "{}{} {}{} mm (the sign reversed), centre ({}, {}) mm",
+                            centre_names[a],
+                            mm(w0),
+                            centre_names[b],
+                            mm(w1),
+                            mm(s0 + w0),
+                            mm(s1 + w1)
+                        ));
+                    }
+                }
                 let (f0, f1) = (e0 + word(a), e1 + word(b));
-                if !off_circle((s0 - f0).hypot(s1 - f1), (e0 - f0).hypot(e1 - f1)) {
+                if fits(f0, f1) {
+                    readings.push(format!(
+                        "{} {} measured from the end point, centre ({}, {}) mm",
+                        centre_names[a],
+                        centre_names[b],
+                        mm(f0),
+                        mm(f1)
+                    ));
+                }
+                if !readings.is_empty() {
                     hint = format!(
-                        "; {} {} measured from the end point instead would fit, but they are the \
-                         centre's offset from the start point: the post wrote them from the \
-                         wrong point",
-                        centre_names[a], centre_names[b]
+                        "; these would fit: {}. {} {} are the centre's offset from the start \
+                         point, with its sign: the post wrote them wrong; post the program \
+                         again (the arc ends where the next move starts, so each reading \
+                         gives another path)",
+                        readings.join("; or "),
+                        centre_names[a],
+                        centre_names[b]
                     );
                 }
             }

@@ -496,7 +496,8 @@ fn program_header<'t>(
 /// The dialect a program's text (upper-cased) shows, if any: Heidenhain (a first block
 /// `BEGIN PGM`, with or without a block number), Sinumerik (`TRAORI`, `TRAFOOF`, `MCALL`,
 /// `CYCLE8…(`, `DEF REAL`, `SUPA`, `G710`, `G700`, `MSG(`), Fanuc (`G43.4`, `G43.5`, `G68.2`,
-/// `G05.1`, `M98`, look-ahead `G08 P…`, macro calls `G65 P…`, Haas `G187`, a first block
+/// `G05.1`, `M98`, look-ahead `G08 P…`, high-precision contour control `G05 P10000`, macro
+/// calls `G65 P…`, Haas `G187`, a first block
 /// `O1234` (after a block number too: `N1 O3`) or ISO code's `:1234` after any comment lines), LinuxCNC (`M428`–`M430`, `O<`, and an `O` number followed
 /// by an O-word keyword: `o100 sub`, `o100 call`, `o101 if`, …, which is not a Fanuc program
 /// number).
@@ -511,7 +512,21 @@ pub fn detect_dialect(upper: &str) -> Option<Dialect> {
     .iter()
     .any(|w| has(w));
     let fanuc = [
-        "G43.4", "G43.5", "G68.2", "G05.1", "G5.1", "M98", "G08 P", "G08P", "G65 P", "G65P", "G187",
+        "G43.4",
+        "G43.5",
+        "G68.2",
+        "G05.1",
+        "G5.1",
+        "M98",
+        "G08 P",
+        "G08P",
+        "G65 P",
+        "G65P",
+        "G187",
+        "G05 P10000",
+        "G05P10000",
+        "G5 P10000",
+        "G5P10000",
     ]
     .iter()
     .any(|w| has(w))

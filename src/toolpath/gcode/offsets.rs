@@ -215,6 +215,15 @@ impl WorkOffsets {
         std::array::from_fn(|i| self.active_origin(i).value + self.external[i].value)
     }
 
+    /// Whether the program gave the origin of the offset in force on X, Y or Z (a `G10`),
+    /// rather than it being the start offset's or taken as equal to the one before.
+    pub(super) fn origin_given(&self) -> bool {
+        (0..3).any(|i| {
+            let o = self.active_origin(i);
+            o.basis == Basis::Machine || (!o.assumed && o.value != 0.0)
+        })
+    }
+
     /// Fanuc's `G92` shift on `axis`.
     pub(super) fn position(&self, axis: usize) -> f64 {
         self.position[axis]
@@ -330,8 +339,10 @@ impl WorkOffsets {
             Setting::Position { here, given } => {
                 // The current position lies on the basis of the offset in force: so does the
                 // new origin.
+                // Set by the program, so not an assumption of its own (the basis may be).
                 *slot = Some(Origin {
                     value: here - external - local - given,
+                    assumed: false,
                     ..here_origin
                 });
             }

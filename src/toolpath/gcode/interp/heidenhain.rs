@@ -1531,6 +1531,9 @@ impl Interpreter<'_> {
         for n in notes {
             self.warn(line, format!("cycle {number}: {n}"));
         }
+        if matches!(number, 207 | 209) {
+            self.tapping(line, format!("CYCL DEF {number} (at line {def_line})"));
+        }
         self.known[2] = true;
         self.warn_unknown(line);
         self.run_steps(line, &steps)?;
