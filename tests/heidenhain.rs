@@ -1953,3 +1953,35 @@ fn rnd_and_chf_between_two_straight_moves_round_and_chamfer_the_corner() {
         assert!(e.contains(&format!(":{line}:")) && e.contains(says), "{e}");
     }
 }
+
+/// Under a tilted plane X Y Z are the tip in the plane's coordinates, as the control reads
+/// them: a move there is read as it runs, and the warning that X Y Z are "taken as the tool
+/// tip" outside tool-tip mode said nothing that could change the path (round 17: it came with
+/// every hyperMILL 3+2 program). A block that turns a rotary axis, read without kinematics,
+/// still warns.
+#[test]
+fn moves_in_a_tilted_plane_draw_no_tool_tip_warning() {
+    let (_, ctx) = ac_table(-150.0, 120.0);
+    let tip = |tp: &Toolpath| {
+        tp.warnings
+            .iter()
+            .filter(|w| w.message.contains("outside tool-tip (TCP) mode"))
+            .count()
+    };
+    let tp = read_on(
+        &ctx,
+        &format!(
+            "{HEADER}4 L X+0 Y+0 Z+50 A+0 C+0 FMAX\n\
+             5 PLANE SPATIAL SPA90 SPB0 SPC180 STAY SEQ- TABLE ROT\n\
+             6 L A+Q120 C+Q122 R0 FMAX M126\n7 L X+127 Y+7 R0 FMAX M3\n\
+             8 L Z-5 F300\n9 L X+100 F600\n10 END PGM T MM\n"
+        ),
+    )
+    .unwrap();
+    assert_eq!(tip(&tp), 0, "{:?}", tp.warnings);
+    // A move that turns A, read without the machine's kinematics: the warning stays.
+    let tp = read(&format!(
+        "{HEADER}4 L X+0 Y+0 Z+50 A+0 C+0 FMAX\n5 L X+10 A+30 F600\n6 END PGM T MM\n"
+    ));
+    assert_eq!(tip(&tp), 1, "{:?}", tp.warnings);
+}

@@ -2907,8 +2907,17 @@ impl<'a> Interpreter<'a> {
         }
 
         let vector = vector_words.iter().any(Option::is_some);
+        // Under a tilted working plane (Klartext PLANE, CYCLE800, G68.2) X Y Z are the tip in
+        // the plane's coordinates, as the control reads them: a block that moves them with the
+        // rotary axes standing where the plane put them is read as the control runs it (a
+        // warning there was noise in every hyperMILL 3+2 program).
+        let framed = (self.swivel.is_some()
+            || self.programmable.r != nalgebra::Matrix3::identity()
+            || self.klartext.rotary_unknown.is_some())
+            && !block.axes[3..].iter().any(Option::is_some);
         if self.tcp == Tcp::Off
             && !self.non_tcp_warned
+            && !framed
             && !self.machine.is_some_and(|m| m.machine_coordinates)
             && !block.plane_rotary.iter().any(|&q| q)
             && (vector || self.axis_kinematics().is_none())
