@@ -600,6 +600,13 @@ fn other_errors_name_the_line() {
     err("G0 X0 Y0 Z0\nG1 X#1 F100\n", 2, &["#1", "before it is set"]);
     err("G0 X0 Y0 Z0\no100 sub\n", 2, &["O-word"]);
     err("G0 X0 Y0 Z0\nG81 X1 Y1 Z-1\n", 2, &["G81", "R"]);
+    // NX's Mori inch post writes `G98 G82 X… Y… Z… B90. C2700. R… P5`: the message names the
+    // words and what to do.
+    err(
+        "G0 X0 Y0 Z5\nG82 X5 Y5 Z-2 R1 P5 B90 C270 F100\n",
+        2,
+        &["G82", "(B C)", "block of their own"],
+    );
     // LinuxCNC repeats a cycle with L; K there is not a repeat count (it drilled the hole K
     // times before), and G87 is back boring with I J K offsets (they were dropped).
     err("G0 X0 Y0 Z5\nG81 X5 Y5 Z-2 R1 K3\n", 2, &["G81", "K", "L"]);

@@ -2365,9 +2365,22 @@ impl<'a> Interpreter<'a> {
             return Ok(());
         };
         if block.axes[3..].iter().any(Option::is_some) {
+            let words: Vec<&str> = ["A", "B", "C"]
+                .iter()
+                .zip(&block.axes[3..])
+                .filter(|(_, w)| w.is_some())
+                .map(|(n, _)| *n)
+                .collect();
             return Err(self.error(
                 line,
-                format!("G{}: rotary axis words in a cycle block", c.code),
+                format!(
+                    "G{}: rotary axis words ({}) in a cycle block: whether and when a control \
+                     turns them for the hole is its own setting, so feedopt does not guess; \
+                     turn the rotary axes in a block of their own before the cycle (post the \
+                     program so)",
+                    c.code,
+                    words.join(" ")
+                ),
             ));
         }
         let incremental = self.distance == Distance::Incremental;
