@@ -780,52 +780,12 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
     let dist = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
         (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt()
     };
-    // Parameter spacing: the programmed tip chords, or angle steps on a reorientation.
-    let h: Vec<f64> = orig
-        .windows(2)
-        .map(|w| {
-            let d = dist(&w[0], &w[1]);
-            let a = ((w[1][3] - w[0][3]).powi(2) + (w[1][4] - w[0][4]).powi(2)).sqrt();
-            if d > 0.0 { d } else { a.max(f64::MIN_POSITIVE) }
-        })
-        .collect();
-    // D² row i (1 ≤ i ≤ n−2): coefficients on w[i−1], w[i], w[i+1]; computed once (the
-    // iterations below read each row sixteen times a point: recomputing its three divisions
-    // there took 80 % of a 36,000-line Fusion APT program's solve).
-    let rows: Vec<[f64; 3]> = (0..n)
-        .map(|i| {
-            if i == 0 || i + 1 == n {
-                return [0.0; 3];
-            }
-            let (a, b) = (h[i - 1], h[i]);
-            [2.0 / (a * (a + b)), -2.0 / (a * b), 2.0 / (b * (a + b))]
-        })
-        .collect();
-    let row = |i: usize| rows[i];
-    // Step 1/L with L ≥ the largest eigenvalue of D²ᵀD² (Gershgorin: the largest absolute row
-    // sum of D² squared is a bound on ‖D²‖²).
-    let l = (1..n - 1)
-        .map(|i| row(i).iter().map(|c| c.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-        .powi(2);
-    let step = 1.0 / l;
-    // Angles that do not change along the span (a three-axis program's zeros) have no bending
-    // to smooth: only the tip's coordinates are iterated then.
-    let dims = if orig.iter().all(|w| w[3..5] == orig[0][3..5]) {
-        3
-    } else {
-        5
-    };
-    // Per point k, the coefficients of the rows k − 1, k, k + 1 on it (D² is tridiagonal).
-    let cols: Vec<[f64; 3]> = (0..n)
-        .map(|k| {
-            if k == 0 || k + 1 == n {
-                [0.0; 3]
-            } else {
-                [row(k - 1)[2], row(k)[1], row(k + 1)[0]]
-            }
-        })
-        .collect();
+    let Descent {
+        rows,
+        cols,
+        step,
+        dims,
+    } = Descent::of(&orig);
     let tube = Tube {
         orig: &orig,
         rows: &rows,
@@ -846,6 +806,78 @@ pub fn smooth_within(values: &mut [[f64; PATH_DIM]], tol_mm: f64, tol_rad: f64) 
         .map(|(i, j)| (values[i][j] - orig[i][j]).abs())
         .fold(0.0, f64::max);
     (dev_mm, dev_rad)
+}
+
+/// The fixed parts of [`smooth_within`]'s descent for the programmed points `orig`.
+struct Descent {
+    /// D²'s rows: for row i (1 ≤ i ≤ n−2) the coefficients on w[i−1], w[i], w[i+1].
+    rows: Vec<[f64; 3]>,
+    /// Per point k, the coefficients of the rows k − 1, k, k + 1 on it.
+    cols: Vec<[f64; 3]>,
+    step: f64,
+    /// The coordinates that move: 3 (the tip) or 5 (and the rotary angles).
+    dims: usize,
+}
+
+impl Descent {
+    fn of(orig: &[[f64; PATH_DIM]]) -> Descent {
+        let n = orig.len();
+        let dist = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
+            (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt()
+        };
+        // Parameter spacing: the programmed tip chords, or angle steps on a reorientation.
+        let h: Vec<f64> = orig
+            .windows(2)
+            .map(|w| {
+                let d = dist(&w[0], &w[1]);
+                let a = ((w[1][3] - w[0][3]).powi(2) + (w[1][4] - w[0][4]).powi(2)).sqrt();
+                if d > 0.0 { d } else { a.max(f64::MIN_POSITIVE) }
+            })
+            .collect();
+        // D² row i (1 ≤ i ≤ n−2): coefficients on w[i−1], w[i], w[i+1]; computed once (the
+        // iterations below read each row sixteen times a point: recomputing its three divisions
+        // there took 80 % of a 36,000-line Fusion APT program's solve).
+        let rows: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                if i == 0 || i + 1 == n {
+                    return [0.0; 3];
+                }
+                let (a, b) = (h[i - 1], h[i]);
+                [2.0 / (a * (a + b)), -2.0 / (a * b), 2.0 / (b * (a + b))]
+            })
+            .collect();
+        let row = |i: usize| rows[i];
+        // Step 1/L with L ≥ the largest eigenvalue of D²ᵀD² (Gershgorin: the largest absolute row
+        // sum of D² squared is a bound on ‖D²‖²).
+        let l = (1..n - 1)
+            .map(|i| row(i).iter().map(|c| c.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+            .powi(2);
+        let step = 1.0 / l;
+        // Angles that do not change along the span (a three-axis program's zeros) have no bending
+        // to smooth: only the tip's coordinates are iterated then.
+        let dims = if orig.iter().all(|w| w[3..5] == orig[0][3..5]) {
+            3
+        } else {
+            5
+        };
+        // Per point k, the coefficients of the rows k − 1, k, k + 1 on it (D² is tridiagonal).
+        let cols: Vec<[f64; 3]> = (0..n)
+            .map(|k| {
+                if k == 0 || k + 1 == n {
+                    [0.0; 3]
+                } else {
+                    [row(k - 1)[2], row(k)[1], row(k + 1)[0]]
+                }
+            })
+            .collect();
+        Descent {
+            rows,
+            cols,
+            step,
+            dims,
+        }
+    }
 }
 
 /// The projected gradient descent of [`smooth_within`]: the tube about the programmed points
@@ -1125,31 +1157,10 @@ mod tests {
         let dist = |a: &[f64; PATH_DIM], b: &[f64; PATH_DIM]| {
             (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt()
         };
-        let h: Vec<f64> = orig
-            .windows(2)
-            .map(|w| {
-                let d = dist(&w[0], &w[1]);
-                let a = ((w[1][3] - w[0][3]).powi(2) + (w[1][4] - w[0][4]).powi(2)).sqrt();
-                if d > 0.0 { d } else { a.max(f64::MIN_POSITIVE) }
-            })
-            .collect();
-        let row = |i: usize| -> [f64; 3] {
-            if i == 0 || i + 1 == n {
-                return [0.0; 3];
-            }
-            let (a, b) = (h[i - 1], h[i]);
-            [2.0 / (a * (a + b)), -2.0 / (a * b), 2.0 / (b * (a + b))]
-        };
-        let l = (1..n - 1)
-            .map(|i| row(i).iter().map(|c| c.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-            .powi(2);
-        let step = 1.0 / l;
-        let dims = if orig.iter().all(|w| w[3..5] == orig[0][3..5]) {
-            3
-        } else {
-            5
-        };
+        let Descent {
+            rows, step, dims, ..
+        } = Descent::of(&orig);
+        let row = |i: usize| rows[i];
         let mut d2 = vec![[0.0; 5]; n];
         for _ in 0..SMOOTH_ITERATIONS {
             for i in 1..n - 1 {
