@@ -141,6 +141,12 @@ pub struct CheckArgs {
     /// tool centre's (CAM wear compensation). Without it such a block is an error.
     #[arg(long)]
     pub wear_compensation: bool,
+    /// A directory that holds the program's subprograms' files (repeatable; searched after the
+    /// program's own directory, in the order given): Fanuc `M98 P1002` reads `O1002`,
+    /// `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik `NAME`,
+    /// `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`.
+    #[arg(long = "subprogram-dir", value_name = "DIR")]
+    pub subprogram_dir: Vec<PathBuf>,
     #[command(flatten)]
     /// Stock, tool and process limits beyond the machine file.
     pub material: MaterialArgs,
@@ -278,6 +284,12 @@ pub struct SolveOptions {
     /// model.
     #[arg(long)]
     pub wear_compensation: bool,
+    /// A directory that holds the program's subprograms' files (repeatable; searched after the
+    /// program's own directory, in the order given): Fanuc `M98 P1002` reads `O1002`,
+    /// `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik `NAME`,
+    /// `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`.
+    #[arg(long = "subprogram-dir", value_name = "DIR")]
+    pub subprogram_dir: Vec<PathBuf>,
     /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
     /// parameter 3401#0 DPI = 0) or `calculator` (100 mm, DPI = 1); default: the machine
     /// file's `decimal_point_input`, else increment with a warning.
@@ -620,6 +632,7 @@ pub fn check(args: &CheckArgs) -> Result<String> {
             cycle_alias: &[],
             block_delete: args.block_delete,
             wear_compensation: args.wear_compensation,
+            subprogram_dirs: &args.subprogram_dir,
             tool_diameter: args.material.tool_diameter,
             decimal_point_input: args.decimal_point_input,
         },
@@ -711,6 +724,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
             cycle_alias: &args.opts.cycle_alias,
             block_delete: args.opts.block_delete,
             wear_compensation: args.opts.wear_compensation,
+            subprogram_dirs: &args.opts.subprogram_dir,
             tool_diameter: args.opts.material.tool_diameter,
             decimal_point_input: args.opts.decimal_point_input,
         },
@@ -725,6 +739,7 @@ struct Reading<'a> {
     cycle_alias: &'a [String],
     block_delete: bool,
     wear_compensation: bool,
+    subprogram_dirs: &'a [PathBuf],
     tool_diameter: Option<f64>,
     decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
@@ -743,9 +758,18 @@ fn read_input_from(
         cycle_alias,
         block_delete,
         wear_compensation,
+        subprogram_dirs,
         tool_diameter,
         decimal_point_input,
     } = reading;
+    for dir in subprogram_dirs {
+        if !dir.is_dir() {
+            return Err(Error::Usage(format!(
+                "--subprogram-dir {}: not a directory",
+                crate::files::escape_control(&dir.display().to_string())
+            )));
+        }
+    }
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
@@ -785,6 +809,7 @@ fn read_input_from(
         }),
         fallback_dialect,
         decimal_point_input,
+        subprogram_dirs: subprogram_dirs.to_vec(),
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary; a
@@ -793,12 +818,7 @@ fn read_input_from(
         toolpath::Input::Cl(t) => toolpath::WarningGroup::group(&t.warnings)
             .iter()
             .map(|g| {
-                let text = format!(
-                    "{}:{}: {}",
-                    toolpath_file.display(),
-                    g.first.line,
-                    g.message()
-                );
+                let text = format!("{}: {}", t.file_line(g.first.line), g.message_in(t));
                 crate::files::escape_control(&text)
             })
             .collect(),

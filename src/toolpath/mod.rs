@@ -166,6 +166,23 @@ pub struct Toolpath {
     /// the spindle with the feed and reverses it at the bottom: `feedopt gcode`, which writes
     /// plain feed moves, refuses such a program.
     pub taps: Vec<TapCycle>,
+    /// The files the program's subprogram calls read, in the order read (empty: every line is
+    /// the main program's). Every `line` of the toolpath (points, warnings, dwells, changes)
+    /// counts in one sequence: the main program's lines 1 to n, then each of these files'
+    /// lines after the lines of the files before it; [`Toolpath::place`] maps one back to
+    /// its file and line there, [`Toolpath::line_name`] and [`Toolpath::file_line`] say it.
+    pub files: Vec<SourceFile>,
+}
+
+/// A file a program's subprogram call read ([`Toolpath::files`]): its line n is line
+/// `offset + n` of the toolpath.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourceFile {
+    pub path: PathBuf,
+    /// The lines (of the main program and the files read before it) numbered before its own.
+    pub offset: usize,
+    /// Its line count.
+    pub lines: usize,
 }
 
 impl Toolpath {
@@ -184,7 +201,38 @@ impl Toolpath {
             machine_points: Vec::new(),
             length_offsets: None,
             taps: Vec::new(),
+            files: Vec::new(),
         }
+    }
+
+    /// The file and its line of toolpath line `line` ([`Toolpath::files`]): the main
+    /// program's (`source`) unless a subprogram's file holds it.
+    pub fn place(&self, line: usize) -> (&Path, usize) {
+        match self.files.iter().rev().find(|f| line > f.offset) {
+            Some(f) => (&f.path, line - f.offset),
+            None => (&self.source, line),
+        }
+    }
+
+    /// `line 12`, or `line 12 of subs/O1002.nc` where a subprogram's file holds it.
+    pub fn line_name(&self, line: usize) -> String {
+        match self.place(line) {
+            (_, local) if local == line => format!("line {line}"),
+            (path, local) => format!("line {local} of {}", path.display()),
+        }
+    }
+
+    /// `file:line` of toolpath line `line`, as a message about it starts
+    /// (`prog.nc:12`, `subs/O1002.nc:3`).
+    pub fn file_line(&self, line: usize) -> String {
+        let (path, local) = self.place(line);
+        format!("{}:{local}", path.display())
+    }
+
+    /// A parse error at toolpath line `line`, naming its file and its line there.
+    pub fn error_at(&self, line: usize, message: impl Into<String>) -> Error {
+        let (path, local) = self.place(line);
+        Error::parse(path, local, message)
     }
 
     /// Total dwell time, seconds.
@@ -442,6 +490,18 @@ impl WarningGroup {
             ),
         }
     }
+
+    /// [`Self::message`], the last line named in `toolpath`'s files ([`Toolpath::line_name`]).
+    pub fn message_in(&self, toolpath: &Toolpath) -> String {
+        match self.more {
+            0 => self.first.message.to_string(),
+            n => format!(
+                "{} (and {n} more like it, the last at {})",
+                self.first.message,
+                toolpath.line_name(self.last_line)
+            ),
+        }
+    }
 }
 
 /// What a reader needs to know about the machine the program runs on: which axes it has (an
@@ -591,6 +651,8 @@ pub struct ReadOptions {
     /// The dialect of a G-code input whose content and extension name none (`None`: the
     /// default, LinuxCNC); [`Self::dialect`] overrides detection altogether.
     pub fallback_dialect: Option<gcode::Dialect>,
+    /// Where subprogram calls look for files ([`gcode::Settings::subprogram_dirs`]).
+    pub subprogram_dirs: Vec<PathBuf>,
 }
 
 /// What a reader was used, and why.
@@ -758,6 +820,7 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
                 block_delete: options.block_delete,
                 tool_diameter: options.tool_diameter,
                 decimal_point_input: options.decimal_point_input,
+                subprogram_dirs: options.subprogram_dirs.clone(),
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

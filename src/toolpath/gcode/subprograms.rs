@@ -54,7 +54,7 @@
 //! program ends it.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::dialect::{DialectSpec, Semicolon, Subprograms};
 use super::expr::Variables;
@@ -82,11 +82,23 @@ pub const MAX_EXPANDED_BLOCKS: usize = 1_000_000;
 /// reads, not only by how many blocks (about 60 ns a character: a second or two).
 pub const MAX_EXPANDED_BYTES: usize = 32 << 20;
 
-/// One line of the file: its 1-based number and its blocks with comments removed (or the
+/// One line of a file: its 1-based number in its file, the file (an index into
+/// [`Program::files`]: 0 is the main program's) and its blocks with comments removed (or the
 /// message of an unclosed comment, reported if the line is ever run).
 struct Line {
     number: usize,
+    file: usize,
     blocks: std::result::Result<Vec<String>, String>,
+}
+
+/// A file read into the program: the main program's (the first) or one a call read.
+struct Unit {
+    path: PathBuf,
+    /// The lines of the files before it: its line n is line `offset + n` of the sequence the
+    /// toolpath's lines are numbered in ([`crate::toolpath::SourceFile`]).
+    offset: usize,
+    /// Its line count.
+    lines: usize,
 }
 
 /// A program or subprogram: its name and header line, and the indices of its lines.
@@ -379,6 +391,59 @@ fn sinumerik_header(block: &str) -> Option<(String, bool)> {
     (!name.is_empty()).then_some((name, false))
 }
 
+/// A Sinumerik `EXTCALL "NAME"` or `CALL "NAME"` block as a call of NAME: the name is the
+/// string's last path component (`"/_N_WKS_DIR/_N_PART_WPD/NAME"`, `"D:\\NC\\NAME.SPF"`)
+/// without an extension `.SPF`/`.MPF` or the control's `_N_…_SPF` form, upper-cased. Nothing
+/// else may stand in the block.
+fn sinumerik_call(block: &str) -> std::result::Result<Call, String> {
+    let body = strip_block_number(block);
+    let keyword = first_word(body);
+    let rest = body[keyword.len()..].trim();
+    let fail = || {
+        format!(
+            "`{}`: expected {keyword} \"NAME\" alone in its block (the program's name in \
+             double quotes)",
+            block.trim()
+        )
+    };
+    let inner = rest
+        .strip_prefix('"')
+        .and_then(|r| r.strip_suffix('"'))
+        .filter(|r| !r.contains('"'))
+        .ok_or_else(fail)?;
+    let last = inner
+        .rsplit(['/', '\\'])
+        .next()
+        .unwrap_or(inner)
+        .to_ascii_uppercase();
+    let mut name = last.as_str();
+    for ext in [".SPF", ".MPF", "_SPF", "_MPF"] {
+        name = name.strip_suffix(ext).unwrap_or(name);
+    }
+    let name = name.strip_prefix("_N_").unwrap_or(name);
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(fail());
+    }
+    Ok(Call {
+        text: format!("{keyword} \"{inner}\""),
+        targets: vec![(name.to_string(), 1)],
+    })
+}
+
+/// Whether a file in `dirs` holds subprogram `name` as `style` names files ([`file_holds`]).
+pub(super) fn in_directories(dirs: &[PathBuf], style: Subprograms, name: &str) -> bool {
+    dirs.iter().any(|dir| {
+        std::fs::read_dir(dir).is_ok_and(|entries| {
+            entries.flatten().any(|e| {
+                e.file_name()
+                    .to_str()
+                    .is_some_and(|f| file_holds(style, name, f))
+                    && e.path().is_file()
+            })
+        })
+    })
+}
+
 /// The file split into its main program and subprograms.
 pub(super) struct Program {
     lines: Vec<Line>,
@@ -389,6 +454,82 @@ pub(super) struct Program {
     /// Heidenhain labels: name → index of the label's line.
     labels: HashMap<String, usize>,
     style: Subprograms,
+    /// The files read: the main program's first, then each a call read, in the order read.
+    files: Vec<Unit>,
+    /// The name of the first section's own header (Fanuc `O1002`, Sinumerik `PROC NAME`), if
+    /// it has one.
+    first_header: Option<String>,
+    /// Where a call of a subprogram the program does not hold looks for its file: the main
+    /// program's directory, then [`Settings::subprogram_dirs`](super::Settings) in order.
+    search: Vec<PathBuf>,
+    /// The names of the files in each searched directory, listed once.
+    listings: HashMap<PathBuf, Vec<String>>,
+    /// The names looked for in the directories and not found (each is looked for once).
+    missing: std::collections::HashSet<String>,
+    /// The bytes of the files calls read.
+    bytes_included: usize,
+}
+
+/// Most files a program may read for its calls.
+pub const MAX_SUBPROGRAM_FILES: usize = 1000;
+
+/// Most bytes the files a program's calls read may hold together (as much as one toolpath
+/// may: [`crate::files::MAX_TOOLPATH_BYTES`]).
+pub const MAX_SUBPROGRAM_BYTES: usize = crate::files::MAX_TOOLPATH_BYTES as usize;
+
+/// The extensions (lower case; "" none) a Fanuc/Haas subprogram's file may have.
+const FANUC_EXTENSIONS: [&str; 8] = ["", "nc", "tap", "ngc", "cnc", "txt", "eia", "prg"];
+
+/// Whether `file` (a file name in a searched directory) holds subprogram `name` as `style`
+/// names its files: Fanuc/Haas `O1002` in `O1002`, `O1002.nc`, `1002.nc`, `o01002.tap` (the
+/// letter O or none, the number with or without leading zeros, any case, an extension of
+/// [`FANUC_EXTENSIONS`]); Sinumerik `NAME` (`L1234`) in `NAME.SPF` or `NAME.MPF`, any case;
+/// LinuxCNC `o<name>` in `name.ngc` exactly (LinuxCNC lower-cases the name, and the file
+/// system's case counts). Numbered LinuxCNC subroutines (`o100`) and Heidenhain labels are
+/// never in files.
+pub(super) fn file_holds(style: Subprograms, name: &str, file: &str) -> bool {
+    let (stem, ext) = match file.rsplit_once('.') {
+        Some((stem, ext)) if !stem.is_empty() => (stem, ext),
+        _ => (file, ""),
+    };
+    match style {
+        Subprograms::OPrograms => {
+            let Some(Ok(n)) = name.strip_prefix('O').map(str::parse::<u64>) else {
+                return false;
+            };
+            let digits = stem.strip_prefix(['O', 'o']).unwrap_or(stem);
+            FANUC_EXTENSIONS.contains(&ext.to_ascii_lowercase().as_str())
+                && !digits.is_empty()
+                && digits.len() <= 12
+                && digits.chars().all(|c| c.is_ascii_digit())
+                && digits.parse::<u64>() == Ok(n)
+        }
+        Subprograms::Procs => {
+            matches!(ext.to_ascii_lowercase().as_str(), "spf" | "mpf")
+                && stem.eq_ignore_ascii_case(name)
+        }
+        Subprograms::OWordSub => name
+            .strip_prefix("O<")
+            .and_then(|n| n.strip_suffix('>'))
+            .is_some_and(|n| !n.is_empty() && ext == "ngc" && stem == n),
+        Subprograms::Labels => false,
+    }
+}
+
+/// What a call looks for, for messages: `O1002`, `O1002.nc`, `1002.nc`, … .
+fn file_names(style: Subprograms, name: &str) -> String {
+    match style {
+        Subprograms::OPrograms => {
+            let n = name.trim_start_matches('O');
+            format!("{name}, {name}.nc, {n}.nc, {name}.tap, … (any case)")
+        }
+        Subprograms::Procs => format!("{name}.SPF, {name}.MPF (any case)"),
+        Subprograms::OWordSub => {
+            let n = name.trim_start_matches("O<").trim_end_matches('>');
+            format!("{n}.ngc")
+        }
+        Subprograms::Labels => String::new(),
+    }
 }
 
 impl Program {
@@ -399,10 +540,21 @@ impl Program {
             .enumerate()
             .map(|(i, raw)| Line {
                 number: i + 1,
+                file: 0,
                 blocks: split_blocks(spec, raw),
             })
             .collect();
         let mut program = Program {
+            files: vec![Unit {
+                path: source.to_path_buf(),
+                offset: 0,
+                lines: lines.len(),
+            }],
+            first_header: None,
+            search: Vec::new(),
+            listings: HashMap::new(),
+            missing: Default::default(),
+            bytes_included: 0,
             lines,
             bytes: text.len(),
             sections: vec![Section {
@@ -583,6 +735,7 @@ impl Program {
                         // The main program's own header, or `PROC NAME` after `%_N_NAME_SPF`.
                         if current == 0 && self.sections[0].header == 0 {
                             self.sections[0].header = number;
+                            self.first_header = Some(name.clone());
                         }
                         self.sections[current].lines.push(i);
                         continue;
@@ -610,6 +763,11 @@ impl Program {
         Ok(())
     }
 
+    /// Where calls look for files ([`Self::search_in`]).
+    pub(super) fn search(&self) -> Vec<PathBuf> {
+        self.search.clone()
+    }
+
     /// The names a bare word may call (Sinumerik `PROC` names).
     pub(super) fn proc_names(&self) -> Vec<String> {
         if self.style == Subprograms::Procs {
@@ -621,12 +779,300 @@ impl Program {
 
     /// The last line number (for "no motion blocks").
     pub(super) fn last_line(&self) -> usize {
-        self.lines.len()
+        self.files[0].lines
     }
 
-    /// Runs the main program through `interp`, expanding calls.
+    /// Runs the main program through `interp`, expanding calls (a call of a subprogram the
+    /// program does not hold reads its file from [`Self::search`]). An error in a block of a
+    /// file a call read names that file and its line.
     pub(super) fn run(
-        &self,
+        &mut self,
+        spec: &DialectSpec,
+        interp: &mut Interpreter,
+        source: &Path,
+    ) -> Result<()> {
+        let run = self.run_lines(spec, interp, source);
+        run.map_err(|e| self.localize(e, source))
+    }
+
+    /// An error at a line of the sequence the program's lines are numbered in (the interpreter's
+    /// and this module's errors name `source`, the main program, and that line) as the file
+    /// and line it is at.
+    pub(super) fn localize(&self, e: Error, source: &Path) -> Error {
+        match e {
+            Error::Parse {
+                file,
+                line,
+                message,
+            } if file == source && line > self.files[0].lines => {
+                let (path, local) = self.place(line);
+                Error::Parse {
+                    file: path.to_path_buf(),
+                    line: local,
+                    message,
+                }
+            }
+            e => e,
+        }
+    }
+
+    /// The file and its line of line `global` of the sequence.
+    fn place(&self, global: usize) -> (&Path, usize) {
+        let unit = self
+            .files
+            .iter()
+            .rev()
+            .find(|u| global > u.offset)
+            .unwrap_or(&self.files[0]);
+        (&unit.path, global - unit.offset)
+    }
+
+    /// `line 12`, or `line 12 of sub/O1002.nc` when line `global` is in a file a call read.
+    fn line_name(&self, global: usize) -> String {
+        let (path, local) = self.place(global);
+        if global <= self.files[0].lines {
+            format!("line {local}")
+        } else {
+            format!("line {local} of {}", path.display())
+        }
+    }
+
+    /// The line number of line index `index` in the sequence all files' lines are numbered in.
+    fn global(&self, index: usize) -> usize {
+        let line = &self.lines[index];
+        self.files[line.file].offset + line.number
+    }
+
+    /// The files calls read, after the main program: (path, lines before it in the sequence,
+    /// its line count).
+    pub(super) fn included(&self) -> Vec<crate::toolpath::SourceFile> {
+        self.files[1..]
+            .iter()
+            .map(|u| crate::toolpath::SourceFile {
+                path: u.path.clone(),
+                offset: u.offset,
+                lines: u.lines,
+            })
+            .collect()
+    }
+
+    /// Sets where calls look for the files of subprograms the program does not hold: the main
+    /// program's directory (`source`'s), then `dirs` in order.
+    pub(super) fn search_in(&mut self, source: &Path, dirs: &[PathBuf]) {
+        let own = match source.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        self.search = std::iter::once(own).chain(dirs.iter().cloned()).collect();
+    }
+
+    /// The file that holds subprogram `name`: the first searched directory with one wins;
+    /// two in one directory are an error naming both.
+    fn find_file(&mut self, name: &str) -> std::result::Result<Option<PathBuf>, String> {
+        for dir in self.search.clone() {
+            if !self.listings.contains_key(&dir) {
+                let entries = std::fs::read_dir(&dir).map_err(|e| {
+                    format!(
+                        "cannot list the subprogram directory {}: {e}",
+                        dir.display()
+                    )
+                })?;
+                let names: Vec<String> = entries
+                    .flatten()
+                    .filter_map(|e| e.file_name().to_str().map(str::to_string))
+                    .collect();
+                self.listings.insert(dir.clone(), names);
+            }
+            let mut found: Vec<&String> = self.listings[&dir]
+                .iter()
+                .filter(|f| file_holds(self.style, name, f) && dir.join(f).is_file())
+                .collect();
+            found.sort();
+            match found[..] {
+                [] => continue,
+                [one] => return Ok(Some(dir.join(one))),
+                [a, b, ..] => {
+                    return Err(format!(
+                        "both {} and {} in {} could hold {name}: remove or rename one",
+                        a,
+                        b,
+                        dir.display()
+                    ));
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Reads the file of subprogram `name` (if a searched directory holds one) and adds its
+    /// programs to this one. `Ok(false)`: no file holds it.
+    fn load(&mut self, spec: &DialectSpec, name: &str) -> Result<bool> {
+        if self.style == Subprograms::Labels || self.missing.contains(name) {
+            return Ok(false);
+        }
+        let path = match self.find_file(name) {
+            Ok(Some(path)) => path,
+            Ok(None) => {
+                self.missing.insert(name.to_string());
+                return Ok(false);
+            }
+            Err(m) => return Err(Error::Usage(m)),
+        };
+        if self.files.len() > MAX_SUBPROGRAM_FILES {
+            return Err(Error::parse(
+                &path,
+                1,
+                format!(
+                    "the program's calls read more than {MAX_SUBPROGRAM_FILES} subprogram                      files: post the program with fewer"
+                ),
+            ));
+        }
+        let bytes = crate::toolpath::read_bytes(&path)?;
+        if self.bytes_included + bytes.len() > MAX_SUBPROGRAM_BYTES {
+            return Err(Error::parse(
+                &path,
+                1,
+                format!(
+                    "the program's subprogram files hold more than {} MiB together: split the                      program",
+                    MAX_SUBPROGRAM_BYTES >> 20
+                ),
+            ));
+        }
+        let text = String::from_utf8_lossy(&bytes);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let text = super::program_header(spec, &path, text)?;
+        let sub = Program::scan(spec, &path, &text)?;
+        self.bytes_included += bytes.len();
+        self.merge(sub, name, &path)?;
+        Ok(true)
+    }
+
+    /// Adds the programs of file `path` (scanned as `sub`), read for a call of `name`: its
+    /// first program is `name` (Fanuc: the program its own `O` header names; LinuxCNC: the
+    /// file holds `o<name> sub` … `endsub` and nothing else but comments and `M2`/`M30`), and
+    /// the file's other programs come with it. An error names the file and line where the
+    /// file does not hold `name` or defines a program the program has already.
+    fn merge(&mut self, sub: Program, name: &str, path: &Path) -> Result<()> {
+        let base = self.lines.len();
+        let file = self.files.len();
+        let offset = self.files.last().map_or(0, |u| u.offset + u.lines);
+        let Program {
+            lines,
+            bytes,
+            sections,
+            first_header,
+            ..
+        } = sub;
+        let defined = |sections: &[Section]| -> String {
+            sections
+                .iter()
+                .skip(1)
+                .map(|s| s.name.clone())
+                .chain(first_header.clone())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let holds = defined(&sections);
+        let mut added = Vec::new();
+        for (k, section) in sections.into_iter().enumerate() {
+            let section_name = if k > 0 {
+                section.name
+            } else {
+                match self.style {
+                    Subprograms::OWordSub => {
+                        // Outside the subroutine: comments, blank lines, `%`, M2 or M30 only.
+                        for &i in &section.lines {
+                            let Ok(blocks) = &lines[i].blocks else {
+                                continue;
+                            };
+                            let code = blocks.iter().map(|b| b.trim()).find(|b| {
+                                !b.is_empty()
+                                    && !b.starts_with('%')
+                                    && !matches!(first_word(b).as_str(), "M2" | "M02" | "M30")
+                            });
+                            if let Some(code) = code {
+                                return Err(Error::parse(
+                                    path,
+                                    lines[i].number,
+                                    format!(
+                                        "`{code}` outside `{name} sub` … `{name} endsub`: \
+                                         LinuxCNC reads a subroutine's file for the one \
+                                         subroutine it defines; move the block into it"
+                                    ),
+                                ));
+                            }
+                        }
+                        continue;
+                    }
+                    Subprograms::OPrograms if !name.starts_with('"') => {
+                        first_header.clone().unwrap_or_else(|| name.to_string())
+                    }
+                    _ => name.to_string(),
+                }
+            };
+            if let Some(&other) = self.by_name.get(&section_name) {
+                let there = self.sections[other]
+                    .lines
+                    .first()
+                    .map_or(0, |&i| self.global(i));
+                return Err(Error::parse(
+                    path,
+                    section.header.max(1),
+                    format!(
+                        "subprogram {section_name} is defined here and at {}: rename one",
+                        self.line_name(there)
+                    ),
+                ));
+            }
+            added.push(section_name.clone());
+            self.by_name
+                .insert(section_name.clone(), self.sections.len());
+            self.sections.push(Section {
+                name: section_name,
+                header: section.header,
+                lines: section.lines.iter().map(|i| i + base).collect(),
+            });
+        }
+        if self.style == Subprograms::OWordSub && added.len() > 1 {
+            return Err(Error::parse(
+                path,
+                1,
+                format!(
+                    "{} defines {}: LinuxCNC reads a subroutine's file for one subroutine, \
+                     the one it is named after; move the others to files of their own",
+                    path.display(),
+                    added.join(", ")
+                ),
+            ));
+        }
+        self.files.push(Unit {
+            path: path.to_path_buf(),
+            offset,
+            lines: lines.len(),
+        });
+        self.bytes += bytes;
+        self.lines
+            .extend(lines.into_iter().map(|l| Line { file, ..l }));
+        if !self.by_name.contains_key(name) {
+            let holds = if holds.is_empty() {
+                "no subprogram".to_string()
+            } else {
+                holds
+            };
+            return Err(Error::parse(
+                path,
+                1,
+                format!(
+                    "read for a call of {name}, this file holds {holds}: name the file after \
+                     the program it holds"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn run_lines(
+        &mut self,
         spec: &DialectSpec,
         interp: &mut Interpreter,
         source: &Path,
@@ -666,8 +1112,8 @@ impl Program {
                 }
                 continue;
             };
+            let number = self.global(index);
             let line = &self.lines[index];
-            let number = line.number;
             interp.vars.line = number;
             let blocks = match &line.blocks {
                 Ok(b) => b,
@@ -802,7 +1248,7 @@ impl Program {
                             targets: vec![(name, 1)],
                         };
                         let depth = stack.len();
-                        self.enter(&mut stack, call, number, source)?;
+                        self.enter(spec, &mut stack, call, number, source)?;
                         if stack.len() > depth
                             && let Some(top) = stack.last_mut()
                         {
@@ -825,6 +1271,14 @@ impl Program {
                     // Definitions were taken apart by the scan.
                     OWord::Sub => {}
                 }
+                continue;
+            }
+            if self.style == Subprograms::Procs
+                && matches!(first_word(text).as_str(), "EXTCALL" | "CALL")
+            {
+                let call = sinumerik_call(text)
+                    .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+                self.enter(spec, &mut stack, call, number, source)?;
                 continue;
             }
             let mut then_text = String::new();
@@ -900,9 +1354,11 @@ impl Program {
                                     let now = Loop::now(&stack, interp.vars.changes());
                                     if macro_taken.get(&(index, block)) == Some(&now) {
                                         return Err(located(format!(
-                                            "`{}` jumps to line {} for ever: no macro                                              variable has changed since it last jumped, so                                              every pass runs the same way; make the loop                                              change what its condition reads (a counter)",
+                                            "`{}` jumps to {} for ever: no macro                                              variable has changed since it last jumped, so                                              every pass runs the same way; make the loop                                              change what its condition reads (a counter)",
                                             text,
-                                            self.lines[self.sections[section].lines[to_pos]].number
+                                            self.line_name(
+                                                self.global(self.sections[section].lines[to_pos])
+                                            )
                                         )));
                                     }
                                     macro_taken.insert((index, block), now);
@@ -950,7 +1406,7 @@ impl Program {
                 .and_then(|()| interp.check_room(number, "this block", 0))
                 .map_err(|e| self.located(delete_hint(e, deleted), &stack))?;
             if let Some(call) = interp.call.take() {
-                self.enter(&mut stack, call, number, source)?;
+                self.enter(spec, &mut stack, call, number, source)?;
             } else if interp.ended {
                 interp.ended = false;
                 if interp.end_of_program || !self.ret(&mut stack, &mut interp.vars) {
@@ -1009,16 +1465,25 @@ impl Program {
 
     /// Starts a call made at line `number`.
     fn enter(
-        &self,
+        &mut self,
+        spec: &DialectSpec,
         stack: &mut Vec<Frame>,
         call: Call,
         number: usize,
         source: &Path,
     ) -> Result<()> {
-        let found = call
+        let mut found = call
             .targets
             .iter()
             .find_map(|(name, runs)| self.by_name.get(name).map(|&k| (k, *runs)));
+        if found.is_none() {
+            for (name, runs) in &call.targets {
+                if self.load(spec, name)? {
+                    found = self.by_name.get(name).map(|&k| (k, *runs));
+                    break;
+                }
+            }
+        }
         let Some((section, runs)) = found else {
             let name = &call.targets[0].0;
             let how = match self.style {
@@ -1027,19 +1492,34 @@ impl Program {
                 Subprograms::OWordSub => format!("{name} sub … {name} endsub"),
                 Subprograms::Labels => format!("LBL {name} … LBL 0"),
             };
-            return Err(self.located(
-                Error::parse(
-                    source,
-                    number,
-                    format!(
-                        "`{}`: subprogram {name} is not in this file; feedopt expands only \
-                         subprograms defined in the same file: add {how} to it, or post the \
-                         program without subprogram calls",
-                        call.text
-                    ),
-                ),
-                stack,
-            ));
+            let files = call
+                .targets
+                .iter()
+                .map(|(n, _)| file_names(self.style, n))
+                .filter(|f| !f.is_empty())
+                .collect::<Vec<_>>()
+                .join("; ");
+            let message = if files.is_empty() {
+                format!(
+                    "`{}`: subprogram {name} is not in this file: add {how} to it, or post the \
+                     program without subprogram calls",
+                    call.text
+                )
+            } else {
+                let dirs = self
+                    .search
+                    .iter()
+                    .map(|d| d.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                format!(
+                    "`{}`: subprogram {name} is neither in this file nor in a file {files} in \
+                     {dirs}: give the directory that holds it with --subprogram-dir DIR, or add \
+                     {how} to this file",
+                    call.text
+                )
+            };
+            return Err(self.located(Error::parse(source, number, message), stack));
         };
         let frame = Frame {
             section,
@@ -1226,7 +1706,10 @@ impl Program {
             } => Error::Parse {
                 file,
                 line: at,
-                message: format!("{message} (in {name}, called by `{text}` at line {line})"),
+                message: format!(
+                    "{message} (in {name}, called by `{text}` at {})",
+                    self.line_name(*line)
+                ),
             },
             other => other,
         }
