@@ -229,6 +229,109 @@ impl Toolpath {
         format!("{}:{local}", path.display())
     }
 
+    /// The line count of the main program where calls read other files (their lines come
+    /// after it), else `None`: every line is the main program's.
+    fn main_lines(&self) -> Option<usize> {
+        self.files.first().map(|f| f.offset)
+    }
+
+    /// `text` with each `line N` whose N is a line of a file a call read ([`Toolpath::files`])
+    /// as `line n of FILE` (one already so named is left as it is) (for messages of the stages after the reader, which number lines
+    /// in the toolpath's sequence: `nearest CL line 1234`, `the last at line 1240`).
+    pub fn name_lines(&self, text: &str) -> String {
+        let Some(main) = self.main_lines() else {
+            return text.to_string();
+        };
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(at) = rest.find("line ") {
+            let before = &rest[..at];
+            let after = &rest[at + 5..];
+            let digits = after.len() - after.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+            out.push_str(before);
+            let word_start = !before.ends_with(|c: char| c.is_alphanumeric() || c == '_');
+            // `line 3 of subs/O1002.nc` is named already.
+            let named = after[digits..].starts_with(" of ");
+            match after[..digits].parse::<usize>() {
+                Ok(n) if word_start && !named && n > main => {
+                    out.push_str(&self.line_name(n));
+                }
+                _ => {
+                    out.push_str("line ");
+                    out.push_str(&after[..digits]);
+                }
+            }
+            rest = &after[digits..];
+        }
+        out.push_str(rest);
+        out
+    }
+
+    /// An error of a stage after the reader about this toolpath, its lines named in their
+    /// files: a parse error at a line of a file a call read names that file and line, and
+    /// every `line N` in a message is named so ([`Toolpath::name_lines`]).
+    pub fn in_files(&self, e: Error) -> Error {
+        if self.files.is_empty() {
+            return e;
+        }
+        match e {
+            Error::Parse {
+                file,
+                line,
+                message,
+            } if file == self.source => {
+                let (path, local) = self.place(line);
+                Error::Parse {
+                    file: path.to_path_buf(),
+                    line: local,
+                    message: self.name_lines(&message),
+                }
+            }
+            Error::Infeasible(m) => Error::Infeasible(self.name_lines(&m)),
+            Error::Solver(m) => Error::Solver(self.name_lines(&m)),
+            Error::Usage(m) => Error::Usage(self.name_lines(&m)),
+            e => e,
+        }
+    }
+
+    /// A JSON value (a report about this toolpath) with each line of a file a call read
+    /// named in its file: an object's `line` (and `first_move_line`, `last_line`) past the
+    /// main program's lines becomes the line in that file, and a key beside it (`file`,
+    /// `first_move_file`, `last_file`) names the file. Objects about the main program's lines
+    /// are left as they are.
+    pub fn name_json_lines(&self, value: &mut serde_json::Value) {
+        let Some(main) = self.main_lines() else {
+            return;
+        };
+        match value {
+            serde_json::Value::Array(items) => {
+                items.iter_mut().for_each(|v| self.name_json_lines(v));
+            }
+            serde_json::Value::Object(map) => {
+                for (key, file_key) in [
+                    ("line", "file"),
+                    ("first_move_line", "first_move_file"),
+                    ("last_line", "last_file"),
+                ] {
+                    let Some(n) = map.get(key).and_then(|v| v.as_u64()) else {
+                        continue;
+                    };
+                    let n = n as usize;
+                    if n > main {
+                        let (path, local) = self.place(n);
+                        let path = path.display().to_string();
+                        map.insert(key.into(), local.into());
+                        map.insert(file_key.into(), path.into());
+                    }
+                }
+                for (_, v) in map.iter_mut() {
+                    self.name_json_lines(v);
+                }
+            }
+            _ => {}
+        }
+    }
+
     /// A parse error at toolpath line `line`, naming its file and its line there.
     pub fn error_at(&self, line: usize, message: impl Into<String>) -> Error {
         let (path, local) = self.place(line);
