@@ -1555,14 +1555,25 @@ impl Program {
             } else {
                 "subprogram calls"
             };
+            // A subprogram that calls itself (directly or through others) without an end.
+            let own = stack[1..]
+                .iter()
+                .any(|f| f.section == frame.section && f.label.is_none())
+                && frame.label.is_none();
+            let why = if own {
+                format!(
+                    "{} calls itself, and does not stop before that: a subprogram that calls \
+                     itself must end the recursion on a condition",
+                    self.sections[frame.section].name
+                )
+            } else {
+                "does a subprogram call itself?".to_string()
+            };
             return Err(self.located(
                 Error::parse(
                     source,
                     number,
-                    format!(
-                        "`{text}`: {what} nested more than {MAX_CALL_DEPTH} deep (does a \
-                         subprogram call itself?)"
-                    ),
+                    format!("`{text}`: {what} nested more than {MAX_CALL_DEPTH} deep ({why})"),
                 ),
                 stack,
             ));
