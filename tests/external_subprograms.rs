@@ -429,3 +429,62 @@ fn warnings_and_check_findings_name_the_called_file() {
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+const FANUC_G65_MAIN: &str = "O1000\n\
+G21 G90 G94 G17\n\
+G0 X0. Y0. Z5.\n\
+#1 = 3.\n\
+G65 P9010 A10. B2. L2\n\
+G1 X#1 F300.\n\
+M30\n";
+
+const FANUC_O9010: &str = "O9010 (SQUARE OF SIDE #1 AT DEPTH #2)\n\
+G1 Z-#2 F600.\n\
+G91 X#1\n\
+Y#1\n\
+G90\n\
+M99\n";
+
+/// `G65 P9010 A10. B2. L2` reads `O9010.nc` to the points of the macro pasted into the file:
+/// A and B are `#1` and `#2` in the body, and the caller's `#1`
+/// comes back; an argument without a decimal point is an error (the control scales it by its
+/// address's increment).
+#[test]
+fn fanuc_g65_passes_its_arguments_as_local_variables() {
+    let dir = scratch(
+        "g65",
+        &[
+            ("main.nc", FANUC_G65_MAIN),
+            ("O9010.nc", FANUC_O9010),
+            ("pasted.nc", &format!("{FANUC_G65_MAIN}{FANUC_O9010}")),
+            ("bad.nc", &FANUC_G65_MAIN.replace("A10. B2.", "A10 B2.")),
+        ],
+    );
+    let external = read(Dialect::Fanuc, &dir.join("main.nc"), &[]);
+    let pasted = read(Dialect::Fanuc, &dir.join("pasted.nc"), &[]);
+    assert_eq!(motion(&external), motion(&pasted));
+    let xyz: Vec<[f64; 3]> = external
+        .points
+        .iter()
+        .map(|p| [p.p.x, p.p.y, p.p.z])
+        .collect();
+    assert_eq!(
+        xyz,
+        vec![
+            [0.0, 0.0, 5.0],
+            [0.0, 0.0, -2.0],
+            [10.0, 0.0, -2.0],
+            [10.0, 10.0, -2.0],
+            [10.0, 10.0, -2.0],
+            [20.0, 10.0, -2.0],
+            [20.0, 20.0, -2.0],
+            [3.0, 20.0, -2.0],
+        ]
+    );
+    let e = fails(Dialect::Fanuc, &dir.join("bad.nc"), &[]);
+    assert!(
+        e.contains("bad.nc:5:") && e.contains("decimal point"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

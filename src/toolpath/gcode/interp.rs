@@ -962,6 +962,12 @@ impl<'a> Interpreter<'a> {
             .collect()
     }
 
+    /// Whether a number without a decimal point counts least input increments (Fanuc's
+    /// default, DPI = 0).
+    pub(super) fn integer_increments(&self) -> bool {
+        self.increments.is_some()
+    }
+
     /// Interprets one block.
     pub(super) fn block(&mut self, line: usize, items: Vec<Item>) -> Result<()> {
         let done = self.block_words(line, items);

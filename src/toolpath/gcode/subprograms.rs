@@ -60,7 +60,7 @@ use super::dialect::{DialectSpec, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
-use super::lexer::{lex, split_blocks};
+use super::lexer::{Item, lex, split_blocks};
 use super::macro_b::{self, Statement};
 use crate::error::{Error, Result};
 
@@ -442,6 +442,120 @@ pub(super) fn in_directories(dirs: &[PathBuf], style: Subprograms, name: &str) -
             })
         })
     })
+}
+
+/// Fanuc's local variables `#1`–`#33`: a `G65` macro call gets its own (vacant but for its
+/// arguments), and the caller's come back on return.
+pub const MACRO_LOCALS: usize = 33;
+
+/// Fanuc argument specification I: the letter of a `G65` argument and the local variable it
+/// sets.
+const MACRO_ARGUMENTS: [(char, usize); 21] = [
+    ('A', 1),
+    ('B', 2),
+    ('C', 3),
+    ('I', 4),
+    ('J', 5),
+    ('K', 6),
+    ('D', 7),
+    ('E', 8),
+    ('F', 9),
+    ('H', 11),
+    ('M', 13),
+    ('Q', 17),
+    ('R', 18),
+    ('S', 19),
+    ('T', 20),
+    ('U', 21),
+    ('V', 22),
+    ('W', 23),
+    ('X', 24),
+    ('Y', 25),
+    ('Z', 26),
+];
+
+/// Whether a Fanuc block is a `G65` macro call.
+fn is_macro_call(items: &[Item]) -> bool {
+    items.iter().any(|i| {
+        matches!(i, Item::Word { text, num, .. }
+            if text.starts_with(['G', 'g']) && num.value == 65.0)
+    })
+}
+
+/// A Fanuc `G65 P9010 L2 A1. B2.` block: the call (program `O<P>`, `L` times) and its
+/// arguments as (local variable, value) by argument specification I. A letter that is no
+/// argument, a word that is no letter, and (where numbers without a decimal point count
+/// increments, `increments`) an argument without a decimal point other than 0 are errors: the
+/// control scales such an argument by its address's increment, which differs between letters
+/// and controls.
+fn macro_call(
+    items: &[Item],
+    increments: bool,
+) -> std::result::Result<(Call, Vec<(usize, f64)>), String> {
+    let mut program = None;
+    let mut count = None;
+    let mut arguments = Vec::new();
+    let whole = |what: &str, v: f64| {
+        if v < 0.0 || v.fract() != 0.0 || v > 1e12 {
+            Err(format!(
+                "`{what}{v}`: expected a whole number of at least 0"
+            ))
+        } else {
+            Ok(v as u64)
+        }
+    };
+    for item in items {
+        let Item::Word { text, num, .. } = item else {
+            return Err(
+                "a G65 block holds the call, its P, L and arguments only (argument \
+                 specification I: A B C D E F H I J K M Q R S T U V W X Y Z)"
+                    .into(),
+            );
+        };
+        let letter = text.chars().next().unwrap_or(' ').to_ascii_uppercase();
+        match letter {
+            'G' if num.value == 65.0 => {}
+            'N' => {}
+            'P' => program = Some(whole("P", num.value)?),
+            'L' => count = Some(whole("L", num.value)?),
+            _ => {
+                let Some(&(_, k)) = MACRO_ARGUMENTS.iter().find(|(l, _)| *l == letter) else {
+                    return Err(format!(
+                        "`{text}` is no G65 argument (argument specification I: A B C D E F H I \
+                         J K M Q R S T U V W X Y Z; G66 and specification II are not read)"
+                    ));
+                };
+                if increments && !num.point && num.value != 0.0 {
+                    return Err(format!(
+                        "G65 argument `{text}` without a decimal point: the control scales it \
+                         by the increment of address {letter}; write it with a decimal point \
+                         (`{letter}{}.`), or read the program with --decimal-point-input \
+                         calculator",
+                        num.value
+                    ));
+                }
+                arguments.push((k, num.value));
+            }
+        }
+    }
+    let Some(program) = program else {
+        return Err("G65 without P (the macro's program number): add P<program number>".into());
+    };
+    let mut text = format!("G65 P{program}");
+    let runs = match count {
+        Some(l) => {
+            text.push_str(&format!(" L{l}"));
+            l
+        }
+        None => 1,
+    };
+    Ok((
+        Call {
+            text,
+            targets: vec![(format!("O{program}"), runs)],
+        },
+        arguments,
+    ))
 }
 
 /// The file split into its main program and subprograms.
@@ -1401,6 +1515,34 @@ impl Program {
                     &stack,
                 )
             })?;
+            if self.style == Subprograms::OPrograms && is_macro_call(&items) {
+                let (call, arguments) =
+                    macro_call(&items, interp.integer_increments()).map_err(|m| {
+                        self.located(
+                            Error::parse(source, number, format!("`{text}`: {m}")),
+                            &stack,
+                        )
+                    })?;
+                let depth = stack.len();
+                self.enter(spec, &mut stack, call, number, source)?;
+                if stack.len() > depth
+                    && let Some(top) = stack.last_mut()
+                {
+                    // #1–#33 are the macro's own: vacant but for the arguments, the caller's
+                    // given back on return.
+                    let saved: Vec<Option<f64>> = (1..=MACRO_LOCALS)
+                        .map(|k| interp.vars.value(&format!("#{k}")))
+                        .collect();
+                    for k in 1..=MACRO_LOCALS {
+                        interp.vars.restore(&format!("#{k}"), None);
+                    }
+                    for (k, v) in arguments {
+                        interp.vars.set(&format!("#{k}"), v);
+                    }
+                    top.locals = Some(saved);
+                }
+                continue;
+            }
             interp
                 .block(number, items)
                 .and_then(|()| interp.check_room(number, "this block", 0))
