@@ -488,3 +488,47 @@ fn fanuc_g65_passes_its_arguments_as_local_variables() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+const KLARTEXT_MAIN: &str = "0  BEGIN PGM MAIN MM\n\
+1  BLK FORM 0.1 Z  X+0  Y+0  Z-20\n\
+2  BLK FORM 0.2  X+100  Y+100  Z+0\n\
+3  TOOL CALL 1 Z S5000\n\
+4  L  X+0  Y+0  Z+5 R0 FMAX M3\n\
+5  L  Z+0 F600\n\
+6  CALL PGM TNC:\\PARTS\\SQUARE.H\n\
+7  L  X+50 F1200\n\
+8  SEL PGM \"square\"\n\
+9  CALL SELECTED PGM\n\
+10 L  Z+5 FMAX\n\
+11 END PGM MAIN MM\n";
+
+/// Heidenhain `CALL PGM TNC:\PARTS\SQUARE.H` and `SEL PGM` + `CALL SELECTED PGM` read
+/// `square.h` (its own label LBL 1, called and then run through) to the points of its blocks
+/// written out in the main program; END PGM of the called program returns.
+#[test]
+fn heidenhain_call_pgm_reads_the_program_file() {
+    let square = "0  BEGIN PGM SQUARE MM\n1  L  IX+10\n2  CALL LBL 1\n3  L  IY+10\n\
+                  4  LBL 1\n5  L  IX+1\n6  LBL 0\n7  L  IX-10\n8  END PGM SQUARE MM\n";
+    let body = "L  IX+10\nL  IX+1\nL  IY+10\nL  IX+1\nL  IX-10\n";
+    let written = KLARTEXT_MAIN
+        .replace("6  CALL PGM TNC:\\PARTS\\SQUARE.H\n", body)
+        .replace("8  SEL PGM \"square\"\n9  CALL SELECTED PGM\n", body);
+    let dir = scratch(
+        "klartext",
+        &[
+            ("MAIN.H", KLARTEXT_MAIN),
+            ("pgm/square.h", square),
+            ("WRITTEN.H", &written),
+        ],
+    );
+    let external = read(Dialect::Heidenhain, &dir.join("MAIN.H"), &[dir.join("pgm")]);
+    let pasted = read(Dialect::Heidenhain, &dir.join("WRITTEN.H"), &[]);
+    assert_eq!(motion(&external), motion(&pasted));
+    assert_eq!(external.files.len(), 1);
+    let e = fails(Dialect::Heidenhain, &dir.join("MAIN.H"), &[]);
+    assert!(
+        e.contains("MAIN.H:7:") && e.contains("SQUARE.h") && e.contains("--subprogram-dir"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

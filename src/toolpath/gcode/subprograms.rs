@@ -430,6 +430,60 @@ fn sinumerik_call(block: &str) -> std::result::Result<Call, String> {
     })
 }
 
+/// A Heidenhain block about another program.
+enum ProgramCall {
+    /// `CALL PGM name`, `PGM CALL name` (`Some`), `CALL SELECTED PGM` (`None`).
+    Call(Option<String>),
+    /// `SEL PGM "name"`.
+    Select(String),
+    /// `END PGM …`.
+    End,
+}
+
+/// A Heidenhain `CALL PGM name` / `CALL PGM TNC:\dir\name.h` / `PGM CALL name`, `SEL PGM
+/// "name"`, `CALL SELECTED PGM` or `END PGM` block (`None`: none of them). The program's
+/// name is the path's last component without `.h`, upper-cased (the TNC's file names do not
+/// depend on case).
+fn program_call(body: &str) -> Option<std::result::Result<ProgramCall, String>> {
+    let t = body.trim().trim_end_matches('~').trim();
+    let upper = t.to_ascii_uppercase();
+    if upper.starts_with("END PGM") {
+        return Some(Ok(ProgramCall::End));
+    }
+    if upper.starts_with("CALL SELECTED PGM") {
+        return Some(Ok(ProgramCall::Call(None)));
+    }
+    let (rest, select) = if let Some(r) = upper
+        .strip_prefix("CALL PGM ")
+        .or_else(|| upper.strip_prefix("PGM CALL "))
+    {
+        (&t[t.len() - r.len()..], false)
+    } else if let Some(r) = upper.strip_prefix("SEL PGM ") {
+        (&t[t.len() - r.len()..], true)
+    } else {
+        return None;
+    };
+    let written = rest.split_whitespace().next().unwrap_or("");
+    let path = written.trim_matches(['"', '\'']);
+    let last = path.rsplit(['\\', '/', ':']).next().unwrap_or(path);
+    let stem = match last.rsplit_once('.') {
+        Some((stem, ext)) if ext.eq_ignore_ascii_case("h") => stem,
+        _ => last,
+    };
+    if stem.is_empty() || stem.contains(char::is_whitespace) {
+        return Some(Err(format!(
+            "`{t}`: expected the program's name after PGM (`CALL PGM name`, `CALL PGM \
+             TNC:\\dir\\name.h`)"
+        )));
+    }
+    let name = stem.to_ascii_uppercase();
+    Some(Ok(if select {
+        ProgramCall::Select(name)
+    } else {
+        ProgramCall::Call(Some(name))
+    }))
+}
+
 /// Whether a file in `dirs` holds subprogram `name` as `style` names files ([`file_holds`]).
 pub(super) fn in_directories(dirs: &[PathBuf], style: Subprograms, name: &str) -> bool {
     dirs.iter().any(|dir| {
@@ -565,8 +619,11 @@ pub(super) struct Program {
     bytes: usize,
     sections: Vec<Section>,
     by_name: HashMap<String, usize>,
-    /// Heidenhain labels: name → index of the label's line.
-    labels: HashMap<String, usize>,
+    /// Heidenhain labels: (section, name) → the label's position in the section (each
+    /// program, the main one or one a `CALL PGM` read, has its own).
+    labels: HashMap<(usize, String), usize>,
+    /// Heidenhain `SEL PGM "name"`: the program `CALL SELECTED PGM` calls.
+    selected: std::cell::RefCell<Option<String>>,
     style: Subprograms,
     /// The files read: the main program's first, then each a call read, in the order read.
     files: Vec<Unit>,
@@ -626,7 +683,7 @@ pub(super) fn file_holds(style: Subprograms, name: &str, file: &str) -> bool {
             .strip_prefix("O<")
             .and_then(|n| n.strip_suffix('>'))
             .is_some_and(|n| !n.is_empty() && ext == "ngc" && stem == n),
-        Subprograms::Labels => false,
+        Subprograms::Labels => ext.eq_ignore_ascii_case("h") && stem.eq_ignore_ascii_case(name),
     }
 }
 
@@ -642,7 +699,7 @@ fn file_names(style: Subprograms, name: &str) -> String {
             let n = name.trim_start_matches("O<").trim_end_matches('>');
             format!("{n}.ngc")
         }
-        Subprograms::Labels => String::new(),
+        Subprograms::Labels => format!("{name}.h (any case)"),
     }
 }
 
@@ -678,6 +735,7 @@ impl Program {
             }],
             by_name: HashMap::new(),
             labels: HashMap::new(),
+            selected: Default::default(),
             style: spec.subprograms,
         };
         match spec.subprograms {
@@ -738,7 +796,7 @@ impl Program {
             let block = klartext::strip_block_number(self.first_block(i));
             // Other label blocks, and malformed ones, are read when they run.
             if let Ok(Some(LabelOp::Label(name))) = klartext::label_op(block) {
-                if let Some(&k) = self.labels.get(&name) {
+                if let Some(&k) = self.labels.get(&(0, name.clone())) {
                     return Err(Error::parse(
                         source,
                         number,
@@ -748,7 +806,7 @@ impl Program {
                         ),
                     ));
                 }
-                self.labels.insert(name, i);
+                self.labels.insert((0, name), i);
             }
         }
         Ok(())
@@ -1021,7 +1079,7 @@ impl Program {
     /// Reads the file of subprogram `name` (if a searched directory holds one) and adds its
     /// programs to this one. `Ok(false)`: no file holds it.
     fn load(&mut self, spec: &DialectSpec, name: &str) -> Result<bool> {
-        if self.style == Subprograms::Labels || self.missing.contains(name) {
+        if self.missing.contains(name) {
             return Ok(false);
         }
         let path = match self.find_file(name) {
@@ -1075,8 +1133,16 @@ impl Program {
             bytes,
             sections,
             first_header,
+            labels,
             ..
         } = sub;
+        if self.style == Subprograms::Labels {
+            // One program, its own labels.
+            let k = self.sections.len();
+            for ((_, label), pos) in labels {
+                self.labels.insert((k, label), pos);
+            }
+        }
         let defined = |sections: &[Section]| -> String {
             sections
                 .iter()
@@ -1282,14 +1348,61 @@ impl Program {
             };
             if self.style == Subprograms::Labels {
                 let body = klartext::strip_block_number(text);
+                match program_call(body) {
+                    None => {}
+                    Some(Err(m)) => {
+                        return Err(self.located(Error::parse(source, number, m), &stack));
+                    }
+                    Some(Ok(ProgramCall::Select(name))) => {
+                        self.selected.replace(Some(name));
+                        continue;
+                    }
+                    Some(Ok(ProgramCall::End)) => {
+                        // The end of a program a CALL PGM runs returns to the caller; the main
+                        // program's ends it.
+                        if stack
+                            .last()
+                            .is_some_and(|f| f.section > 0 && f.label.is_none())
+                        {
+                            if !self.ret(&mut stack, &mut interp.vars) {
+                                return Ok(());
+                            }
+                            continue;
+                        }
+                    }
+                    Some(Ok(ProgramCall::Call(name))) => {
+                        let name = match name {
+                            Some(name) => name,
+                            None => self.selected.borrow().clone().ok_or_else(|| {
+                                self.located(
+                                    Error::parse(
+                                        source,
+                                        number,
+                                        "CALL SELECTED PGM with no SEL PGM before it: select \
+                                         the program with SEL PGM \"name\"",
+                                    ),
+                                    &stack,
+                                )
+                            })?,
+                        };
+                        let call = Call {
+                            text: body.trim().to_string(),
+                            targets: vec![(name, 1)],
+                        };
+                        self.enter(spec, &mut stack, call, number, source)?;
+                        continue;
+                    }
+                }
                 let op = klartext::label_op(body)
                     .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
                 match op {
                     None => {}
                     Some(LabelOp::Label(_)) => continue,
                     Some(LabelOp::End) => {
-                        // In the main program, a subprogram's end is run through.
-                        if stack.len() > 1 && !self.ret(&mut stack, &mut interp.vars) {
+                        // In a program (the main one, or one a CALL PGM runs), a subprogram's
+                        // end is run through; it ends a label call.
+                        let in_label = stack.last().is_some_and(|f| f.label.is_some());
+                        if in_label && !self.ret(&mut stack, &mut interp.vars) {
                             return Ok(());
                         }
                         continue;
@@ -1328,7 +1441,8 @@ impl Program {
                             let target = self.label(&name, number, source, &stack)?;
                             let now = Loop::now(&stack, interp.vars.changes());
                             if taken.get(&index) == Some(&now) {
-                                return Err(self.endless(source, number, body, &name, target));
+                                let at = self.global(self.sections[section].lines[target]);
+                                return Err(self.endless(source, number, body, &name, at));
                             }
                             taken.insert(index, now);
                             jumps += 1;
@@ -1654,11 +1768,20 @@ impl Program {
                     .map(|d| d.display().to_string())
                     .collect::<Vec<_>>()
                     .join(", ");
+                let add = if self.style == Subprograms::Labels {
+                    String::new()
+                } else {
+                    format!(", or add {how} to this file")
+                };
                 format!(
-                    "`{}`: subprogram {name} is neither in this file nor in a file {files} in \
-                     {dirs}: give the directory that holds it with --subprogram-dir DIR, or add \
-                     {how} to this file",
-                    call.text
+                    "`{}`: {} {name} is neither in this file nor in a file {files} in {dirs}: \
+                     give the directory that holds it with --subprogram-dir DIR{add}",
+                    call.text,
+                    if self.style == Subprograms::Labels {
+                        "program"
+                    } else {
+                        "subprogram"
+                    }
                 )
             };
             return Err(self.located(Error::parse(source, number, message), stack));
@@ -1729,8 +1852,12 @@ impl Program {
 
     /// The line index of label `name` (an error naming it when the file lacks it).
     fn label(&self, name: &str, number: usize, source: &Path, stack: &[Frame]) -> Result<usize> {
-        self.labels.get(name).copied().ok_or_else(|| {
-            self.located(
+        let section = stack.last().map_or(0, |f| f.section);
+        self.labels
+            .get(&(section, name.to_string()))
+            .copied()
+            .ok_or_else(|| {
+                self.located(
                 Error::parse(
                     source,
                     number,
@@ -1741,7 +1868,7 @@ impl Program {
                 ),
                 stack,
             )
-        })
+            })
     }
 
     /// `CALL LBL name [REP repeats]` at line index `at` (line `number`).
@@ -1779,7 +1906,7 @@ impl Program {
             Some(r) => r,
         };
         let frame = Frame {
-            section: 0,
+            section: stack.last().map_or(0, |f| f.section),
             pos: target + 1,
             block: 0,
             start: target + 1,
@@ -1828,10 +1955,10 @@ impl Program {
             source,
             number,
             format!(
-                "`{block}` jumps back to LBL {name} (line {}) for ever: no Q parameter has \
+                "`{block}` jumps back to LBL {name} ({}) for ever: no Q parameter has \
                  changed since it last jumped, so every pass runs the same way; make the loop \
                  change what the condition reads (a counter), or remove the jump",
-                self.lines[target].number
+                self.line_name(target)
             ),
         )
     }
