@@ -532,3 +532,34 @@ fn heidenhain_call_pgm_reads_the_program_file() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Haas `M98 "pocket.nc" L2` reads the file of that name (any case) as `M98 P…` reads a
+/// program, and repeats it.
+#[test]
+fn haas_m98_with_a_file_name() {
+    let sub = "O2000\nG91 G1 X5. F300.\nG90\nM99\n";
+    let dir = scratch(
+        "haas",
+        &[
+            (
+                "main.nc",
+                "O1000\nG0 X0. Y0. Z0.\nM98 \"Pocket.NC\" L2\nM30\n",
+            ),
+            ("subs/pocket.nc", sub),
+            (
+                "pasted.nc",
+                &format!("O1000\nG0 X0. Y0. Z0.\nM98 P2000 L2\nM30\n{sub}"),
+            ),
+        ],
+    );
+    let external = read(Dialect::Fanuc, &dir.join("main.nc"), &[dir.join("subs")]);
+    let pasted = read(Dialect::Fanuc, &dir.join("pasted.nc"), &[]);
+    assert_eq!(motion(&external), motion(&pasted));
+    assert_eq!(external.points.last().unwrap().p.x, 10.0);
+    let e = fails(Dialect::Fanuc, &dir.join("main.nc"), &[]);
+    assert!(
+        e.contains("main.nc:3:") && e.contains("Pocket.NC (any case)"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

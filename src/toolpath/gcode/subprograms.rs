@@ -430,6 +430,45 @@ fn sinumerik_call(block: &str) -> std::result::Result<Call, String> {
     })
 }
 
+/// A Haas `M98 "name.nc"` or `M98 "name.nc" L3` block: a call of the program in file
+/// `name.nc` (its name in the call is the quoted text, quotes included). Nothing else may
+/// stand in the block.
+fn haas_file_call(block: &str) -> std::result::Result<Call, String> {
+    let body = strip_block_number(block);
+    let fail = || {
+        format!(
+            "`{}`: expected M98 \"file name\" and at most a repeat count L, alone in its block",
+            block.trim()
+        )
+    };
+    let rest = body[3..].trim_start();
+    let inner_end = rest
+        .strip_prefix('"')
+        .and_then(|r| r.find('"'))
+        .ok_or_else(fail)?;
+    let file = &rest[1..=inner_end];
+    let tail: String = rest[inner_end + 2..]
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect();
+    let runs = match tail.strip_prefix(['L', 'l']) {
+        None if tail.is_empty() => 1,
+        Some(n) => n.parse::<u64>().map_err(|_| fail())?,
+        None => return Err(fail()),
+    };
+    if file.is_empty() || file.contains(['/', '\\']) {
+        return Err(fail());
+    }
+    let mut text = format!("M98 \"{file}\"");
+    if !tail.is_empty() {
+        text.push_str(&format!(" L{runs}"));
+    }
+    Ok(Call {
+        text,
+        targets: vec![(format!("\"{file}\""), runs)],
+    })
+}
+
 /// A Heidenhain block about another program.
 enum ProgramCall {
     /// `CALL PGM name`, `PGM CALL name` (`Some`), `CALL SELECTED PGM` (`None`).
@@ -665,6 +704,10 @@ pub(super) fn file_holds(style: Subprograms, name: &str, file: &str) -> bool {
     };
     match style {
         Subprograms::OPrograms => {
+            // Haas `M98 "name.nc"`: the file of that name.
+            if let Some(quoted) = name.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+                return file.eq_ignore_ascii_case(quoted);
+            }
             let Some(Ok(n)) = name.strip_prefix('O').map(str::parse::<u64>) else {
                 return false;
             };
@@ -690,6 +733,9 @@ pub(super) fn file_holds(style: Subprograms, name: &str, file: &str) -> bool {
 /// What a call looks for, for messages: `O1002`, `O1002.nc`, `1002.nc`, … .
 fn file_names(style: Subprograms, name: &str) -> String {
     match style {
+        Subprograms::OPrograms if name.starts_with('"') => {
+            format!("{} (any case)", name.trim_matches('"'))
+        }
         Subprograms::OPrograms => {
             let n = name.trim_start_matches('O');
             format!("{name}, {name}.nc, {n}.nc, {name}.tap, … (any case)")
@@ -1499,6 +1545,15 @@ impl Program {
                     // Definitions were taken apart by the scan.
                     OWord::Sub => {}
                 }
+                continue;
+            }
+            if self.style == Subprograms::OPrograms
+                && text.contains('"')
+                && first_word(text).starts_with("M98")
+            {
+                let call = haas_file_call(text)
+                    .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+                self.enter(spec, &mut stack, call, number, source)?;
                 continue;
             }
             if self.style == Subprograms::Procs
