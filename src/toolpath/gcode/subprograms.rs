@@ -1,4 +1,4 @@
-//! Subprograms defined in the same file, expanded where they are called.
+//! Subprograms, in the same file or in files of their own, expanded where they are called.
 //!
 //! # What a file holds
 //!
@@ -35,6 +35,56 @@
 //!   second time with no Q parameter changed since the first (and the same calls running)
 //!   would run the same pass for ever: an error naming the jump and its label, at once. A
 //!   `~` at the end of a line continues the block on the next line.
+//!
+//! # Subprograms in other files
+//!
+//! A call of a subprogram the program does not hold reads its file, as the control reads it
+//! from its memory: the main program's directory is searched first, then
+//! [`Settings::subprogram_dirs`](super::Settings) (`--subprogram-dir`) in the order given; the
+//! first directory that holds a file for the name wins, and two files in one directory that
+//! could both hold it are an error naming both. What each call looks for
+//! (`file_holds`):
+//!
+//! * Fanuc/Haas `M98 P1002` (`L3`, the packed `P31002`) and `G65 P1002 …`: a file `O1002`,
+//!   `O1002.nc`, `1002.nc`, `o01002.tap`, … (the letter O or none, leading zeros or none, any
+//!   case, no extension or `.nc .tap .ngc .cnc .txt .eia .prg`). The file's first program is
+//!   the one its `O` header names (a file whose header names another program is an error); a
+//!   file without a header holds the program called. Further `O` programs in the file come
+//!   with it. Haas `M98 "name.nc"` reads the file of that name (any case).
+//! * LinuxCNC `o<name> call`: `name.ngc`, exactly (LinuxCNC lower-cases the name; numbered
+//!   `o100` subroutines are never in files). The file holds `o<name> sub` … `o<name> endsub`
+//!   and nothing else but comments, blank lines, `%` and `M2`/`M30` (an error naming the line
+//!   otherwise, and for a second subroutine).
+//! * Sinumerik `NAME`, `NAME P3`, `L1234`, `CALL "NAME"`, `EXTCALL "NAME"` (a path in the
+//!   string is reduced to its last part, `.SPF`/`.MPF` and `_N_…_SPF` taken off): `NAME.SPF`
+//!   or `NAME.MPF`, any case. A bare name that is neither a PROC of the file nor a file's is
+//!   the error it was.
+//! * Heidenhain `CALL PGM name`, `CALL PGM TNC:\dir\name.h`, `PGM CALL name`, `SEL PGM
+//!   "name"` + `CALL SELECTED PGM`: `name.h`, any case (the path's directories are not
+//!   followed: the file is searched for by name). The called program has its own labels; its
+//!   `END PGM` returns to the caller.
+//!
+//! Each file is read once however often it is called (a name not found is looked for once);
+//! at most [`MAX_SUBPROGRAM_FILES`] files and [`MAX_SUBPROGRAM_BYTES`] together. A call that
+//! finds no file is an error naming the line, the names tried, the directories and
+//! `--subprogram-dir`. Modal state (units, G90/G91, feed, plane, work offset, tool-tip mode)
+//! carries into the called file and back out, as on the controls; variables too, but for the
+//! locals a call gets (LinuxCNC `#1`–`#30`, Fanuc G65's `#1`–`#33`). A subprogram that calls
+//! itself is bounded by [`MAX_CALL_DEPTH`] (the message says that it calls itself).
+//!
+//! **Lines.** A called file's lines are numbered after the main program's, in the order the
+//! files are read: every line the reader records (points, warnings, dwells, changes) is a
+//! number in that one sequence, and [`crate::toolpath::Toolpath::files`] maps it back to its
+//! file and line there. The reader's own errors name the file and line directly.
+//!
+//! # Fanuc G65 macro calls
+//!
+//! `G65 P9010 L2 A1. B2. …` calls O9010 (in the file or a file) `L` times with argument
+//! specification I (A → `#1`, B → `#2`, C → `#3`, I J K → `#4`–`#6`, D E F → `#7`–`#9`, H
+//! `#11`, M `#13`, Q R S T U V W → `#17`–`#23`, X Y Z → `#24`–`#26`): the macro's `#1`–`#33` are
+//! its own, vacant but for the arguments, and the caller's come back on return. Under
+//! increment input an argument without a decimal point (other than 0) is an error: the
+//! control scales it by its address's increment. `G66` and specification II are errors.
 //!
 //! # How a call runs
 //!
@@ -1403,19 +1453,19 @@ impl Program {
                         self.selected.replace(Some(name));
                         continue;
                     }
-                    Some(Ok(ProgramCall::End)) => {
-                        // The end of a program a CALL PGM runs returns to the caller; the main
-                        // program's ends it.
+                    // The end of a program a CALL PGM runs returns to the caller; the main
+                    // program's ends it (read as the table says).
+                    Some(Ok(ProgramCall::End))
                         if stack
                             .last()
-                            .is_some_and(|f| f.section > 0 && f.label.is_none())
-                        {
-                            if !self.ret(&mut stack, &mut interp.vars) {
-                                return Ok(());
-                            }
-                            continue;
+                            .is_some_and(|f| f.section > 0 && f.label.is_none()) =>
+                    {
+                        if !self.ret(&mut stack, &mut interp.vars) {
+                            return Ok(());
                         }
+                        continue;
                     }
+                    Some(Ok(ProgramCall::End)) => {}
                     Some(Ok(ProgramCall::Call(name))) => {
                         let name = match name {
                             Some(name) => name,
