@@ -222,6 +222,9 @@ pub(super) struct Interpreter<'a> {
     /// Where the files of subprograms the program does not hold are looked for (Sinumerik: a
     /// bare name that a file `NAME.SPF` there holds calls it).
     pub(super) subprogram_search: Vec<std::path::PathBuf>,
+    /// Names looked for as files there and not found (each is looked for once: a program
+    /// with an unknown word on every block lists the directories once).
+    not_files: std::collections::HashSet<String>,
     pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
     /// Every warning text said so far, once ([`Interpreter::warn`]).
@@ -337,6 +340,7 @@ impl<'a> Interpreter<'a> {
             call: None,
             procs: Vec::new(),
             subprogram_search: Vec::new(),
+            not_files: Default::default(),
             points: Vec::new(),
             warnings: Vec::new(),
             warning_texts: std::collections::HashSet::new(),
@@ -564,11 +568,7 @@ impl<'a> Interpreter<'a> {
                         && text.starts_with(|c: char| c.is_ascii_alphabetic())
                         && text.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
                         && !self.procs.contains(&text)
-                        && super::subprograms::in_directories(
-                            &self.subprogram_search,
-                            super::dialect::Subprograms::Procs,
-                            &text,
-                        ) =>
+                        && self.subprogram_file(&text) =>
                 {
                     // A subprogram in a file `NAME.SPF`: a call, as for PROC NAME in the file.
                     self.procs.push(text.clone());
@@ -960,6 +960,23 @@ impl<'a> Interpreter<'a> {
                 }
             })
             .collect()
+    }
+
+    /// Whether a file in the subprogram directories holds Sinumerik subprogram `name`
+    /// (looked for once per name).
+    fn subprogram_file(&mut self, name: &str) -> bool {
+        if self.not_files.contains(name) {
+            return false;
+        }
+        let found = super::subprograms::in_directories(
+            &self.subprogram_search,
+            super::dialect::Subprograms::Procs,
+            name,
+        );
+        if !found {
+            self.not_files.insert(name.to_string());
+        }
+        found
     }
 
     /// Whether a number without a decimal point counts least input increments (Fanuc's
