@@ -142,9 +142,10 @@ pub struct CheckArgs {
     #[arg(long)]
     pub wear_compensation: bool,
     /// A directory that holds the program's subprograms' files (repeatable; searched after the
-    /// program's own directory, in the order given): Fanuc `M98 P1002` reads `O1002`,
-    /// `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik `NAME`,
-    /// `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`.
+    /// program's own directory, in the order given): Fanuc `M98 P1002` and `G65 P1002` read
+    /// `O1002`, `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik
+    /// `NAME`, `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`; Heidenhain `CALL PGM
+    /// name` reads `name.h`.
     #[arg(long = "subprogram-dir", value_name = "DIR")]
     pub subprogram_dir: Vec<PathBuf>,
     #[command(flatten)]
@@ -285,9 +286,10 @@ pub struct SolveOptions {
     #[arg(long)]
     pub wear_compensation: bool,
     /// A directory that holds the program's subprograms' files (repeatable; searched after the
-    /// program's own directory, in the order given): Fanuc `M98 P1002` reads `O1002`,
-    /// `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik `NAME`,
-    /// `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`.
+    /// program's own directory, in the order given): Fanuc `M98 P1002` and `G65 P1002` read
+    /// `O1002`, `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik
+    /// `NAME`, `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`; Heidenhain `CALL PGM
+    /// name` reads `name.h`.
     #[arg(long = "subprogram-dir", value_name = "DIR")]
     pub subprogram_dir: Vec<PathBuf>,
     /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
