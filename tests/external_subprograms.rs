@@ -486,6 +486,17 @@ fn fanuc_g65_passes_its_arguments_as_local_variables() {
         e.contains("bad.nc:5:") && e.contains("decimal point"),
         "{e}"
     );
+    // Specification II (I J K repeated) is refused, not read as I overwritten.
+    std::fs::write(
+        dir.join("bad.nc"),
+        FANUC_G65_MAIN.replace("A10. B2.", "A10. B2. I1. I2."),
+    )
+    .unwrap();
+    let e = fails(Dialect::Fanuc, &dir.join("bad.nc"), &[]);
+    assert!(
+        e.contains("bad.nc:5:") && e.contains("specification II"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

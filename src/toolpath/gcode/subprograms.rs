@@ -637,7 +637,7 @@ fn macro_call(
 ) -> std::result::Result<(Call, Vec<(usize, f64)>), String> {
     let mut program = None;
     let mut count = None;
-    let mut arguments = Vec::new();
+    let mut arguments: Vec<(usize, f64)> = Vec::new();
     let whole = |what: &str, v: f64| {
         if v < 0.0 || v.fract() != 0.0 || v > 1e12 {
             Err(format!(
@@ -668,6 +668,14 @@ fn macro_call(
                          J K M Q R S T U V W X Y Z; G66 and specification II are not read)"
                     ));
                 };
+                if arguments.iter().any(|&(seen, _)| seen == k) {
+                    // Specification II repeats I J K (`I1. J2. K3. I4. …` → #4 … #33): read
+                    // as specification I, the second would overwrite the first.
+                    return Err(format!(
+                        "`{text}`: {letter} given twice; argument specification II (I J K \
+                         repeated) is not read: give each argument once (specification I)"
+                    ));
+                }
                 if increments && !num.point && num.value != 0.0 {
                     return Err(format!(
                         "G65 argument `{text}` without a decimal point: the control scales it \
