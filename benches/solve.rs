@@ -66,6 +66,7 @@ fn toolpath() -> Toolpath {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     }
 }
 

@@ -126,6 +126,7 @@ fn main() -> Result<(), feedopt::error::Error> {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

@@ -141,6 +141,13 @@ pub struct CheckArgs {
     /// tool centre's (CAM wear compensation). Without it such a block is an error.
     #[arg(long)]
     pub wear_compensation: bool,
+    /// A directory that holds the program's subprograms' files (repeatable; searched after the
+    /// program's own directory, in the order given): Fanuc `M98 P1002` and `G65 P1002` read
+    /// `O1002`, `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik
+    /// `NAME`, `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`; Heidenhain `CALL PGM
+    /// name` reads `name.h`.
+    #[arg(long = "subprogram-dir", value_name = "DIR")]
+    pub subprogram_dir: Vec<PathBuf>,
     #[command(flatten)]
     /// Stock, tool and process limits beyond the machine file.
     pub material: MaterialArgs,
@@ -278,6 +285,13 @@ pub struct SolveOptions {
     /// model.
     #[arg(long)]
     pub wear_compensation: bool,
+    /// A directory that holds the program's subprograms' files (repeatable; searched after the
+    /// program's own directory, in the order given): Fanuc `M98 P1002` and `G65 P1002` read
+    /// `O1002`, `O1002.nc`, `1002.nc`, …; LinuxCNC `o<name> call` reads `name.ngc`; Sinumerik
+    /// `NAME`, `L1234`, `EXTCALL "NAME"` read `NAME.SPF` or `NAME.MPF`; Heidenhain `CALL PGM
+    /// name` reads `name.h`.
+    #[arg(long = "subprogram-dir", value_name = "DIR")]
+    pub subprogram_dir: Vec<PathBuf>,
     /// How a Fanuc number without a decimal point is read: `increment` (`X100` is 0.1 mm,
     /// parameter 3401#0 DPI = 0) or `calculator` (100 mm, DPI = 1); default: the machine
     /// file's `decimal_point_input`, else increment with a warning.
@@ -475,56 +489,60 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     let mut options = args.options()?;
     let machine = args.machine(&options)?;
     let (input, warnings, detected) = read_input(args)?;
-    let material = apply_material(
-        &args.machine,
-        &args.toolpath,
-        &args.opts.material,
-        &input,
-        &mut options,
-    )?;
-    let solution = solve_with_progress(&machine, &input, &options)?;
-    let dwell = match &input {
-        toolpath::Input::Cl(t) => t.dwell_time(),
-        toolpath::Input::Joint(_) => 0.0,
-    };
-    if let Some(out) = &args.output {
-        writers::write_schedule(out, &solution.schedule, &solution.path.holds)?;
-    }
-    #[cfg(feature = "plot")]
-    if let Some(plot) = &args.plot {
-        writers::plot::write_solution_plot(
-            plot,
-            &args.toolpath.display().to_string(),
-            &machine,
-            &solution,
+    let run = || -> Result<String> {
+        let material = apply_material(
+            &args.machine,
+            &args.toolpath,
+            &args.opts.material,
+            &input,
+            &mut options,
         )?;
-    }
-    let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
-    summary.warnings = warnings;
-    summary.set_reader(&detected, dwell);
-    Ok(if args.json {
-        let mut value = serde_json::to_value(&summary)
-            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
-        if let (Some(m), Some(obj)) = (&material, value.as_object_mut()) {
-            let m = serde_json::to_value(m)
+        let solution = solve_with_progress(&machine, &input, &options)?;
+        let dwell = match &input {
+            toolpath::Input::Cl(t) => t.dwell_time(),
+            toolpath::Input::Joint(_) => 0.0,
+        };
+        if let Some(out) = &args.output {
+            writers::write_schedule(out, &solution.schedule, &solution.path.holds)?;
+        }
+        #[cfg(feature = "plot")]
+        if let Some(plot) = &args.plot {
+            writers::plot::write_solution_plot(
+                plot,
+                &args.toolpath.display().to_string(),
+                &machine,
+                &solution,
+            )?;
+        }
+        let mut summary = Summary::new(&machine, &args.toolpath.display().to_string(), &solution);
+        summary.warnings = warnings;
+        summary.set_reader(&detected, dwell);
+        Ok(if args.json {
+            let mut value = serde_json::to_value(&summary)
                 .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
-            obj.insert("material".into(), m);
-        }
-        let mut s = serde_json::to_string_pretty(&value)
-            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
-        s.push('\n');
-        s
-    } else {
-        let mut s = summary.to_string();
-        if let Some(m) = &material {
-            s.push('\n');
-            s.push_str(&m.to_string());
-            for f in &m.findings {
-                s.push_str(&format!("check         line {}: {f}\n", f.line));
+            if let (Some(m), Some(obj)) = (&material, value.as_object_mut()) {
+                let m = serde_json::to_value(m)
+                    .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+                obj.insert("material".into(), m);
             }
-        }
-        s
-    })
+            name_json_lines(&input, &mut value);
+            let mut s = serde_json::to_string_pretty(&value)
+                .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+            s.push('\n');
+            s
+        } else {
+            let mut s = summary.to_string();
+            if let Some(m) = &material {
+                s.push('\n');
+                s.push_str(&m.to_string());
+                for f in &m.findings {
+                    s.push_str(&format!("check         line {}: {f}\n", f.line));
+                }
+            }
+            name_lines(&input, &s)
+        })
+    };
+    in_files(&input, run())
 }
 
 /// Runs the material stage when the machine file has a stock (and `--no-material` is not
@@ -620,18 +638,19 @@ pub fn check(args: &CheckArgs) -> Result<String> {
             cycle_alias: &[],
             block_delete: args.block_delete,
             wear_compensation: args.wear_compensation,
+            subprogram_dirs: &args.subprogram_dir,
             tool_diameter: args.material.tool_diameter,
             decimal_point_input: args.decimal_point_input,
         },
     )?;
-    let Some(report) = apply_material(
+    let material = apply_material(
         &args.machine,
         &args.toolpath,
         &args.material,
         &input,
         &mut options,
-    )?
-    else {
+    );
+    let Some(report) = in_files(&input, material)? else {
         return Err(Error::Usage(format!(
             "{}: the overload check needs a stock: add the machine file's `stock` section \
              (and `tool`, `process`)",
@@ -639,7 +658,10 @@ pub fn check(args: &CheckArgs) -> Result<String> {
         )));
     };
     if args.json {
-        let mut s = serde_json::to_string_pretty(&report)
+        let mut value = serde_json::to_value(&report)
+            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+        name_json_lines(&input, &mut value);
+        let mut s = serde_json::to_string_pretty(&value)
             .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
         s.push('\n');
         return Ok(s);
@@ -688,15 +710,17 @@ pub fn check(args: &CheckArgs) -> Result<String> {
                 String::new()
             };
             s.push_str(&format!(
-                "{}:{}: {f}{more}\n",
-                args.toolpath.display(),
-                f.line
+                "{}: {f}{more}\n",
+                file_line(&input, &args.toolpath, f.line)
             ));
             continue;
         }
-        s.push_str(&format!("{}:{}: {f}\n", args.toolpath.display(), f.line));
+        s.push_str(&format!(
+            "{}: {f}\n",
+            file_line(&input, &args.toolpath, f.line)
+        ));
     }
-    Ok(s)
+    Ok(name_lines(&input, &s))
 }
 
 /// Reads the toolpath of `args`; its reader's warnings are printed on stderr and returned.
@@ -711,6 +735,7 @@ fn read_input(args: &SolveArgs) -> Result<(toolpath::Input, Vec<String>, toolpat
             cycle_alias: &args.opts.cycle_alias,
             block_delete: args.opts.block_delete,
             wear_compensation: args.opts.wear_compensation,
+            subprogram_dirs: &args.opts.subprogram_dir,
             tool_diameter: args.opts.material.tool_diameter,
             decimal_point_input: args.opts.decimal_point_input,
         },
@@ -725,6 +750,7 @@ struct Reading<'a> {
     cycle_alias: &'a [String],
     block_delete: bool,
     wear_compensation: bool,
+    subprogram_dirs: &'a [PathBuf],
     tool_diameter: Option<f64>,
     decimal_point_input: Option<crate::machine::DecimalPointInput>,
 }
@@ -743,9 +769,18 @@ fn read_input_from(
         cycle_alias,
         block_delete,
         wear_compensation,
+        subprogram_dirs,
         tool_diameter,
         decimal_point_input,
     } = reading;
+    for dir in subprogram_dirs {
+        if !dir.is_dir() {
+            return Err(Error::Usage(format!(
+                "--subprogram-dir {}: not a directory",
+                crate::files::escape_control(&dir.display().to_string())
+            )));
+        }
+    }
     let format = format.map(|f| match f {
         FormatChoice::Apt => toolpath::Format::Apt,
         FormatChoice::Gcode => toolpath::Format::Gcode,
@@ -785,6 +820,7 @@ fn read_input_from(
         }),
         fallback_dialect,
         decimal_point_input,
+        subprogram_dirs: subprogram_dirs.to_vec(),
     };
     let (input, detected) = toolpath::read_with(toolpath_file, &options)?;
     // What the reader skipped or doubted: one line each on stderr, and in the summary; a
@@ -794,10 +830,9 @@ fn read_input_from(
             .iter()
             .map(|g| {
                 let text = format!(
-                    "{}:{}: {}",
-                    toolpath_file.display(),
-                    g.first.line,
-                    g.message()
+                    "{}: {}",
+                    t.file_line(g.first.line),
+                    t.name_lines(&g.message())
                 );
                 crate::files::escape_control(&text)
             })
@@ -825,41 +860,44 @@ pub fn compare(args: &CompareArgs) -> Result<String> {
     options.validate()?;
     let machine = a.machine(&options.solve)?;
     let (input, _, _) = read_input(a)?;
-    apply_material(
-        &a.machine,
-        &a.toolpath,
-        &a.opts.material,
-        &input,
-        &mut options.solve,
-    )?;
-    let name = a.toolpath.display().to_string();
-    let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
-    #[cfg(feature = "plot")]
-    if let Some(plot) = &a.plot {
-        let curves: Vec<writers::plot::ProfileCurve> = cmp
-            .schedules
-            .iter()
-            .map(|r| writers::plot::ProfileCurve {
-                label: format!(
-                    "{}: {:.4} s{}",
-                    r.label,
-                    r.cycle_time_s,
-                    if r.verified { "" } else { " (exceeds limits)" }
-                ),
-                schedule: &r.schedule,
-            })
-            .collect();
-        let title = format!("{name} on {}: feed profiles", machine.name);
-        writers::plot::write_profiles_plot(plot, &title, cmp.joint_space, &curves)?;
-    }
-    Ok(if a.json {
-        let mut s = serde_json::to_string_pretty(&cmp)
-            .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
-        s.push('\n');
-        s
-    } else {
-        cmp.to_string()
-    })
+    let mut run = || -> Result<String> {
+        apply_material(
+            &a.machine,
+            &a.toolpath,
+            &a.opts.material,
+            &input,
+            &mut options.solve,
+        )?;
+        let name = a.toolpath.display().to_string();
+        let cmp = crate::compare::compare(&machine, &input, &name, &options)?;
+        #[cfg(feature = "plot")]
+        if let Some(plot) = &a.plot {
+            let curves: Vec<writers::plot::ProfileCurve> = cmp
+                .schedules
+                .iter()
+                .map(|r| writers::plot::ProfileCurve {
+                    label: format!(
+                        "{}: {:.4} s{}",
+                        r.label,
+                        r.cycle_time_s,
+                        if r.verified { "" } else { " (exceeds limits)" }
+                    ),
+                    schedule: &r.schedule,
+                })
+                .collect();
+            let title = format!("{name} on {}: feed profiles", machine.name);
+            writers::plot::write_profiles_plot(plot, &title, cmp.joint_space, &curves)?;
+        }
+        Ok(if a.json {
+            let mut s = serde_json::to_string_pretty(&cmp)
+                .map_err(|e| Error::Solver(format!("JSON encoding: {e}")))?;
+            s.push('\n');
+            s
+        } else {
+            cmp.to_string()
+        })
+    };
+    in_files(&input, run())
 }
 
 /// `feedopt sweep`: returns what to print on stdout.
@@ -876,26 +914,30 @@ pub fn sweep(args: &SweepArgs) -> Result<String> {
     o.validate()?;
     let machine = solve.machine(&o.solve)?;
     let (input, _, _) = read_input(solve)?;
-    apply_material(
-        &solve.machine,
-        &solve.toolpath,
-        &solve.opts.material,
-        &input,
-        &mut o.solve,
-    )?;
-    let result = crate::sweep::sweep(&machine, &input, &solve.toolpath.display().to_string(), &o)?;
-    if let Some(out) = &solve.output {
-        result.write(out)?;
-    }
-    #[cfg(feature = "plot")]
-    if let Some(plot) = &args.solve.plot {
-        result.write_plot(plot)?;
-    }
-    if solve.json {
-        result.to_json()
-    } else {
-        Ok(result.to_string())
-    }
+    let mut run = || -> Result<String> {
+        apply_material(
+            &solve.machine,
+            &solve.toolpath,
+            &solve.opts.material,
+            &input,
+            &mut o.solve,
+        )?;
+        let result =
+            crate::sweep::sweep(&machine, &input, &solve.toolpath.display().to_string(), &o)?;
+        if let Some(out) = &solve.output {
+            result.write(out)?;
+        }
+        #[cfg(feature = "plot")]
+        if let Some(plot) = &args.solve.plot {
+            result.write_plot(plot)?;
+        }
+        if solve.json {
+            result.to_json()
+        } else {
+            Ok(result.to_string())
+        }
+    };
+    in_files(&input, run())
 }
 
 /// Runs a parsed command line; returns what to print on stdout. An option the library refuses
@@ -964,15 +1006,52 @@ fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize
     let mut options = args.options()?;
     let machine = args.machine(&options)?;
     let (input, _, _) = read_input(args)?;
-    apply_material(
-        &args.machine,
-        &args.toolpath,
-        &args.opts.material,
-        &input,
-        &mut options,
-    )?;
-    let solution = solve_with_progress(&machine, &input, &options)?;
+    let mut run = || -> Result<optimize::Solution> {
+        apply_material(
+            &args.machine,
+            &args.toolpath,
+            &args.opts.material,
+            &input,
+            &mut options,
+        )?;
+        solve_with_progress(&machine, &input, &options)
+    };
+    let solution = in_files(&input, run())?;
     Ok((machine, input, options, solution))
+}
+
+/// An error of the stages after the reader with the toolpath's lines named in their files
+/// ([`toolpath::Toolpath::in_files`]: a line of a subprogram's file a call read).
+fn in_files<T>(input: &toolpath::Input, result: Result<T>) -> Result<T> {
+    result.map_err(|e| match input {
+        toolpath::Input::Cl(t) => t.in_files(e),
+        toolpath::Input::Joint(_) => e,
+    })
+}
+
+/// Text about the toolpath with its lines named in their files
+/// ([`toolpath::Toolpath::name_lines`]).
+fn name_lines(input: &toolpath::Input, text: &str) -> String {
+    match input {
+        toolpath::Input::Cl(t) => t.name_lines(text),
+        toolpath::Input::Joint(_) => text.to_string(),
+    }
+}
+
+/// A JSON report with the toolpath's lines named in their files
+/// ([`toolpath::Toolpath::name_json_lines`]).
+fn name_json_lines(input: &toolpath::Input, value: &mut serde_json::Value) {
+    if let toolpath::Input::Cl(t) = input {
+        t.name_json_lines(value);
+    }
+}
+
+/// `file:line` of toolpath line `line` (the toolpath's file otherwise).
+fn file_line(input: &toolpath::Input, file: &std::path::Path, line: usize) -> String {
+    match input {
+        toolpath::Input::Cl(t) => t.file_line(line),
+        toolpath::Input::Joint(_) => format!("{}:{line}", file.display()),
+    }
 }
 
 #[derive(Debug, Args)]
@@ -1029,13 +1108,16 @@ pub fn gcode(args: &GcodeArgs) -> Result<String> {
             args.plan.toolpath.display()
         )));
     };
-    let prog = writers::gcode::write_gcode(
-        &args.output,
-        &machine,
-        path,
-        &solution,
-        &options.geometry,
-        &gcode_options,
+    let prog = in_files(
+        &input,
+        writers::gcode::write_gcode(
+            &args.output,
+            &machine,
+            path,
+            &solution,
+            &options.geometry,
+            &gcode_options,
+        ),
     )?;
     let time = match args.block_feed {
         writers::gcode::BlockFeed::Average => format!(

@@ -45,6 +45,7 @@ fn groove() -> Toolpath {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     }
 }
 

@@ -249,6 +249,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     };
     (m, t)
 }

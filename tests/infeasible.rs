@@ -60,6 +60,7 @@ fn line() -> Toolpath {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     }
 }
 
@@ -278,6 +279,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

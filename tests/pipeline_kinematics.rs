@@ -33,6 +33,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     }
 }
 

@@ -226,6 +226,7 @@ fn random_cl(seed: u64) -> Case {
             machine_points: Vec::new(),
             length_offsets: None,
             taps: Vec::new(),
+            files: Vec::new(),
         },
     }
 }
@@ -603,6 +604,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
             machine_points: Vec::new(),
             length_offsets: None,
             taps: Vec::new(),
+            files: Vec::new(),
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

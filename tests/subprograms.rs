@@ -203,7 +203,7 @@ fn a_call_of_a_subprogram_not_in_the_file_is_an_error_naming_line_call_and_fix()
         e.contains("t.nc:3:")
             && e.contains("M98 P3000")
             && e.contains("O3000")
-            && e.contains("not in this file")
+            && e.contains("neither in this file")
             && e.contains("O3000 … M99"),
         "{e}"
     );

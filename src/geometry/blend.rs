@@ -116,6 +116,7 @@ pub fn blend_corners(
         source: toolpath.source.clone(),
         points: out,
         warnings: toolpath.warnings.clone(),
+        files: toolpath.files.clone(),
         dwells: (toolpath.dwells.iter())
             .map(|d| Dwell {
                 point: moved(d.point),

@@ -261,6 +261,7 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         machine_points: Vec::new(),
         length_offsets: None,
         taps: reader.taps,
+        files: Vec::new(),
     })
 }
 

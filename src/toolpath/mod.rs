@@ -166,6 +166,23 @@ pub struct Toolpath {
     /// the spindle with the feed and reverses it at the bottom: `feedopt gcode`, which writes
     /// plain feed moves, refuses such a program.
     pub taps: Vec<TapCycle>,
+    /// The files the program's subprogram calls read, in the order read (empty: every line is
+    /// the main program's). Every `line` of the toolpath (points, warnings, dwells, changes)
+    /// counts in one sequence: the main program's lines 1 to n, then each of these files'
+    /// lines after the lines of the files before it; [`Toolpath::place`] maps one back to
+    /// its file and line there, [`Toolpath::line_name`] and [`Toolpath::file_line`] say it.
+    pub files: Vec<SourceFile>,
+}
+
+/// A file a program's subprogram call read ([`Toolpath::files`]): its line n is line
+/// `offset + n` of the toolpath.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourceFile {
+    pub path: PathBuf,
+    /// The lines (of the main program and the files read before it) numbered before its own.
+    pub offset: usize,
+    /// Its line count.
+    pub lines: usize,
 }
 
 impl Toolpath {
@@ -184,7 +201,141 @@ impl Toolpath {
             machine_points: Vec::new(),
             length_offsets: None,
             taps: Vec::new(),
+            files: Vec::new(),
         }
+    }
+
+    /// The file and its line of toolpath line `line` ([`Toolpath::files`]): the main
+    /// program's (`source`) unless a subprogram's file holds it.
+    pub fn place(&self, line: usize) -> (&Path, usize) {
+        match self.files.iter().rev().find(|f| line > f.offset) {
+            Some(f) => (&f.path, line - f.offset),
+            None => (&self.source, line),
+        }
+    }
+
+    /// `line 12`, or `line 12 of subs/O1002.nc` where a subprogram's file holds it.
+    pub fn line_name(&self, line: usize) -> String {
+        match self.place(line) {
+            (_, local) if local == line => format!("line {line}"),
+            (path, local) => format!("line {local} of {}", path.display()),
+        }
+    }
+
+    /// `file:line` of toolpath line `line`, as a message about it starts
+    /// (`prog.nc:12`, `subs/O1002.nc:3`).
+    pub fn file_line(&self, line: usize) -> String {
+        let (path, local) = self.place(line);
+        format!("{}:{local}", path.display())
+    }
+
+    /// The line count of the main program where calls read other files (their lines come
+    /// after it), else `None`: every line is the main program's.
+    fn main_lines(&self) -> Option<usize> {
+        self.files.first().map(|f| f.offset)
+    }
+
+    /// `text` with each `line N` whose N is a line of a file a call read ([`Toolpath::files`])
+    /// as `line n of FILE` (one already so named is left as it is) (for messages of the stages after the reader, which number lines
+    /// in the toolpath's sequence: `nearest CL line 1234`, `the last at line 1240`).
+    pub fn name_lines(&self, text: &str) -> String {
+        let Some(main) = self.main_lines() else {
+            return text.to_string();
+        };
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(at) = rest.find("line ") {
+            let before = &rest[..at];
+            let after = &rest[at + 5..];
+            let digits = after.len() - after.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+            out.push_str(before);
+            let word_start = !before.ends_with(|c: char| c.is_alphanumeric() || c == '_');
+            // `line 3 of subs/O1002.nc` is named already.
+            let named = after[digits..].starts_with(" of ");
+            match after[..digits].parse::<usize>() {
+                Ok(n) if word_start && !named && n > main => {
+                    out.push_str(&self.line_name(n));
+                }
+                _ => {
+                    out.push_str("line ");
+                    out.push_str(&after[..digits]);
+                }
+            }
+            rest = &after[digits..];
+        }
+        out.push_str(rest);
+        out
+    }
+
+    /// An error of a stage after the reader about this toolpath, its lines named in their
+    /// files: a parse error at a line of a file a call read names that file and line, and
+    /// every `line N` in a message is named so ([`Toolpath::name_lines`]).
+    pub fn in_files(&self, e: Error) -> Error {
+        if self.files.is_empty() {
+            return e;
+        }
+        match e {
+            Error::Parse {
+                file,
+                line,
+                message,
+            } if file == self.source => {
+                let (path, local) = self.place(line);
+                Error::Parse {
+                    file: path.to_path_buf(),
+                    line: local,
+                    message: self.name_lines(&message),
+                }
+            }
+            Error::Infeasible(m) => Error::Infeasible(self.name_lines(&m)),
+            Error::Solver(m) => Error::Solver(self.name_lines(&m)),
+            Error::Usage(m) => Error::Usage(self.name_lines(&m)),
+            e => e,
+        }
+    }
+
+    /// A JSON value (a report about this toolpath) with each line of a file a call read
+    /// named in its file: an object's `line` (and `first_move_line`, `last_line`) past the
+    /// main program's lines becomes the line in that file, and a key beside it (`file`,
+    /// `first_move_file`, `last_file`) names the file. Objects about the main program's lines
+    /// are left as they are.
+    pub fn name_json_lines(&self, value: &mut serde_json::Value) {
+        let Some(main) = self.main_lines() else {
+            return;
+        };
+        match value {
+            serde_json::Value::Array(items) => {
+                items.iter_mut().for_each(|v| self.name_json_lines(v));
+            }
+            serde_json::Value::Object(map) => {
+                for (key, file_key) in [
+                    ("line", "file"),
+                    ("first_move_line", "first_move_file"),
+                    ("last_line", "last_file"),
+                ] {
+                    let Some(n) = map.get(key).and_then(|v| v.as_u64()) else {
+                        continue;
+                    };
+                    let n = n as usize;
+                    if n > main {
+                        let (path, local) = self.place(n);
+                        let path = path.display().to_string();
+                        map.insert(key.into(), local.into());
+                        map.insert(file_key.into(), path.into());
+                    }
+                }
+                for (_, v) in map.iter_mut() {
+                    self.name_json_lines(v);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// A parse error at toolpath line `line`, naming its file and its line there.
+    pub fn error_at(&self, line: usize, message: impl Into<String>) -> Error {
+        let (path, local) = self.place(line);
+        Error::parse(path, local, message)
     }
 
     /// Total dwell time, seconds.
@@ -442,6 +593,18 @@ impl WarningGroup {
             ),
         }
     }
+
+    /// [`Self::message`], the last line named in `toolpath`'s files ([`Toolpath::line_name`]).
+    pub fn message_in(&self, toolpath: &Toolpath) -> String {
+        match self.more {
+            0 => self.first.message.to_string(),
+            n => format!(
+                "{} (and {n} more like it, the last at {})",
+                self.first.message,
+                toolpath.line_name(self.last_line)
+            ),
+        }
+    }
 }
 
 /// What a reader needs to know about the machine the program runs on: which axes it has (an
@@ -591,6 +754,8 @@ pub struct ReadOptions {
     /// The dialect of a G-code input whose content and extension name none (`None`: the
     /// default, LinuxCNC); [`Self::dialect`] overrides detection altogether.
     pub fallback_dialect: Option<gcode::Dialect>,
+    /// Where subprogram calls look for files ([`gcode::Settings::subprogram_dirs`]).
+    pub subprogram_dirs: Vec<PathBuf>,
 }
 
 /// What a reader was used, and why.
@@ -758,6 +923,7 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
                 block_delete: options.block_delete,
                 tool_diameter: options.tool_diameter,
                 decimal_point_input: options.decimal_point_input,
+                subprogram_dirs: options.subprogram_dirs.clone(),
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

@@ -37,6 +37,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
         machine_points: Vec::new(),
         length_offsets: None,
         taps: Vec::new(),
+        files: Vec::new(),
     }
 }
 

@@ -906,8 +906,12 @@ pub static FANUC: DialectSpec = DialectSpec {
         ("54.1", Action::WorkOffset),
         ("60", Note(G60)),
         ("61..64", Action::Ignored),
-        ("65", Unsup("macro calls (G65/G66) are not supported")),
-        ("66", Unsup("macro calls (G65/G66) are not supported")),
+        // A G65 block is read as a macro call before the table (subprograms.rs).
+        ("65", Unsup("macro calls (G65) are not supported here")),
+        (
+            "66",
+            Unsup("modal macro calls (G66) are not supported: call the macro with G65"),
+        ),
         ("67", Action::Ignored),
         ("68", Unsup(TRANSFORM)),
         ("68.2", Action::TiltedPlane),

@@ -219,6 +219,12 @@ pub(super) struct Interpreter<'a> {
     /// Names of the file's named subprograms (Sinumerik `PROC NAME`): a bare word with one of
     /// these names is a call.
     pub(super) procs: Vec<String>,
+    /// Where the files of subprograms the program does not hold are looked for (Sinumerik: a
+    /// bare name that a file `NAME.SPF` there holds calls it).
+    pub(super) subprogram_search: Vec<std::path::PathBuf>,
+    /// Names looked for as files there and not found (each is looked for once: a program
+    /// with an unknown word on every block lists the directories once).
+    not_files: std::collections::HashSet<String>,
     pub(super) points: Vec<ClPoint>,
     warnings: Vec<Warning>,
     /// Every warning text said so far, once ([`Interpreter::warn`]).
@@ -333,6 +339,8 @@ impl<'a> Interpreter<'a> {
             end_of_program: false,
             call: None,
             procs: Vec::new(),
+            subprogram_search: Vec::new(),
+            not_files: Default::default(),
             points: Vec::new(),
             warnings: Vec::new(),
             warning_texts: std::collections::HashSet::new(),
@@ -529,6 +537,7 @@ impl<'a> Interpreter<'a> {
             length_offsets: (self.spec.length_offsets != LengthOffsets::Absent)
                 .then_some(self.length_offsets),
             taps: self.taps,
+            files: Vec::new(),
         })
     }
 
@@ -550,6 +559,24 @@ impl<'a> Interpreter<'a> {
                         return Err(
                             self.error(line, "`T=`: the same word appears twice in the block")
                         );
+                    }
+                    continue;
+                }
+                Item::Unknown { text, call: false }
+                    if self.spec.subprograms == super::dialect::Subprograms::Procs
+                        && text.len() > 1
+                        && text.starts_with(|c: char| c.is_ascii_alphabetic())
+                        && text.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+                        && !self.procs.contains(&text)
+                        && self.subprogram_file(&text) =>
+                {
+                    // A subprogram in a file `NAME.SPF`: a call, as for PROC NAME in the file.
+                    self.procs.push(text.clone());
+                    if let Some(first) = call_word.replace(text.clone()) {
+                        return Err(self.error(
+                            line,
+                            format!("`{first}`, `{text}`: two subprogram calls in one block"),
+                        ));
                     }
                     continue;
                 }
@@ -589,8 +616,9 @@ impl<'a> Interpreter<'a> {
                         format!(
                             "`{text}`: not a {name} command feedopt knows{like}; a bare name \
                              switches a function or calls a subprogram, which may change the \
-                             motion, so it is not skipped: correct it, remove it, or define \
-                             PROC {text} … RET in this file"
+                             motion, so it is not skipped: correct it, remove it, define \
+                             PROC {text} … RET in this file, or give the directory of its \
+                             file {text}.SPF with --subprogram-dir"
                         ),
                     ));
                 }
@@ -932,6 +960,29 @@ impl<'a> Interpreter<'a> {
                 }
             })
             .collect()
+    }
+
+    /// Whether a file in the subprogram directories holds Sinumerik subprogram `name`
+    /// (looked for once per name).
+    fn subprogram_file(&mut self, name: &str) -> bool {
+        if self.not_files.contains(name) {
+            return false;
+        }
+        let found = super::subprograms::in_directories(
+            &self.subprogram_search,
+            super::dialect::Subprograms::Procs,
+            name,
+        );
+        if !found {
+            self.not_files.insert(name.to_string());
+        }
+        found
+    }
+
+    /// Whether a number without a decimal point counts least input increments (Fanuc's
+    /// default, DPI = 0).
+    pub(super) fn integer_increments(&self) -> bool {
+        self.increments.is_some()
     }
 
     /// Interprets one block.

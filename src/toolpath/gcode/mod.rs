@@ -372,6 +372,11 @@ pub struct Settings {
     /// increments (Fanuc's default), with one warning at the first such word whose value is
     /// not 0. The other dialects have no such setting and ignore it.
     pub decimal_point_input: Option<crate::machine::DecimalPointInput>,
+    /// Where a call of a subprogram the program does not hold (Fanuc `M98 P1002`, LinuxCNC
+    /// `o<name> call`, Sinumerik `NAME`, `L1234`, `EXTCALL "NAME"`) looks for its file, after
+    /// the main program's own directory, in order (the CLI's `--subprogram-dir`). See
+    /// [`subprograms`] for the file names each dialect's calls look for.
+    pub subprogram_dirs: Vec<std::path::PathBuf>,
 }
 
 /// As [`parse_assumed`], under the operator's `settings`.
@@ -384,9 +389,11 @@ pub fn parse_configured(
 ) -> Result<(Toolpath, Assumed)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let text = program_header(spec, source, text)?;
-    let program = Program::scan(spec, source, &text)?;
+    let mut program = Program::scan(spec, source, &text)?;
+    program.search_in(source, &settings.subprogram_dirs);
     let mut interp = Interpreter::new(spec, source, machine);
     interp.procs = program.proc_names();
+    interp.subprogram_search = program.search();
     interp.cycle_aliases = settings.cycle_aliases.clone();
     interp.block_delete = settings.block_delete;
     interp.tool_diameter = settings.tool_diameter;
@@ -395,9 +402,11 @@ pub fn parse_configured(
     interp.note_units();
     interp.note_assumed_parameters();
     let assumed = interp.assumed;
-    interp
+    let mut toolpath = interp
         .finish(program.last_line())
-        .map(|toolpath| (toolpath, assumed))
+        .map_err(|e| program.localize(e, source))?;
+    toolpath.files = program.included();
+    Ok((toolpath, assumed))
 }
 
 /// The first line of a program that holds code: not blank, not a `%` line, not a `( … )`

@@ -1,4 +1,4 @@
-//! Subprograms defined in the same file, expanded where they are called.
+//! Subprograms, in the same file or in files of their own, expanded where they are called.
 //!
 //! # What a file holds
 //!
@@ -36,6 +36,56 @@
 //!   would run the same pass for ever: an error naming the jump and its label, at once. A
 //!   `~` at the end of a line continues the block on the next line.
 //!
+//! # Subprograms in other files
+//!
+//! A call of a subprogram the program does not hold reads its file, as the control reads it
+//! from its memory: the main program's directory is searched first, then
+//! [`Settings::subprogram_dirs`](super::Settings) (`--subprogram-dir`) in the order given; the
+//! first directory that holds a file for the name wins, and two files in one directory that
+//! could both hold it are an error naming both. What each call looks for
+//! (`file_holds`):
+//!
+//! * Fanuc/Haas `M98 P1002` (`L3`, the packed `P31002`) and `G65 P1002 …`: a file `O1002`,
+//!   `O1002.nc`, `1002.nc`, `o01002.tap`, … (the letter O or none, leading zeros or none, any
+//!   case, no extension or `.nc .tap .ngc .cnc .txt .eia .prg`). The file's first program is
+//!   the one its `O` header names (a file whose header names another program is an error); a
+//!   file without a header holds the program called. Further `O` programs in the file come
+//!   with it. Haas `M98 "name.nc"` reads the file of that name (any case).
+//! * LinuxCNC `o<name> call`: `name.ngc`, exactly (LinuxCNC lower-cases the name; numbered
+//!   `o100` subroutines are never in files). The file holds `o<name> sub` … `o<name> endsub`
+//!   and nothing else but comments, blank lines, `%` and `M2`/`M30` (an error naming the line
+//!   otherwise, and for a second subroutine).
+//! * Sinumerik `NAME`, `NAME P3`, `L1234`, `CALL "NAME"`, `EXTCALL "NAME"` (a path in the
+//!   string is reduced to its last part, `.SPF`/`.MPF` and `_N_…_SPF` taken off): `NAME.SPF`
+//!   or `NAME.MPF`, any case. A bare name that is neither a PROC of the file nor a file's is
+//!   the error it was.
+//! * Heidenhain `CALL PGM name`, `CALL PGM TNC:\dir\name.h`, `PGM CALL name`, `SEL PGM
+//!   "name"` + `CALL SELECTED PGM`: `name.h`, any case (the path's directories are not
+//!   followed: the file is searched for by name). The called program has its own labels; its
+//!   `END PGM` returns to the caller.
+//!
+//! Each file is read once however often it is called (a name not found is looked for once);
+//! at most [`MAX_SUBPROGRAM_FILES`] files and [`MAX_SUBPROGRAM_BYTES`] together. A call that
+//! finds no file is an error naming the line, the names tried, the directories and
+//! `--subprogram-dir`. Modal state (units, G90/G91, feed, plane, work offset, tool-tip mode)
+//! carries into the called file and back out, as on the controls; variables too, but for the
+//! locals a call gets (LinuxCNC `#1`–`#30`, Fanuc G65's `#1`–`#33`). A subprogram that calls
+//! itself is bounded by [`MAX_CALL_DEPTH`] (the message says that it calls itself).
+//!
+//! **Lines.** A called file's lines are numbered after the main program's, in the order the
+//! files are read: every line the reader records (points, warnings, dwells, changes) is a
+//! number in that one sequence, and [`crate::toolpath::Toolpath::files`] maps it back to its
+//! file and line there. The reader's own errors name the file and line directly.
+//!
+//! # Fanuc G65 macro calls
+//!
+//! `G65 P9010 L2 A1. B2. …` calls O9010 (in the file or a file) `L` times with argument
+//! specification I (A → `#1`, B → `#2`, C → `#3`, I J K → `#4`–`#6`, D E F → `#7`–`#9`, H
+//! `#11`, M `#13`, Q R S T U V W → `#17`–`#23`, X Y Z → `#24`–`#26`): the macro's `#1`–`#33` are
+//! its own, vacant but for the arguments, and the caller's come back on return. Under
+//! increment input an argument without a decimal point (other than 0) is an error: the
+//! control scales it by its address's increment. `G66` and specification II are errors.
+//!
 //! # How a call runs
 //!
 //! The block's own words run first (a move in the same block is made), then the body's blocks
@@ -54,13 +104,13 @@
 //! program ends it.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::dialect::{DialectSpec, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
-use super::lexer::{lex, split_blocks};
+use super::lexer::{Item, lex, split_blocks};
 use super::macro_b::{self, Statement};
 use crate::error::{Error, Result};
 
@@ -82,11 +132,23 @@ pub const MAX_EXPANDED_BLOCKS: usize = 1_000_000;
 /// reads, not only by how many blocks (about 60 ns a character: a second or two).
 pub const MAX_EXPANDED_BYTES: usize = 32 << 20;
 
-/// One line of the file: its 1-based number and its blocks with comments removed (or the
+/// One line of a file: its 1-based number in its file, the file (an index into
+/// [`Program::files`]: 0 is the main program's) and its blocks with comments removed (or the
 /// message of an unclosed comment, reported if the line is ever run).
 struct Line {
     number: usize,
+    file: usize,
     blocks: std::result::Result<Vec<String>, String>,
+}
+
+/// A file read into the program: the main program's (the first) or one a call read.
+struct Unit {
+    path: PathBuf,
+    /// The lines of the files before it: its line n is line `offset + n` of the sequence the
+    /// toolpath's lines are numbered in ([`crate::toolpath::SourceFile`]).
+    offset: usize,
+    /// Its line count.
+    lines: usize,
 }
 
 /// A program or subprogram: its name and header line, and the indices of its lines.
@@ -379,6 +441,274 @@ fn sinumerik_header(block: &str) -> Option<(String, bool)> {
     (!name.is_empty()).then_some((name, false))
 }
 
+/// A Sinumerik `EXTCALL "NAME"` or `CALL "NAME"` block as a call of NAME: the name is the
+/// string's last path component (`"/_N_WKS_DIR/_N_PART_WPD/NAME"`, `"D:\\NC\\NAME.SPF"`)
+/// without an extension `.SPF`/`.MPF` or the control's `_N_…_SPF` form, upper-cased. Nothing
+/// else may stand in the block.
+fn sinumerik_call(block: &str) -> std::result::Result<Call, String> {
+    let body = strip_block_number(block);
+    let keyword = first_word(body);
+    let rest = body[keyword.len()..].trim();
+    let fail = || {
+        format!(
+            "`{}`: expected {keyword} \"NAME\" alone in its block (the program's name in \
+             double quotes)",
+            block.trim()
+        )
+    };
+    let inner = rest
+        .strip_prefix('"')
+        .and_then(|r| r.strip_suffix('"'))
+        .filter(|r| !r.contains('"'))
+        .ok_or_else(fail)?;
+    let last = inner
+        .rsplit(['/', '\\'])
+        .next()
+        .unwrap_or(inner)
+        .to_ascii_uppercase();
+    let mut name = last.as_str();
+    for ext in [".SPF", ".MPF", "_SPF", "_MPF"] {
+        name = name.strip_suffix(ext).unwrap_or(name);
+    }
+    let name = name.strip_prefix("_N_").unwrap_or(name);
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(fail());
+    }
+    Ok(Call {
+        text: format!("{keyword} \"{inner}\""),
+        targets: vec![(name.to_string(), 1)],
+    })
+}
+
+/// A Haas `M98 "name.nc"` or `M98 "name.nc" L3` block: a call of the program in file
+/// `name.nc` (its name in the call is the quoted text, quotes included). Nothing else may
+/// stand in the block.
+fn haas_file_call(block: &str) -> std::result::Result<Call, String> {
+    let body = strip_block_number(block);
+    let fail = || {
+        format!(
+            "`{}`: expected M98 \"file name\" and at most a repeat count L, alone in its block",
+            block.trim()
+        )
+    };
+    let rest = body[3..].trim_start();
+    let inner_end = rest
+        .strip_prefix('"')
+        .and_then(|r| r.find('"'))
+        .ok_or_else(fail)?;
+    let file = &rest[1..=inner_end];
+    let tail: String = rest[inner_end + 2..]
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect();
+    let runs = match tail.strip_prefix(['L', 'l']) {
+        None if tail.is_empty() => 1,
+        Some(n) => n.parse::<u64>().map_err(|_| fail())?,
+        None => return Err(fail()),
+    };
+    if file.is_empty() || file.contains(['/', '\\']) {
+        return Err(fail());
+    }
+    let mut text = format!("M98 \"{file}\"");
+    if !tail.is_empty() {
+        text.push_str(&format!(" L{runs}"));
+    }
+    Ok(Call {
+        text,
+        targets: vec![(format!("\"{file}\""), runs)],
+    })
+}
+
+/// A Heidenhain block about another program.
+enum ProgramCall {
+    /// `CALL PGM name`, `PGM CALL name` (`Some`), `CALL SELECTED PGM` (`None`).
+    Call(Option<String>),
+    /// `SEL PGM "name"`.
+    Select(String),
+    /// `END PGM …`.
+    End,
+}
+
+/// A Heidenhain `CALL PGM name` / `CALL PGM TNC:\dir\name.h` / `PGM CALL name`, `SEL PGM
+/// "name"`, `CALL SELECTED PGM` or `END PGM` block (`None`: none of them). The program's
+/// name is the path's last component without `.h`, upper-cased (the TNC's file names do not
+/// depend on case).
+fn program_call(body: &str) -> Option<std::result::Result<ProgramCall, String>> {
+    let t = body.trim().trim_end_matches('~').trim();
+    let upper = t.to_ascii_uppercase();
+    if upper.starts_with("END PGM") {
+        return Some(Ok(ProgramCall::End));
+    }
+    if upper.starts_with("CALL SELECTED PGM") {
+        return Some(Ok(ProgramCall::Call(None)));
+    }
+    let (rest, select) = if let Some(r) = upper
+        .strip_prefix("CALL PGM ")
+        .or_else(|| upper.strip_prefix("PGM CALL "))
+    {
+        (&t[t.len() - r.len()..], false)
+    } else if let Some(r) = upper.strip_prefix("SEL PGM ") {
+        (&t[t.len() - r.len()..], true)
+    } else {
+        return None;
+    };
+    let written = rest.split_whitespace().next().unwrap_or("");
+    let path = written.trim_matches(['"', '\'']);
+    let last = path.rsplit(['\\', '/', ':']).next().unwrap_or(path);
+    let stem = match last.rsplit_once('.') {
+        Some((stem, ext)) if ext.eq_ignore_ascii_case("h") => stem,
+        _ => last,
+    };
+    if stem.is_empty() || stem.contains(char::is_whitespace) {
+        return Some(Err(format!(
+            "`{t}`: expected the program's name after PGM (`CALL PGM name`, `CALL PGM \
+             TNC:\\dir\\name.h`)"
+        )));
+    }
+    let name = stem.to_ascii_uppercase();
+    Some(Ok(if select {
+        ProgramCall::Select(name)
+    } else {
+        ProgramCall::Call(Some(name))
+    }))
+}
+
+/// Whether a file in `dirs` holds subprogram `name` as `style` names files ([`file_holds`]).
+pub(super) fn in_directories(dirs: &[PathBuf], style: Subprograms, name: &str) -> bool {
+    dirs.iter().any(|dir| {
+        std::fs::read_dir(dir).is_ok_and(|entries| {
+            entries.flatten().any(|e| {
+                e.file_name()
+                    .to_str()
+                    .is_some_and(|f| file_holds(style, name, f))
+                    && e.path().is_file()
+            })
+        })
+    })
+}
+
+/// Fanuc's local variables `#1`–`#33`: a `G65` macro call gets its own (vacant but for its
+/// arguments), and the caller's come back on return.
+pub const MACRO_LOCALS: usize = 33;
+
+/// Fanuc argument specification I: the letter of a `G65` argument and the local variable it
+/// sets.
+const MACRO_ARGUMENTS: [(char, usize); 21] = [
+    ('A', 1),
+    ('B', 2),
+    ('C', 3),
+    ('I', 4),
+    ('J', 5),
+    ('K', 6),
+    ('D', 7),
+    ('E', 8),
+    ('F', 9),
+    ('H', 11),
+    ('M', 13),
+    ('Q', 17),
+    ('R', 18),
+    ('S', 19),
+    ('T', 20),
+    ('U', 21),
+    ('V', 22),
+    ('W', 23),
+    ('X', 24),
+    ('Y', 25),
+    ('Z', 26),
+];
+
+/// Whether a Fanuc block is a `G65` macro call.
+fn is_macro_call(items: &[Item]) -> bool {
+    items.iter().any(|i| {
+        matches!(i, Item::Word { text, num, .. }
+            if text.starts_with(['G', 'g']) && num.value == 65.0)
+    })
+}
+
+/// A Fanuc `G65 P9010 L2 A1. B2.` block: the call (program `O<P>`, `L` times) and its
+/// arguments as (local variable, value) by argument specification I. A letter that is no
+/// argument, a word that is no letter, and (where numbers without a decimal point count
+/// increments, `increments`) an argument without a decimal point other than 0 are errors: the
+/// control scales such an argument by its address's increment, which differs between letters
+/// and controls.
+fn macro_call(
+    items: &[Item],
+    increments: bool,
+) -> std::result::Result<(Call, Vec<(usize, f64)>), String> {
+    let mut program = None;
+    let mut count = None;
+    let mut arguments: Vec<(usize, f64)> = Vec::new();
+    let whole = |what: &str, v: f64| {
+        if v < 0.0 || v.fract() != 0.0 || v > 1e12 {
+            Err(format!(
+                "`{what}{v}`: expected a whole number of at least 0"
+            ))
+        } else {
+            Ok(v as u64)
+        }
+    };
+    for item in items {
+        let Item::Word { text, num, .. } = item else {
+            return Err(
+                "a G65 block holds the call, its P, L and arguments only (argument \
+                 specification I: A B C D E F H I J K M Q R S T U V W X Y Z)"
+                    .into(),
+            );
+        };
+        let letter = text.chars().next().unwrap_or(' ').to_ascii_uppercase();
+        match letter {
+            'G' if num.value == 65.0 => {}
+            'N' => {}
+            'P' => program = Some(whole("P", num.value)?),
+            'L' => count = Some(whole("L", num.value)?),
+            _ => {
+                let Some(&(_, k)) = MACRO_ARGUMENTS.iter().find(|(l, _)| *l == letter) else {
+                    return Err(format!(
+                        "`{text}` is no G65 argument (argument specification I: A B C D E F H I \
+                         J K M Q R S T U V W X Y Z; G66 and specification II are not read)"
+                    ));
+                };
+                if arguments.iter().any(|&(seen, _)| seen == k) {
+                    // Specification II repeats I J K (`I1. J2. K3. I4. …` → #4 … #33): read
+                    // as specification I, the second would overwrite the first.
+                    return Err(format!(
+                        "`{text}`: {letter} given twice; argument specification II (I J K \
+                         repeated) is not read: give each argument once (specification I)"
+                    ));
+                }
+                if increments && !num.point && num.value != 0.0 {
+                    return Err(format!(
+                        "G65 argument `{text}` without a decimal point: the control scales it \
+                         by the increment of address {letter}; write it with a decimal point \
+                         (`{letter}{}.`), or read the program with --decimal-point-input \
+                         calculator",
+                        num.value
+                    ));
+                }
+                arguments.push((k, num.value));
+            }
+        }
+    }
+    let Some(program) = program else {
+        return Err("G65 without P (the macro's program number): add P<program number>".into());
+    };
+    let mut text = format!("G65 P{program}");
+    let runs = match count {
+        Some(l) => {
+            text.push_str(&format!(" L{l}"));
+            l
+        }
+        None => 1,
+    };
+    Ok((
+        Call {
+            text,
+            targets: vec![(format!("O{program}"), runs)],
+        },
+        arguments,
+    ))
+}
+
 /// The file split into its main program and subprograms.
 pub(super) struct Program {
     lines: Vec<Line>,
@@ -386,9 +716,95 @@ pub(super) struct Program {
     bytes: usize,
     sections: Vec<Section>,
     by_name: HashMap<String, usize>,
-    /// Heidenhain labels: name → index of the label's line.
-    labels: HashMap<String, usize>,
+    /// Heidenhain labels: (section, name) → the label's position in the section (each
+    /// program, the main one or one a `CALL PGM` read, has its own).
+    labels: HashMap<(usize, String), usize>,
+    /// Heidenhain `SEL PGM "name"`: the program `CALL SELECTED PGM` calls.
+    selected: std::cell::RefCell<Option<String>>,
     style: Subprograms,
+    /// The files read: the main program's first, then each a call read, in the order read.
+    files: Vec<Unit>,
+    /// The name of the first section's own header (Fanuc `O1002`, Sinumerik `PROC NAME`), if
+    /// it has one.
+    first_header: Option<String>,
+    /// Where a call of a subprogram the program does not hold looks for its file: the main
+    /// program's directory, then [`Settings::subprogram_dirs`](super::Settings) in order.
+    search: Vec<PathBuf>,
+    /// The names of the files in each searched directory, listed once.
+    listings: HashMap<PathBuf, Vec<String>>,
+    /// The names looked for in the directories and not found (each is looked for once).
+    missing: std::collections::HashSet<String>,
+    /// The bytes of the files calls read.
+    bytes_included: usize,
+}
+
+/// Most files a program may read for its calls.
+pub const MAX_SUBPROGRAM_FILES: usize = 1000;
+
+/// Most bytes the files a program's calls read may hold together (as much as one toolpath
+/// may: [`crate::files::MAX_TOOLPATH_BYTES`]).
+pub const MAX_SUBPROGRAM_BYTES: usize = crate::files::MAX_TOOLPATH_BYTES as usize;
+
+/// The extensions (lower case; "" none) a Fanuc/Haas subprogram's file may have.
+const FANUC_EXTENSIONS: [&str; 8] = ["", "nc", "tap", "ngc", "cnc", "txt", "eia", "prg"];
+
+/// Whether `file` (a file name in a searched directory) holds subprogram `name` as `style`
+/// names its files: Fanuc/Haas `O1002` in `O1002`, `O1002.nc`, `1002.nc`, `o01002.tap` (the
+/// letter O or none, the number with or without leading zeros, any case, an extension of
+/// [`FANUC_EXTENSIONS`]); Sinumerik `NAME` (`L1234`) in `NAME.SPF` or `NAME.MPF`, any case;
+/// LinuxCNC `o<name>` in `name.ngc` exactly (LinuxCNC lower-cases the name, and the file
+/// system's case counts). Numbered LinuxCNC subroutines (`o100`) and Heidenhain labels are
+/// never in files.
+pub(super) fn file_holds(style: Subprograms, name: &str, file: &str) -> bool {
+    let (stem, ext) = match file.rsplit_once('.') {
+        Some((stem, ext)) if !stem.is_empty() => (stem, ext),
+        _ => (file, ""),
+    };
+    match style {
+        Subprograms::OPrograms => {
+            // Haas `M98 "name.nc"`: the file of that name.
+            if let Some(quoted) = name.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+                return file.eq_ignore_ascii_case(quoted);
+            }
+            let Some(Ok(n)) = name.strip_prefix('O').map(str::parse::<u64>) else {
+                return false;
+            };
+            let digits = stem.strip_prefix(['O', 'o']).unwrap_or(stem);
+            FANUC_EXTENSIONS.contains(&ext.to_ascii_lowercase().as_str())
+                && !digits.is_empty()
+                && digits.len() <= 12
+                && digits.chars().all(|c| c.is_ascii_digit())
+                && digits.parse::<u64>() == Ok(n)
+        }
+        Subprograms::Procs => {
+            matches!(ext.to_ascii_lowercase().as_str(), "spf" | "mpf")
+                && stem.eq_ignore_ascii_case(name)
+        }
+        Subprograms::OWordSub => name
+            .strip_prefix("O<")
+            .and_then(|n| n.strip_suffix('>'))
+            .is_some_and(|n| !n.is_empty() && ext == "ngc" && stem == n),
+        Subprograms::Labels => ext.eq_ignore_ascii_case("h") && stem.eq_ignore_ascii_case(name),
+    }
+}
+
+/// What a call looks for, for messages: `O1002`, `O1002.nc`, `1002.nc`, … .
+fn file_names(style: Subprograms, name: &str) -> String {
+    match style {
+        Subprograms::OPrograms if name.starts_with('"') => {
+            format!("{} (any case)", name.trim_matches('"'))
+        }
+        Subprograms::OPrograms => {
+            let n = name.trim_start_matches('O');
+            format!("{name}, {name}.nc, {n}.nc, {name}.tap, … (any case)")
+        }
+        Subprograms::Procs => format!("{name}.SPF, {name}.MPF (any case)"),
+        Subprograms::OWordSub => {
+            let n = name.trim_start_matches("O<").trim_end_matches('>');
+            format!("{n}.ngc")
+        }
+        Subprograms::Labels => format!("{name}.h (any case)"),
+    }
 }
 
 impl Program {
@@ -399,10 +815,21 @@ impl Program {
             .enumerate()
             .map(|(i, raw)| Line {
                 number: i + 1,
+                file: 0,
                 blocks: split_blocks(spec, raw),
             })
             .collect();
         let mut program = Program {
+            files: vec![Unit {
+                path: source.to_path_buf(),
+                offset: 0,
+                lines: lines.len(),
+            }],
+            first_header: None,
+            search: Vec::new(),
+            listings: HashMap::new(),
+            missing: Default::default(),
+            bytes_included: 0,
             lines,
             bytes: text.len(),
             sections: vec![Section {
@@ -412,6 +839,7 @@ impl Program {
             }],
             by_name: HashMap::new(),
             labels: HashMap::new(),
+            selected: Default::default(),
             style: spec.subprograms,
         };
         match spec.subprograms {
@@ -472,7 +900,7 @@ impl Program {
             let block = klartext::strip_block_number(self.first_block(i));
             // Other label blocks, and malformed ones, are read when they run.
             if let Ok(Some(LabelOp::Label(name))) = klartext::label_op(block) {
-                if let Some(&k) = self.labels.get(&name) {
+                if let Some(&k) = self.labels.get(&(0, name.clone())) {
                     return Err(Error::parse(
                         source,
                         number,
@@ -482,7 +910,7 @@ impl Program {
                         ),
                     ));
                 }
-                self.labels.insert(name, i);
+                self.labels.insert((0, name), i);
             }
         }
         Ok(())
@@ -583,6 +1011,7 @@ impl Program {
                         // The main program's own header, or `PROC NAME` after `%_N_NAME_SPF`.
                         if current == 0 && self.sections[0].header == 0 {
                             self.sections[0].header = number;
+                            self.first_header = Some(name.clone());
                         }
                         self.sections[current].lines.push(i);
                         continue;
@@ -610,6 +1039,11 @@ impl Program {
         Ok(())
     }
 
+    /// Where calls look for files ([`Self::search_in`]).
+    pub(super) fn search(&self) -> Vec<PathBuf> {
+        self.search.clone()
+    }
+
     /// The names a bare word may call (Sinumerik `PROC` names).
     pub(super) fn proc_names(&self) -> Vec<String> {
         if self.style == Subprograms::Procs {
@@ -621,12 +1055,308 @@ impl Program {
 
     /// The last line number (for "no motion blocks").
     pub(super) fn last_line(&self) -> usize {
-        self.lines.len()
+        self.files[0].lines
     }
 
-    /// Runs the main program through `interp`, expanding calls.
+    /// Runs the main program through `interp`, expanding calls (a call of a subprogram the
+    /// program does not hold reads its file from [`Self::search`]). An error in a block of a
+    /// file a call read names that file and its line.
     pub(super) fn run(
-        &self,
+        &mut self,
+        spec: &DialectSpec,
+        interp: &mut Interpreter,
+        source: &Path,
+    ) -> Result<()> {
+        let run = self.run_lines(spec, interp, source);
+        run.map_err(|e| self.localize(e, source))
+    }
+
+    /// An error at a line of the sequence the program's lines are numbered in (the interpreter's
+    /// and this module's errors name `source`, the main program, and that line) as the file
+    /// and line it is at.
+    pub(super) fn localize(&self, e: Error, source: &Path) -> Error {
+        match e {
+            Error::Parse {
+                file,
+                line,
+                message,
+            } if file == source && line > self.files[0].lines => {
+                let (path, local) = self.place(line);
+                Error::Parse {
+                    file: path.to_path_buf(),
+                    line: local,
+                    message,
+                }
+            }
+            e => e,
+        }
+    }
+
+    /// The file and its line of line `global` of the sequence.
+    fn place(&self, global: usize) -> (&Path, usize) {
+        let unit = self
+            .files
+            .iter()
+            .rev()
+            .find(|u| global > u.offset)
+            .unwrap_or(&self.files[0]);
+        (&unit.path, global - unit.offset)
+    }
+
+    /// `line 12`, or `line 12 of sub/O1002.nc` when line `global` is in a file a call read.
+    fn line_name(&self, global: usize) -> String {
+        let (path, local) = self.place(global);
+        if global <= self.files[0].lines {
+            format!("line {local}")
+        } else {
+            format!("line {local} of {}", path.display())
+        }
+    }
+
+    /// The line number of line index `index` in the sequence all files' lines are numbered in.
+    fn global(&self, index: usize) -> usize {
+        let line = &self.lines[index];
+        self.files[line.file].offset + line.number
+    }
+
+    /// The files calls read, after the main program: (path, lines before it in the sequence,
+    /// its line count).
+    pub(super) fn included(&self) -> Vec<crate::toolpath::SourceFile> {
+        self.files[1..]
+            .iter()
+            .map(|u| crate::toolpath::SourceFile {
+                path: u.path.clone(),
+                offset: u.offset,
+                lines: u.lines,
+            })
+            .collect()
+    }
+
+    /// Sets where calls look for the files of subprograms the program does not hold: the main
+    /// program's directory (`source`'s), then `dirs` in order.
+    pub(super) fn search_in(&mut self, source: &Path, dirs: &[PathBuf]) {
+        let own = match source.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        self.search = std::iter::once(own).chain(dirs.iter().cloned()).collect();
+    }
+
+    /// The file that holds subprogram `name`: the first searched directory with one wins;
+    /// two in one directory are an error naming both.
+    fn find_file(&mut self, name: &str) -> std::result::Result<Option<PathBuf>, String> {
+        for dir in self.search.clone() {
+            if !self.listings.contains_key(&dir) {
+                let entries = std::fs::read_dir(&dir).map_err(|e| {
+                    format!(
+                        "cannot list the subprogram directory {}: {e}",
+                        dir.display()
+                    )
+                })?;
+                let names: Vec<String> = entries
+                    .flatten()
+                    .filter_map(|e| e.file_name().to_str().map(str::to_string))
+                    .collect();
+                self.listings.insert(dir.clone(), names);
+            }
+            let mut found: Vec<&String> = self.listings[&dir]
+                .iter()
+                .filter(|f| file_holds(self.style, name, f) && dir.join(f).is_file())
+                .collect();
+            found.sort();
+            match found[..] {
+                [] => continue,
+                [one] => return Ok(Some(dir.join(one))),
+                [a, b, ..] => {
+                    return Err(format!(
+                        "both {} and {} in {} could hold {name}: remove or rename one",
+                        a,
+                        b,
+                        dir.display()
+                    ));
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Reads the file of subprogram `name` (if a searched directory holds one) and adds its
+    /// programs to this one. `Ok(false)`: no file holds it.
+    fn load(&mut self, spec: &DialectSpec, name: &str) -> Result<bool> {
+        if self.missing.contains(name) {
+            return Ok(false);
+        }
+        let path = match self.find_file(name) {
+            Ok(Some(path)) => path,
+            Ok(None) => {
+                self.missing.insert(name.to_string());
+                return Ok(false);
+            }
+            Err(m) => return Err(Error::Usage(m)),
+        };
+        if self.files.len() > MAX_SUBPROGRAM_FILES {
+            return Err(Error::parse(
+                &path,
+                1,
+                format!(
+                    "the program's calls read more than {MAX_SUBPROGRAM_FILES} subprogram                      files: post the program with fewer"
+                ),
+            ));
+        }
+        let bytes = crate::toolpath::read_bytes(&path)?;
+        if self.bytes_included + bytes.len() > MAX_SUBPROGRAM_BYTES {
+            return Err(Error::parse(
+                &path,
+                1,
+                format!(
+                    "the program's subprogram files hold more than {} MiB together: split the                      program",
+                    MAX_SUBPROGRAM_BYTES >> 20
+                ),
+            ));
+        }
+        let text = String::from_utf8_lossy(&bytes);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let text = super::program_header(spec, &path, text)?;
+        let sub = Program::scan(spec, &path, &text)?;
+        self.bytes_included += bytes.len();
+        self.merge(sub, name, &path)?;
+        Ok(true)
+    }
+
+    /// Adds the programs of file `path` (scanned as `sub`), read for a call of `name`: its
+    /// first program is `name` (Fanuc: the program its own `O` header names; LinuxCNC: the
+    /// file holds `o<name> sub` … `endsub` and nothing else but comments and `M2`/`M30`), and
+    /// the file's other programs come with it. An error names the file and line where the
+    /// file does not hold `name` or defines a program the program has already.
+    fn merge(&mut self, sub: Program, name: &str, path: &Path) -> Result<()> {
+        let base = self.lines.len();
+        let file = self.files.len();
+        let offset = self.files.last().map_or(0, |u| u.offset + u.lines);
+        let Program {
+            lines,
+            bytes,
+            sections,
+            first_header,
+            labels,
+            ..
+        } = sub;
+        if self.style == Subprograms::Labels {
+            // One program, its own labels.
+            let k = self.sections.len();
+            for ((_, label), pos) in labels {
+                self.labels.insert((k, label), pos);
+            }
+        }
+        let defined = |sections: &[Section]| -> String {
+            sections
+                .iter()
+                .skip(1)
+                .map(|s| s.name.clone())
+                .chain(first_header.clone())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let holds = defined(&sections);
+        let mut added = Vec::new();
+        for (k, section) in sections.into_iter().enumerate() {
+            let section_name = if k > 0 {
+                section.name
+            } else {
+                match self.style {
+                    Subprograms::OWordSub => {
+                        // Outside the subroutine: comments, blank lines, `%`, M2 or M30 only.
+                        for &i in &section.lines {
+                            let Ok(blocks) = &lines[i].blocks else {
+                                continue;
+                            };
+                            let code = blocks.iter().map(|b| b.trim()).find(|b| {
+                                !b.is_empty()
+                                    && !b.starts_with('%')
+                                    && !matches!(first_word(b).as_str(), "M2" | "M02" | "M30")
+                            });
+                            if let Some(code) = code {
+                                return Err(Error::parse(
+                                    path,
+                                    lines[i].number,
+                                    format!(
+                                        "`{code}` outside `{name} sub` … `{name} endsub`: \
+                                         LinuxCNC reads a subroutine's file for the one \
+                                         subroutine it defines; move the block into it"
+                                    ),
+                                ));
+                            }
+                        }
+                        continue;
+                    }
+                    Subprograms::OPrograms if !name.starts_with('"') => {
+                        first_header.clone().unwrap_or_else(|| name.to_string())
+                    }
+                    _ => name.to_string(),
+                }
+            };
+            if let Some(&other) = self.by_name.get(&section_name) {
+                let there = self.sections[other]
+                    .lines
+                    .first()
+                    .map_or(0, |&i| self.global(i));
+                return Err(Error::parse(
+                    path,
+                    section.header.max(1),
+                    format!(
+                        "subprogram {section_name} is defined here and at {}: rename one",
+                        self.line_name(there)
+                    ),
+                ));
+            }
+            added.push(section_name.clone());
+            self.by_name
+                .insert(section_name.clone(), self.sections.len());
+            self.sections.push(Section {
+                name: section_name,
+                header: section.header,
+                lines: section.lines.iter().map(|i| i + base).collect(),
+            });
+        }
+        if self.style == Subprograms::OWordSub && added.len() > 1 {
+            return Err(Error::parse(
+                path,
+                1,
+                format!(
+                    "{} defines {}: LinuxCNC reads a subroutine's file for one subroutine, \
+                     the one it is named after; move the others to files of their own",
+                    path.display(),
+                    added.join(", ")
+                ),
+            ));
+        }
+        self.files.push(Unit {
+            path: path.to_path_buf(),
+            offset,
+            lines: lines.len(),
+        });
+        self.bytes += bytes;
+        self.lines
+            .extend(lines.into_iter().map(|l| Line { file, ..l }));
+        if !self.by_name.contains_key(name) {
+            let holds = if holds.is_empty() {
+                "no subprogram".to_string()
+            } else {
+                holds
+            };
+            return Err(Error::parse(
+                path,
+                1,
+                format!(
+                    "read for a call of {name}, this file holds {holds}: name the file after \
+                     the program it holds"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn run_lines(
+        &mut self,
         spec: &DialectSpec,
         interp: &mut Interpreter,
         source: &Path,
@@ -666,8 +1396,8 @@ impl Program {
                 }
                 continue;
             };
+            let number = self.global(index);
             let line = &self.lines[index];
-            let number = line.number;
             interp.vars.line = number;
             let blocks = match &line.blocks {
                 Ok(b) => b,
@@ -722,14 +1452,61 @@ impl Program {
             };
             if self.style == Subprograms::Labels {
                 let body = klartext::strip_block_number(text);
+                match program_call(body) {
+                    None => {}
+                    Some(Err(m)) => {
+                        return Err(self.located(Error::parse(source, number, m), &stack));
+                    }
+                    Some(Ok(ProgramCall::Select(name))) => {
+                        self.selected.replace(Some(name));
+                        continue;
+                    }
+                    // The end of a program a CALL PGM runs returns to the caller; the main
+                    // program's ends it (read as the table says).
+                    Some(Ok(ProgramCall::End))
+                        if stack
+                            .last()
+                            .is_some_and(|f| f.section > 0 && f.label.is_none()) =>
+                    {
+                        if !self.ret(&mut stack, &mut interp.vars) {
+                            return Ok(());
+                        }
+                        continue;
+                    }
+                    Some(Ok(ProgramCall::End)) => {}
+                    Some(Ok(ProgramCall::Call(name))) => {
+                        let name = match name {
+                            Some(name) => name,
+                            None => self.selected.borrow().clone().ok_or_else(|| {
+                                self.located(
+                                    Error::parse(
+                                        source,
+                                        number,
+                                        "CALL SELECTED PGM with no SEL PGM before it: select \
+                                         the program with SEL PGM \"name\"",
+                                    ),
+                                    &stack,
+                                )
+                            })?,
+                        };
+                        let call = Call {
+                            text: body.trim().to_string(),
+                            targets: vec![(name, 1)],
+                        };
+                        self.enter(spec, &mut stack, call, number, source)?;
+                        continue;
+                    }
+                }
                 let op = klartext::label_op(body)
                     .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
                 match op {
                     None => {}
                     Some(LabelOp::Label(_)) => continue,
                     Some(LabelOp::End) => {
-                        // In the main program, a subprogram's end is run through.
-                        if stack.len() > 1 && !self.ret(&mut stack, &mut interp.vars) {
+                        // In a program (the main one, or one a CALL PGM runs), a subprogram's
+                        // end is run through; it ends a label call.
+                        let in_label = stack.last().is_some_and(|f| f.label.is_some());
+                        if in_label && !self.ret(&mut stack, &mut interp.vars) {
                             return Ok(());
                         }
                         continue;
@@ -768,7 +1545,8 @@ impl Program {
                             let target = self.label(&name, number, source, &stack)?;
                             let now = Loop::now(&stack, interp.vars.changes());
                             if taken.get(&index) == Some(&now) {
-                                return Err(self.endless(source, number, body, &name, target));
+                                let at = self.global(self.sections[section].lines[target]);
+                                return Err(self.endless(source, number, body, &name, at));
                             }
                             taken.insert(index, now);
                             jumps += 1;
@@ -802,7 +1580,7 @@ impl Program {
                             targets: vec![(name, 1)],
                         };
                         let depth = stack.len();
-                        self.enter(&mut stack, call, number, source)?;
+                        self.enter(spec, &mut stack, call, number, source)?;
                         if stack.len() > depth
                             && let Some(top) = stack.last_mut()
                         {
@@ -825,6 +1603,23 @@ impl Program {
                     // Definitions were taken apart by the scan.
                     OWord::Sub => {}
                 }
+                continue;
+            }
+            if self.style == Subprograms::OPrograms
+                && text.contains('"')
+                && first_word(text).starts_with("M98")
+            {
+                let call = haas_file_call(text)
+                    .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+                self.enter(spec, &mut stack, call, number, source)?;
+                continue;
+            }
+            if self.style == Subprograms::Procs
+                && matches!(first_word(text).as_str(), "EXTCALL" | "CALL")
+            {
+                let call = sinumerik_call(text)
+                    .map_err(|m| self.located(Error::parse(source, number, m), &stack))?;
+                self.enter(spec, &mut stack, call, number, source)?;
                 continue;
             }
             let mut then_text = String::new();
@@ -900,9 +1695,11 @@ impl Program {
                                     let now = Loop::now(&stack, interp.vars.changes());
                                     if macro_taken.get(&(index, block)) == Some(&now) {
                                         return Err(located(format!(
-                                            "`{}` jumps to line {} for ever: no macro                                              variable has changed since it last jumped, so                                              every pass runs the same way; make the loop                                              change what its condition reads (a counter)",
+                                            "`{}` jumps to {} for ever: no macro                                              variable has changed since it last jumped, so                                              every pass runs the same way; make the loop                                              change what its condition reads (a counter)",
                                             text,
-                                            self.lines[self.sections[section].lines[to_pos]].number
+                                            self.line_name(
+                                                self.global(self.sections[section].lines[to_pos])
+                                            )
                                         )));
                                     }
                                     macro_taken.insert((index, block), now);
@@ -945,12 +1742,40 @@ impl Program {
                     &stack,
                 )
             })?;
+            if self.style == Subprograms::OPrograms && is_macro_call(&items) {
+                let (call, arguments) =
+                    macro_call(&items, interp.integer_increments()).map_err(|m| {
+                        self.located(
+                            Error::parse(source, number, format!("`{text}`: {m}")),
+                            &stack,
+                        )
+                    })?;
+                let depth = stack.len();
+                self.enter(spec, &mut stack, call, number, source)?;
+                if stack.len() > depth
+                    && let Some(top) = stack.last_mut()
+                {
+                    // #1–#33 are the macro's own: vacant but for the arguments, the caller's
+                    // given back on return.
+                    let saved: Vec<Option<f64>> = (1..=MACRO_LOCALS)
+                        .map(|k| interp.vars.value(&format!("#{k}")))
+                        .collect();
+                    for k in 1..=MACRO_LOCALS {
+                        interp.vars.restore(&format!("#{k}"), None);
+                    }
+                    for (k, v) in arguments {
+                        interp.vars.set(&format!("#{k}"), v);
+                    }
+                    top.locals = Some(saved);
+                }
+                continue;
+            }
             interp
                 .block(number, items)
                 .and_then(|()| interp.check_room(number, "this block", 0))
                 .map_err(|e| self.located(delete_hint(e, deleted), &stack))?;
             if let Some(call) = interp.call.take() {
-                self.enter(&mut stack, call, number, source)?;
+                self.enter(spec, &mut stack, call, number, source)?;
             } else if interp.ended {
                 interp.ended = false;
                 if interp.end_of_program || !self.ret(&mut stack, &mut interp.vars) {
@@ -1009,16 +1834,25 @@ impl Program {
 
     /// Starts a call made at line `number`.
     fn enter(
-        &self,
+        &mut self,
+        spec: &DialectSpec,
         stack: &mut Vec<Frame>,
         call: Call,
         number: usize,
         source: &Path,
     ) -> Result<()> {
-        let found = call
+        let mut found = call
             .targets
             .iter()
             .find_map(|(name, runs)| self.by_name.get(name).map(|&k| (k, *runs)));
+        if found.is_none() {
+            for (name, runs) in &call.targets {
+                if self.load(spec, name)? {
+                    found = self.by_name.get(name).map(|&k| (k, *runs));
+                    break;
+                }
+            }
+        }
         let Some((section, runs)) = found else {
             let name = &call.targets[0].0;
             let how = match self.style {
@@ -1027,19 +1861,43 @@ impl Program {
                 Subprograms::OWordSub => format!("{name} sub … {name} endsub"),
                 Subprograms::Labels => format!("LBL {name} … LBL 0"),
             };
-            return Err(self.located(
-                Error::parse(
-                    source,
-                    number,
-                    format!(
-                        "`{}`: subprogram {name} is not in this file; feedopt expands only \
-                         subprograms defined in the same file: add {how} to it, or post the \
-                         program without subprogram calls",
-                        call.text
-                    ),
-                ),
-                stack,
-            ));
+            let files = call
+                .targets
+                .iter()
+                .map(|(n, _)| file_names(self.style, n))
+                .filter(|f| !f.is_empty())
+                .collect::<Vec<_>>()
+                .join("; ");
+            let message = if files.is_empty() {
+                format!(
+                    "`{}`: subprogram {name} is not in this file: add {how} to it, or post the \
+                     program without subprogram calls",
+                    call.text
+                )
+            } else {
+                let dirs = self
+                    .search
+                    .iter()
+                    .map(|d| d.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let add = if self.style == Subprograms::Labels {
+                    String::new()
+                } else {
+                    format!(", or add {how} to this file")
+                };
+                format!(
+                    "`{}`: {} {name} is neither in this file nor in a file {files} in {dirs}: \
+                     give the directory that holds it with --subprogram-dir DIR{add}",
+                    call.text,
+                    if self.style == Subprograms::Labels {
+                        "program"
+                    } else {
+                        "subprogram"
+                    }
+                )
+            };
+            return Err(self.located(Error::parse(source, number, message), stack));
         };
         let frame = Frame {
             section,
@@ -1075,14 +1933,25 @@ impl Program {
             } else {
                 "subprogram calls"
             };
+            // A subprogram that calls itself (directly or through others) without an end.
+            let own = stack[1..]
+                .iter()
+                .any(|f| f.section == frame.section && f.label.is_none())
+                && frame.label.is_none();
+            let why = if own {
+                format!(
+                    "{} calls itself, and does not stop before that: a subprogram that calls \
+                     itself must end the recursion on a condition",
+                    self.sections[frame.section].name
+                )
+            } else {
+                "does a subprogram call itself?".to_string()
+            };
             return Err(self.located(
                 Error::parse(
                     source,
                     number,
-                    format!(
-                        "`{text}`: {what} nested more than {MAX_CALL_DEPTH} deep (does a \
-                         subprogram call itself?)"
-                    ),
+                    format!("`{text}`: {what} nested more than {MAX_CALL_DEPTH} deep ({why})"),
                 ),
                 stack,
             ));
@@ -1096,8 +1965,12 @@ impl Program {
 
     /// The line index of label `name` (an error naming it when the file lacks it).
     fn label(&self, name: &str, number: usize, source: &Path, stack: &[Frame]) -> Result<usize> {
-        self.labels.get(name).copied().ok_or_else(|| {
-            self.located(
+        let section = stack.last().map_or(0, |f| f.section);
+        self.labels
+            .get(&(section, name.to_string()))
+            .copied()
+            .ok_or_else(|| {
+                self.located(
                 Error::parse(
                     source,
                     number,
@@ -1108,7 +1981,7 @@ impl Program {
                 ),
                 stack,
             )
-        })
+            })
     }
 
     /// `CALL LBL name [REP repeats]` at line index `at` (line `number`).
@@ -1146,7 +2019,7 @@ impl Program {
             Some(r) => r,
         };
         let frame = Frame {
-            section: 0,
+            section: stack.last().map_or(0, |f| f.section),
             pos: target + 1,
             block: 0,
             start: target + 1,
@@ -1195,10 +2068,10 @@ impl Program {
             source,
             number,
             format!(
-                "`{block}` jumps back to LBL {name} (line {}) for ever: no Q parameter has \
+                "`{block}` jumps back to LBL {name} ({}) for ever: no Q parameter has \
                  changed since it last jumped, so every pass runs the same way; make the loop \
                  change what the condition reads (a counter), or remove the jump",
-                self.lines[target].number
+                self.line_name(target)
             ),
         )
     }
@@ -1226,7 +2099,10 @@ impl Program {
             } => Error::Parse {
                 file,
                 line: at,
-                message: format!("{message} (in {name}, called by `{text}` at line {line})"),
+                message: format!(
+                    "{message} (in {name}, called by `{text}` at {})",
+                    self.line_name(*line)
+                ),
             },
             other => other,
         }
