@@ -56,17 +56,7 @@ fn toolpath() -> Toolpath {
     Toolpath {
         source: PathBuf::from("bench.cls"),
         points,
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     }
 }
 

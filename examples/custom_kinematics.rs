@@ -116,17 +116,7 @@ fn main() -> Result<(), feedopt::error::Error> {
                 line: k + 1,
             })
             .collect(),
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     };
     let builtin = optimize(&builtin_machine, &cl, &Options::default())?;
 

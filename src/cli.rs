@@ -490,14 +490,7 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
     let machine = args.machine(&options)?;
     let (input, warnings, detected) = read_input(args)?;
     let run = || -> Result<String> {
-        let material = apply_material(
-            &args.machine,
-            &args.toolpath,
-            &args.opts.material,
-            &input,
-            &mut options,
-        )?;
-        let solution = solve_with_progress(&machine, &input, &options)?;
+        let (material, solution) = cut_and_solve(args, &machine, &input, &mut options)?;
         let dwell = match &input {
             toolpath::Input::Cl(t) => t.dwell_time(),
             toolpath::Input::Joint(_) => 0.0,
@@ -543,6 +536,23 @@ pub fn solve(args: &SolveArgs) -> Result<String> {
         })
     };
     in_files(&input, run())
+}
+
+/// The material stage ([`apply_material`]) and the solve under the feed caps it sets.
+fn cut_and_solve(
+    args: &SolveArgs,
+    machine: &Machine,
+    input: &toolpath::Input,
+    options: &mut Options,
+) -> Result<(Option<crate::material::MaterialReport>, optimize::Solution)> {
+    let material = apply_material(
+        &args.machine,
+        &args.toolpath,
+        &args.opts.material,
+        input,
+        options,
+    )?;
+    Ok((material, solve_with_progress(machine, input, options)?))
 }
 
 /// Runs the material stage when the machine file has a stock (and `--no-material` is not
@@ -1006,16 +1016,7 @@ fn plan(args: &SolveArgs) -> Result<(Machine, toolpath::Input, Options, optimize
     let mut options = args.options()?;
     let machine = args.machine(&options)?;
     let (input, _, _) = read_input(args)?;
-    let mut run = || -> Result<optimize::Solution> {
-        apply_material(
-            &args.machine,
-            &args.toolpath,
-            &args.opts.material,
-            &input,
-            &mut options,
-        )?;
-        solve_with_progress(&machine, &input, &options)
-    };
+    let mut run = || cut_and_solve(args, &machine, &input, &mut options).map(|(_, s)| s);
     let solution = in_files(&input, run())?;
     Ok((machine, input, options, solution))
 }

@@ -239,17 +239,7 @@ fn dresser_arc() -> (Machine, Toolpath) {
     let t = Toolpath {
         source: PathBuf::from("arc.cls"),
         points: pts,
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     };
     (m, t)
 }
@@ -622,14 +612,17 @@ fn machine_words(t: &Toolpath) -> Vec<(String, Option<[f64; 3]>)> {
     );
     v.sort_by_key(|e| (e.0, e.1, e.2));
     v.into_iter()
-        .map(|(point, _, _, what)| {
-            let at = point
-                .checked_sub(1)
-                .map(|k| t.points[k.min(t.points.len() - 1)].p)
-                .map(|p| [p.x, p.y, p.z]);
-            (what, at)
-        })
+        .map(|(point, _, _, what)| (what, stands_at(t, point)))
         .collect()
+}
+
+/// Where the tool stands before the move ending at CL point `point` (`None`: before the
+/// first).
+fn stands_at(t: &Toolpath, point: usize) -> Option<[f64; 3]> {
+    point
+        .checked_sub(1)
+        .map(|k| t.points[k.min(t.points.len() - 1)].p)
+        .map(|p| [p.x, p.y, p.z])
 }
 
 #[test]
@@ -666,14 +659,7 @@ fn length_words(t: &Toolpath) -> Vec<(String, Option<[f64; 3]>)> {
     t.length_offsets
         .iter()
         .flatten()
-        .map(|c| {
-            let at = c
-                .point
-                .checked_sub(1)
-                .map(|k| t.points[k.min(t.points.len() - 1)].p)
-                .map(|p| [p.x, p.y, p.z]);
-            (format!("{:?}", c.offset), at)
-        })
+        .map(|c| (format!("{:?}", c.offset), stands_at(t, c.point)))
         .collect()
 }
 

@@ -50,17 +50,7 @@ fn line() -> Toolpath {
                 line: k + 1,
             })
             .collect(),
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -269,17 +259,7 @@ fn a_nonzero_start_feed_on_a_pure_reorientation_is_refused() {
     let path = Toolpath {
         source: PathBuf::from("reorient.cls"),
         points,
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     };
     for kind in BOTH {
         // At rest it solves: a reorientation span, then a moving span.

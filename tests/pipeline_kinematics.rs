@@ -23,17 +23,7 @@ fn path(points: Vec<(Vector3<f64>, Vector3<f64>)>) -> Toolpath {
                 line: k + 1,
             })
             .collect(),
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     }
 }
 

@@ -216,17 +216,7 @@ fn random_cl(seed: u64) -> Case {
         path: Toolpath {
             source: PathBuf::from(format!("random_{seed}.cls")),
             points,
-            warnings: Vec::new(),
-            dwells: Vec::new(),
-            tool_changes: Vec::new(),
-            spindle_changes: Vec::new(),
-            switches: Vec::new(),
-            work_offset: None,
-            offset_changes: Vec::new(),
-            machine_points: Vec::new(),
-            length_offsets: None,
-            taps: Vec::new(),
-            files: Vec::new(),
+            ..Default::default()
         },
     }
 }
@@ -594,17 +584,7 @@ fn blended_corners_solve_verify_and_are_no_slower_than_stops() {
         let path = Toolpath {
             source: PathBuf::from(format!("blend_{seed}.cls")),
             points,
-            warnings: Vec::new(),
-            dwells: Vec::new(),
-            tool_changes: Vec::new(),
-            spindle_changes: Vec::new(),
-            switches: Vec::new(),
-            work_offset: None,
-            offset_changes: Vec::new(),
-            machine_points: Vec::new(),
-            length_offsets: None,
-            taps: Vec::new(),
-            files: Vec::new(),
+            ..Default::default()
         };
         let tolerance = 10f64.powf(g.range(-4.0, -0.3));
         let stop = optimize(&machine, &path, &Options::default())

@@ -256,12 +256,8 @@ pub fn parse_for(source: &Path, text: &str, _machine: Option<&MachineContext>) -
         tool_changes: reader.tool_changes,
         spindle_changes: reader.spindle_changes,
         switches: reader.switches,
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
         taps: reader.taps,
-        files: Vec::new(),
+        ..Default::default()
     })
 }
 

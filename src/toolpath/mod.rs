@@ -122,8 +122,9 @@ pub struct ClPoint {
     pub line: usize,
 }
 
-/// A toolpath as read from a file: CL points in program order.
-#[derive(Debug, Clone, PartialEq)]
+/// A toolpath as read from a file: CL points in program order. (`Default`: no points, no
+/// source, nothing else; struct literals take the fields they set and `..Default::default()`.)
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Toolpath {
     /// The file it came from (for error messages).
     pub source: PathBuf,
@@ -191,17 +192,7 @@ impl Toolpath {
         Toolpath {
             source,
             points,
-            warnings: Vec::new(),
-            dwells: Vec::new(),
-            tool_changes: Vec::new(),
-            spindle_changes: Vec::new(),
-            switches: Vec::new(),
-            work_offset: None,
-            offset_changes: Vec::new(),
-            machine_points: Vec::new(),
-            length_offsets: None,
-            taps: Vec::new(),
-            files: Vec::new(),
+            ..Default::default()
         }
     }
 

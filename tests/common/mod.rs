@@ -27,17 +27,7 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
                 line: k + 1,
             })
             .collect(),
-        warnings: Vec::new(),
-        dwells: Vec::new(),
-        tool_changes: Vec::new(),
-        spindle_changes: Vec::new(),
-        switches: Vec::new(),
-        work_offset: None,
-        offset_changes: Vec::new(),
-        machine_points: Vec::new(),
-        length_offsets: None,
-        taps: Vec::new(),
-        files: Vec::new(),
+        ..Default::default()
     }
 }
 

@@ -1559,19 +1559,29 @@ impl<'a> Interpreter<'a> {
             return Ok(());
         }
         for (text, _, _) in &block.actions {
-            let code = code_name(text);
-            let sign = match code.as_str() {
-                "G43" | "G43.4" | "G43.5" | "G234" => Some(true),
-                "G44" => Some(false),
-                "G49" => None,
-                _ => continue,
+            // (Every block passes here: the code's number, without making its name.)
+            let Some(n) = text
+                .strip_prefix(['G', 'g'])
+                .and_then(|n| n.parse::<f64>().ok())
+            else {
+                continue;
+            };
+            let sign = if [43.0, 43.4, 43.5, 234.0].contains(&n) {
+                Some(true)
+            } else if n == 44.0 {
+                Some(false)
+            } else if n == 49.0 {
+                None
+            } else {
+                continue;
             };
             let offset = match sign {
                 None => LengthOffset::Cancel,
                 Some(plus) => {
                     let h = match block.letter('H') {
                         Some(h) => {
-                            let n = self.tool_number(line, &format!("{code} H"), h.value)?;
+                            let n =
+                                self.tool_number(line, &format!("{} H", code_name(text)), h.value)?;
                             self.last_h = Some(n);
                             Some(n)
                         }

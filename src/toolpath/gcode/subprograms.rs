@@ -1586,13 +1586,12 @@ impl Program {
                         {
                             // #1–#30 are the call's own: the arguments, then the caller's
                             // values, all given back on return.
-                            let saved: Vec<Option<f64>> = (1..=MAX_CALL_ARGUMENTS)
-                                .map(|k| interp.vars.value(&format!("#{k}")))
-                                .collect();
-                            for (k, v) in arguments.iter().enumerate() {
-                                interp.vars.set(&format!("#{}", k + 1), *v);
-                            }
-                            top.locals = Some(saved);
+                            top.locals = Some(bind_locals(
+                                &mut interp.vars,
+                                MAX_CALL_ARGUMENTS,
+                                false,
+                                arguments.iter().enumerate().map(|(k, v)| (k + 1, *v)),
+                            ));
                         }
                     }
                     OWord::Return | OWord::EndSub => {
@@ -1757,16 +1756,7 @@ impl Program {
                 {
                     // #1–#33 are the macro's own: vacant but for the arguments, the caller's
                     // given back on return.
-                    let saved: Vec<Option<f64>> = (1..=MACRO_LOCALS)
-                        .map(|k| interp.vars.value(&format!("#{k}")))
-                        .collect();
-                    for k in 1..=MACRO_LOCALS {
-                        interp.vars.restore(&format!("#{k}"), None);
-                    }
-                    for (k, v) in arguments {
-                        interp.vars.set(&format!("#{k}"), v);
-                    }
-                    top.locals = Some(saved);
+                    top.locals = Some(bind_locals(&mut interp.vars, MACRO_LOCALS, true, arguments));
                 }
                 continue;
             }
@@ -2128,4 +2118,25 @@ fn delete_hint(e: Error, deleted: bool) -> Error {
         },
         e => e,
     }
+}
+
+/// A call's own local variables `#1`–`#count`: the caller's, returned for [`Program::ret`] to
+/// give back, then vacant where `vacate` (a Fanuc macro's), and `arguments` (`(k, v)`: `#k`
+/// = v) set.
+fn bind_locals(
+    vars: &mut Variables,
+    count: usize,
+    vacate: bool,
+    arguments: impl IntoIterator<Item = (usize, f64)>,
+) -> Vec<Option<f64>> {
+    let saved = (1..=count).map(|k| vars.value(&format!("#{k}"))).collect();
+    if vacate {
+        for k in 1..=count {
+            vars.restore(&format!("#{k}"), None);
+        }
+    }
+    for (k, v) in arguments {
+        vars.set(&format!("#{k}"), v);
+    }
+    saved
 }
