@@ -81,7 +81,9 @@ fn problem(case: &Case, parts: usize) -> SpanProblem {
         spacing: span.length() / n as f64,
         min_parts: parts,
     };
-    let p = SpanProblem::build(span, &Kinematics::new(&case.machine), &case.machine, grid);
+    let mut p = SpanProblem::build(span, &Kinematics::new(&case.machine), &case.machine, grid);
+    // COPP's discretisation (ü constant per interval), as its TOPP2-RA and COPP2-SOCP state it.
+    p.ramp = feedopt::constraints::Ramp::Constant;
     assert_eq!(p.intervals(), n, "the grid is the CSV's, divided {parts}×");
     p
 }

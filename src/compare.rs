@@ -237,6 +237,7 @@ fn realize(ctx: &Context, profile: &Profile, notes: Vec<String>) -> Candidate {
         }
         problems.push(SpanProblem::at_stations(span, kin, ctx.machine, u));
         solutions.push(SpanSolution {
+            ends: None,
             a: None,
             slopes: None,
             b,
@@ -524,7 +525,7 @@ fn dynamics(ctx: &Context, c: &Candidate) -> Result<Dynamics> {
         let mut jj = verify::first_instant(t0, period);
         let mut ta = t0;
         for i in 0..p.intervals() {
-            let iv = Interval::of(&p.u, b, sol.a.as_deref(), sol.slopes.as_deref(), i);
+            let iv = Interval::of(&p.u, b, sol.shape(), i);
             jj = verify::servo_instants(
                 &iv,
                 (p.u[i], p.u[i + 1]),

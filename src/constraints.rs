@@ -1,7 +1,6 @@
 //! Constraints on V²: one span's axis and feed limits as linear rows on b = u̇² at stations.
 //!
-//! With b = u̇² and ü = ½ db/du (constant between stations, b linear in u), every axis moves as
-//! (eq. 28–39 written in u)
+//! With b = u̇² and ü = ½ db/du, every axis moves as (eq. 28–39 written in u)
 //!
 //! - q̇ = q' u̇, so the velocity limit v_min ≤ q̇ ≤ v_max is `q'² b ≤ v²` (the side of q'),
 //! - q̈ = q'' b + q' ü, so the acceleration limit is `a_min ≤ q'' b + q' ü ≤ a_max`,
@@ -11,10 +10,28 @@
 //!
 //! Discretisation: stations u_0 … u_N at every CL knot of the span, each CL segment divided
 //! evenly (the spline's q'' is linear between knots, so its extremes are at stations); the
-//! velocity rows of all axes and the feed
-//! are merged into the single tightest bound `b_i ≤ b_max_i`; the acceleration of every axis is
-//! bounded at *both ends* of every interval with that interval's ü = (b_{k+1} − b_k)/(2Δu),
-//! so the piecewise-linear b respects the limits at every station from either side.
+//! velocity rows of all axes and the feed are merged into the single tightest bound
+//! `b_i ≤ b_max_i`; the acceleration of every axis is bounded at *both ends* of every
+//! interval ([`SpanProblem::interval_rows`]), with ü between stations as the problem's
+//! [`Ramp`] says:
+//!
+//! - [`Ramp::Linear`] (the default): ü linear on each interval, from ü⁰ at its start to ü¹ at
+//!   its end, b quadratic; each end's rows hold with that end's ü. ü⁰ and ü¹ are eliminated,
+//!   so the rows stay linear in (b_k, b_{k+1}), and chosen after the solve
+//!   ([`SpanProblem::ramp_ends`]).
+//! - [`Ramp::Constant`] (seed 000; what COPP's solvers state): one ü = (b_{k+1} − b_k)/(2Δu)
+//!   per interval, b linear.
+//!
+//! Why the default is the linear law: along a curve the ü the limits allow changes along an
+//! interval (`(a − q'' b)/q'`, with q', q'' and b all moving). One ü per interval must meet
+//! the tighter end and loses time of first order in Δu on every such ramp, so the cycle time
+//! converged at first order and the refinement spent its stations halving intervals on curves
+//! at high feed (NX's Röders finish on the machine's limits alone: 2.7 M stations, not
+//! converged; LinuxCNC's `3D_Chips.ngc` sample at ×10,000 feed: 1.81 M). An ü that follows the
+//! limit linearly loses time of second order. The price is that the rows are tight at both
+//! ends of an interval, so the motion between stations exceeds a limit by O(Δu²) where the
+//! constant law's slack at one end hid it: the refinement halves such intervals
+//! ([`SpanProblem::overshoot`]).
 
 use crate::geometry::{Span, SpanKind};
 use crate::kinematics::{AxisJets, Kinematics};
@@ -252,6 +269,8 @@ pub struct SpanProblem {
     /// b at the first and last station (0: at rest).
     pub b_start: f64,
     pub b_end: f64,
+    /// How ü varies between stations ([`Ramp`]).
+    pub ramp: Ramp,
 }
 
 impl SpanProblem {
@@ -272,6 +291,7 @@ impl SpanProblem {
             essential,
             b_start,
             b_end,
+            ramp,
         } = self;
         let StationJets {
             n_axes,
@@ -284,6 +304,7 @@ impl SpanProblem {
             *n_axes as u64,
             b_start.to_bits(),
             b_end.to_bits(),
+            *ramp as u64,
         ]);
         for v in [u, b_max, tip_speed, dq, ddq] {
             out.push(v.len() as u64);
@@ -335,6 +356,7 @@ impl SpanProblem {
             essential: Vec::with_capacity(u.len()),
             b_start: 0.0,
             b_end: 0.0,
+            ramp: Ramp::default(),
         };
         for (&ui, &cap) in u.iter().zip(&feed) {
             p.push_station(span, kin, machine, None, ui, cap);
@@ -416,6 +438,7 @@ impl SpanProblem {
             essential: Vec::with_capacity(n),
             b_start: self.b_start,
             b_end: self.b_end,
+            ramp: self.ramp,
         }
     }
 
@@ -456,6 +479,7 @@ impl SpanProblem {
             essential: self.essential[a..=b].to_vec(),
             b_start,
             b_end,
+            ramp: self.ramp,
         }
     }
 
@@ -476,12 +500,17 @@ impl SpanProblem {
 
     /// The range of ü that every axis's acceleration row allows at station `i` with b there
     /// (`q'' b + q' ü` within its limits, solved for ü).
+    ///
+    /// An axis whose q' is below [`STILL_AXIS`] of the largest there (an axis turning round,
+    /// q' through 0) bounds b alone (`q'' b` within its limits, which `b_max` holds): solved
+    /// for ü its row is `(a − q'' b)/q'`, a rounding error over almost nothing at b = b*.
     pub fn udd_range(&self, i: usize, b: f64) -> (f64, f64) {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         let (dq, ddq) = (self.jets.dq(i), self.jets.ddq(i));
+        let still = STILL_AXIS * dq.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         for (j, lim) in self.acceleration.iter().enumerate() {
             let (d, dd) = (dq[j], ddq[j]);
-            if d != 0.0 {
+            if d.abs() > still {
                 let (x, y) = ((lim.max - dd * b) / d, (lim.min - dd * b) / d);
                 lo = lo.max(x.min(y));
                 hi = hi.min(x.max(y));
@@ -490,16 +519,293 @@ impl SpanProblem {
         (lo, hi)
     }
 
-    /// ü on interval k: (b_{k+1} − b_k) / (2Δu_k).
-    pub fn path_acceleration(&self, b: &[f64], k: usize) -> f64 {
-        (b[k + 1] - b[k]) / (2.0 * self.du(k))
+    /// ü of interval k at its station `i` (k or k + 1): its end of `ends` (the profile's
+    /// [`Ramp::Linear`] ü, [`SpanProblem::ramp_ends`]), or without them the constant
+    /// (b_{k+1} − b_k) / (2Δu_k).
+    pub fn path_acceleration(
+        &self,
+        b: &[f64],
+        ends: Option<&[[f64; 2]]>,
+        k: usize,
+        i: usize,
+    ) -> f64 {
+        match ends {
+            Some(e) => e[k][usize::from(i > k)],
+            None => (b[k + 1] - b[k]) / (2.0 * self.du(k)),
+        }
     }
 
-    /// Acceleration q̈ = q'' b + q' ü of axis `j` at station `i`, with interval `k`'s ü
-    /// (`k` is `i − 1` or `i`).
-    pub fn axis_acceleration(&self, b: &[f64], k: usize, i: usize, j: usize) -> f64 {
-        self.jets.ddq(i)[j] * b[i] + self.jets.dq(i)[j] * self.path_acceleration(b, k)
+    /// Acceleration q̈ = q'' b + q' ü of axis `j` at station `i`, with interval `k`'s ü there
+    /// (`k` is `i − 1` or `i`; `ends` as in [`SpanProblem::path_acceleration`]).
+    pub fn axis_acceleration(
+        &self,
+        b: &[f64],
+        ends: Option<&[[f64; 2]]>,
+        k: usize,
+        i: usize,
+        j: usize,
+    ) -> f64 {
+        self.jets.ddq(i)[j] * b[i] + self.jets.dq(i)[j] * self.path_acceleration(b, ends, k, i)
     }
+
+    /// Interval `k`'s acceleration rows as rows `cx b_k + cy b_{k+1} ≤ d` on its two stations'
+    /// b, under the problem's [`Ramp`]; only the essential rows ([`essential_rows`]) and those
+    /// with a nonzero coefficient.
+    ///
+    /// - [`Ramp::Constant`]: every essential row of both ends, `q''_e b_e + q'_e ü ≤ a_max` (and
+    ///   `≥ a_min`) with the interval's one ü = (b_{k+1} − b_k)/(2Δu).
+    /// - [`Ramp::Linear`]: ü⁰ at the start and ü¹ at the end are free but for
+    ///   `ü⁰ + ü¹ = (b_{k+1} − b_k)/Δu`; each end's rows bound its own ü between lines in its b,
+    ///   `L(b) ≤ ü ≤ U(b)` (the envelopes of [`essential_rows`]). Eliminating ü⁰ and ü¹ (Fourier–
+    ///   Motzkin) leaves, for every pair of an upper line at the start and one at the end,
+    ///   `(b_{k+1} − b_k)/Δu ≤ U⁰(b_k) + U¹(b_{k+1})`, and the same with the lower lines and
+    ///   `≥`. (The pairs of one end alone, `L(b) ≤ U(b)`, say that b is below the
+    ///   acceleration-limited b* there, which `b_max` holds already; the rows with q' = 0, a
+    ///   bound on b alone, are in b* too.)
+    pub fn interval_rows(&self, k: usize, mut f: impl FnMut(IntervalRow)) {
+        let du = self.du(k);
+        match self.ramp {
+            Ramp::Constant => {
+                let inv = 1.0 / (2.0 * du);
+                for (e, at_end) in [(k, false), (k + 1, true)] {
+                    let (dq, ddq) = (self.jets.dq(e), self.jets.ddq(e));
+                    for (j, lim) in self.acceleration.iter().enumerate() {
+                        let rows = self.essential[e] >> (2 * j) & 3;
+                        let (d, dd) = (dq[j], ddq[j]);
+                        if rows == 0 || (d == 0.0 && dd == 0.0) {
+                            continue;
+                        }
+                        // dd b_e + d (y − x)/(2Δu) as cx x + cy y.
+                        let (mut cx, mut cy) = (-d * inv, d * inv);
+                        if at_end {
+                            cy += dd;
+                        } else {
+                            cx += dd;
+                        }
+                        if rows & 1 != 0 {
+                            f(IntervalRow {
+                                cx,
+                                cy,
+                                d: lim.max,
+                                scale: lim.max.abs(),
+                                limits: [Some((j, true, 1.0)), None],
+                            });
+                        }
+                        if rows & 2 != 0 {
+                            f(IntervalRow {
+                                cx: -cx,
+                                cy: -cy,
+                                d: -lim.min,
+                                scale: lim.min.abs(),
+                                limits: [Some((j, false, -1.0)), None],
+                            });
+                        }
+                    }
+                }
+            }
+            Ramp::Linear => {
+                let inv = 1.0 / du;
+                // b stays well above 0 inside: as a quadratic Bézier on the interval b has the
+                // control points b_k, P = b_k + Δu ü⁰ (= b_{k+1} − Δu ü¹) and b_{k+1}, and
+                // P ≥ (b_k + b_{k+1})/4 keeps b ≥ 0, and from or to rest (b = 0 at an end) keeps
+                // ü away from 0 there, so the interval takes finite time, at most twice the
+                // linear law's. Near a stop, without it, a convex b bottoms out below 0 between
+                // two small b, or reaches b = 0 at a station with ü = 0 or still braking. It is
+                // ü⁰ ≥ (b_{k+1} − 3 b_k)/(4Δu): against each upper bound on ü⁰ a row, and against
+                // each lower bound on ü¹ (ü⁰ = S − ü¹) another. (A linear b has P at the mean.)
+                let quarter = 0.25 * inv;
+                self.each_udd_line(k, |p| {
+                    if p.upper {
+                        // (y − 3x)/(4Δu) ≤ α_p + β_p x
+                        f(IntervalRow {
+                            cx: -3.0 * quarter - p.beta,
+                            cy: quarter,
+                            d: p.alpha,
+                            scale: p.alpha.abs(),
+                            limits: [Some((p.axis, p.max, p.per_limit)), None],
+                        });
+                    }
+                });
+                self.each_udd_line(k + 1, |q| {
+                    if !q.upper {
+                        // α_q + β_q y ≤ (3y − x)/(4Δu)
+                        f(IntervalRow {
+                            cx: quarter,
+                            cy: q.beta - 3.0 * quarter,
+                            d: -q.alpha,
+                            scale: q.alpha.abs(),
+                            limits: [Some((q.axis, q.max, -q.per_limit)), None],
+                        });
+                    }
+                });
+                self.each_udd_line(k, |p| {
+                    self.each_udd_line(k + 1, |q| {
+                        if q.upper != p.upper {
+                            return;
+                        }
+                        // upper: (y − x)/Δu ≤ α_p + β_p x + α_q + β_q y; lower: ≥, negated.
+                        let s = if p.upper { 1.0 } else { -1.0 };
+                        f(IntervalRow {
+                            cx: s * (-inv - p.beta),
+                            cy: s * (inv - q.beta),
+                            d: s * (p.alpha + q.alpha),
+                            scale: p.alpha.abs() + q.alpha.abs(),
+                            limits: [
+                                Some((p.axis, p.max, s * p.per_limit)),
+                                Some((q.axis, q.max, s * q.per_limit)),
+                            ],
+                        });
+                    })
+                });
+            }
+        }
+    }
+
+    /// The lines that station `i`'s essential rows with q' ≠ 0 put on ü: `ü ≤ α + β b`
+    /// (upper) or `ü ≥ α + β b` (lower), each given to `f`.
+    fn each_udd_line(&self, i: usize, mut f: impl FnMut(UddLine)) {
+        let (dq, ddq) = (self.jets.dq(i), self.jets.ddq(i));
+        let rows = self.essential[i];
+        let still = STILL_AXIS * dq.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        for (j, lim) in self.acceleration.iter().enumerate() {
+            let (d, dd) = (dq[j], ddq[j]);
+            if d.abs() <= still || rows >> (2 * j) & 3 == 0 {
+                continue;
+            }
+            for (bit, a, max) in [(1, lim.max, true), (2, lim.min, false)] {
+                if rows >> (2 * j) & bit != 0 {
+                    // dd b + d ü ≤ a_max (or ≥ a_min): ü on the side the sign of d gives.
+                    f(UddLine {
+                        alpha: a / d,
+                        beta: -dd / d,
+                        upper: max == (d > 0.0),
+                        axis: j,
+                        max,
+                        per_limit: 1.0 / d,
+                    });
+                }
+            }
+        }
+    }
+
+    /// ü at both ends of every interval of the profile `b` under [`Ramp::Linear`]: with
+    /// `S = (b_{k+1} − b_k)/Δu`, ü⁰ + ü¹ = S, and each end's ü within what every axis allows
+    /// there ([`SpanProblem::udd_range`]), ü⁰ as close to S/2 as those ranges let it be. So b is
+    /// linear in u wherever that meets the limits, and bends only as much as they make it;
+    /// where no split meets them (a profile off the discretisation's feasible set by rounding),
+    /// the middle of the conflicting range. `None` under [`Ramp::Constant`].
+    pub fn ramp_ends(&self, b: &[f64]) -> Option<Vec<[f64; 2]>> {
+        if self.ramp == Ramp::Constant {
+            return None;
+        }
+        Some(
+            (0..self.intervals())
+                .map(|k| {
+                    let (x, y) = (b[k].max(0.0), b[k + 1].max(0.0));
+                    let s = (y - x) / self.du(k);
+                    let (l0, u0) = self.udd_range(k, x);
+                    let (l1, u1) = self.udd_range(k + 1, y);
+                    // ü⁰ ≥ (y − 3x)/(4Δu): b well above 0 inside ([`SpanProblem::interval_rows`]).
+                    let floor = (y - 3.0 * x) / (4.0 * self.du(k));
+                    let (lo, hi) = (l0.max(s - u1).max(floor), u0.min(s - l1));
+                    let a0 = if lo <= hi {
+                        (0.5 * s).clamp(lo, hi)
+                    } else {
+                        0.5 * (lo + hi)
+                    };
+                    [a0, s - a0]
+                })
+                .collect(),
+        )
+    }
+}
+
+impl SpanProblem {
+    /// How far interval `k` of profile `b` (ü at its ends `ends`, [`Ramp::Linear`]) exceeds an
+    /// acceleration limit *between* its stations, estimated: the largest `q̈/limit − 1` of any
+    /// axis at a quarter, half and three quarters of the interval (0 if none is above), with
+    /// every axis's q' and q'' continued from the start station by the q''' their difference
+    /// gives (exact where the span is a cubic spline in the axes, as on a 3-axis machine).
+    ///
+    /// The rows hold the acceleration at the stations; inside, q̈ = q'' b + q' ü with b
+    /// quadratic and ü linear departs from them by O(Δu²). Under [`Ramp::Constant`] the rows
+    /// leave an O(Δu) slack at one end that hides it; under [`Ramp::Linear`] both ends are
+    /// often on their limit, and a grid fine enough for the cycle time can still exceed a limit
+    /// between stations by more than the re-simulation allows. The adaptive refinement halves
+    /// such intervals before the final solve.
+    pub fn overshoot(&self, b: &[f64], ends: &[[f64; 2]], k: usize) -> f64 {
+        let h = self.du(k);
+        let (b0, [a0, a1]) = (b[k].max(0.0), ends[k]);
+        let alpha = (a1 - a0) / h;
+        let (dq0, ddq0, ddq1) = (self.jets.dq(k), self.jets.ddq(k), self.jets.ddq(k + 1));
+        let mut worst: f64 = 0.0;
+        for f in [0.25, 0.5, 0.75] {
+            let t = f * h;
+            let (bt, at) = (b0 + t * (2.0 * a0 + alpha * t), a0 + alpha * t);
+            for (j, lim) in self.acceleration.iter().enumerate() {
+                let q3 = (ddq1[j] - ddq0[j]) / h;
+                let q2 = ddq0[j] + q3 * t;
+                let q1 = dq0[j] + t * (ddq0[j] + 0.5 * q3 * t);
+                let acc = q2 * bt + q1 * at;
+                worst = worst.max(acc / lim.max - 1.0).max(acc / lim.min - 1.0);
+            }
+        }
+        worst
+    }
+}
+
+/// Below this share of the largest |q'| at a station an axis's acceleration row bounds b
+/// alone under [`Ramp::Linear`] ([`SpanProblem::udd_range`]): its ü term is then at most 1e-9
+/// of the others' (on a circle through an axis-aligned point, q' of the axis turning round was
+/// 2.6e-15, and its row solved for ü gave −2147 mm/s² out of b's last bits).
+pub const STILL_AXIS: f64 = 1e-9;
+
+/// How ü = ½ db/du varies between two stations of an acceleration-limited profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Ramp {
+    /// ü constant on each interval, b linear in u (seed 000; COPP's TOPP2-RA and COPP2-SOCP
+    /// state the same problem): every axis's acceleration is bounded at both ends of the
+    /// interval with that one ü. On a curve the ü the limits allow changes along the
+    /// interval, and the one ü must meet the tighter end: on every acceleration ramp along a
+    /// curve the profile loses time of first order in Δu.
+    Constant,
+    /// ü linear on each interval, from ü⁰ at its start to ü¹ at its end (b quadratic,
+    /// `b_{k+1} − b_k = Δu (ü⁰ + ü¹)`, [`crate::motion::Law::Quadratic`]), each end's rows
+    /// with its own ü ([`SpanProblem::interval_rows`]): a ramp follows a limit that changes
+    /// along the curve to second order in Δu.
+    #[default]
+    Linear,
+}
+
+/// One acceleration row of an interval, `cx b_k + cy b_{k+1} ≤ d`
+/// ([`SpanProblem::interval_rows`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntervalRow {
+    /// Coefficient of b_k.
+    pub cx: f64,
+    /// Coefficient of b_{k+1}.
+    pub cy: f64,
+    /// Right-hand side.
+    pub d: f64,
+    /// The row's natural size, to normalise it (the limit's magnitude, or the sum of the two
+    /// ü bounds' constants).
+    pub scale: f64,
+    /// The limits in `d`: (axis, whether it is a_max (else a_min), ∂d/∂limit); the second
+    /// only for a [`Ramp::Linear`] row, which joins a row of each end.
+    pub limits: [Option<(usize, bool, f64)>; 2],
+}
+
+/// A line `ü ≤ α + β b` (upper) or `ü ≥ α + β b` of one acceleration row at a station.
+#[derive(Debug, Clone, Copy)]
+struct UddLine {
+    alpha: f64,
+    beta: f64,
+    upper: bool,
+    axis: usize,
+    /// a_max's row (else a_min's).
+    max: bool,
+    /// ∂α/∂limit = 1/q'.
+    per_limit: f64,
 }
 
 /// Every velocity bound of one path point merged: what [`point_bound`] finds.

@@ -8,10 +8,14 @@
 //! - [`Law::Linear`] (acceleration-limited profiles, seed 000): b linear in u, so ü is
 //!   constant and eq. 43 integrates in closed form, `Δt = 2Δu / (√b_0 + √b_1)`;
 //!   `√b(t) = √b_0 + ü t`. ü jumps at stations.
-//! - [`Law::Quadratic`] (jerk-limited, issue 6): a = ü linear in u between its station values
-//!   a_0, a_1, so b is quadratic, `b(x) = b_0 + 2 a_0 x + α x²` with `α = (a_1 − a_0)/Δu`, and
-//!   `b_1 − b_0 = Δu (a_0 + a_1)`. ü is continuous; the path jerk is `u⃛ = dü/dt = α u̇`.
-//!   Time is `∫ dx / √b(x)` (Gauss–Legendre; the integrand is analytic on the interval).
+//! - [`Law::Quadratic`]: a = ü linear in u between a_0 at the interval's start and a_1 at its
+//!   end, so b is quadratic, `b(x) = b_0 + 2 a_0 x + α x²` with `α = (a_1 − a_0)/Δu`, and
+//!   `b_1 − b_0 = Δu (a_0 + a_1)`; the path jerk is `u⃛ = dü/dt = α u̇`. Jerk-limited profiles
+//!   (issue 6) give ü at the stations, continuous; acceleration-limited ones under
+//!   [`Ramp::Linear`](crate::constraints::Ramp::Linear) give it at both ends of every
+//!   interval ([`Shape::ends`]), and it may jump at a station. Time is `∫ dx / √b(x)` in
+//!   closed form (`time_to`); from or to rest (b = 0 at an end, ü leading away) it is finite,
+//!   as under the linear law.
 //! - [`Law::Cubic`] (jerk-limited, issue 11): a' = dü/du linear in u between its values s_0,
 //!   s_1 at the interval's ends (a' may jump at a station), so ü is quadratic and b cubic:
 //!   `a(x) = a_0 + s_0 x + (s_1 − s_0) x²/(2Δu)`, `b(x) = b_0 + 2 a_0 x + s_0 x² +
@@ -121,20 +125,27 @@ impl State {
     }
 }
 
-/// Time taken by each interval of a profile (eq. 43 under its law): `b` at the stations `u`,
-/// and `a` (ü at the stations) for a jerk-limited profile, as in [`Interval::of`]. The one
-/// time integration every stage uses (the schedule, the solvers, the re-simulation, the
-/// setpoints); an interval the profile cannot traverse (b zero on the whole of it) is
-/// [`Error::Infeasible`].
-pub fn interval_times(
-    u: &[f64],
-    b: &[f64],
-    a: Option<&[f64]>,
-    slopes: Option<&[[f64; 2]]>,
-) -> Result<Vec<f64>> {
+/// What a profile gives beside b at its stations, which decides each interval's law
+/// ([`Interval::of`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Shape<'a> {
+    /// ü at every station of a jerk-limited profile (ü continuous).
+    pub a: Option<&'a [f64]>,
+    /// With `a`: a' = dü/du at both ends of every interval ([`Law::Cubic`]).
+    pub slopes: Option<&'a [[f64; 2]]>,
+    /// Without `a`: ü at both ends of every interval of an acceleration-limited profile whose ü
+    /// is linear between stations ([`crate::constraints::Ramp::Linear`]; [`Law::Quadratic`]).
+    pub ends: Option<&'a [[f64; 2]]>,
+}
+
+/// Time taken by each interval of a profile (eq. 43 under its law): `b` at the stations `u`
+/// and the rest of the profile in `shape`, as in [`Interval::of`]. The one time integration
+/// every stage uses (the schedule, the solvers, the re-simulation, the setpoints); an interval
+/// the profile cannot traverse (b zero on the whole of it) is [`Error::Infeasible`].
+pub fn interval_times(u: &[f64], b: &[f64], shape: Shape) -> Result<Vec<f64>> {
     (0..u.len().saturating_sub(1))
         .map(|k| {
-            Interval::of(u, b, a, slopes, k).duration().map_err(|_| {
+            Interval::of(u, b, shape, k).duration().map_err(|_| {
                 Error::Infeasible(format!(
                     "the feed is zero on a whole interval (station {k}): the path cannot be \
                      traversed"
@@ -155,21 +166,16 @@ pub fn hermite_slope_weights(du: f64) -> [[f64; 4]; 2] {
 }
 
 impl Interval {
-    /// Interval `k` of a profile: `b` at the stations `u`, and `a` (ü at the stations) for a
-    /// jerk-limited profile (`None`: [`Law::Linear`]), with `slopes` (a' at both ends of every
-    /// interval: [`Law::Cubic`]) or without (`None`: [`Law::Quadratic`]). Negative rounding
-    /// noise in b is clamped to 0.
-    pub fn of(
-        u: &[f64],
-        b: &[f64],
-        a: Option<&[f64]>,
-        slopes: Option<&[[f64; 2]]>,
-        k: usize,
-    ) -> Interval {
+    /// Interval `k` of a profile: `b` at the stations `u`, and in `shape` ü at the stations
+    /// for a jerk-limited profile, with `slopes` (a' at both ends of every interval:
+    /// [`Law::Cubic`]) or without ([`Law::Quadratic`]; the rest laws from or to b = 0); for an
+    /// acceleration-limited profile ü at both ends of every interval ([`Law::Quadratic`]) or
+    /// nothing ([`Law::Linear`]). Negative rounding noise in b is clamped to 0.
+    pub fn of(u: &[f64], b: &[f64], shape: Shape, k: usize) -> Interval {
         let du = u[k + 1] - u[k];
         let (b0, b1) = (b[k].max(0.0), b[k + 1].max(0.0));
-        match a {
-            None => {
+        match (shape.a, shape.ends) {
+            (None, None) => {
                 let udd = (b1 - b0) / (2.0 * du);
                 Interval {
                     du,
@@ -182,7 +188,25 @@ impl Interval {
                     law: Law::Linear,
                 }
             }
-            Some(a) => {
+            (None, Some(e)) => {
+                // ü⁰ + ü¹ = (b_1 − b_0)/Δu holds for the clamped b as for the solver's: the
+                // end ü are taken as given and ü¹ follows from the b actually used.
+                let a0 = e[k][0];
+                let a1 = (b1 - b0) / du - a0;
+                let alpha = (a1 - a0) / du;
+                Interval {
+                    du,
+                    b0,
+                    b1,
+                    a0,
+                    a1,
+                    s0: alpha,
+                    s1: alpha,
+                    law: Law::Quadratic,
+                }
+            }
+            (Some(a), _) => {
+                let slopes = shape.slopes;
                 let law = if b0 == 0.0 && b1 > 0.0 {
                     Law::RestStart
                 } else if b1 == 0.0 && b0 > 0.0 {
@@ -247,6 +271,7 @@ impl Interval {
     }
 
     /// The smallest b on the interval (quadratic law; the vertex if it lies inside).
+    #[cfg(test)]
     fn b_min(&self) -> f64 {
         let alpha = (self.a1 - self.a0) / self.du;
         let mut m = self.b0.min(self.b1);
@@ -257,6 +282,18 @@ impl Interval {
             }
         }
         m
+    }
+
+    /// Whether the motion under the quadratic law stops on the interval: b reaches 0 inside,
+    /// or at an end where ü does not lead away from it (from rest ü⁰ > 0, to rest ü¹ < 0 take
+    /// finite time: b is linear in x there, as under the linear law).
+    fn quadratic_stalls(&self) -> bool {
+        let alpha = (self.a1 - self.a0) / self.du;
+        let xv = if alpha > 0.0 { -self.a0 / alpha } else { -1.0 };
+        (xv > 0.0 && xv < self.du && self.b_at(xv) <= 0.0)
+            || (self.b0 <= 0.0 && self.a0 <= 0.0)
+            || (self.b1 <= 0.0 && self.a1 >= 0.0)
+            || (self.b0 <= 0.0 && self.b1 <= 0.0)
     }
 
     /// b at x (cubic law).
@@ -450,7 +487,7 @@ impl Interval {
                 2.0 * self.du / root
             }
             Law::Quadratic => {
-                if self.b_min() <= 0.0 {
+                if self.quadratic_stalls() {
                     return stall();
                 }
                 self.time_to(self.du)
@@ -657,7 +694,9 @@ impl Interval {
         let alpha = (self.a1 - self.a0) / self.du;
         let z = alpha * tau * tau;
         let (c, s) = if z.abs() < 0.5 {
-            // C = τ² Σ z^k/(2k+2)!, S = τ Σ z^k/(2k+1)!: 13 terms reach 1e-17 at |z| = 0.5.
+            // C = τ² Σ z^k/(2k+2)!, S = τ Σ z^k/(2k+1)!: 13 terms reach 1e-17 at |z| = 0.5;
+            // the sums stop where the next terms no longer change them (after two to four on
+            // the short intervals of an acceleration-limited profile, where |z| ~ 1e-6).
             let (mut c, mut s) = (0.0, 0.0);
             let (mut tc, mut ts) = (0.5, 1.0);
             for k in 0..13 {
@@ -666,6 +705,9 @@ impl Interval {
                 let m = (2 * k + 2) as f64;
                 ts *= z / (m * (m + 1.0));
                 tc *= z / ((m + 1.0) * (m + 2.0));
+                if ts.abs() <= 1e-17 * s.abs() && tc.abs() <= 1e-17 * c.abs() {
+                    break;
+                }
             }
             (c * tau * tau, s * tau)
         } else if alpha > 0.0 {
@@ -711,6 +753,80 @@ fn piece_time(dx: f64, a0: f64, a1: f64, r0: f64, r1: f64, alpha: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Under the linear-ü law an interval may start or end at rest (b = 0) with ü leading away
+    /// from it: its time is finite, the integral of 1/√b from the rest end, where b is linear
+    /// in x to first order. Checked against the constant-ü closed form (ü⁰ = ü¹) and, with ü
+    /// changing, against Gauss–Legendre on x = Δu s² (which takes the rest end's 1/√x away).
+    #[test]
+    fn the_quadratic_law_leaves_and_reaches_rest_in_finite_time() {
+        let du = 0.3;
+        let same = quad(0.0, 5.0, 5.0, du);
+        assert!((same.duration().unwrap() - (2.0 * du / 5.0).sqrt()).abs() < 1e-14);
+        for (a0, a1) in [(5.0, 1.0), (1.0, 5.0), (5.0, -2.0)] {
+            let iv = quad(0.0, a0, a1, du);
+            let (x, w) = gauss_legendre_32();
+            let numeric: f64 = x
+                .iter()
+                .zip(&w)
+                .map(|(&x, &w)| {
+                    let s = 0.5 * (x + 1.0);
+                    let u = du * s * s;
+                    0.5 * w * 2.0 * du * s / iv.b_at(u).sqrt()
+                })
+                .sum();
+            let t = iv.duration().unwrap();
+            assert!(
+                (t - numeric).abs() < 1e-10 * t,
+                "{a0} {a1}: {t} vs {numeric}"
+            );
+            // The same interval run backwards, to rest: the same time.
+            let back = Interval {
+                b0: iv.b1,
+                b1: 0.0,
+                a0: -a1,
+                a1: -a0,
+                ..iv
+            };
+            assert!((back.duration().unwrap() - t).abs() < 1e-12 * t);
+        }
+        // Leaving rest with ü = 0, or b = 0 at both ends, is no motion.
+        assert!(quad(0.0, 0.0, 4.0, du).duration().is_err());
+    }
+
+    /// Nodes and weights of 32-point Gauss–Legendre on [−1, 1] (Golub–Welsch would need a
+    /// matrix; Newton on P_32 is enough for a test).
+    fn gauss_legendre_32() -> (Vec<f64>, Vec<f64>) {
+        let n = 32;
+        let (mut x, mut w) = (Vec::new(), Vec::new());
+        for i in 1..=n {
+            let mut z = (std::f64::consts::PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, z);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+                let dz = p1 / dp;
+                z -= dz;
+                if dz.abs() < 1e-16 {
+                    let (mut q0, mut q1) = (1.0, z);
+                    for k in 2..=n {
+                        let q2 = ((2 * k - 1) as f64 * z * q1 - (k - 1) as f64 * q0) / k as f64;
+                        q0 = q1;
+                        q1 = q2;
+                    }
+                    let dq = n as f64 * (z * q1 - q0) / (z * z - 1.0);
+                    x.push(z);
+                    w.push(2.0 / ((1.0 - z * z) * dq * dq));
+                    break;
+                }
+            }
+        }
+        (x, w)
+    }
 
     fn quad(b0: f64, a0: f64, a1: f64, du: f64) -> Interval {
         Interval {
@@ -911,13 +1027,13 @@ mod tests {
         let iv = quad(0.01, -1.0, 1.0, 1.0);
         assert!(iv.b_min() < 0.0);
         assert!(iv.duration().is_err());
-        let flat = Interval::of(&[0.0, 1.0], &[0.0, 0.0], None, None, 0);
+        let flat = Interval::of(&[0.0, 1.0], &[0.0, 0.0], Default::default(), 0);
         assert!(flat.duration().is_err());
     }
 
     #[test]
     fn the_law_and_its_inverse_agree() {
-        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], None, None, 0);
+        let iv = Interval::of(&[1.0, 3.0], &[4.0, 9.0], Default::default(), 0);
         // Δt = 2·2/(2+3) = 0.8 s; ü = 5/4.
         let dur = iv.duration().unwrap();
         assert!((dur - 0.8).abs() < 1e-15);
@@ -928,7 +1044,7 @@ mod tests {
             assert!((iv.time_to_x(st.x).unwrap() - tau).abs() < 1e-12, "{tau}");
         }
         // From rest: u = ½ ü τ².
-        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], None, None, 0);
+        let rest = Interval::of(&[0.0, 2.0], &[0.0, 16.0], Default::default(), 0);
         let st = rest.at(0.5, rest.duration().unwrap());
         assert!((st.udd - 4.0).abs() < 1e-15 && (st.x - 0.5).abs() < 1e-15);
         assert!((rest.time_to_x(0.5).unwrap() - 0.5).abs() < 1e-15);

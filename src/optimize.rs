@@ -77,6 +77,10 @@ pub struct Options {
     /// Process feed caps from the material stage ([`crate::material::FeedLimits`], computed
     /// on the same toolpath): attached to the spans before the constraints are built.
     pub process: Option<std::sync::Arc<crate::material::FeedLimits>>,
+    /// How ü varies between stations of an acceleration-limited profile: linearly (the
+    /// default, second order in Δu) or constant per interval, the discretisation of seed 000
+    /// that COPP's solvers state (for like-for-like comparisons with them on their grid).
+    pub ramp: crate::constraints::Ramp,
     /// Solve each distinct span problem once and give its answer to every span that poses
     /// the same one (a drilling cycle's moves at every hole): the same schedule, bit for bit,
     /// as solving each (see `reuse`). Default on.
@@ -102,6 +106,7 @@ impl Default for Options {
             jerk: JerkOptions::default(),
             process: None,
             reuse_spans: true,
+            ramp: Default::default(),
         }
     }
 }
@@ -420,7 +425,13 @@ fn optimize_path(
         let t0 = std::time::Instant::now();
         plan.progress
             .stage("adding stations where the re-simulation found a limit exceeded");
-        let (touched, failed, replaced) = plan.refine_where_violated(&mut lv, &marks, options)?;
+        let mut all = marks_of(&marks);
+        all.extend(
+            predicted_marks(&lv.problems, &lv.solutions, &options.verify, mark)?
+                .into_iter()
+                .filter(|m| !frozen[m.0]),
+        );
+        let (touched, failed, replaced) = plan.refine_where_violated(&mut lv, &all, options)?;
         for (si, p, sol) in replaced {
             let e = excess[si].last().copied().unwrap_or(0.0);
             if least.get(&si).is_none_or(|(l, ..)| e < *l) {
@@ -601,17 +612,62 @@ fn ramp_end(p: &SpanProblem, b: &[f64], k: usize) -> Option<f64> {
     (at > u0 + 1e-3 * du && at < u1 - 1e-3 * du).then_some(at)
 }
 
+/// An interval a local refinement divides: (span, interval, the ratio to a limit found or
+/// predicted there).
+pub(crate) type Mark = (usize, usize, f64);
+
+/// The marks of re-simulated violations.
+pub(crate) fn marks_of<'a>(v: impl IntoIterator<Item = &'a Violation>) -> Vec<Mark> {
+    v.into_iter()
+        .map(|w| (w.span, w.interval, w.ratio))
+        .collect()
+}
+
+/// The intervals of acceleration-limited profiles with ü linear between stations whose
+/// estimated excess over a limit between stations ([`SpanProblem::overshoot`]) is above
+/// `mark` (relative), with 1 + that excess. Where the re-simulation has found some limit
+/// exceeded, these are divided with the intervals it found: its servo instants fall at other
+/// places of an interval each time the clock before it moves, so a round that divided only
+/// what they found left excesses they had missed for the next round to find (the bear's
+/// machine-limits run: 712, 77, 18, 1, then 26 intervals as earlier spans' times changed).
+/// Intervals too short for an instant to be likely inside are left (as in the adaptive
+/// rounds, [`OVERSHOOT_MARK`]).
+pub(crate) fn predicted_marks(
+    problems: &[SpanProblem],
+    solutions: &[SpanSolution],
+    verify: &VerifyOptions,
+    mark: f64,
+) -> Result<Vec<Mark>> {
+    let brief = verify.period / 64.0;
+    let mut out = Vec::new();
+    for (si, (p, s)) in problems.iter().zip(solutions).enumerate() {
+        let Some(ends) = s.ends.as_deref() else {
+            continue;
+        };
+        let dt = interval_times(p, s)?;
+        for (k, &t) in dt.iter().enumerate() {
+            if t > brief {
+                let o = p.overshoot(&s.b, ends, k);
+                if o > mark {
+                    out.push((si, k, 1.0 + o));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Per span (of `spans`), the intervals `marks` name and into how many parts each is divided
 /// ([`local_parts`]): sorted, one entry per interval (its worst violation's, the most parts),
 /// as [`divide`] takes them.
-pub(crate) fn marked_parts<'a>(
-    marks: impl IntoIterator<Item = &'a Violation>,
+pub(crate) fn marked_parts(
+    marks: impl IntoIterator<Item = Mark>,
     spans: usize,
     tolerance: f64,
 ) -> Vec<Vec<(usize, usize)>> {
     let mut split: Vec<Vec<(usize, usize)>> = vec![Vec::new(); spans];
-    for viol in marks {
-        split[viol.span].push((viol.interval, local_parts(viol.ratio, tolerance)));
+    for (span, interval, ratio) in marks {
+        split[span].push((interval, local_parts(ratio, tolerance)));
     }
     for ks in &mut split {
         ks.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
@@ -783,7 +839,15 @@ struct Round {
     time: f64,
     e: Vec<f64>,
     estimate: f64,
+    /// Per interval of G: whether F exceeds an acceleration limit between its stations there
+    /// by more than [`OVERSHOOT_MARK`] of the re-simulation's tolerance
+    /// ([`SpanProblem::overshoot`]): halved whatever its e_k.
+    over: Vec<bool>,
 }
+
+/// The share of the re-simulation's tolerance above which an interval's estimated excess
+/// between stations ([`SpanProblem::overshoot`]) has the adaptive refinement halve it.
+const OVERSHOOT_MARK: f64 = 0.25;
 
 /// One round of the jerk-limited adaptive refinement of one span: G and F both solved by the
 /// SCP.
@@ -809,6 +873,10 @@ trait AdaptiveRound: Send + Sync {
     /// The error each interval of its grid G carries (e_k or ε_k), s: what the threshold
     /// marks for refinement.
     fn errors(&self) -> &[f64];
+    /// Intervals of G to refine whatever their error (empty: none).
+    fn forced(&self) -> &[bool] {
+        &[]
+    }
 }
 
 impl AdaptiveRound for Round {
@@ -820,6 +888,9 @@ impl AdaptiveRound for Round {
     }
     fn errors(&self) -> &[f64] {
         &self.e
+    }
+    fn forced(&self) -> &[bool] {
+        &self.over
     }
 }
 
@@ -1079,6 +1150,7 @@ impl Plan<'_> {
             min_parts: 1,
         };
         let mut p = SpanProblem::build(span, &self.kin, self.machine, grid);
+        p.ramp = options.ramp;
         if let Some(c) = &options.verify.chord {
             p.apply_chord(span, c);
         }
@@ -1112,12 +1184,28 @@ impl Plan<'_> {
         let e: Vec<f64> = (0..n)
             .map(|k| (t[k] - tf[2 * k] - tf[2 * k + 1]).abs())
             .collect();
+        // Intervals so short that no servo instant is likely to fall inside are left alone (a
+        // rotary axis reversing on a reorientation span of NX's Mori program drove them to
+        // 1e-10° with the estimate unchanged: there ü is huge and the jets' terms cancel).
+        let (mark, brief) = (
+            OVERSHOOT_MARK * options.verify.tolerance,
+            options.verify.period / 64.0,
+        );
+        let over = match gf.ends.as_deref() {
+            Some(ends) => (0..n)
+                .map(|k| {
+                    (2 * k..2 * k + 2).any(|i| tf[i] > brief && pf.overshoot(&gf.b, ends, i) > mark)
+                })
+                .collect(),
+            None => Vec::new(),
+        };
         Ok(Round {
             fine: pf,
             greedy: gf,
             time,
             estimate: e.iter().sum(),
             e,
+            over,
         })
     }
 
@@ -1129,7 +1217,7 @@ impl Plan<'_> {
         let pf = &r.fine;
         let mut keep: Vec<bool> = (0..pf.u.len()).map(|i| i % 2 == 0).collect();
         for (k, &e) in r.e.iter().enumerate() {
-            if e > threshold {
+            if e > threshold || r.over.get(k) == Some(&true) {
                 keep[2 * k + 1] = true;
             }
         }
@@ -1381,7 +1469,8 @@ impl Plan<'_> {
                     unconverged: why.filter(|_| !within),
                 })
             };
-            if settled && within {
+            let forced = rounds.iter().any(|r| r.forced().contains(&true));
+            if settled && within && !forced {
                 return done(rounds, refinement, None);
             }
             if refinement.len() >= MAX_ADAPTIVE_ROUNDS {
@@ -1411,7 +1500,10 @@ impl Plan<'_> {
             } else {
                 1.0
             };
-            let threshold = if within {
+            let threshold = if within && settled {
+                // Only the intervals that exceed a limit between stations.
+                f64::INFINITY
+            } else if within {
                 0.0
             } else {
                 threshold(
@@ -1423,7 +1515,7 @@ impl Plan<'_> {
                 .par_iter()
                 .enumerate()
                 .map(|(si, r)| {
-                    if r.errors().iter().all(|&e| e <= threshold) {
+                    if r.errors().iter().all(|&e| e <= threshold) && !r.forced().contains(&true) {
                         return Ok(None);
                     }
                     next(si, r, threshold).map(Some)
@@ -1721,7 +1813,7 @@ impl Plan<'_> {
             u,
             options.verify.chord.as_ref(),
         );
-        (q.b_start, q.b_end) = (p.b_start, p.b_end);
+        (q.b_start, q.b_end, q.ramp) = (p.b_start, p.b_end, p.ramp);
         q
     }
 
@@ -1754,11 +1846,15 @@ impl Plan<'_> {
     fn refine_where_violated(
         &self,
         lv: &mut Level,
-        marks: &[Violation],
+        marks: &[Mark],
         options: &Options,
     ) -> Result<RefineOutcome> {
         use rayon::prelude::*;
-        let split = marked_parts(marks, lv.problems.len(), options.verify.tolerance);
+        let split = marked_parts(
+            marks.iter().copied(),
+            lv.problems.len(),
+            options.verify.tolerance,
+        );
         // The spans concerned in parallel (each span's windows join the same pool).
         let jobs: Vec<(usize, Vec<(usize, usize)>)> = split
             .into_iter()
@@ -1778,7 +1874,7 @@ impl Plan<'_> {
                     options.verify.chord.as_ref(),
                 );
                 self.check_travel(si, &p)?;
-                (p.b_start, p.b_end) = (old.b_start, old.b_end);
+                (p.b_start, p.b_end, p.ramp) = (old.b_start, old.b_end, old.ramp);
                 match self.solve_span(si, &p, options, Some((old, &lv.solutions[si])), None, true) {
                     Ok(s) => Ok((si, Some((p, s)))),
                     // A span from rest to rest whose finer grid the solver fails on keeps its

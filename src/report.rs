@@ -59,7 +59,7 @@ pub fn interval_binding(
 fn axis_acceleration(p: &SpanProblem, sol: &SpanSolution, k: usize, e: usize, j: usize) -> f64 {
     match &sol.a {
         Some(a) => p.jets.ddq(e)[j] * sol.b[e] + p.jets.dq(e)[j] * a[e],
-        None => p.axis_acceleration(&sol.b, k, e, j),
+        None => p.axis_acceleration(&sol.b, sol.ends.as_deref(), k, e, j),
     }
 }
 
@@ -74,7 +74,7 @@ pub fn jerk_ratios(
     p: &SpanProblem,
     sol: &SpanSolution,
 ) -> Option<Vec<(f64, usize)>> {
-    let a = sol.a.as_deref()?;
+    sol.a.as_ref()?;
     if !machine.has_jerk() {
         return None;
     }
@@ -82,7 +82,7 @@ pub fn jerk_ratios(
     let last = knots.len() - 2;
     let mut out = Vec::with_capacity(p.intervals());
     for k in 0..p.intervals() {
-        let iv = Interval::of(&p.u, &sol.b, Some(a), sol.slopes.as_deref(), k);
+        let iv = Interval::of(&p.u, &sol.b, sol.shape(), k);
         let (s0, s1) = iv.ends();
         let mut best = (0.0, 0);
         for (e, st) in [(k, s0), (k + 1, s1)] {

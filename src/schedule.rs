@@ -59,7 +59,10 @@ pub struct Schedule {
 pub fn station_udd(problem: &SpanProblem, sol: &SpanSolution, i: usize) -> f64 {
     match &sol.a {
         Some(a) => a[i],
-        None => problem.path_acceleration(&sol.b, i.min(problem.intervals() - 1)),
+        None => {
+            let k = i.min(problem.intervals() - 1);
+            problem.path_acceleration(&sol.b, sol.ends.as_deref(), k, i)
+        }
     }
 }
 
@@ -184,6 +187,9 @@ pub struct SpanTimeline {
     /// a' at both ends of every interval of a jerk-limited profile with quadratic ü
     /// ([`crate::motion::Law::Cubic`]).
     pub slopes: Option<Vec<[f64; 2]>>,
+    /// ü at both ends of every interval of an acceleration-limited profile with linear ü
+    /// ([`crate::solver::SpanSolution::ends`]).
+    pub ends: Option<Vec<[f64; 2]>>,
     /// Time at each station, s (the schedule's).
     pub t: Vec<f64>,
     /// Arc length at each station, mm (the schedule's).
@@ -193,13 +199,12 @@ pub struct SpanTimeline {
 impl SpanTimeline {
     /// Interval `i` (stations i, i + 1).
     pub fn interval(&self, i: usize) -> Interval {
-        Interval::of(
-            &self.u,
-            &self.b,
-            self.a.as_deref(),
-            self.slopes.as_deref(),
-            i,
-        )
+        let shape = crate::motion::Shape {
+            a: self.a.as_deref(),
+            slopes: self.slopes.as_deref(),
+            ends: self.ends.as_deref(),
+        };
+        Interval::of(&self.u, &self.b, shape, i)
     }
 
     /// The interval containing `u` (the last one at the span's end).
@@ -251,6 +256,7 @@ impl Timeline {
                 b: sol.b.clone(),
                 a: sol.a.clone(),
                 slopes: sol.slopes.clone(),
+                ends: sol.ends.clone(),
                 t: st.iter().map(|s| s.t).collect(),
                 s: st.iter().map(|s| s.s).collect(),
             });

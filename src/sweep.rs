@@ -113,7 +113,7 @@ use crate::schedule::Schedule;
 use crate::solver::clarabel::{Sensitivity, solve_with_sensitivity};
 use crate::solver::{self, SolverKind, Status};
 use crate::toolpath::Input;
-use crate::verify::{Violation, verify_marked};
+use crate::verify::verify_marked;
 
 /// Which limit of the axis is swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -320,9 +320,10 @@ struct Eval {
     summary: Summary,
     /// Spans solved as cone programs (the others: the lattice relaxation's exact optimum).
     cone_spans: usize,
-    /// Where its re-simulation found a limit exceeded (or nearly, [`optimize::LOCAL_MARK`]);
+    /// Where its re-simulation found a limit exceeded (or nearly, [`optimize::LOCAL_MARK`]),
+    /// with the intervals the motion's model predicts so ([`optimize::predicted_marks`]);
     /// empty where it verified.
-    marks: Vec<Violation>,
+    marks: Vec<optimize::Mark>,
 }
 
 impl Study<'_> {
@@ -402,6 +403,17 @@ impl Study<'_> {
         if verification.verified {
             marks.clear();
         }
+        let mut marks = optimize::marks_of(&marks);
+        if !marks.is_empty() {
+            // What the model of the motion between stations predicts too (`solve`'s local
+            // refinement does the same).
+            marks.extend(optimize::predicted_marks(
+                &problems,
+                &solutions,
+                &self.options.verify,
+                optimize::LOCAL_MARK * self.options.verify.tolerance,
+            )?);
+        }
         let cycle_time = schedule.cycle_time;
         let sol = Solution {
             path: self.base.path.clone(),
@@ -443,7 +455,7 @@ impl Study<'_> {
     /// would pass `max_stations` stations.
     fn divided(&self, evals: &[Eval], max_stations: usize) -> Option<Vec<Vec<f64>>> {
         let split = optimize::marked_parts(
-            evals.iter().flat_map(|e| &e.marks),
+            evals.iter().flat_map(|e| e.marks.iter().copied()),
             self.grid.len(),
             self.options.verify.tolerance,
         );
@@ -467,7 +479,7 @@ impl Study<'_> {
             self.grid[si].clone(),
             self.options.verify.chord.as_ref(),
         );
-        (p.b_start, p.b_end) = (old.b_start, old.b_end);
+        (p.b_start, p.b_end, p.ramp) = (old.b_start, old.b_end, old.ramp);
         p
     }
 
@@ -1036,6 +1048,7 @@ mod tests {
             essential: vec![u16::MAX; 2],
             b_start: 0.0,
             b_end: 0.0,
+            ramp: Default::default(),
         };
         assert!((db_star_dmu(&p, 0, 0) - 1.0).abs() < 1e-8);
         assert!((db_star_dmu(&p, 0, 1) - 0.5).abs() < 1e-8);

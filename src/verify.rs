@@ -459,14 +459,11 @@ fn check_intervals(
     let mut udd_before = if i0 == 0 {
         0.0
     } else {
-        Interval::of(&p.u, b, sol.a.as_deref(), sol.slopes.as_deref(), i0 - 1)
-            .ends()
-            .1
-            .udd
+        Interval::of(&p.u, b, sol.shape(), i0 - 1).ends().1.udd
     };
     for i in i0..i1 {
         let (ua, ub) = (p.u[i], p.u[i + 1]);
-        let iv = Interval::of(&p.u, b, sol.a.as_deref(), sol.slopes.as_deref(), i);
+        let iv = Interval::of(&p.u, b, sol.shape(), i);
         let (s0, s1) = iv.ends();
         let tb = ta + dt[i];
         // The segment of the spline this interval starts in (a station at a knot starts
@@ -771,6 +768,7 @@ mod tests {
 
     fn solution(b: Vec<f64>) -> SpanSolution {
         SpanSolution {
+            ends: None,
             a: None,
             slopes: None,
             b,
@@ -784,7 +782,7 @@ mod tests {
     #[test]
     fn exact_integration_with_constant_path_acceleration() {
         let lin = |ua: f64, ub: f64, ba: f64, bb: f64| {
-            Interval::of(&[ua, ub], &[ba * ba, bb * bb], None, None, 0)
+            Interval::of(&[ua, ub], &[ba * ba, bb * bb], Default::default(), 0)
         };
         // From rest with ü = 3 (√b 0 → 6 over u 0 → 6, 2 s): √b = 3τ, u = 1.5 τ².
         let iv = lin(0.0, 6.0, 0.0, 6.0);

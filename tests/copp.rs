@@ -65,14 +65,16 @@ fn load(dir: &Path, index: usize) -> Case {
     }
 }
 
-/// Solves on COPP's grid exactly: 1,000 intervals, every CSV row a station, and no stations
-/// added where the re-simulation between stations finds a limit exceeded
+/// Solves on COPP's grid exactly: 1,000 intervals, every CSV row a station, ü constant on
+/// each (`Ramp::Constant`, the discretisation COPP's solvers state), and no stations added
+/// where the re-simulation between stations finds a limit exceeded
 /// (`refine_until_verified: false`), so both sides solve the same discretisation.
 fn solve(case: &Case, kind: SolverKind) -> Solution {
     let options = Options {
         stations: Some(1000),
         solver_kind: kind,
         refine_until_verified: false,
+        ramp: feedopt::constraints::Ramp::Constant,
         ..Options::default()
     };
     optimize_joint(&case.machine, &case.path, &options)

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use feedopt::constraints::Ramp;
 use feedopt::machine::{Limit, Machine};
 use feedopt::optimize::Options;
 use feedopt::solver::Status;
@@ -37,9 +38,15 @@ fn line(l: f64) -> Input {
 
 /// Sweep with a fixed station count.
 fn run(m: &Machine, input: &Input, o: SweepOptions, stations: usize) -> Sweep {
+    run_ramp(m, input, o, stations, Ramp::default())
+}
+
+/// [`run`] with ü varying between stations as `ramp` says.
+fn run_ramp(m: &Machine, input: &Input, o: SweepOptions, stations: usize, ramp: Ramp) -> Sweep {
     let o = SweepOptions {
         solve: Options {
             stations: Some(stations),
+            ramp,
             ..Options::default()
         },
         ..o
@@ -198,8 +205,10 @@ fn zigzag(n: usize) -> Input {
 /// The two ways to dT/dv agree: a cone program per span with Clarabel's multipliers, and the
 /// central difference (ε = 1e-6) of the lattice relaxation's largest profile where that is the
 /// exact optimum (the default). On the zig-zag every span is lattice-exact, so by default no
-/// cone program is solved; around the circle the relaxation breaks the centripetal rows where
-/// X's tangent vanishes, so the span is a cone program either way, with the same answer.
+/// cone program is solved; around the circle, with ü constant per interval, the relaxation
+/// breaks the centripetal rows where X's tangent vanishes, so the span is a cone program
+/// either way, with the same answer. (With ü linear, the default, X turning round there bounds
+/// b alone, and the circle is lattice-exact too.)
 #[test]
 fn the_lattice_derivative_equals_clarabels_duals() {
     let m = machine(
@@ -208,17 +217,18 @@ fn the_lattice_derivative_equals_clarabels_duals() {
                      "Y": {"velocity": 400, "acceleration": 2000},
                      "Z": {"velocity": 1e4, "acceleration": 1000}}}"#,
     );
-    for (name, path, lattice_cones) in [
-        ("zig-zag", zigzag(12), 0),
-        ("circle", circle(20.0, 3, 120), 1),
+    for (name, path, ramp, lattice_cones) in [
+        ("zig-zag", zigzag(12), Ramp::Linear, 0),
+        ("circle", circle(20.0, 3, 120), Ramp::Constant, 1),
+        ("circle", circle(20.0, 3, 120), Ramp::Linear, 0),
     ] {
         for (which, from, to) in [
             (SweptLimit::Acceleration, 500.0, 1500.0),
             (SweptLimit::Velocity, 20.0, 60.0),
         ] {
             let o = SweepOptions::new("X", which, from, to, 3);
-            let lattice = run(&m, &path, o.clone(), 2000);
-            let duals = run(
+            let lattice = run_ramp(&m, &path, o.clone(), 2000, ramp);
+            let duals = run_ramp(
                 &m,
                 &path,
                 SweepOptions {
@@ -226,6 +236,7 @@ fn the_lattice_derivative_equals_clarabels_duals() {
                     ..o
                 },
                 2000,
+                ramp,
             );
             for (a, b) in lattice.points.iter().zip(&duals.points) {
                 let (da, db) = (a.sensitivity_dual.unwrap(), b.sensitivity_dual.unwrap());

@@ -150,7 +150,8 @@ impl Reuse {
         let words = key.0.len()
             + sol.b.len()
             + sol.a.as_ref().map_or(0, Vec::len)
-            + 2 * sol.slopes.as_ref().map_or(0, Vec::len);
+            + 2 * sol.slopes.as_ref().map_or(0, Vec::len)
+            + 2 * sol.ends.as_ref().map_or(0, Vec::len);
         let mut inner = self.inner.lock().unwrap_or_else(|e| e.into_inner());
         if inner.words + words <= MAX_WORDS && !inner.answers.contains_key(&key) {
             inner.words += words;

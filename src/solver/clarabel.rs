@@ -8,8 +8,16 @@
 //! subject to c_i² ≤ x_i                              (rotated cone: c_i ≤ √x_i)
 //!            d_k (c_k + c_{k+1}) ≥ 1                 (rotated cone)
 //!            x_i ≤ b_max_i / B                       (all velocity limits and the feed)
-//!            a_min ≤ B (q''_e x_e + q'_e (x_{k+1} − x_k)/(2Δu_k)) ≤ a_max   at both ends e of k
+//!            cx x_k + cy x_{k+1} ≤ d / B              interval k's acceleration rows
 //! ```
+//!
+//! The acceleration rows are [`SpanProblem::interval_rows`]: under
+//! [`Ramp::Constant`](crate::constraints::Ramp::Constant)
+//! `a_min ≤ B (q''_e x_e + q'_e (x_{k+1} − x_k)/(2Δu_k)) ≤ a_max` at both ends e of k; under
+//! [`Ramp::Linear`](crate::constraints::Ramp::Linear) (the default) the pairs of an end's
+//! bound on its own ü, with ü linear between the ends and the ends' ü eliminated. Each row is
+//! divided by its scale. The objective is eq. 43 with b linear between stations under either
+//! law (under the linear-ü law the motion's own time differs from it by O(Δu³) an interval).
 //!
 //! The end stations are not variables: b_0 and b_N (and c = √b there) are constants, so no
 //! cone is left without interior (a cone `c_0² ≤ b_0` with b_0 fixed to 0 has none and makes
@@ -54,11 +62,12 @@
 //! rows as dT/dθ = ∂/∂θ [yᵀ(Az − h)] at the optimum. For the rows that carry a limit:
 //!
 //! - velocity and feed, x_i ≤ b_max_i / B: dT/db_max_i = −y_i / B (s per unit of b = u̇²);
-//! - acceleration, (g·z + c)/a ≤ 1 with a = a_max (or a = a_min < 0, which flips the
-//!   inequality the normalisation divides by): dT/da = −y_r (g·z + c)/a² = −y_r / a, because
-//!   complementary slackness makes (g·z + c)/a = 1 wherever y_r > 0. The same formula holds
-//!   for both sides; for a_min it is positive (a more negative a_min is looser). Summed over
-//!   every row of the axis and side: [`Sensitivity::acceleration`].
+//! - acceleration, g·z ≤ h with h = d/s − c (d the row's right-hand side in the limits, s its
+//!   scale, c the fixed stations' part): dT/da = −y_r ∂h/∂a = −y_r (∂d/∂a)/s; for a row of one
+//!   limit (the constant-ü law) d = a_max, s = |a_max| (or d = −a_min, s = |a_min|), so
+//!   dT/da = −y_r / a on both sides (positive for a_min: a more negative a_min is looser); a
+//!   linear-ü row joins two ends' bounds, α = a/q' each, and gives each limit its share.
+//!   Summed over every row of the axis and side: [`Sensitivity::acceleration`].
 //!
 //! Dropped rows (implied by the others, [`essential_rows`](crate::constraints::essential_rows))
 //! carry no multiplier; the implied bound b* they give is stated as `b_max` instead, so part of
@@ -126,8 +135,9 @@ impl Layout {
 enum RowTag {
     /// x_i ≤ b_max_i / B.
     BMax(usize),
-    /// An acceleration row of axis `j` normalised by `limit` (a_max or a_min).
-    Acceleration { j: usize, upper: bool, limit: f64 },
+    /// An acceleration row divided by its scale: the limits in its right-hand side, each
+    /// with ∂h/∂limit (axis, a_max's (else a_min's), derivative).
+    Acceleration([Option<(usize, bool, f64)>; 2]),
 }
 
 /// First-order sensitivities of one span's optimal time T to its bounds, from the dual
@@ -291,41 +301,29 @@ fn linear_rows(p: &SpanProblem, scale: f64) -> Vec<LinearRow> {
         }
     }
     for k in 0..n {
-        let inv2du = 1.0 / (2.0 * p.du(k));
-        for e in [k, k + 1] {
-            for (j, lim) in p.acceleration.iter().enumerate() {
-                let (dq, ddq) = (p.jets.dq(e)[j], p.jets.ddq(e)[j]);
-                let which = p.essential[e] >> (2 * j);
-                if (dq == 0.0 && ddq == 0.0) || which & 3 == 0 {
-                    continue;
-                }
-                // row(x) = B (ddq x_e + dq (x_{k+1} − x_k)/(2Δu)) as coefficients + constant.
-                let mut coefs: Vec<(usize, f64)> = Vec::with_capacity(3);
-                let mut constant = 0.0;
-                let mut add = |i: usize, v: f64| match xvar(i) {
-                    Some(col) => coefs.push((col, v * scale)),
-                    None => constant += v * scale * xconst(i),
-                };
-                add(e, ddq);
-                add(k + 1, dq * inv2du);
-                add(k, -dq * inv2du);
-                merge_duplicates(&mut coefs);
-                // ≤ a_max and ≥ a_min, each row normalised by its limit.
-                for (bit, a) in [(1, lim.max), (2, lim.min)] {
-                    if which & bit != 0 {
-                        rows.push(LinearRow {
-                            coefs: coefs.iter().map(|&(c, v)| (c, v / a)).collect(),
-                            h: 1.0 - constant / a,
-                            tag: RowTag::Acceleration {
-                                j,
-                                upper: bit == 1,
-                                limit: a,
-                            },
-                        });
-                    }
+        p.interval_rows(k, |r| {
+            // cx x_k + cy x_{k+1} ≤ d/B, divided by the row's scale (so h is about 1).
+            let norm = scale / r.scale;
+            let mut coefs: Vec<(usize, f64)> = Vec::with_capacity(2);
+            let mut constant = 0.0;
+            for (i, c) in [(k, r.cx), (k + 1, r.cy)] {
+                match xvar(i) {
+                    Some(col) => coefs.push((col, c * norm)),
+                    None => constant += c * norm * xconst(i),
                 }
             }
-        }
+            if coefs.iter().all(|c| c.1 == 0.0) && constant == 0.0 {
+                return;
+            }
+            rows.push(LinearRow {
+                coefs,
+                h: r.d / r.scale - constant,
+                tag: RowTag::Acceleration(
+                    r.limits
+                        .map(|l| l.map(|(j, upper, dd)| (j, upper, dd / r.scale))),
+                ),
+            });
+        });
     }
     rows
 }
@@ -511,12 +509,15 @@ fn program(
         let y = y.max(0.0); // y ∈ K*: nonnegative up to the solver's tolerance
         match *tag {
             RowTag::BMax(i) => sens.b_max[i] = -y / scale,
-            RowTag::Acceleration { j, upper, limit } => {
-                let side = &mut sens.acceleration[j];
-                if upper {
-                    side.max -= y / limit;
-                } else {
-                    side.min -= y / limit;
+            RowTag::Acceleration(limits) => {
+                // dT/dh = −y, and h moves with a limit by ∂h/∂limit.
+                for (j, upper, dh) in limits.into_iter().flatten() {
+                    let side = &mut sens.acceleration[j];
+                    if upper {
+                        side.max -= y * dh;
+                    } else {
+                        side.min -= y * dh;
+                    }
                 }
             }
         }
@@ -542,15 +543,7 @@ fn program(
         sens.b_max[i] = dt_dc / (2.0 * xi.sqrt()) / scale;
     }
     Ok((
-        SpanSolution {
-            a: None,
-            slopes: None,
-            b,
-            status,
-            iterations,
-            solve_time,
-            scp_iterations: 0,
-        },
+        SpanSolution::acceleration_limited(p, b, status, iterations, solve_time),
         sens,
         x,
     ))
@@ -623,26 +616,11 @@ pub fn solve_windowed(
         iterations += s.iterations;
         b.extend_from_slice(if i == 0 { &s.b[..] } else { &s.b[1..] });
     }
-    Ok(SpanSolution {
-        a: None,
-        slopes: None,
+    Ok(SpanSolution::acceleration_limited(
+        p,
         b,
         status,
         iterations,
-        solve_time: t0.elapsed().as_secs_f64(),
-        scp_iterations: 0,
-    })
-}
-
-/// Sums coefficients that share a column (x_e may also be x_k or x_{k+1}).
-fn merge_duplicates(coefs: &mut Vec<(usize, f64)>) {
-    coefs.sort_by_key(|c| c.0);
-    coefs.dedup_by(|later, first| {
-        if later.0 == first.0 {
-            first.1 += later.1;
-            true
-        } else {
-            false
-        }
-    });
+        t0.elapsed().as_secs_f64(),
+    ))
 }

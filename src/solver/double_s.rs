@@ -26,7 +26,7 @@
 use super::{SpanSolution, Status};
 use crate::constraints::SpanProblem;
 use crate::machine::Machine;
-use crate::motion::{Interval, hermite_slope_weights};
+use crate::motion::{Interval, Shape, hermite_slope_weights};
 
 /// The path's limits along a straight span: u̇ ≤ `v`, |ü| ≤ `a`, |u⃛| ≤ `j`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -270,7 +270,16 @@ pub fn profile_stations(s: &DoubleS, u0: f64) -> Option<(Vec<f64>, SpanSolution)
         let mut time = 0.0;
         let mut jerk_ok = true;
         for k in 0..n {
-            let iv = Interval::of(&u, &b, Some(&a), Some(&slopes), k);
+            let iv = Interval::of(
+                &u,
+                &b,
+                Shape {
+                    a: Some(&a),
+                    slopes: Some(&slopes),
+                    ends: None,
+                },
+                k,
+            );
             time += iv.duration().ok()?;
             // The cubic law's path jerk a'(x)·√b(x) at a few points of the interval (the rest
             // laws are the profile's own).
@@ -289,6 +298,7 @@ pub fn profile_stations(s: &DoubleS, u0: f64) -> Option<(Vec<f64>, SpanSolution)
                 *x += u0;
             }
             let sol = SpanSolution {
+                ends: None,
                 b: std::mem::take(&mut b),
                 a: Some(std::mem::take(&mut a)),
                 slopes: Some(slopes),
@@ -363,11 +373,10 @@ mod tests {
             let (u, sol) = profile_stations(&s, 2.0).expect("within tolerance");
             assert_eq!(u[0], 2.0);
             assert!((u[u.len() - 1] - 2.0 - length).abs() <= 1e-12 * length.max(1.0));
-            let t: f64 =
-                crate::motion::interval_times(&u, &sol.b, sol.a.as_deref(), sol.slopes.as_deref())
-                    .unwrap()
-                    .iter()
-                    .sum();
+            let t: f64 = crate::motion::interval_times(&u, &sol.b, sol.shape())
+                .unwrap()
+                .iter()
+                .sum();
             assert!(
                 (t - s.duration()).abs() <= TIME_TOLERANCE * s.duration(),
                 "{length}: {t}"

@@ -78,7 +78,7 @@ use crate::error::{Error, Result};
 use crate::geometry::Span;
 use crate::kinematics::{AxisJets, Kinematics, MAX_AXES};
 use crate::machine::{Limit, Machine};
-use crate::motion::Interval;
+use crate::motion::{Interval, Shape};
 use crate::solver::interval_times;
 
 /// Settings of the sequential convex programme.
@@ -679,7 +679,16 @@ impl Warm {
             while k < last && old_p.u[k + 1] <= mid {
                 k += 1;
             }
-            let iv = Interval::of(&old_p.u, &old.b, Some(a_old), s_old, k);
+            let iv = Interval::of(
+                &old_p.u,
+                &old.b,
+                Shape {
+                    a: Some(a_old),
+                    slopes: s_old,
+                    ends: None,
+                },
+                k,
+            );
             slopes.push([
                 iv.slope_at_x(p.u[j] - old_p.u[k]),
                 iv.slope_at_x(p.u[j + 1] - old_p.u[k]),
@@ -696,7 +705,16 @@ impl Warm {
             while k < last && old_p.u[k + 1] <= u {
                 k += 1;
             }
-            let iv = Interval::of(&old_p.u, &old.b, Some(a_old), s_old, k);
+            let iv = Interval::of(
+                &old_p.u,
+                &old.b,
+                Shape {
+                    a: Some(a_old),
+                    slopes: s_old,
+                    ends: None,
+                },
+                k,
+            );
             let (bu, au) = iv.at_x(u - old_p.u[k]);
             b.push(bu);
             a.push(au);
@@ -783,6 +801,7 @@ pub fn solve(
                 // No new station in this window: the previous profile is its solution still
                 // (its ends are fixed at that profile's values).
                 return Ok(SpanSolution {
+                    ends: None,
                     b: w.b[a..=b].to_vec(),
                     a: Some(w.a[a..=b].to_vec()),
                     slopes: Some(w.slopes[a..b].to_vec()),
@@ -1035,6 +1054,7 @@ fn stitch(windows: &[(usize, usize)], results: Vec<Result<SpanSolution>>) -> Res
         iterations += s.iterations;
     }
     Ok(SpanSolution {
+        ends: None,
         b,
         a: Some(a),
         slopes: Some(slopes),
@@ -1064,6 +1084,7 @@ fn solve_piece(
             interval_times(
                 p,
                 &SpanSolution {
+                    ends: None,
                     b: bbar.clone(),
                     a: Some(a.clone()),
                     slopes: sbar.clone(),
@@ -1186,6 +1207,7 @@ fn solve_piece(
                         .collect()
                 };
                 let trial = SpanSolution {
+                    ends: None,
                     b: mix(&bbar, &sol.b),
                     a: sol.a.as_deref().map(|a| mix(a0, a)),
                     slopes: match (sbar.as_deref(), sol.slopes.as_deref()) {
@@ -2015,6 +2037,7 @@ impl<'a> Program<'a> {
             })
             .collect();
         Ok(SpanSolution {
+            ends: None,
             a: Some(acc),
             slopes: Some(slopes),
             b,

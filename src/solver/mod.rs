@@ -165,6 +165,11 @@ pub struct SpanSolution {
     /// is quadratic between stations ([`crate::motion::Law::Cubic`]); `None` with `a`: ü
     /// linear between stations.
     pub slopes: Option<Vec<[f64; 2]>>,
+    /// ü at the start and end of every interval of an acceleration-limited profile whose ü
+    /// is linear between stations ([`crate::constraints::Ramp::Linear`], from
+    /// [`crate::constraints::SpanProblem::ramp_ends`]); `None` without `a`: ü constant on
+    /// each interval.
+    pub ends: Option<Vec<[f64; 2]>>,
     /// How the solve ended.
     pub status: Status,
     /// Interior-point iterations (0 for the reach pass).
@@ -177,6 +182,38 @@ pub struct SpanSolution {
 }
 
 impl SpanSolution {
+    /// An acceleration-limited profile `b` of problem `p`: ü at the intervals' ends as the
+    /// problem's [`Ramp`](crate::constraints::Ramp) says ([`SpanProblem::ramp_ends`]).
+    ///
+    /// [`SpanProblem::ramp_ends`]: crate::constraints::SpanProblem::ramp_ends
+    pub fn acceleration_limited(
+        p: &crate::constraints::SpanProblem,
+        b: Vec<f64>,
+        status: Status,
+        iterations: u32,
+        solve_time: f64,
+    ) -> SpanSolution {
+        SpanSolution {
+            a: None,
+            slopes: None,
+            ends: p.ramp_ends(&b),
+            b,
+            status,
+            iterations,
+            solve_time,
+            scp_iterations: 0,
+        }
+    }
+
+    /// Everything but b that decides the motion between stations.
+    pub fn shape(&self) -> crate::motion::Shape<'_> {
+        crate::motion::Shape {
+            a: self.a.as_deref(),
+            slopes: self.slopes.as_deref(),
+            ends: self.ends.as_deref(),
+        }
+    }
+
     /// The same motion `factor` (≥ 1) times slower: u̇ → u̇/f, so b, ü and a' = dü/du all
     /// divide by f². Every motion law is homogeneous in them, so each interval takes f times
     /// as long, and every axis's velocity, acceleration and jerk along the path divide by f,
@@ -187,7 +224,7 @@ impl SpanSolution {
         if let Some(a) = &mut self.a {
             a.iter_mut().for_each(|x| *x *= k);
         }
-        if let Some(s) = &mut self.slopes {
+        for s in [&mut self.slopes, &mut self.ends].into_iter().flatten() {
             s.iter_mut().for_each(|x| {
                 x[0] *= k;
                 x[1] *= k;
@@ -202,7 +239,7 @@ pub fn interval_times(
     problem: &crate::constraints::SpanProblem,
     sol: &SpanSolution,
 ) -> crate::error::Result<Vec<f64>> {
-    crate::motion::interval_times(&problem.u, &sol.b, sol.a.as_deref(), sol.slopes.as_deref())
+    crate::motion::interval_times(&problem.u, &sol.b, sol.shape())
 }
 
 /// A sparse row block under construction (triplets in row order), with its right-hand side.
@@ -324,7 +361,7 @@ pub fn optimal(
         }
         // A window's time (s) under profile `x` (`None`: not finite).
         let window_time = |a: usize, c: usize, x: &[f64]| {
-            crate::motion::interval_times(&p.u[a..=c], &x[a..=c], None, None)
+            crate::motion::interval_times(&p.u[a..=c], &x[a..=c], Default::default())
                 .ok()
                 .map(|t| t.iter().sum::<f64>())
         };
@@ -366,15 +403,13 @@ pub fn optimal(
              interior-point iterations"
         );
     }
-    Ok(SpanSolution {
+    Ok(SpanSolution::acceleration_limited(
+        p,
         b,
-        a: None,
-        slopes: None,
         status,
         iterations,
-        solve_time: t0.elapsed().as_secs_f64(),
-        scp_iterations: 0,
-    })
+        t0.elapsed().as_secs_f64(),
+    ))
 }
 
 impl SolverSettings {

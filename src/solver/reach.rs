@@ -1,9 +1,11 @@
 //! The exact O(N) reachability solver: a backward pass of controllable sets and a forward greedy
 //! pass (the maximum-velocity-profile idea of TOPP-RA, Pham & Pham 2018; COPP's TOPP2-RA).
 //!
-//! It solves the same discretisation as [`super::clarabel`]: b = u̇² at stations, linear in u
-//! between them, each axis's acceleration bounded at both ends of every interval with that
-//! interval's ü = (b_{k+1} − b_k)/(2Δu_k), and every velocity limit merged into `b_k ≤ b_max_k`.
+//! It solves the same discretisation as [`super::clarabel`]: b = u̇² at stations, each axis's
+//! acceleration bounded at both ends of every interval (under the problem's
+//! [`Ramp`](crate::constraints::Ramp): with that interval's one ü, or with ü linear between its
+//! ends and the ends' ü eliminated, [`SpanProblem::interval_rows`]), and every velocity limit
+//! merged into `b_k ≤ b_max_k`.
 //!
 //! On interval k every row is linear in (x, y) = (b_k, b_{k+1}). Solved for y, a row is a line
 //! y ≤ α + βx (an *upper* line) or y ≥ α + βx (a *lower* line), or a bound on x alone. Some y
@@ -67,8 +69,9 @@ impl IntervalRows {
         }
     }
 
-    /// Builds interval k's rows, with b_{k+1} restricted to the set `next`; with
-    /// `lattice_only`, without the rows that are not max-closed (see [`is_lattice_row`]).
+    /// Builds interval k's rows ([`SpanProblem::interval_rows`]), with b_{k+1} restricted to
+    /// the set `next`; with `lattice_only`, without the rows that are not max-closed (see
+    /// [`is_lattice_row`]).
     fn build(&mut self, p: &SpanProblem, k: usize, next: &Set, lattice_only: bool) {
         self.upper.clear();
         self.lower.clear();
@@ -84,33 +87,13 @@ impl IntervalRows {
             beta: 0.0,
             src: next.lo_by,
         });
-        let inv = 1.0 / (2.0 * p.du(k));
-        for (e, at_end) in [(k, false), (k + 1, true)] {
-            let jet = p.jets.view(e);
-            for (j, lim) in p.acceleration.iter().enumerate() {
-                let rows = p.essential[e] >> (2 * j) & 3;
-                if rows == 0 {
-                    continue;
-                }
-                let (dq, ddq) = (jet.dq[j], jet.ddq[j]);
-                // ddq b_e + dq (y − x)/(2Δu) as cx x + cy y.
-                let (mut cx, mut cy) = (-dq * inv, dq * inv);
-                if at_end {
-                    cy += ddq;
-                } else {
-                    cx += ddq;
-                }
-                if lattice_only && !is_lattice_row(cx, cy) {
-                    continue;
-                }
-                if rows & 1 != 0 {
-                    self.le(cx, cy, lim.max, j);
-                }
-                if rows & 2 != 0 {
-                    self.le(-cx, -cy, -lim.min, j);
-                }
+        p.interval_rows(k, |r| {
+            if lattice_only && !is_lattice_row(r.cx, r.cy) {
+                return;
             }
-        }
+            let axis = r.limits[0].map_or(0, |l| l.0);
+            self.le(r.cx, r.cy, r.d, axis);
+        });
     }
 
     /// The x in `[x_min, x_max]` for which some y meets every row (with the limits that set
@@ -268,25 +251,10 @@ pub fn solve_lattice(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
 pub fn lattice_violations(p: &SpanProblem, b: &[f64], tol: f64) -> Vec<usize> {
     let mut out = Vec::new();
     for k in 0..p.intervals() {
-        let inv = 1.0 / (2.0 * p.du(k));
-        let udd = (b[k + 1] - b[k]) * inv;
-        let broken = [(k, false), (k + 1, true)].into_iter().any(|(e, at_end)| {
-            let jet = p.jets.view(e);
-            p.acceleration.iter().enumerate().any(|(j, lim)| {
-                let rows = p.essential[e] >> (2 * j) & 3;
-                let (dq, ddq) = (jet.dq[j], jet.ddq[j]);
-                let (cx, cy) = if at_end {
-                    (-dq * inv, dq * inv + ddq)
-                } else {
-                    (-dq * inv + ddq, dq * inv)
-                };
-                if rows == 0 || is_lattice_row(cx, cy) {
-                    return false;
-                }
-                let a = ddq * b[e] + dq * udd;
-                (rows & 1 != 0 && a > lim.max * (1.0 + tol))
-                    || (rows & 2 != 0 && a < lim.min * (1.0 + tol))
-            })
+        let mut broken = false;
+        p.interval_rows(k, |r| {
+            broken |=
+                !is_lattice_row(r.cx, r.cy) && r.cx * b[k] + r.cy * b[k + 1] > r.d + tol * r.scale;
         });
         if broken {
             out.push(k);
@@ -331,13 +299,11 @@ fn passes(p: &SpanProblem, lattice_only: bool) -> Result<SpanSolution, Infeasibl
         rows.build(p, k, &next, lattice_only);
         b.push(rows.y_max(b[k]).clamp(next.lo, next.hi));
     }
-    Ok(SpanSolution {
-        a: None,
-        slopes: None,
+    Ok(SpanSolution::acceleration_limited(
+        p,
         b,
-        status: Status::Greedy,
-        iterations: 0,
-        solve_time: t0.elapsed().as_secs_f64(),
-        scp_iterations: 0,
-    })
+        Status::Greedy,
+        0,
+        t0.elapsed().as_secs_f64(),
+    ))
 }

@@ -628,7 +628,7 @@ fn axis_ratios(
         for k in 0..p.intervals() {
             for e in [k, k + 1] {
                 for (j, series) in acc.iter_mut().enumerate() {
-                    let a = p.axis_acceleration(&sol.b, k, e, j);
+                    let a = p.axis_acceleration(&sol.b, sol.ends.as_deref(), k, e, j);
                     series.push((st[offset + e].t, machine.axes[j].acceleration.ratio(a)));
                 }
             }
