@@ -1028,80 +1028,164 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
     }
 }
 
-/// A tapping cycle is refused by the writer, naming the block that runs it: its moves are
-/// read as feeds at the tap's pitch × speed (the solve times them right), but written back as
-/// G1 blocks they would feed the tap in and out with the spindle turning forward, neither
-/// synchronised nor reversed, which strips the thread or breaks the tap. Round 17: a
-/// hyperMILL DMU 85 program's eight M14 holes (`CYCL DEF 207`, called by `M99`) and an NX Haas
-/// program's `G84` holes were written so. Every reader's tapping cycle is refused; a drilling
-/// cycle is still written.
-#[test]
-fn tapping_cycles_are_refused_not_written_as_feed_moves() {
-    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
-    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+/// The xyz pocket's machine, and a program read in `dialect`.
+fn xyz_and(name: &str, text: &str, dialect: Dialect) -> (Machine, Toolpath) {
+    let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
+    (m, toolpath::gcode::parse(Path::new(name), text, dialect).unwrap())
+}
+
+/// Written with peak feeds (the command line's default) in `dialect`.
+fn written_in(m: &Machine, t: &Toolpath, dialect: Dialect) -> feedopt::error::Result<Program> {
     let options = reach();
-    let fanuc = |cycle: &str| {
-        toolpath::gcode::parse(
-            Path::new("tap.nc"),
-            &format!(
-                "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\n\
-                 G99 {cycle} X5. Y0 Z-10. R2. F750.\nX15.\nG80\nM30\n%\n"
-            ),
-            Dialect::Fanuc,
-        )
-        .unwrap()
+    let sol = optimize(m, t, &options).unwrap();
+    program(m, t, &sol, &options.geometry, &peak(dialect))
+}
+
+/// The program read back (no warning), with its points equal to the input's, each tap's
+/// feeds in and out the input's, and its schedule's cycle time the input's (the same points
+/// at the same feeds: the same schedule).
+fn tapped_back(m: &Machine, input: &Toolpath, prog: &Program, dialect: Dialect) -> Toolpath {
+    let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, dialect).unwrap();
+    assert!(back.warnings.is_empty(), "{dialect}: {:?}", back.warnings);
+    let at = |t: &Toolpath| -> Vec<[f64; 3]> {
+        let mut v: Vec<[f64; 3]> = Vec::new();
+        for p in &t.points {
+            let q = [p.p.x, p.p.y, p.p.z];
+            if v.last() != Some(&q) {
+                v.push(q);
+            }
+        }
+        v
     };
-    let written = |t: &Toolpath| {
-        let sol = optimize(&m, t, &options).unwrap();
-        program(&m, t, &sol, &options.geometry, &peak(Dialect::Fanuc)).map(|p| p.text)
-    };
-    // Drilling (G81) is written; tapping (G84, left-hand G74) is not.
-    assert!(written(&fanuc("G81")).is_ok());
-    for (cycle, name) in [("G84", "G84"), ("G74", "G74")] {
-        let e = written(&fanuc(cycle)).unwrap_err().to_string();
+    let (want, got) = (at(input), at(&back));
+    assert_eq!(got.len(), want.len(), "{dialect}:\n{}", prog.text);
+    for (a, b) in got.iter().zip(&want) {
+        assert!((0..3).all(|i| (a[i] - b[i]).abs() < 1e-6), "{dialect}: {a:?} vs {b:?}");
+    }
+    assert_eq!(back.taps.len(), input.taps.len(), "{dialect}");
+    for (a, b) in back.taps.iter().zip(&input.taps) {
         assert!(
-            e.contains("tap.nc:5:")
-                && e.contains(&format!("{name}: a tapping cycle (and 1 more)"))
-                && e.contains("feedopt solve"),
-            "{e}"
+            (a.feed_in - b.feed_in).abs() < 1e-6 * b.feed_in
+                && (a.feed_out - b.feed_out).abs() < 1e-6 * b.feed_out
+                && (a.dwell - b.dwell).abs() < 1e-9
+                && a.left_hand == b.left_hand,
+            "{dialect}: {a:?} vs {b:?}"
         );
     }
-    // Sinumerik CYCLE84 (called and modal), Klartext 207 (by M99), APT CYCLE/TAP.
-    let sinumerik = |call: &str| {
-        toolpath::gcode::parse(
-            Path::new("tap.mpf"),
-            &format!("G71 G90 G17 G94\nS500 M3\nG0 X0 Y0 Z50\nF60\n{call}\nM30\n"),
-            Dialect::Sinumerik,
-        )
-        .unwrap()
+    // The program's own sum is what its blocks and cycles take at their feeds.
+    let time = programmed_time(&back).unwrap() + back.dwell_time();
+    assert!((prog.time - time).abs() < 1e-6, "{dialect}: {} vs {time}", prog.time);
+    let options = reach();
+    let (before, after) = (
+        optimize(m, input, &options).unwrap().schedule.cycle_time,
+        optimize(m, &back, &options).unwrap().schedule.cycle_time,
+    );
+    assert!(
+        (before - after).abs() <= 1e-3 * before,
+        "{dialect}: solved again {after} s, the input {before} s"
+    );
+    back
+}
+
+/// A Fanuc program that mills, taps three holes with a modal G84 (M3, S500, F750 = pitch
+/// 1.5 × S in G94) and mills on.
+const FANUC_TAPS: &str = "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\nG1 Z0 F300.\n\
+    G1 X20. F600.\nG0 Z10.\nG98 G84 X5. Y0 Z-10. R2. F750.\nX15.\nY10.\nG80\nG0 X30. Y5.\n\
+    G1 Z0 F300.\nG1 X40. F600.\nG0 Z10.\nM30\n%\n";
+
+/// Each output dialect writes a modal tap's holes as its own tapping cycle, never as feed
+/// moves (round 17: an NX Haas program's G84 holes were written as G1 in and out, which
+/// strips the thread or breaks the tap), and the written program reads back to the same CL
+/// points, the same taps at the same feeds, and the same schedule.
+#[test]
+fn taps_are_written_as_each_dialects_tapping_cycle_and_read_back_to_the_same_points() {
+    let (m, input) = xyz_and("tap.nc", FANUC_TAPS, Dialect::Fanuc);
+    assert_eq!(input.taps.len(), 3);
+    for (dialect, cycle) in [
+        (Dialect::Fanuc, "G99 G84 X"),
+        (Dialect::LinuxCnc, "G33.1 Z"),
+        (Dialect::Sinumerik, "CYCLE84("),
+    ] {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        // One cycle per hole, and no feed move of a tap's (Z-10 is only ever a cycle's).
+        assert_eq!(prog.text.matches(cycle).count(), 3, "{dialect}:\n{}", prog.text);
+        assert!(
+            !prog.text.lines().any(|l| l.starts_with("G1") && l.contains("Z-10.")),
+            "{dialect}:\n{}",
+            prog.text
+        );
+        tapped_back(&m, &input, &prog, dialect);
+    }
+}
+
+/// One hole's block in each dialect, as its manual writes it:
+/// * Fanuc (Series 30i/0i operator's manual, "Rigid tapping (G84)"): `M29 S…` before
+///   `G84 X Y Z R P F K`, F in mm/min under G94 = pitch × S; G99 returns to R, `G80` cancels.
+/// * LinuxCNC (G-code reference, "G33.1 Rigid Tapping"): `G33.1 X- Y- Z- K- I- $-`, K the
+///   distance per revolution; "for Z only tapping preposition the XY location prior to
+///   calling G33.1 and only use a Z word"; the move ends at the original coordinate.
+/// * Sinumerik 840D (cycles manual, CYCLE84 "Tapping without compensating chuck"):
+///   `CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1)`, SDAC 3 for M3
+///   after the cycle, PIT in the program's unit, SST the speed in, SST1 out.
+#[test]
+fn a_holes_tapping_block_is_the_manuals_form_in_each_dialect() {
+    let one = FANUC_TAPS.replace("X15.\nY10.\n", "");
+    let (m, input) = xyz_and("tap.nc", &one, Dialect::Fanuc);
+    let block = |dialect: Dialect| -> Vec<String> {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        let lines: Vec<String> = prog.text.lines().map(String::from).collect();
+        // The block over the hole at R, then the cycle, then on to the initial level.
+        let at = lines
+            .iter()
+            .position(|l| l.starts_with("G1 X5.000000 Y0.000000 Z2.000000 "))
+            .unwrap_or_else(|| panic!("{dialect}:\n{}", prog.text));
+        let end = (at + 1..lines.len())
+            .find(|&k| lines[k].starts_with("G1 "))
+            .unwrap();
+        assert!(lines[end].starts_with("G1 X5.000000 Y0.000000 Z10.000000 "));
+        lines[at + 1..end].to_vec()
     };
-    let called = sinumerik("CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)");
-    let e = written(&called).unwrap_err().to_string();
-    assert!(e.contains("tap.mpf:5:") && e.contains("CYCLE84"), "{e}");
-    let modal = sinumerik("MCALL CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)\nX10\nMCALL");
-    let e = written(&modal).unwrap_err().to_string();
-    assert!(
-        e.contains("tap.mpf:6:") && e.contains("MCALL CYCLE84"),
-        "{e}"
+    assert_eq!(
+        block(Dialect::Fanuc),
+        [
+            "M29 S500",
+            "G99 G84 X5.000000 Y0.000000 Z-10.000000 R2.000000 F750.0000",
+            "G80"
+        ]
     );
-    let text = "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
-                3 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3 ;SET-UP CLEARANCE~\n\
-                Q201=-12 ;DEPTH~\n Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n\
-                Q204=5 ;2ND SET-UP CLEARANCE\n4 L X+0 Y+0 R0 F MAX M99\n5 END PGM T MM\n";
-    let call = 1 + text.lines().position(|l| l.contains("M99")).unwrap();
-    let klartext = toolpath::gcode::parse(Path::new("tap.h"), text, Dialect::Heidenhain).unwrap();
-    let e = written(&klartext).unwrap_err().to_string();
-    assert!(
-        e.contains(&format!("tap.h:{call}:"))
-            && e.contains("CYCL DEF 207 (at line 4): a tapping cycle;"),
-        "{e}"
+    assert_eq!(block(Dialect::LinuxCnc), ["G33.1 Z-10.000000 K1.5"]);
+    assert_eq!(
+        block(Dialect::Sinumerik),
+        ["CYCLE84(2.000000,2.000000,0,-10.000000,,,3,,1.5,0,500,500)"]
     );
-    let apt = toolpath::apt::parse(
-        Path::new("tap.cls"),
-        "FEDRAT/MMPM,300\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0\n\
-         CYCLE/OFF\nGOTO/5,0,20\n",
-    )
-    .unwrap();
-    let e = written(&apt).unwrap_err().to_string();
-    assert!(e.contains("tap.cls:4:") && e.contains("CYCLE/TAP"), "{e}");
+}
+
+/// A tap between milling moves changes nothing around it: the program whose holes are
+/// bored with G85 (feed in, feed out at the same F: the same points at the same feeds) is
+/// written with the same blocks, the tap's two G1 blocks per hole replaced by its cycle.
+#[test]
+fn a_tap_between_milling_moves_leaves_the_neighbouring_blocks_as_they_are() {
+    let (m, tapped) = xyz_and("tap.nc", FANUC_TAPS, Dialect::Fanuc);
+    let (_, bored) = xyz_and("bore.nc", &FANUC_TAPS.replace("G84", "G85"), Dialect::Fanuc);
+    for dialect in Dialect::GCODE {
+        let a = written_in(&m, &tapped, dialect).unwrap();
+        let b = written_in(&m, &bored, dialect).unwrap();
+        // (Comments name the file.) The tap's cycle lines; the bore's feeds at F750, the
+        // only blocks at that feed.
+        let tap_words = ["M29 ", "G99 G84", "G80", "G33.1", "CYCLE84("];
+        let rest = |text: &str, drop: &dyn Fn(&str) -> bool| -> Vec<String> {
+            text.lines()
+                .filter(|l| !l.starts_with('(') && !l.starts_with(';'))
+                .filter(|l| !drop(l))
+                .map(String::from)
+                .collect()
+        };
+        let around_taps = rest(&a.text, &|l| tap_words.iter().any(|w| l.starts_with(w)));
+        let around_bores = rest(&b.text, &|l| l.starts_with("G1 ") && l.ends_with(" F750.0000"));
+        assert_eq!(b.text.matches(" F750.0000").count(), 6, "{}", b.text);
+        assert_eq!(around_taps, around_bores, "{dialect}:\n{}\n---\n{}", a.text, b.text);
+        assert_eq!(a.blocks, b.blocks, "{dialect}: a cycle stands for the tap's two blocks");
+        // The same schedule: the moves around the tap take the time they took.
+        assert!((a.time - b.time).abs() < 1e-6, "{} vs {}", a.time, b.time);
+    }
 }
