@@ -1031,7 +1031,10 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
 /// The xyz pocket's machine, and a program read in `dialect`.
 fn xyz_and(name: &str, text: &str, dialect: Dialect) -> (Machine, Toolpath) {
     let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
-    (m, toolpath::gcode::parse(Path::new(name), text, dialect).unwrap())
+    (
+        m,
+        toolpath::gcode::parse(Path::new(name), text, dialect).unwrap(),
+    )
 }
 
 /// Written with peak feeds (the command line's default) in `dialect`.
@@ -1060,7 +1063,10 @@ fn tapped_back(m: &Machine, input: &Toolpath, prog: &Program, dialect: Dialect) 
     let (want, got) = (at(input), at(&back));
     assert_eq!(got.len(), want.len(), "{dialect}:\n{}", prog.text);
     for (a, b) in got.iter().zip(&want) {
-        assert!((0..3).all(|i| (a[i] - b[i]).abs() < 1e-6), "{dialect}: {a:?} vs {b:?}");
+        assert!(
+            (0..3).all(|i| (a[i] - b[i]).abs() < 1e-6),
+            "{dialect}: {a:?} vs {b:?}"
+        );
     }
     assert_eq!(back.taps.len(), input.taps.len(), "{dialect}");
     for (a, b) in back.taps.iter().zip(&input.taps) {
@@ -1074,7 +1080,11 @@ fn tapped_back(m: &Machine, input: &Toolpath, prog: &Program, dialect: Dialect) 
     }
     // The program's own sum is what its blocks and cycles take at their feeds.
     let time = programmed_time(&back).unwrap() + back.dwell_time();
-    assert!((prog.time - time).abs() < 1e-6, "{dialect}: {} vs {time}", prog.time);
+    assert!(
+        (prog.time - time).abs() < 1e-6,
+        "{dialect}: {} vs {time}",
+        prog.time
+    );
     let options = reach();
     let (before, after) = (
         optimize(m, input, &options).unwrap().schedule.cycle_time,
@@ -1108,9 +1118,17 @@ fn taps_are_written_as_each_dialects_tapping_cycle_and_read_back_to_the_same_poi
     ] {
         let prog = written_in(&m, &input, dialect).unwrap();
         // One cycle per hole, and no feed move of a tap's (Z-10 is only ever a cycle's).
-        assert_eq!(prog.text.matches(cycle).count(), 3, "{dialect}:\n{}", prog.text);
+        assert_eq!(
+            prog.text.matches(cycle).count(),
+            3,
+            "{dialect}:\n{}",
+            prog.text
+        );
         assert!(
-            !prog.text.lines().any(|l| l.starts_with("G1") && l.contains("Z-10.")),
+            !prog
+                .text
+                .lines()
+                .any(|l| l.starts_with("G1") && l.contains("Z-10.")),
             "{dialect}:\n{}",
             prog.text
         );
@@ -1181,11 +1199,261 @@ fn a_tap_between_milling_moves_leaves_the_neighbouring_blocks_as_they_are() {
                 .collect()
         };
         let around_taps = rest(&a.text, &|l| tap_words.iter().any(|w| l.starts_with(w)));
-        let around_bores = rest(&b.text, &|l| l.starts_with("G1 ") && l.ends_with(" F750.0000"));
+        let around_bores = rest(&b.text, &|l| {
+            l.starts_with("G1 ") && l.ends_with(" F750.0000")
+        });
         assert_eq!(b.text.matches(" F750.0000").count(), 6, "{}", b.text);
-        assert_eq!(around_taps, around_bores, "{dialect}:\n{}\n---\n{}", a.text, b.text);
-        assert_eq!(a.blocks, b.blocks, "{dialect}: a cycle stands for the tap's two blocks");
+        assert_eq!(
+            around_taps, around_bores,
+            "{dialect}:\n{}\n---\n{}",
+            a.text, b.text
+        );
+        assert_eq!(
+            a.blocks, b.blocks,
+            "{dialect}: a cycle stands for the tap's two blocks"
+        );
         // The same schedule: the moves around the tap take the time they took.
         assert!((a.time - b.time).abs() < 1e-6, "{} vs {}", a.time, b.time);
     }
+}
+
+/// A left-hand tap (G74, the spindle M4) with a dwell at the bottom: Fanuc writes `G74 … P`
+/// (P in ms in a Fanuc cycle), Sinumerik a negative PIT (CYCLE84: "the sign of the pitch
+/// gives the direction of rotation") and DTB in s; LinuxCNC's G33.1 has no dwell (it reverses
+/// at the bottom) and is refused, naming the line. Without the dwell, G33.1 taps in the
+/// spindle's M4.
+#[test]
+fn a_left_hand_tap_with_a_dwell_is_written_where_the_cycle_can_say_it() {
+    let text = "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S400 M4\n\
+                G99 G74 X5. Y0 Z-8. R2. P250 F500.\nG80\nG0 Z10.\nM30\n%\n";
+    let (m, input) = xyz_and("left.nc", text, Dialect::Fanuc);
+    assert!(input.taps[0].left_hand && input.taps[0].dwell == 0.25);
+    let fanuc = written_in(&m, &input, Dialect::Fanuc).unwrap();
+    assert!(
+        fanuc.text.contains(
+            "M29 S400\nG99 G74 X5.000000 Y0.000000 Z-8.000000 R2.000000 P250 F500.0000\nG80\n"
+        ),
+        "{}",
+        fanuc.text
+    );
+    tapped_back(&m, &input, &fanuc, Dialect::Fanuc);
+    let sinumerik = written_in(&m, &input, Dialect::Sinumerik).unwrap();
+    assert!(
+        sinumerik
+            .text
+            .contains("CYCLE84(2.000000,2.000000,0,-8.000000,,0.250000,4,,-1.25,0,400,400)"),
+        "{}",
+        sinumerik.text
+    );
+    tapped_back(&m, &input, &sinumerik, Dialect::Sinumerik);
+    let e = written_in(&m, &input, Dialect::LinuxCnc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("left.nc:5:") && e.contains("G74") && e.contains("dwells 0.25 s"),
+        "{e}"
+    );
+    let (_, no_dwell) = xyz_and("left.nc", &text.replace(" P250", ""), Dialect::Fanuc);
+    let linuxcnc = written_in(&m, &no_dwell, Dialect::LinuxCnc).unwrap();
+    assert!(
+        linuxcnc.text.contains("\nG33.1 Z-8.000000 K1.25\n"),
+        "{}",
+        linuxcnc.text
+    );
+    let back = tapped_back(&m, &no_dwell, &linuxcnc, Dialect::LinuxCnc);
+    assert!(back.taps[0].left_hand);
+}
+
+/// Sinumerik's CYCLE84 retracts at SST1: Sinumerik writes it back, LinuxCNC as G33.1's
+/// speed factor I (SST1 / SST), and Fanuc, whose G84 retracts at F (its retract override is
+/// machine data), refuses the tap, naming its line.
+#[test]
+fn a_tap_that_retracts_faster_is_written_where_the_cycle_says_so() {
+    let text = "G71 G90 G17 G94\nS500 M3\nG0 X4 Y3 Z20\nF60\n\
+                CYCLE84(20,0,2,-12,,,3,,1.5,0,500,1000)\nG0 X30\nM30\n";
+    let (m, input) = xyz_and("fast.mpf", text, Dialect::Sinumerik);
+    let tap = &input.taps[0];
+    assert!((tap.feed_in - 750.0).abs() < 1e-9 && (tap.feed_out - 1500.0).abs() < 1e-9);
+    let sinumerik = written_in(&m, &input, Dialect::Sinumerik).unwrap();
+    assert!(
+        sinumerik
+            .text
+            .contains("\nCYCLE84(2.000000,2.000000,0,-12.000000,,,3,,1.5,0,500,1000)\n"),
+        "{}",
+        sinumerik.text
+    );
+    tapped_back(&m, &input, &sinumerik, Dialect::Sinumerik);
+    let linuxcnc = written_in(&m, &input, Dialect::LinuxCnc).unwrap();
+    assert!(
+        linuxcnc.text.contains("\nG33.1 Z-12.000000 K1.5 I2\n"),
+        "{}",
+        linuxcnc.text
+    );
+    tapped_back(&m, &input, &linuxcnc, Dialect::LinuxCnc);
+    let e = written_in(&m, &input, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("fast.mpf:5:") && e.contains("feeds out at 1500 mm/min, in at 750"),
+        "{e}"
+    );
+}
+
+/// On a machine with tool-tip mode, a tap with every rotary axis at zero is written out of
+/// it (Fanuc `G49`, the tool's `G43 H`, the cycle, `G43.4` again; LinuxCNC `M429`/`M428`;
+/// Sinumerik `TRAFOOF`/`TRAORI`) and reads back to the same points. With the head turned
+/// (C45: the tool still along Z, but out of tool-tip mode the coordinates turn with it) or
+/// tilted (A30, the tap along the tool), it is refused as a tilted tap, naming the line.
+#[test]
+fn a_tap_under_tool_tip_mode_is_written_out_of_it_and_a_tilted_one_is_refused() {
+    let (m, _) = bundled("seed_head_head", "impeller_blade.cls");
+    let text = |c: &str| {
+        format!(
+            "%\nO1\nG21 G90 G94\nT2 M6\nG43.4 H2\nG0 X0 Y0 Z50. A0 C{c} S600 M3\n\
+             G1 Z10. F1000.\nG1 X10. F800.\nG0 Z20.\nG98 G84 X20. Y0 Z-6. R2. F900.\nG80\n\
+             G0 Z50.\nG1 X40. F800.\nG49\nM30\n%\n"
+        )
+    };
+    let input = toolpath::gcode::parse(Path::new("tcp.nc"), &text("0"), Dialect::Fanuc).unwrap();
+    for (dialect, around) in [
+        (
+            Dialect::Fanuc,
+            [
+                "G49",
+                "G43 H2",
+                "M29 S600",
+                "G99 G84 X20.000000 Y0.000000 Z-6.000000 R2.000000 F900.0000",
+                "G80",
+                "G43.4 H2",
+            ],
+        ),
+        (
+            Dialect::LinuxCnc,
+            ["M429", "G33.1 Z-6.000000 K1.5", "M428", "", "", ""],
+        ),
+        (
+            Dialect::Sinumerik,
+            [
+                "TRAFOOF",
+                "CYCLE84(2.000000,2.000000,0,-6.000000,,,3,,1.5,0,600,600)",
+                "TRAORI",
+                "",
+                "",
+                "",
+            ],
+        ),
+    ] {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        let want: Vec<&str> = around.iter().copied().filter(|l| !l.is_empty()).collect();
+        let lines: Vec<&str> = prog.text.lines().collect();
+        assert!(
+            lines.windows(want.len()).any(|w| w == want.as_slice()),
+            "{dialect}:\n{}",
+            prog.text
+        );
+        tapped_back(&m, &input, &prog, dialect);
+    }
+    let turned = toolpath::gcode::parse(Path::new("tcp.nc"), &text("45"), Dialect::Fanuc).unwrap();
+    let e = written_in(&m, &turned, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tcp.nc:10:") && e.contains("rotary axes stand at"),
+        "{e}"
+    );
+    // APT: the tap along a tool tilted 30° about X.
+    let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+    let apt = toolpath::apt::parse(
+        Path::new("tilt.cls"),
+        &format!(
+            "FEDRAT/MMPM,300\nSPINDL/RPM,500,CLW\nGOTO/0,0,20,0,{},{}\n\
+             CYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0,0,{},{}\nCYCLE/OFF\nGOTO/5,0,20\n",
+            -s, c, -s, c
+        ),
+    )
+    .unwrap();
+    let e = written_in(&m, &apt, Dialect::Sinumerik)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tilt.cls:5:")
+            && e.contains("tilted by 30.000°")
+            && e.contains("not written yet"),
+        "{e}"
+    );
+}
+
+/// Klartext 207 (rigid tapping) is written in each dialect; 209 with chip breaking (Q257: in
+/// steps, back Q256 between them) is refused: its steps are no output cycle's. APT's
+/// `CYCLE/TAP` is written (the speed is the `SPINDL/`'s).
+#[test]
+fn klartext_and_apt_taps_are_written_and_chip_breaking_is_refused() {
+    let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let klartext = |cycle: &str, extra: &str| {
+        format!(
+            "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 M3\n3 L X+0 Y+0 Z+10 R0 FMAX\n\
+             4 CYCL DEF {cycle}~\n Q200=3 ;SET-UP CLEARANCE~\n Q201=-12 ;DEPTH~\n\
+             Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n{extra}\
+             Q204=5 ;2ND SET-UP CLEARANCE\n5 L X+0 Y+0 R0 F MAX M99\n6 END PGM T MM\n"
+        )
+    };
+    let t207 = toolpath::gcode::parse(
+        Path::new("tap.h"),
+        &klartext("207 RIGID TAPPING NEW", ""),
+        Dialect::Heidenhain,
+    )
+    .unwrap();
+    for dialect in Dialect::GCODE {
+        let prog = written_in(&m, &t207, dialect).unwrap();
+        tapped_back(&m, &t207, &prog, dialect);
+    }
+    let t209 = toolpath::gcode::parse(
+        Path::new("tap.h"),
+        &klartext(
+            "209 TAPPING W/ CHIP BRKG",
+            " Q257=4 ;DEPTH FOR CHIP BRKG~\n Q256=1 ;DIST FOR CHIP BRKG~\n Q336=0 ;ANGLE OF SPINDLE~\n",
+        ),
+        Dialect::Heidenhain,
+    )
+    .unwrap();
+    let call = 1 + klartext("209", "")
+        .lines()
+        .position(|l| l.contains("M99"))
+        .unwrap();
+    let e = written_in(&m, &t209, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("tap.h:{}:", call + 3)) && e.contains("breaks chips"),
+        "{e}"
+    );
+    let apt = toolpath::apt::parse(
+        Path::new("tap.cls"),
+        "FEDRAT/MMPM,300\nSPINDL/RPM,500,CLW\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\n\
+         GOTO/5,0,0\nCYCLE/OFF\nGOTO/5,0,20\n",
+    )
+    .unwrap();
+    let prog = written_in(&m, &apt, Dialect::Fanuc).unwrap();
+    assert!(
+        prog.text.contains(
+            "\nM29 S500\nG99 G84 X5.000000 Y0.000000 Z-10.000000 R2.000000 F750.0000\nG80\n"
+        ),
+        "{}",
+        prog.text
+    );
+    tapped_back(&m, &apt, &prog, Dialect::Fanuc);
+    // Without a spindle speed the cycle has no pitch to tap at: refused, naming the line.
+    let no_speed = toolpath::apt::parse(
+        Path::new("tap.cls"),
+        "FEDRAT/MMPM,300\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0\n\
+         CYCLE/OFF\nGOTO/5,0,20\n",
+    )
+    .unwrap();
+    let e = written_in(&m, &no_speed, Dialect::Sinumerik)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tap.cls:4:") && e.contains("no spindle speed"),
+        "{e}"
+    );
 }
