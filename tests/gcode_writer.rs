@@ -1361,6 +1361,20 @@ fn a_tap_under_tool_tip_mode_is_written_out_of_it_and_a_tilted_one_is_refused() 
         e.contains("tcp.nc:10:") && e.contains("rotary axes stand at"),
         "{e}"
     );
+    // The head tilted (A30) under tool-tip mode, the cycle along the part's Z (no tilted
+    // plane: as NX's Mori NMV5000 and DMU 70 eVo programs tap): the tap would feed 30° off its
+    // own axis, which no cycle written reproduces.
+    let tilted = text("0").replace("G98 G84", "G0 A30.\nG98 G84");
+    let tilted = toolpath::gcode::parse(Path::new("tcp.nc"), &tilted, Dialect::Fanuc).unwrap();
+    let e = written_in(&m, &tilted, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tcp.nc:11:")
+            && e.contains("30.000° off the direction the cycle feeds")
+            && e.contains("A30"),
+        "{e}"
+    );
     // APT: the tap along a tool tilted 30° about X.
     let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
     let apt = toolpath::apt::parse(
@@ -1376,9 +1390,7 @@ fn a_tap_under_tool_tip_mode_is_written_out_of_it_and_a_tilted_one_is_refused() 
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("tilt.cls:5:")
-            && e.contains("tilted by 30.000°")
-            && e.contains("not written yet"),
+        e.contains("tilt.cls:5:") && e.contains("30.000° off Z") && e.contains("not written yet"),
         "{e}"
     );
 }

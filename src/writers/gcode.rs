@@ -277,15 +277,18 @@ impl std::fmt::Display for BlockFeed {
 pub struct Program {
     /// The program, as written to the file.
     pub text: String,
-    /// Motion blocks after the first point (each with its F).
+    /// Motion blocks after the first point (each with its F; a tap's cycle counts as its two
+    /// moves, in and out).
     pub blocks: usize,
     /// Of those, blocks under G93.
     pub inverse_time_blocks: usize,
     /// Sum of the written blocks' times at their F (no acceleration), s, and of the dwells
     /// (`dwell_time`): the schedule's cycle time under [`BlockFeed::Average`], less under
-    /// [`BlockFeed::Peak`].
+    /// [`BlockFeed::Peak`]. A tap's cycle counts at its feed in and out, as a control runs
+    /// it: under `Average` too, less than the schedule's time for it by its stops.
     pub time: f64,
-    /// Sum of the written dwells (G4), s: the program's, each where it stands.
+    /// Sum of the written dwells (G4, and those of the taps' cycles), s: the program's, each
+    /// where it stands.
     pub dwell_time: f64,
     /// Blocks merged away because they were shorter than [`MIN_BLOCK_TIME_S`].
     pub merged: usize,
@@ -1024,6 +1027,18 @@ fn spindle_direction(toolpath: &Toolpath, point: usize) -> Option<bool> {
         .flatten()
 }
 
+/// Why a tap whose tool stands `degrees` off the direction its cycle feeds (Z, no tilted
+/// plane in force) is not written; `at`: the rotary words there.
+fn off_axis(degrees: f64, at: &str) -> String {
+    format!(
+        "the tool axis stands {degrees:.3}° off the direction the cycle feeds (Z: no tilted \
+         working plane is in force{at}): as programmed, the tap feeds at that angle to its own \
+         axis, which no tapping cycle feedopt writes reproduces (a tilted tap needs the tilted \
+         working plane, G68.2, CYCLE800 or PLANE, which is not written yet); post the holes \
+         under the tilted plane"
+    )
+}
+
 /// Each tap of the toolpath as the output's cycle can write it, or an error naming the first
 /// it cannot (module doc, "Tapping"): a tap is never written as feed moves.
 fn tap_plans(toolpath: &Toolpath, dialect: Dialect) -> Result<Vec<TapPlan>> {
@@ -1058,28 +1073,24 @@ fn tap_plans(toolpath: &Toolpath, dialect: Dialect) -> Result<Vec<TapPlan>> {
             &pts[range.start],
             &pts[range.end - 1],
         );
-        // A tilted tap: under a tilted working plane or frame, or with the tool off +Z.
+        // A tilted tap: under a tilted working plane or frame (APT: along a tilted tool).
         let tilt = |v: &nalgebra::Vector3<f64>| v.angle(&z).to_degrees();
-        // (Points with rotary positions: the writer checks the tool axis they give.)
+        if tilt(&tap.axis) > 1e-6 {
+            return refuse(format!(
+                "it feeds along an axis {:.3}° off Z (a tilted working plane or frame, or a \
+                 tilted tool), and a tilted tap is not written yet",
+                tilt(&tap.axis)
+            ));
+        }
+        // A tool off the direction the cycle feeds (points given with a tool vector; those
+        // with rotary positions: the writer checks the tool axis they give).
         if let Some(o) = [top, bottom, back]
             .iter()
             .filter(|p| p.rotary.is_none())
             .map(|p| p.o)
-            .find(|o| tilt(o) > 1e-6)
+            .find(|o| o.angle(&tap.axis) > 1e-8)
         {
-            return refuse(format!(
-                "the tool axis is tilted by {:.3}° from Z, and a tilted tap (under G68.2, \
-                CYCLE800 or a Klartext PLANE, not under tool-tip mode, which these controls \
-                refuse in a tapping cycle) is not written yet",
-                tilt(&o)
-            ));
-        }
-        if tilt(&tap.axis) > 1e-6 {
-            return refuse(format!(
-                "it taps along an axis tilted by {:.3}° from Z (a tilted working plane or frame), \
-                and a tilted tap is not written yet",
-                tilt(&tap.axis)
-            ));
+            return refuse(off_axis(o.angle(&tap.axis).to_degrees(), ""));
         }
         let down = bottom.p - top.p;
         if (back.p - top.p).norm() > 1e-6 || down.xy().norm() > 1e-6 || down.z >= 0.0 {
@@ -1164,7 +1175,7 @@ fn tap_plans(toolpath: &Toolpath, dialect: Dialect) -> Result<Vec<TapPlan>> {
 /// stands) down to `bottom` (Z) and back, with the time its moves take at the written feed
 /// (in and out, no acceleration) and the dwell it writes (module doc, "Tapping"). Out of
 /// tool-tip mode: on a Fanuc machine with it, the tool's length offset `G43 H` for the cycle.
-fn tap_cycle(setup: &mut Setup, plan: &TapPlan, top: [f64; 3], bottom: f64) -> (String, f64, f64) {
+fn tap_cycle(setup: &Setup, plan: &TapPlan, top: [f64; 3], bottom: f64) -> (String, f64, f64) {
     let depth = top[2] - bottom;
     let (x, y, r, z) = (coord(top[0]), coord(top[1]), coord(top[2]), coord(bottom));
     // The feed a cycle reads back: pitch × S as written.
@@ -1501,6 +1512,7 @@ pub fn program(
     // added), and the dwells the taps' cycles write.
     let mut last_point = first.point;
     let mut tap_dwell = 0.0;
+    let mut taps_written = 0usize;
     for (w, &i) in keep.iter().enumerate().skip(1) {
         let n = &nodes[i];
         setup.before(&mut text, n.point);
@@ -1531,27 +1543,22 @@ pub fn program(
                         ),
                     ));
                 }
-                // A tilted tap (module doc, "Tapping"): the tool off Z, or on a machine with
-                // tool-tip mode the rotary axes off zero.
+                // A tilted tap (module doc, "Tapping"): the tool off the direction the cycle
+                // feeds, or on a machine with tool-tip mode the rotary axes off zero.
                 let tool = kin.tool_axis(n.angles);
-                let tilt = tool.angle(&nalgebra::Vector3::z()).to_degrees();
+                let off = tool.angle(&tap.axis).to_degrees();
                 let at: Vec<String> = rotary
                     .iter()
                     .zip(&r)
                     .map(|((name, _), v)| format!("{name}{v}"))
                     .collect();
-                let why = if tilt > 1e-6 {
-                    Some(format!(
-                        "the tool axis stands {tilt:.3}° off Z, the direction the cycle feeds \
-                         ({}), and a tilted tap (under G68.2, CYCLE800, PLANE: these controls \
-                         run no tapping cycle under tool-tip mode) is not written yet",
-                        at.join(" ")
-                    ))
+                let why = if off > 1e-6 {
+                    Some(off_axis(off, &format!("; {}", at.join(" "))))
                 } else if setup.tcp && prev_r.iter().chain(&r).any(|a| *a != 0.0) {
                     Some(format!(
                         "the rotary axes stand at {}: the controls run a tapping cycle out of \
-                         tool-tip mode, where these coordinates would turn with the axes, which \
-                         is not written yet",
+                         tool-tip mode, where these coordinates would turn with the axes, and \
+                         such a tap is not written yet",
                         at.join(" ")
                     ))
                 } else {
@@ -1573,10 +1580,11 @@ pub fn program(
                     inverse_mode = false;
                 }
                 setup.tcp_off(&mut text);
-                let (block, secs, dwell) = tap_cycle(&mut setup, plan, prev_p, p[2]);
+                let (block, secs, dwell) = tap_cycle(&setup, plan, prev_p, p[2]);
                 let _ = writeln!(text, "{block}");
                 total += secs;
                 tap_dwell += dwell;
+                taps_written += 1;
                 let rest = dwell_after[w] - plan.dwell;
                 if rest.abs() > 1e-9 {
                     return Err(toolpath.error_at(
@@ -1648,6 +1656,19 @@ pub fn program(
         dwell(&mut text, dwell_after[w]);
         blocks += 1;
         (prev_p, prev_r, prev_t) = (p, r, n.t);
+    }
+    if taps_written != taps.len() {
+        // (A tap whose bottom no written block reached: never dropped quietly.)
+        let tap = &toolpath.taps[taps[taps_written.min(taps.len() - 1)].tap];
+        return Err(toolpath.error_at(
+            tap.line,
+            format!(
+                "internal: {}: {} of the program's {} taps were written",
+                tap.name,
+                taps_written,
+                taps.len()
+            ),
+        ));
     }
     if inverse_mode {
         let _ = writeln!(text, "G94");
