@@ -1032,10 +1032,9 @@ fn spindle_direction(toolpath: &Toolpath, point: usize) -> Option<bool> {
 fn off_axis(degrees: f64, at: &str) -> String {
     format!(
         "the tool axis stands {degrees:.3}° off the direction the cycle feeds (Z: no tilted \
-         working plane is in force{at}): as programmed, the tap feeds at that angle to its own \
-         axis, which no tapping cycle feedopt writes reproduces (a tilted tap needs the tilted \
-         working plane, G68.2, CYCLE800 or PLANE, which is not written yet); post the holes \
-         under the tilted plane"
+         working plane is in force{at}): as read, the tap feeds at that angle to its own axis, \
+         and a tilted tap, which needs the tilted working plane (G68.2, CYCLE800, PLANE), is \
+         not written yet"
     )
 }
 
