@@ -1228,6 +1228,21 @@ fn a_left_hand_tap_with_a_dwell_is_written_where_the_cycle_can_say_it() {
                 G99 G74 X5. Y0 Z-8. R2. P250 F500.\nG80\nG0 Z10.\nM30\n%\n";
     let (m, input) = xyz_and("left.nc", text, Dialect::Fanuc);
     assert!(input.taps[0].left_hand && input.taps[0].dwell == 0.25);
+    assert!(input.warnings.is_empty(), "{:?}", input.warnings);
+    // A Q (Fanuc peck tapping, machine data) is read as one pass, and said.
+    let (_, pecks) = xyz_and(
+        "left.nc",
+        &text.replace(" P250", " P250 Q3."),
+        Dialect::Fanuc,
+    );
+    assert!(
+        pecks
+            .warnings
+            .iter()
+            .any(|w| w.line == 5 && w.message.contains("PCT")),
+        "{:?}",
+        pecks.warnings
+    );
     let fanuc = written_in(&m, &input, Dialect::Fanuc).unwrap();
     assert!(
         fanuc.text.contains(

@@ -2479,6 +2479,17 @@ impl<'a> Interpreter<'a> {
         })?;
         if let Some(q) = block.letter('Q') {
             c.q = Some(self.length(q).abs());
+            if matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84) {
+                // Fanuc's peck tapping is machine data (parameter 5200#6 PCT): read as one pass.
+                self.warn(
+                    line,
+                    format!(
+                        "G{}: Q in a tapping cycle pecks (Fanuc peck tapping, parameter 5200#6 \
+                         PCT = 1) or is ignored (PCT = 0): read as one pass, without pecks",
+                        c.code
+                    ),
+                );
+            }
         }
         if let Some(p) = block.letter('P') {
             c.dwell = if self.spec.integer_increments.is_some() && !p.point {
