@@ -1017,13 +1017,13 @@ fn spindle_direction(toolpath: &Toolpath, point: usize) -> Option<bool> {
         .switches
         .iter()
         .filter(|s| s.point <= point)
-        .filter_map(|s| match s.switch {
+        .rev()
+        .find_map(|s| match s.switch {
             Switch::SpindleClockwise => Some(Some(false)),
             Switch::SpindleCounterClockwise => Some(Some(true)),
             Switch::SpindleStop => Some(None),
             _ => None,
         })
-        .last()
         .flatten()
 }
 
