@@ -1749,3 +1749,62 @@ fn cutter_radius_compensation_is_an_error_unless_it_is_wear_only() {
         .collect();
     assert_eq!(said, [4]);
 }
+
+/// LinuxCNC `G33.1 Z- K- I-` (the G-code reference's "G33.1 Rigid Tapping"): from where the
+/// tool stands to Z at K per revolution (feed K × S), and back to the start at I times the
+/// speed; a tap ([`Toolpath::taps`]) of its two points, in the spindle's direction. Until
+/// round 19 it was refused as spindle-synchronised motion.
+#[test]
+fn linuxcnc_rigid_tapping_g33_1_feeds_at_k_times_s_and_back_at_i_times_that() {
+    let tp = ok("G21 G90 G94\nG0 X5 Y3 Z2 S400 M4\nG33.1 Z-10 K1.25 I2\nG0 X20\nM2\n");
+    let z: Vec<f64> = tp.points.iter().map(|p| p.p.z).collect();
+    assert_eq!(z, [2.0, -10.0, 2.0, 2.0]);
+    assert_eq!(tp.points[1].feed, Feed::Programmed(500.0 / 60.0));
+    assert_eq!(tp.points[2].feed, Feed::Programmed(1000.0 / 60.0));
+    let tap = &tp.taps[0];
+    assert_eq!(
+        (tap.line, tap.name.as_str(), tap.points.clone()),
+        (3, "G33.1", 1..3)
+    );
+    assert_eq!(
+        (tap.pitch, tap.rpm, tap.left_hand),
+        (Some(1.25), Some(400.0), true)
+    );
+    assert!(others(&tp).is_empty(), "{:?}", tp.warnings);
+    // Inch: K in inches per revolution.
+    let tp = ok("G20 G90\nG0 X0 Y0 Z0.1 S100 M3\nG33.1 Z-0.75 K0.05\nM2\n");
+    let want = 0.05 * 25.4 * 100.0 / 60.0;
+    assert!(
+        matches!(tp.points[1].feed, Feed::Programmed(v) if (v - want).abs() < 1e-9),
+        "{:?}",
+        tp.points[1].feed
+    );
+    // Its motion ends with the block: an axis word after it is no tap, and no G1.
+    for (text, says) in [
+        (
+            "G21 G90\nG0 X0 Y0 Z2 S400 M3\nG33.1 Z-10 K1.25\nZ-5\nM2\n",
+            "without a motion mode",
+        ),
+        (
+            "G21 G90\nG0 X0 Y0 Z2 S400 M3\nG33.1 X5 Z-10 K1.25\nM2\n",
+            "slant",
+        ),
+        (
+            "G21 G90\nG0 X0 Y0 Z2 M3\nG33.1 Z-10 K1.25\nM2\n",
+            "no spindle speed",
+        ),
+        (
+            "G21 G90\nG0 X0 Y0 Z2 S400 M3\nG33.1 Z-10\nM2\n",
+            "K (the distance per revolution)",
+        ),
+        (
+            "G21 G90\nG0 X0 Y0 Z2 S400 M3\nG33.1 Z-10 K1 I0\nM2\n",
+            "speed factor I",
+        ),
+    ] {
+        let e = parse(Path::new("test.ngc"), text, Dialect::LinuxCnc)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("test.ngc:") && e.contains(says), "{text}: {e}");
+    }
+}

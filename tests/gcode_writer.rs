@@ -1028,80 +1028,459 @@ fn moves_in_machine_coordinates_are_written_in_machine_coordinates() {
     }
 }
 
-/// A tapping cycle is refused by the writer, naming the block that runs it: its moves are
-/// read as feeds at the tap's pitch × speed (the solve times them right), but written back as
-/// G1 blocks they would feed the tap in and out with the spindle turning forward, neither
-/// synchronised nor reversed, which strips the thread or breaks the tap. Round 17: a
-/// hyperMILL DMU 85 program's eight M14 holes (`CYCL DEF 207`, called by `M99`) and an NX Haas
-/// program's `G84` holes were written so. Every reader's tapping cycle is refused; a drilling
-/// cycle is still written.
-#[test]
-fn tapping_cycles_are_refused_not_written_as_feed_moves() {
-    let text = std::fs::read_to_string(root().join("problems/xyz_pocket/machine.json")).unwrap();
-    let m = Machine::from_json(Path::new("machine.json"), &text).unwrap();
+/// The xyz pocket's machine, and a program read in `dialect`.
+fn xyz_and(name: &str, text: &str, dialect: Dialect) -> (Machine, Toolpath) {
+    let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
+    (
+        m,
+        toolpath::gcode::parse(Path::new(name), text, dialect).unwrap(),
+    )
+}
+
+/// Written with peak feeds (the command line's default) in `dialect`.
+fn written_in(m: &Machine, t: &Toolpath, dialect: Dialect) -> feedopt::error::Result<Program> {
     let options = reach();
-    let fanuc = |cycle: &str| {
-        toolpath::gcode::parse(
-            Path::new("tap.nc"),
-            &format!(
-                "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\n\
-                 G99 {cycle} X5. Y0 Z-10. R2. F750.\nX15.\nG80\nM30\n%\n"
-            ),
-            Dialect::Fanuc,
-        )
-        .unwrap()
+    let sol = optimize(m, t, &options).unwrap();
+    program(m, t, &sol, &options.geometry, &peak(dialect))
+}
+
+/// The program read back (no warning), with its points equal to the input's, each tap's
+/// feeds in and out the input's, and its schedule's cycle time the input's (the same points
+/// at the same feeds: the same schedule).
+fn tapped_back(m: &Machine, input: &Toolpath, prog: &Program, dialect: Dialect) -> Toolpath {
+    let back = toolpath::gcode::parse(Path::new("back.nc"), &prog.text, dialect).unwrap();
+    assert!(back.warnings.is_empty(), "{dialect}: {:?}", back.warnings);
+    let at = |t: &Toolpath| -> Vec<[f64; 3]> {
+        let mut v: Vec<[f64; 3]> = Vec::new();
+        for p in &t.points {
+            let q = [p.p.x, p.p.y, p.p.z];
+            if v.last() != Some(&q) {
+                v.push(q);
+            }
+        }
+        v
     };
-    let written = |t: &Toolpath| {
-        let sol = optimize(&m, t, &options).unwrap();
-        program(&m, t, &sol, &options.geometry, &peak(Dialect::Fanuc)).map(|p| p.text)
-    };
-    // Drilling (G81) is written; tapping (G84, left-hand G74) is not.
-    assert!(written(&fanuc("G81")).is_ok());
-    for (cycle, name) in [("G84", "G84"), ("G74", "G74")] {
-        let e = written(&fanuc(cycle)).unwrap_err().to_string();
+    let (want, got) = (at(input), at(&back));
+    assert_eq!(got.len(), want.len(), "{dialect}:\n{}", prog.text);
+    for (a, b) in got.iter().zip(&want) {
         assert!(
-            e.contains("tap.nc:5:")
-                && e.contains(&format!("{name}: a tapping cycle (and 1 more)"))
-                && e.contains("feedopt solve"),
-            "{e}"
+            (0..3).all(|i| (a[i] - b[i]).abs() < 1e-6),
+            "{dialect}: {a:?} vs {b:?}"
         );
     }
-    // Sinumerik CYCLE84 (called and modal), Klartext 207 (by M99), APT CYCLE/TAP.
-    let sinumerik = |call: &str| {
-        toolpath::gcode::parse(
-            Path::new("tap.mpf"),
-            &format!("G71 G90 G17 G94\nS500 M3\nG0 X0 Y0 Z50\nF60\n{call}\nM30\n"),
-            Dialect::Sinumerik,
-        )
-        .unwrap()
-    };
-    let called = sinumerik("CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)");
-    let e = written(&called).unwrap_err().to_string();
-    assert!(e.contains("tap.mpf:5:") && e.contains("CYCLE84"), "{e}");
-    let modal = sinumerik("MCALL CYCLE84(3,3,,-20,,,3,,1.5,0,500,500)\nX10\nMCALL");
-    let e = written(&modal).unwrap_err().to_string();
+    assert_eq!(back.taps.len(), input.taps.len(), "{dialect}");
+    for (a, b) in back.taps.iter().zip(&input.taps) {
+        assert!(
+            (a.feed_in - b.feed_in).abs() < 1e-6 * b.feed_in
+                && (a.feed_out - b.feed_out).abs() < 1e-6 * b.feed_out
+                && (a.dwell - b.dwell).abs() < 1e-9
+                && a.left_hand == b.left_hand,
+            "{dialect}: {a:?} vs {b:?}"
+        );
+    }
+    // The program's own sum is what its blocks and cycles take at their feeds.
+    let time = programmed_time(&back).unwrap() + back.dwell_time();
     assert!(
-        e.contains("tap.mpf:6:") && e.contains("MCALL CYCLE84"),
+        (prog.time - time).abs() < 1e-6,
+        "{dialect}: {} vs {time}",
+        prog.time
+    );
+    let options = reach();
+    let (before, after) = (
+        optimize(m, input, &options).unwrap().schedule.cycle_time,
+        optimize(m, &back, &options).unwrap().schedule.cycle_time,
+    );
+    assert!(
+        (before - after).abs() <= 1e-3 * before,
+        "{dialect}: solved again {after} s, the input {before} s"
+    );
+    back
+}
+
+/// A Fanuc program that mills, taps three holes with a modal G84 (M3, S500, F750 = pitch
+/// 1.5 × S in G94) and mills on.
+const FANUC_TAPS: &str = "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S500 M3\nG1 Z0 F300.\n\
+    G1 X20. F600.\nG0 Z10.\nG98 G84 X5. Y0 Z-10. R2. F750.\nX15.\nY10.\nG80\nG0 X30. Y5.\n\
+    G1 Z0 F300.\nG1 X40. F600.\nG0 Z10.\nM30\n%\n";
+
+/// Each output dialect writes a modal tap's holes as its own tapping cycle, never as feed
+/// moves (round 17: an NX Haas program's G84 holes were written as G1 in and out, which
+/// strips the thread or breaks the tap), and the written program reads back to the same CL
+/// points, the same taps at the same feeds, and the same schedule.
+#[test]
+fn taps_are_written_as_each_dialects_tapping_cycle_and_read_back_to_the_same_points() {
+    let (m, input) = xyz_and("tap.nc", FANUC_TAPS, Dialect::Fanuc);
+    assert_eq!(input.taps.len(), 3);
+    for (dialect, cycle) in [
+        (Dialect::Fanuc, "G99 G84 X"),
+        (Dialect::LinuxCnc, "G33.1 Z"),
+        (Dialect::Sinumerik, "CYCLE84("),
+    ] {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        // One cycle per hole, and no feed move of a tap's (Z-10 is only ever a cycle's).
+        assert_eq!(
+            prog.text.matches(cycle).count(),
+            3,
+            "{dialect}:\n{}",
+            prog.text
+        );
+        assert!(
+            !prog
+                .text
+                .lines()
+                .any(|l| l.starts_with("G1") && l.contains("Z-10.")),
+            "{dialect}:\n{}",
+            prog.text
+        );
+        tapped_back(&m, &input, &prog, dialect);
+    }
+}
+
+/// One hole's block in each dialect, as its manual writes it:
+/// * Fanuc (Series 30i/0i operator's manual, "Rigid tapping (G84)"): `M29 S…` before
+///   `G84 X Y Z R P F K`, F in mm/min under G94 = pitch × S; G99 returns to R, `G80` cancels.
+/// * LinuxCNC (G-code reference, "G33.1 Rigid Tapping"): `G33.1 X- Y- Z- K- I- $-`, K the
+///   distance per revolution; "for Z only tapping preposition the XY location prior to
+///   calling G33.1 and only use a Z word"; the move ends at the original coordinate.
+/// * Sinumerik 840D (cycles manual, CYCLE84 "Tapping without compensating chuck"):
+///   `CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1)`, SDAC 3 for M3
+///   after the cycle, PIT in the program's unit, SST the speed in, SST1 out.
+#[test]
+fn a_holes_tapping_block_is_the_manuals_form_in_each_dialect() {
+    let one = FANUC_TAPS.replace("X15.\nY10.\n", "");
+    let (m, input) = xyz_and("tap.nc", &one, Dialect::Fanuc);
+    let block = |dialect: Dialect| -> Vec<String> {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        let lines: Vec<String> = prog.text.lines().map(String::from).collect();
+        // The block over the hole at R, then the cycle, then on to the initial level.
+        let at = lines
+            .iter()
+            .position(|l| l.starts_with("G1 X5.000000 Y0.000000 Z2.000000 "))
+            .unwrap_or_else(|| panic!("{dialect}:\n{}", prog.text));
+        let end = (at + 1..lines.len())
+            .find(|&k| lines[k].starts_with("G1 "))
+            .unwrap();
+        assert!(lines[end].starts_with("G1 X5.000000 Y0.000000 Z10.000000 "));
+        lines[at + 1..end].to_vec()
+    };
+    assert_eq!(
+        block(Dialect::Fanuc),
+        [
+            "M29 S500",
+            "G99 G84 X5.000000 Y0.000000 Z-10.000000 R2.000000 F750.0000",
+            "G80"
+        ]
+    );
+    assert_eq!(block(Dialect::LinuxCnc), ["G33.1 Z-10.000000 K1.5"]);
+    assert_eq!(
+        block(Dialect::Sinumerik),
+        ["CYCLE84(2.000000,2.000000,0,-10.000000,,,3,,1.5,0,500,500)"]
+    );
+}
+
+/// A tap between milling moves changes nothing around it: the program whose holes are
+/// bored with G85 (feed in, feed out at the same F: the same points at the same feeds) is
+/// written with the same blocks, the tap's two G1 blocks per hole replaced by its cycle.
+#[test]
+fn a_tap_between_milling_moves_leaves_the_neighbouring_blocks_as_they_are() {
+    let (m, tapped) = xyz_and("tap.nc", FANUC_TAPS, Dialect::Fanuc);
+    let (_, bored) = xyz_and("bore.nc", &FANUC_TAPS.replace("G84", "G85"), Dialect::Fanuc);
+    for dialect in Dialect::GCODE {
+        let a = written_in(&m, &tapped, dialect).unwrap();
+        let b = written_in(&m, &bored, dialect).unwrap();
+        // (Comments name the file.) The tap's cycle lines; the bore's feeds at F750, the
+        // only blocks at that feed.
+        let tap_words = ["M29 ", "G99 G84", "G80", "G33.1", "CYCLE84("];
+        let rest = |text: &str, drop: &dyn Fn(&str) -> bool| -> Vec<String> {
+            text.lines()
+                .filter(|l| !l.starts_with('(') && !l.starts_with(';'))
+                .filter(|l| !drop(l))
+                .map(String::from)
+                .collect()
+        };
+        let around_taps = rest(&a.text, &|l| tap_words.iter().any(|w| l.starts_with(w)));
+        let around_bores = rest(&b.text, &|l| {
+            l.starts_with("G1 ") && l.ends_with(" F750.0000")
+        });
+        assert_eq!(b.text.matches(" F750.0000").count(), 6, "{}", b.text);
+        assert_eq!(
+            around_taps, around_bores,
+            "{dialect}:\n{}\n---\n{}",
+            a.text, b.text
+        );
+        assert_eq!(
+            a.blocks, b.blocks,
+            "{dialect}: a cycle stands for the tap's two blocks"
+        );
+        // The same schedule: the moves around the tap take the time they took.
+        assert!((a.time - b.time).abs() < 1e-6, "{} vs {}", a.time, b.time);
+    }
+}
+
+/// A left-hand tap (G74, the spindle M4) with a dwell at the bottom: Fanuc writes `G74 … P`
+/// (P in ms in a Fanuc cycle), Sinumerik a negative PIT (CYCLE84: "the sign of the pitch
+/// gives the direction of rotation") and DTB in s; LinuxCNC's G33.1 has no dwell (it reverses
+/// at the bottom) and is refused, naming the line. Without the dwell, G33.1 taps in the
+/// spindle's M4.
+#[test]
+fn a_left_hand_tap_with_a_dwell_is_written_where_the_cycle_can_say_it() {
+    let text = "%\nO1000\nG21 G90 G94\nG0 X0 Y0 Z10. S400 M4\n\
+                G99 G74 X5. Y0 Z-8. R2. P250 F500.\nG80\nG0 Z10.\nM30\n%\n";
+    let (m, input) = xyz_and("left.nc", text, Dialect::Fanuc);
+    assert!(input.taps[0].left_hand && input.taps[0].dwell == 0.25);
+    assert!(input.warnings.is_empty(), "{:?}", input.warnings);
+    // A Q (Fanuc peck tapping, machine data) is read as one pass, and said.
+    let (_, pecks) = xyz_and(
+        "left.nc",
+        &text.replace(" P250", " P250 Q3."),
+        Dialect::Fanuc,
+    );
+    assert!(
+        pecks
+            .warnings
+            .iter()
+            .any(|w| w.line == 5 && w.message.contains("PCT")),
+        "{:?}",
+        pecks.warnings
+    );
+    let fanuc = written_in(&m, &input, Dialect::Fanuc).unwrap();
+    assert!(
+        fanuc.text.contains(
+            "M29 S400\nG99 G74 X5.000000 Y0.000000 Z-8.000000 R2.000000 P250 F500.0000\nG80\n"
+        ),
+        "{}",
+        fanuc.text
+    );
+    tapped_back(&m, &input, &fanuc, Dialect::Fanuc);
+    let sinumerik = written_in(&m, &input, Dialect::Sinumerik).unwrap();
+    assert!(
+        sinumerik
+            .text
+            .contains("CYCLE84(2.000000,2.000000,0,-8.000000,,0.250000,4,,-1.25,0,400,400)"),
+        "{}",
+        sinumerik.text
+    );
+    tapped_back(&m, &input, &sinumerik, Dialect::Sinumerik);
+    let e = written_in(&m, &input, Dialect::LinuxCnc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("left.nc:5:") && e.contains("G74") && e.contains("dwells 0.25 s"),
         "{e}"
     );
-    let text = "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 L X+0 Y+0 Z+10 R0 FMAX\n\
-                3 CYCL DEF 207 RIGID TAPPING NEW~\n Q200=3 ;SET-UP CLEARANCE~\n\
-                Q201=-12 ;DEPTH~\n Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n\
-                Q204=5 ;2ND SET-UP CLEARANCE\n4 L X+0 Y+0 R0 F MAX M99\n5 END PGM T MM\n";
-    let call = 1 + text.lines().position(|l| l.contains("M99")).unwrap();
-    let klartext = toolpath::gcode::parse(Path::new("tap.h"), text, Dialect::Heidenhain).unwrap();
-    let e = written(&klartext).unwrap_err().to_string();
+    let (_, no_dwell) = xyz_and("left.nc", &text.replace(" P250", ""), Dialect::Fanuc);
+    let linuxcnc = written_in(&m, &no_dwell, Dialect::LinuxCnc).unwrap();
     assert!(
-        e.contains(&format!("tap.h:{call}:"))
-            && e.contains("CYCL DEF 207 (at line 4): a tapping cycle;"),
+        linuxcnc.text.contains("\nG33.1 Z-8.000000 K1.25\n"),
+        "{}",
+        linuxcnc.text
+    );
+    let back = tapped_back(&m, &no_dwell, &linuxcnc, Dialect::LinuxCnc);
+    assert!(back.taps[0].left_hand);
+}
+
+/// Sinumerik's CYCLE84 retracts at SST1: Sinumerik writes it back, LinuxCNC as G33.1's
+/// speed factor I (SST1 / SST), and Fanuc, whose G84 retracts at F (its retract override is
+/// machine data), refuses the tap, naming its line.
+#[test]
+fn a_tap_that_retracts_faster_is_written_where_the_cycle_says_so() {
+    let text = "G71 G90 G17 G94\nS500 M3\nG0 X4 Y3 Z20\nF60\n\
+                CYCLE84(20,0,2,-12,,,3,,1.5,0,500,1000)\nG0 X30\nM30\n";
+    let (m, input) = xyz_and("fast.mpf", text, Dialect::Sinumerik);
+    let tap = &input.taps[0];
+    assert!((tap.feed_in - 750.0).abs() < 1e-9 && (tap.feed_out - 1500.0).abs() < 1e-9);
+    let sinumerik = written_in(&m, &input, Dialect::Sinumerik).unwrap();
+    assert!(
+        sinumerik
+            .text
+            .contains("\nCYCLE84(2.000000,2.000000,0,-12.000000,,,3,,1.5,0,500,1000)\n"),
+        "{}",
+        sinumerik.text
+    );
+    tapped_back(&m, &input, &sinumerik, Dialect::Sinumerik);
+    let linuxcnc = written_in(&m, &input, Dialect::LinuxCnc).unwrap();
+    assert!(
+        linuxcnc.text.contains("\nG33.1 Z-12.000000 K1.5 I2\n"),
+        "{}",
+        linuxcnc.text
+    );
+    tapped_back(&m, &input, &linuxcnc, Dialect::LinuxCnc);
+    let e = written_in(&m, &input, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("fast.mpf:5:") && e.contains("feeds out at 1500 mm/min, in at 750"),
+        "{e}"
+    );
+}
+
+/// On a machine with tool-tip mode, a tap with every rotary axis at zero is written out of
+/// it (Fanuc `G49`, the tool's `G43 H`, the cycle, `G43.4` again; LinuxCNC `M429`/`M428`;
+/// Sinumerik `TRAFOOF`/`TRAORI`) and reads back to the same points. With the head turned
+/// (C45: the tool still along Z, but out of tool-tip mode the coordinates turn with it) or
+/// tilted (A30, the tap along the tool), it is refused as a tilted tap, naming the line.
+#[test]
+fn a_tap_under_tool_tip_mode_is_written_out_of_it_and_a_tilted_one_is_refused() {
+    let (m, _) = bundled("seed_head_head", "impeller_blade.cls");
+    let text = |c: &str| {
+        format!(
+            "%\nO1\nG21 G90 G94\nT2 M6\nG43.4 H2\nG0 X0 Y0 Z50. A0 C{c} S600 M3\n\
+             G1 Z10. F1000.\nG1 X10. F800.\nG0 Z20.\nG98 G84 X20. Y0 Z-6. R2. F900.\nG80\n\
+             G0 Z50.\nG1 X40. F800.\nG49\nM30\n%\n"
+        )
+    };
+    let input = toolpath::gcode::parse(Path::new("tcp.nc"), &text("0"), Dialect::Fanuc).unwrap();
+    for (dialect, around) in [
+        (
+            Dialect::Fanuc,
+            [
+                "G49",
+                "G43 H2",
+                "M29 S600",
+                "G99 G84 X20.000000 Y0.000000 Z-6.000000 R2.000000 F900.0000",
+                "G80",
+                "G43.4 H2",
+            ],
+        ),
+        (
+            Dialect::LinuxCnc,
+            ["M429", "G33.1 Z-6.000000 K1.5", "M428", "", "", ""],
+        ),
+        (
+            Dialect::Sinumerik,
+            [
+                "TRAFOOF",
+                "CYCLE84(2.000000,2.000000,0,-6.000000,,,3,,1.5,0,600,600)",
+                "TRAORI",
+                "",
+                "",
+                "",
+            ],
+        ),
+    ] {
+        let prog = written_in(&m, &input, dialect).unwrap();
+        let want: Vec<&str> = around.iter().copied().filter(|l| !l.is_empty()).collect();
+        let lines: Vec<&str> = prog.text.lines().collect();
+        assert!(
+            lines.windows(want.len()).any(|w| w == want.as_slice()),
+            "{dialect}:\n{}",
+            prog.text
+        );
+        tapped_back(&m, &input, &prog, dialect);
+    }
+    let turned = toolpath::gcode::parse(Path::new("tcp.nc"), &text("45"), Dialect::Fanuc).unwrap();
+    let e = written_in(&m, &turned, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tcp.nc:10:") && e.contains("rotary axes stand at"),
+        "{e}"
+    );
+    // The head tilted (A30) under tool-tip mode, the cycle along the part's Z (no tilted
+    // plane: as NX's Mori NMV5000 and DMU 70 eVo programs tap): the tap would feed 30° off its
+    // own axis, which no cycle written reproduces.
+    let tilted = text("0").replace("G98 G84", "G0 A30.\nG98 G84");
+    let tilted = toolpath::gcode::parse(Path::new("tcp.nc"), &tilted, Dialect::Fanuc).unwrap();
+    let e = written_in(&m, &tilted, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tcp.nc:11:")
+            && e.contains("30.000° off the direction the cycle feeds")
+            && e.contains("A30"),
+        "{e}"
+    );
+    // APT: the tap along a tool tilted 30° about X.
+    let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+    let apt = toolpath::apt::parse(
+        Path::new("tilt.cls"),
+        &format!(
+            "FEDRAT/MMPM,300\nSPINDL/RPM,500,CLW\nGOTO/0,0,20,0,{},{}\n\
+             CYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0,0,{},{}\nCYCLE/OFF\nGOTO/5,0,20\n",
+            -s, c, -s, c
+        ),
+    )
+    .unwrap();
+    let e = written_in(&m, &apt, Dialect::Sinumerik)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tilt.cls:5:") && e.contains("30.000° off Z") && e.contains("not written yet"),
+        "{e}"
+    );
+}
+
+/// Klartext 207 (rigid tapping) is written in each dialect; 209 with chip breaking (Q257: in
+/// steps, back Q256 between them) is refused: its steps are no output cycle's. APT's
+/// `CYCLE/TAP` is written (the speed is the `SPINDL/`'s).
+#[test]
+fn klartext_and_apt_taps_are_written_and_chip_breaking_is_refused() {
+    let m = Machine::from_file(&root().join("problems/xyz_pocket/machine.json")).unwrap();
+    let klartext = |cycle: &str, extra: &str| {
+        format!(
+            "0 BEGIN PGM T MM\n1 TOOL CALL 3 Z S1000\n2 M3\n3 L X+0 Y+0 Z+10 R0 FMAX\n\
+             4 CYCL DEF {cycle}~\n Q200=3 ;SET-UP CLEARANCE~\n Q201=-12 ;DEPTH~\n\
+             Q239=+1.5 ;THREAD PITCH~\n Q203=0 ;SURFACE COORDINATE~\n{extra}\
+             Q204=5 ;2ND SET-UP CLEARANCE\n5 L X+0 Y+0 R0 F MAX M99\n6 END PGM T MM\n"
+        )
+    };
+    let t207 = toolpath::gcode::parse(
+        Path::new("tap.h"),
+        &klartext("207 RIGID TAPPING NEW", ""),
+        Dialect::Heidenhain,
+    )
+    .unwrap();
+    for dialect in Dialect::GCODE {
+        let prog = written_in(&m, &t207, dialect).unwrap();
+        tapped_back(&m, &t207, &prog, dialect);
+    }
+    let t209 = toolpath::gcode::parse(
+        Path::new("tap.h"),
+        &klartext(
+            "209 TAPPING W/ CHIP BRKG",
+            " Q257=4 ;DEPTH FOR CHIP BRKG~\n Q256=1 ;DIST FOR CHIP BRKG~\n Q336=0 ;ANGLE OF SPINDLE~\n",
+        ),
+        Dialect::Heidenhain,
+    )
+    .unwrap();
+    let call = 1 + klartext("209", "")
+        .lines()
+        .position(|l| l.contains("M99"))
+        .unwrap();
+    let e = written_in(&m, &t209, Dialect::Fanuc)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("tap.h:{}:", call + 3)) && e.contains("breaks chips"),
         "{e}"
     );
     let apt = toolpath::apt::parse(
+        Path::new("tap.cls"),
+        "FEDRAT/MMPM,300\nSPINDL/RPM,500,CLW\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\n\
+         GOTO/5,0,0\nCYCLE/OFF\nGOTO/5,0,20\n",
+    )
+    .unwrap();
+    let prog = written_in(&m, &apt, Dialect::Fanuc).unwrap();
+    assert!(
+        prog.text.contains(
+            "\nM29 S500\nG99 G84 X5.000000 Y0.000000 Z-10.000000 R2.000000 F750.0000\nG80\n"
+        ),
+        "{}",
+        prog.text
+    );
+    tapped_back(&m, &apt, &prog, Dialect::Fanuc);
+    // Without a spindle speed the cycle has no pitch to tap at: refused, naming the line.
+    let no_speed = toolpath::apt::parse(
         Path::new("tap.cls"),
         "FEDRAT/MMPM,300\nGOTO/0,0,20\nCYCLE/TAP,FEDTO,10,MMPM,750,RAPTO,2\nGOTO/5,0,0\n\
          CYCLE/OFF\nGOTO/5,0,20\n",
     )
     .unwrap();
-    let e = written(&apt).unwrap_err().to_string();
-    assert!(e.contains("tap.cls:4:") && e.contains("CYCLE/TAP"), "{e}");
+    let e = written_in(&m, &no_speed, Dialect::Sinumerik)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tap.cls:4:") && e.contains("no spindle speed"),
+        "{e}"
+    );
 }

@@ -44,7 +44,7 @@ use std::borrow::Cow;
 use super::SAME_POSITION_MM;
 use crate::toolpath::{
     ClPoint, Dwell, Feed, LengthOffsetChange, MachinePoint, MachineSwitch, OffsetChange,
-    SpindleChange, ToolChange, Toolpath,
+    SpindleChange, TapCycle, ToolChange, Toolpath,
 };
 
 /// The sharpest corner blended, degrees of turning (see the module docs).
@@ -162,7 +162,12 @@ pub fn blend_corners(
                 })
                 .collect()
         }),
-        taps: toolpath.taps.clone(),
+        taps: (toolpath.taps.iter())
+            .map(|t| TapCycle {
+                points: moved(t.points.start)..moved(t.points.end.saturating_sub(1)) + 1,
+                ..t.clone()
+            })
+            .collect(),
     };
     (Cow::Owned(tp), blended)
 }

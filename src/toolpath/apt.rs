@@ -1184,18 +1184,33 @@ impl<'a> Reader<'a> {
                 line,
             });
         }
-        if c.kind == "TAP" {
-            self.taps.push(crate::toolpath::TapCycle {
-                line,
-                name: "CYCLE/TAP".into(),
-            });
-        }
         let out = if matches!(c.kind, "TAP" | "BORE" | "REAM") {
             feed
         } else {
             Feed::Rapid
         };
         self.emit(at(c.retract), out, line);
+        if c.kind == "TAP" {
+            // Into the hole and back out along the tool axis, at the cycle's feed; the speed
+            // is the last `SPINDL/`.
+            let n = self.points.len();
+            let mm_per_min = match feed {
+                Feed::Programmed(v) => v * 60.0,
+                _ => 0.0,
+            };
+            self.taps.push(crate::toolpath::TapCycle {
+                line,
+                name: "CYCLE/TAP".into(),
+                points: n - 2..n,
+                feed_in: mm_per_min,
+                feed_out: mm_per_min,
+                pitch: None,
+                rpm: self.spindle_changes.last().map(|c| c.rpm),
+                left_hand: false,
+                dwell: c.dwell,
+                axis: self.points[n - 1].o,
+            });
+        }
         Ok(())
     }
 

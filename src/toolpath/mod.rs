@@ -162,10 +162,10 @@ pub struct Toolpath {
     /// length); `feedopt gcode` writes them back as the program has them, so that the
     /// written Z means what the program's meant.
     pub length_offsets: Option<Vec<LengthOffsetChange>>,
-    /// The tapping cycles the program runs, in program order. Their moves are timed as
-    /// feeds at the tap's pitch × spindle speed, but on the control the cycle synchronises
-    /// the spindle with the feed and reverses it at the bottom: `feedopt gcode`, which writes
-    /// plain feed moves, refuses such a program.
+    /// The tapping cycles the program runs, one per hole, in program order. Their moves are
+    /// timed as feeds at the tap's pitch × spindle speed, but on the control the cycle
+    /// synchronises the spindle with the feed and reverses it at the bottom: `feedopt gcode`
+    /// writes each back as the output control's tapping cycle, never as feed moves.
     pub taps: Vec<TapCycle>,
     /// The files the program's subprogram calls read, in the order read (empty: every line is
     /// the main program's). Every `line` of the toolpath (points, warnings, dwells, changes)
@@ -342,13 +342,36 @@ impl Toolpath {
     }
 }
 
-/// A tapping cycle the program runs (Fanuc/LinuxCNC `G84`/`G74`, Sinumerik `CYCLE84`,
-/// Klartext cycles 207/209, APT `CYCLE/TAP`): `line` is the block that runs it (a hole of a
+/// One hole of a tapping cycle the program runs (Fanuc/LinuxCNC `G84`/`G74`, LinuxCNC
+/// `G33.1`, Sinumerik `CYCLE84`, Klartext cycles 207/209, APT `CYCLE/TAP`): what `feedopt
+/// gcode` needs to write it back as a cycle. `line` is the block that runs it (a hole of a
 /// modal cycle, an `M99`, a `CYCL CALL`), `name` the cycle as the program writes it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TapCycle {
     pub line: usize,
     pub name: String,
+    /// The CL points the cycle's feed into the hole and back out made (indices into
+    /// [`Toolpath::points`]): the first is the hole's bottom, the last where the feed out
+    /// ends; the point before them is where the feed in starts (the R plane, RFP + SDIS,
+    /// the set-up clearance). More than two: the cycle breaks chips on the way.
+    pub points: std::ops::Range<usize>,
+    /// The feed into the hole and out of it, mm/min, as the reader timed them (pitch ×
+    /// spindle speed where the program gives both).
+    pub feed_in: f64,
+    pub feed_out: f64,
+    /// The thread's pitch, mm per revolution, where the program gives it (Sinumerik PIT or
+    /// MPIT, Klartext Q239, LinuxCNC K); `None`: the feed and the speed give it.
+    pub pitch: Option<f64>,
+    /// The spindle speed the tap runs at, rpm (Sinumerik SST, else the speed in force), where
+    /// the program gives one.
+    pub rpm: Option<f64>,
+    /// A left-hand thread (`G74`, a negative pitch, a spindle turning M4).
+    pub left_hand: bool,
+    /// The dwell at the bottom, s.
+    pub dwell: f64,
+    /// The direction the cycle feeds out of the hole in workpiece coordinates: +Z of the
+    /// working plane in force (a tilted plane's, a frame's), or the tool axis (APT).
+    pub axis: Vector3<f64>,
 }
 
 /// The tool stands still at CL point `point` (an index into [`Toolpath::points`]) for

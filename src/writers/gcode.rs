@@ -122,6 +122,39 @@
 //! bare `G55`, the second part was cut on the first). Nor are `G52`/`G92` shifts (the
 //! coordinates include them), LinuxCNC's `G43.1`/`G43.2` or other M codes.
 //!
+//! **Tapping.** A tap ([`crate::toolpath::TapCycle`]: Fanuc/LinuxCNC `G84`/`G74`, LinuxCNC
+//! `G33.1`, Sinumerik `CYCLE84`, Klartext 207, APT `CYCLE/TAP`) is written as the output
+//! control's tapping cycle, never as G1 blocks, which would feed the tap in and out with the
+//! spindle neither synchronised nor reversed. The moves to where its feed starts (over the
+//! hole, at R) and from where it ends are written as any others; the cycle replaces exactly
+//! the tap's two feeds, in at its bottom and back out, and taps from where the tool stands,
+//! so that, read back, it makes the same two points at the same feeds:
+//!
+//! * Fanuc (rigid tapping): `M29 S…`, `G99 G84 X… Y… Z… R… [P ms] F…` (`G74` for a
+//!   left-hand thread), `G80`; G94, F = pitch × S in mm/min, R the point where the tool
+//!   stands, G99 back to it. A Fanuc G84 feeds out at F: a tap that feeds out at another
+//!   speed (Sinumerik SST1, LinuxCNC I) is refused, as is an S that is not a whole number.
+//! * LinuxCNC: `G33.1 Z… K… [I…]` (the manual's "G33.1 Rigid Tapping": from the current
+//!   point to Z at K per revolution, the spindle reverses, back at I times the speed). LinuxCNC's
+//!   G84 is floating-chuck tapping, not synchronised. G33.1 taps in the direction the spindle
+//!   turns and has no dwell: a tap whose hand is not the spindle's direction, or that dwells
+//!   at the bottom, is refused.
+//! * Sinumerik: `CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1)` with
+//!   RTP = RFP the Z where the tool stands, SDIS 0, DP the bottom, DTB the dwell, SDAC the
+//!   spindle's direction before it (3, 4; 5: stopped), PIT the pitch (negative: left-hand),
+//!   SST the speed in, SST1 out.
+//!
+//! The pitch written is the feed the tap was timed at over its speed, which must be the
+//! program's pitch where it gives one. The program's time ([`Program::time`]) counts a tap at
+//! its feed both ways, as its other blocks at their F, and its dwell; the schedule times it at
+//! that feed too, with its stops at the ends. On a machine with tool-tip mode the cycle is
+//! written out of it (`G49` and the tool's `G43 H`, `M429`, `TRAFOOF`), which the controls
+//! require and which changes nothing where every rotary axis stands at zero. A tilted tap —
+//! the tool axis off Z, or the rotary axes off zero — is refused, naming it: its cycle would
+//! need the tilted working plane (`G68.2`, `CYCLE800`, `PLANE`), which is not written yet. So
+//! is a tap that breaks chips (Klartext 209 with Q257), has no spindle speed, or does not feed
+//! straight down Z and back to where it started. A Heidenhain output is not written at all.
+//!
 //! **Rapids.** The schedule times rapid moves like any other, at the machine's limits (and
 //! `feed.max`); they are written as G1 blocks with their optimised feed, so the file's time is
 //! the schedule's. Only the first point is reached by a G0, as every program starts: that move
@@ -244,15 +277,18 @@ impl std::fmt::Display for BlockFeed {
 pub struct Program {
     /// The program, as written to the file.
     pub text: String,
-    /// Motion blocks after the first point (each with its F).
+    /// Motion blocks after the first point (each with its F; a tap's cycle counts as its two
+    /// moves, in and out).
     pub blocks: usize,
     /// Of those, blocks under G93.
     pub inverse_time_blocks: usize,
     /// Sum of the written blocks' times at their F (no acceleration), s, and of the dwells
     /// (`dwell_time`): the schedule's cycle time under [`BlockFeed::Average`], less under
-    /// [`BlockFeed::Peak`].
+    /// [`BlockFeed::Peak`]. A tap's cycle counts at its feed in and out, as a control runs
+    /// it: under `Average` too, less than the schedule's time for it by its stops.
     pub time: f64,
-    /// Sum of the written dwells (G4), s: the program's, each where it stands.
+    /// Sum of the written dwells (G4, and those of the taps' cycles), s: the program's, each
+    /// where it stands.
     pub dwell_time: f64,
     /// Blocks merged away because they were shorter than [`MIN_BLOCK_TIME_S`].
     pub merged: usize,
@@ -958,30 +994,267 @@ fn point_parameters(toolpath: &Toolpath, idx: &[usize], span: &Span) -> Result<V
     Ok(us)
 }
 
-/// A tapping cycle's moves cannot be written as the G1 blocks this writer writes: on the
-/// control the cycle feeds the tap at the spindle's pitch, synchronised with its rotation
-/// (Fanuc `M29` rigid tapping, LinuxCNC `G33.1`, Sinumerik `CYCLE84`, Heidenhain 207), and
-/// reverses the spindle at the bottom; a G1 into the hole and back with the spindle running
-/// forward strips the thread or breaks the tap. An error names the first such cycle.
-pub fn refuse_tapping(toolpath: &Toolpath) -> Result<()> {
-    match toolpath.taps.first() {
-        None => Ok(()),
-        Some(tap) => {
-            let more = match toolpath.taps.len() {
-                1 => String::new(),
-                n => format!(" (and {} more)", n - 1),
-            };
-            Err(Error::parse(
-                &toolpath.source,
+/// One tap as the writer writes it ([`crate::toolpath::TapCycle`], module doc "Tapping").
+#[derive(Debug, Clone, Copy)]
+struct TapPlan {
+    /// Index into [`Toolpath::taps`].
+    tap: usize,
+    /// The feed in and out, mm/min; the speed, rpm; the pitch, mm; the dwell at the bottom, s.
+    feed_in: f64,
+    feed_out: f64,
+    rpm: f64,
+    pitch: f64,
+    dwell: f64,
+    left_hand: bool,
+    /// The spindle's direction before the tap: M3 (`Some(false)`), M4 (`Some(true)`), none.
+    reversed: Option<bool>,
+}
+
+/// The spindle's direction in force at the move ending at CL point `point`: the last M3, M4
+/// or M5 that comes before it (M5: `None`).
+fn spindle_direction(toolpath: &Toolpath, point: usize) -> Option<bool> {
+    toolpath
+        .switches
+        .iter()
+        .filter(|s| s.point <= point)
+        .rev()
+        .find_map(|s| match s.switch {
+            Switch::SpindleClockwise => Some(Some(false)),
+            Switch::SpindleCounterClockwise => Some(Some(true)),
+            Switch::SpindleStop => Some(None),
+            _ => None,
+        })
+        .flatten()
+}
+
+/// Why a tap whose tool stands `degrees` off the direction its cycle feeds (Z, no tilted
+/// plane in force) is not written; `at`: the rotary words there.
+fn off_axis(degrees: f64, at: &str) -> String {
+    format!(
+        "the tool axis stands {degrees:.3}° off the direction the cycle feeds (Z: no tilted \
+         working plane is in force{at}): as read, the tap feeds at that angle to its own axis, \
+         and a tilted tap, which needs the tilted working plane (G68.2, CYCLE800, PLANE), is \
+         not written yet"
+    )
+}
+
+/// Each tap of the toolpath as the output's cycle can write it, or an error naming the first
+/// it cannot (module doc, "Tapping"): a tap is never written as feed moves.
+fn tap_plans(toolpath: &Toolpath, dialect: Dialect) -> Result<Vec<TapPlan>> {
+    let pts = &toolpath.points;
+    let z = nalgebra::Vector3::z();
+    let mut plans = Vec::with_capacity(toolpath.taps.len());
+    for (j, tap) in toolpath.taps.iter().enumerate() {
+        let refuse = |why: String| {
+            Err(toolpath.error_at(
                 tap.line,
                 format!(
-                    "{}: a tapping cycle{more}; feedopt gcode writes plain feed moves, which \
-                     would feed the tap in and out without the spindle synchronised or \
-                     reversed: it does not write tapping cycles yet. `feedopt solve` times \
-                     them; to write the other operations, post the tapping separately",
+                    "{}: a tapping cycle that feedopt gcode cannot write as a {dialect} tapping \
+                    cycle: {why} (written as feed moves, the tap would be fed in and out with \
+                    the spindle neither synchronised nor reversed). `feedopt solve` times it; \
+                    to write the other operations, post this tapping separately",
                     tap.name
                 ),
             ))
+        };
+        let range = tap.points.clone();
+        if range.start == 0 || range.end > pts.len() || range.len() < 2 {
+            return refuse("its moves are not two feeds into the hole and out".into());
+        }
+        if range.len() > 2 {
+            return refuse(
+                "it breaks chips on the way in (Klartext 209's Q257), which is not written yet"
+                    .into(),
+            );
+        }
+        let (top, bottom, back) = (
+            &pts[range.start - 1],
+            &pts[range.start],
+            &pts[range.end - 1],
+        );
+        // A tilted tap: under a tilted working plane or frame (APT: along a tilted tool).
+        let tilt = |v: &nalgebra::Vector3<f64>| v.angle(&z).to_degrees();
+        if tilt(&tap.axis) > 1e-6 {
+            return refuse(format!(
+                "it feeds along an axis {:.3}° off Z (a tilted working plane or frame, or a \
+                 tilted tool), and a tilted tap is not written yet",
+                tilt(&tap.axis)
+            ));
+        }
+        // A tool off the direction the cycle feeds (points given with a tool vector; those
+        // with rotary positions: the writer checks the tool axis they give).
+        if let Some(o) = [top, bottom, back]
+            .iter()
+            .filter(|p| p.rotary.is_none())
+            .map(|p| p.o)
+            .find(|o| o.angle(&tap.axis) > 1e-8)
+        {
+            return refuse(off_axis(o.angle(&tap.axis).to_degrees(), ""));
+        }
+        let down = bottom.p - top.p;
+        if (back.p - top.p).norm() > 1e-6 || down.xy().norm() > 1e-6 || down.z >= 0.0 {
+            return refuse(
+                "it does not feed straight down along Z and back to where it started".into(),
+            );
+        }
+        let Some(rpm) = tap.rpm.filter(|r| r.is_finite() && *r > 0.0) else {
+            return refuse(
+                "the program gives no spindle speed for it, which the cycle needs (feed = \
+                pitch × S)"
+                    .into(),
+            );
+        };
+        let (feed_in, feed_out) = (tap.feed_in, tap.feed_out);
+        if !(feed_in > 0.0 && feed_out > 0.0 && feed_in.is_finite() && feed_out.is_finite()) {
+            return refuse("its feed is not known".into());
+        }
+        // The cycle feeds at pitch × S: the pitch it is written with is the feed it was timed
+        // at over the speed, which must be the program's pitch where it gives one.
+        let pitch = feed_in / rpm;
+        if let Some(p) = tap.pitch
+            && (p - pitch).abs() > 1e-6 * p
+        {
+            return refuse(format!(
+                "it was read at F = {feed_in} mm/min, not at its pitch {p} mm × S{rpm}"
+            ));
+        }
+        let same_out = (feed_out - feed_in).abs() <= 1e-9 * feed_in;
+        let reversed = spindle_direction(toolpath, range.start);
+        match dialect {
+            Dialect::Fanuc if !same_out => {
+                return refuse(format!(
+                    "it feeds out at {feed_out} mm/min, in at {feed_in}: G84 feeds out as in"
+                ));
+            }
+            Dialect::Fanuc if rpm.fract() != 0.0 => {
+                return refuse(format!(
+                    "its speed S{rpm} is not a whole number of rpm, which a Fanuc S is"
+                ));
+            }
+            Dialect::LinuxCnc if tap.dwell > 0.0 => {
+                return refuse(format!(
+                    "it dwells {} s at the bottom, and LinuxCNC's rigid tap G33.1 reverses \
+                    without a dwell",
+                    tap.dwell
+                ));
+            }
+            Dialect::LinuxCnc if reversed != Some(tap.left_hand) => {
+                return refuse(format!(
+                    "a {} thread with the spindle {}: G33.1 taps in the direction the spindle \
+                    turns",
+                    if tap.left_hand {
+                        "left-hand"
+                    } else {
+                        "right-hand"
+                    },
+                    match reversed {
+                        Some(true) => "turning M4",
+                        Some(false) => "turning M3",
+                        None => "stopped",
+                    }
+                ));
+            }
+            _ => {}
+        }
+        plans.push(TapPlan {
+            tap: j,
+            feed_in,
+            feed_out,
+            rpm,
+            pitch,
+            dwell: tap.dwell,
+            left_hand: tap.left_hand,
+            reversed,
+        });
+    }
+    Ok(plans)
+}
+
+/// The block of a tap's cycle ([`TapPlan`]) from `top` (written coordinates, where the tool
+/// stands) down to `bottom` (Z) and back, with the time its moves take at the written feed
+/// (in and out, no acceleration) and the dwell it writes (module doc, "Tapping"). Out of
+/// tool-tip mode: on a Fanuc machine with it, the tool's length offset `G43 H` for the cycle.
+fn tap_cycle(setup: &Setup, plan: &TapPlan, top: [f64; 3], bottom: f64) -> (String, f64, f64) {
+    let depth = top[2] - bottom;
+    let (x, y, r, z) = (coord(top[0]), coord(top[1]), coord(top[2]), coord(bottom));
+    // The feed a cycle reads back: pitch × S as written.
+    let parsed = |s: &str, v: f64| s.parse::<f64>().unwrap_or(v);
+    match setup.dialect {
+        Dialect::Fanuc => {
+            // Fanuc rigid tapping (M29 S, then G84 right-hand / G74 left-hand; G94: F = pitch
+            // × S in mm/min); G99 returns to R, where the tool started; P the dwell in ms.
+            let f = feed_number(plan.feed_in);
+            let fv = parsed(&f, plan.feed_in);
+            let ms = (plan.dwell * 1000.0).round();
+            let p = if ms > 0.0 {
+                format!(" P{ms}")
+            } else {
+                String::new()
+            };
+            let code = if plan.left_hand { "G74" } else { "G84" };
+            let length = if setup.tcp {
+                format!("G43 H{}\n", setup.h.or(setup.tool).unwrap_or(1))
+            } else {
+                String::new()
+            };
+            (
+                format!(
+                    "{length}M29 S{}\nG99 {code} X{x} Y{y} Z{z} R{r}{p} F{f}\nG80",
+                    plan.rpm
+                ),
+                2.0 * depth * 60.0 / fv,
+                ms / 1000.0,
+            )
+        }
+        Dialect::Sinumerik => {
+            // CYCLE84(RTP, RFP, SDIS, DP, DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1): from
+            // where the tool stands (RFP + SDIS = RTP), pitch PIT (negative: left-hand) at
+            // SST in, SST1 out; SDAC the spindle after it (3 M3, 4 M4, 5 M5).
+            let pit = crate::base::trimmed(plan.pitch, 9);
+            let (sst, sst1) = (
+                crate::base::trimmed(plan.rpm, 6),
+                crate::base::trimmed(plan.feed_out / plan.pitch, 6),
+            );
+            let pv = parsed(&pit, plan.pitch);
+            let (down, up) = (pv * parsed(&sst, plan.rpm), pv * parsed(&sst1, plan.rpm));
+            let sdac = match plan.reversed {
+                Some(false) => 3,
+                Some(true) => 4,
+                None => 5,
+            };
+            let dtb = if plan.dwell > 0.0 {
+                coord(plan.dwell)
+            } else {
+                String::new()
+            };
+            let sign = if plan.left_hand { "-" } else { "" };
+            (
+                format!("CYCLE84({r},{r},0,{z},,{dtb},{sdac},,{sign}{pit},0,{sst},{sst1})"),
+                depth * 60.0 / down + depth * 60.0 / up,
+                parsed(&dtb, 0.0),
+            )
+        }
+        _ => {
+            // LinuxCNC G33.1 (rigid tapping: down at K per revolution, the spindle reverses,
+            // back at I × the speed), Z only, the tool already over the hole.
+            let k = crate::base::trimmed(plan.pitch, 9);
+            let ratio = plan.feed_out / plan.feed_in;
+            let i = if ratio == 1.0 {
+                String::new()
+            } else {
+                format!(" I{}", crate::base::trimmed(ratio, 9))
+            };
+            let down = parsed(&k, plan.pitch) * parsed(&crate::base::trimmed(plan.rpm, 3), 0.0);
+            let iv = if i.is_empty() {
+                1.0
+            } else {
+                parsed(&i[2..], ratio)
+            };
+            (
+                format!("G33.1 Z{z} K{k}{i}"),
+                depth * 60.0 / down + depth * 60.0 / (down * iv),
+                0.0,
+            )
         }
     }
 }
@@ -997,7 +1270,6 @@ pub fn program(
     geometry: &GeometryOptions,
     options: &GcodeOptions,
 ) -> Result<Program> {
-    refuse_tapping(toolpath)?;
     let (blended, _) = crate::geometry::blend::blend_corners(
         toolpath,
         geometry.corner_tolerance_mm,
@@ -1005,6 +1277,13 @@ pub fn program(
     );
     let toolpath: &Toolpath = &blended;
     let w = words(options.dialect)?;
+    let taps = tap_plans(toolpath, options.dialect)?;
+    // The tap each CL point of a tap's moves belongs to.
+    let tap_at: std::collections::HashMap<usize, usize> = taps
+        .iter()
+        .enumerate()
+        .flat_map(|(k, plan)| toolpath.taps[plan.tap].points.clone().map(move |i| (i, k)))
+        .collect();
     let kin = &solution.kinematics;
     if matches!(kin, Kinematics::Joint { .. }) {
         return Err(Error::Usage(
@@ -1228,6 +1507,11 @@ pub fn program(
     };
     dwell(&mut text, dwell_after[0]);
     let mut prev_t = first.t;
+    // The CL point the last block written as the program's ended at (not a point the writer
+    // added), and the dwells the taps' cycles write.
+    let mut last_point = first.point;
+    let mut tap_dwell = 0.0;
+    let mut taps_written = 0usize;
     for (w, &i) in keep.iter().enumerate().skip(1) {
         let n = &nodes[i];
         setup.before(&mut text, n.point);
@@ -1238,6 +1522,92 @@ pub fn program(
                 "block to line {} has no positive time ({dt} s)",
                 n.line
             )));
+        }
+        if let Some(&k) = tap_at.get(&n.point) {
+            // A tap's moves: its cycle, written at the block that reaches the bottom.
+            let plan = &taps[k];
+            let tap = &toolpath.taps[plan.tap];
+            let (start, end) = (tap.points.start, tap.points.end);
+            if n.line != 0 && n.point == start {
+                // The tool stands where the feed in starts (the point before the tap's, or a
+                // repeat of it that the geometry dropped).
+                let top = toolpath.points[start - 1].p;
+                let top: [f64; 3] = std::array::from_fn(|i| rounded(top[i] - setup.origin[i]));
+                if last_point + 1 < start && (0..3).any(|i| (top[i] - prev_p[i]).abs() > 1e-6) {
+                    return Err(toolpath.error_at(
+                        tap.line,
+                        format!(
+                            "internal: {}: the block to where the tap starts was not written",
+                            tap.name
+                        ),
+                    ));
+                }
+                // A tilted tap (module doc, "Tapping"): the tool off the direction the cycle
+                // feeds, or on a machine with tool-tip mode the rotary axes off zero.
+                let tool = kin.tool_axis(n.angles);
+                let off = tool.angle(&tap.axis).to_degrees();
+                let at: Vec<String> = rotary
+                    .iter()
+                    .zip(&r)
+                    .map(|((name, _), v)| format!("{name}{v}"))
+                    .collect();
+                let why = if off > 1e-6 {
+                    Some(off_axis(off, &format!("; {}", at.join(" "))))
+                } else if setup.tcp && prev_r.iter().chain(&r).any(|a| *a != 0.0) {
+                    Some(format!(
+                        "the rotary axes stand at {}: the controls run a tapping cycle out of \
+                         tool-tip mode, where these coordinates would turn with the axes, and \
+                         such a tap is not written yet",
+                        at.join(" ")
+                    ))
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    return Err(toolpath.error_at(
+                        tap.line,
+                        format!(
+                            "{}: a tapping cycle that feedopt gcode cannot write: {why}. \
+                             `feedopt solve` times it; to write the other operations, post \
+                             this tapping separately",
+                            tap.name
+                        ),
+                    ));
+                }
+                if inverse_mode {
+                    let _ = writeln!(text, "G94");
+                    inverse_mode = false;
+                }
+                setup.tcp_off(&mut text);
+                let (block, secs, dwell) = tap_cycle(&setup, plan, prev_p, p[2]);
+                let _ = writeln!(text, "{block}");
+                total += secs;
+                tap_dwell += dwell;
+                taps_written += 1;
+                let rest = dwell_after[w] - plan.dwell;
+                if rest.abs() > 1e-9 {
+                    return Err(toolpath.error_at(
+                        tap.line,
+                        format!(
+                            "{}: a dwell of {rest} s at the tap's bottom besides the cycle's \
+                            own: it cannot be written inside the cycle",
+                            tap.name
+                        ),
+                    ));
+                }
+            }
+            if n.line != 0 {
+                blocks += 1;
+                last_point = n.point;
+                if n.point + 1 == end {
+                    dwell(&mut text, dwell_after[w]);
+                }
+            }
+            (prev_p, prev_r, prev_t) = (p, r, n.t);
+            continue;
+        }
+        if n.line != 0 {
+            last_point = n.point;
         }
         if let Some(mv) = machine_move(n) {
             // At the control's rapid: the schedule's time stands for it.
@@ -1286,6 +1656,19 @@ pub fn program(
         blocks += 1;
         (prev_p, prev_r, prev_t) = (p, r, n.t);
     }
+    if taps_written != taps.len() {
+        // (A tap whose bottom no written block reached: never dropped quietly.)
+        let tap = &toolpath.taps[taps[taps_written.min(taps.len() - 1)].tap];
+        return Err(toolpath.error_at(
+            tap.line,
+            format!(
+                "internal: {}: {} of the program's {} taps were written",
+                tap.name,
+                taps_written,
+                taps.len()
+            ),
+        ));
+    }
     if inverse_mode {
         let _ = writeln!(text, "G94");
     }
@@ -1299,8 +1682,8 @@ pub fn program(
         text,
         blocks,
         inverse_time_blocks: inverse_blocks,
-        time: total + dwell_time,
-        dwell_time,
+        time: total + dwell_time + tap_dwell,
+        dwell_time: dwell_time + tap_dwell,
         merged,
         split,
         process_split,

@@ -320,6 +320,9 @@ pub enum Action {
     CycleReturn(bool),
     /// `G28` (1) / `G30` (2): via an intermediate point to a reference point.
     Reference(u8),
+    /// LinuxCNC `G33.1 Z- K- I-`: rigid tapping, into the hole at K per spindle revolution and
+    /// back to the start at I times the speed.
+    RigidTap,
     /// `G4`: dwell.
     Dwell,
     /// Sinumerik programmable frame instructions.
@@ -697,7 +700,7 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         ("30", Action::Reference(2)),
         ("30.1", Action::Ignored),
         ("33", Unsup(THREADS)),
-        ("33.1", Unsup(THREADS)),
+        ("33.1", Action::RigidTap),
         ("38.2", Unsup("probing moves are not supported")),
         ("38.3", Unsup("probing moves are not supported")),
         ("38.4", Unsup("probing moves are not supported")),

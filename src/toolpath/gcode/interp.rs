@@ -132,6 +132,17 @@ struct ModalCall {
     number: u32,
     /// Its moves along the drilling axis, which depend on its arguments only.
     steps: Vec<cycles::Step>,
+    /// CYCLE84's pitch, speed and hand ([`Interpreter::sinumerik_tap`]).
+    tap: Option<Tap>,
+}
+
+/// What a tapping cycle's call gives besides its moves: the pitch (mm), the speed (rpm) and
+/// whether the thread is left-hand ([`crate::toolpath::TapCycle`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Tap {
+    pub pitch: Option<f64>,
+    pub rpm: Option<f64>,
+    pub left_hand: bool,
 }
 
 /// A subprogram call a block makes, run after the block's own words.
@@ -1019,6 +1030,7 @@ impl<'a> Interpreter<'a> {
         let mut end_of_program = false;
         let mut fanuc_call = false;
         let mut reference: Option<u8> = None;
+        let mut rigid_tap = false;
         let mut dwell = false;
         let mut spindle_limit = false;
         let mut frame_op: Option<(&str, FrameOp)> = None;
@@ -1109,6 +1121,7 @@ impl<'a> Interpreter<'a> {
                     self.m92 = true;
                 }
                 Action::Reference(k) => reference = Some(k),
+                Action::RigidTap => rigid_tap = true,
                 Action::Dwell => dwell = true,
                 Action::Frame(op) => frame_op = Some((text.as_str(), op)),
                 Action::Swivel => {
@@ -1483,6 +1496,9 @@ impl<'a> Interpreter<'a> {
         if let Some(k) = reference {
             return self.reference(line, k, &block).map(|()| self.end_if(end));
         }
+        if rigid_tap {
+            return self.rigid_tap(line, &block).map(|()| self.end_if(end));
+        }
         if let Some((text, number, args)) = sinumerik_cycle {
             let args = self.arguments(line, &args)?;
             let args = self.sinumerik_cycle_units(number, args);
@@ -1494,7 +1510,8 @@ impl<'a> Interpreter<'a> {
                 for n in notes {
                     self.warn(line, format!("MCALL {text}: {n}"));
                 }
-                self.mcall = Some(ModalCall { number, steps });
+                let tap = (number == 84).then(|| self.sinumerik_tap(&args));
+                self.mcall = Some(ModalCall { number, steps, tap });
             } else {
                 self.run_sinumerik_cycle(line, &text, number, &args)?;
             }
@@ -1535,12 +1552,13 @@ impl<'a> Interpreter<'a> {
             if let Some(call) = self.mcall.take()
                 && block.axes[..2].iter().any(Option::is_some)
             {
-                if call.number == 84 {
-                    self.tapping(line, "MCALL CYCLE84".into());
-                }
+                let from = self.points.len();
                 let run = self
                     .cycle_plane(line, &format!("MCALL CYCLE{}", call.number))
                     .and_then(|()| self.run_steps(line, &call.steps));
+                if let Some(tap) = call.tap {
+                    self.tapping(line, "MCALL CYCLE84".into(), from, tap);
+                }
                 self.mcall = Some(call);
                 run?;
             }
@@ -2461,6 +2479,17 @@ impl<'a> Interpreter<'a> {
         })?;
         if let Some(q) = block.letter('Q') {
             c.q = Some(self.length(q).abs());
+            if matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84) {
+                // Fanuc's peck tapping is machine data (parameter 5200#6 PCT): read as one pass.
+                self.warn(
+                    line,
+                    format!(
+                        "G{}: Q in a tapping cycle pecks (Fanuc peck tapping, parameter 5200#6 \
+                         PCT = 1) or is ignored (PCT = 0): read as one pass, without pecks",
+                        c.code
+                    ),
+                );
+            }
         }
         if let Some(p) = block.letter('P') {
             c.dwell = if self.spec.integer_increments.is_some() && !p.point {
@@ -2527,9 +2556,11 @@ impl<'a> Interpreter<'a> {
         if let Some(note) = note {
             self.warn(line, format!("G{}: {note}", c.code));
         }
-        if matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84) {
-            self.tapping(line, format!("G{}", c.code));
-        }
+        let tap = matches!(c.kind, cycles::Kind::G74 | cycles::Kind::G84).then_some(Tap {
+            pitch: None,
+            rpm: self.rpm,
+            left_hand: c.kind == cycles::Kind::G74,
+        });
         // Each repeat: up to R, over the hole, and the cycle's moves.
         self.check_room(
             line,
@@ -2564,8 +2595,84 @@ impl<'a> Interpreter<'a> {
             }
             self.known[2] = true;
             self.rapid_z(line, r);
+            let from = self.points.len();
             self.run_steps(line, &steps)?;
+            if let Some(tap) = tap {
+                self.tapping(line, format!("G{}", c.code), from, tap);
+            }
         }
+        Ok(())
+    }
+
+    /// LinuxCNC `G33.1 Z- K- I-` (rigid tapping, the LinuxCNC manual's "G33.1 Rigid
+    /// Tapping"): from the current point to Z synchronised with the spindle at K per
+    /// revolution, the spindle reverses, and back to the start at I times the speed (I
+    /// optional, 1). The overtravel while the spindle reverses is not modelled. Read along Z
+    /// only: X and Y, if given, must be where the tool stands (the manual: otherwise the tap
+    /// runs on a slant to the point), and the spindle must turn at a known speed. Its motion
+    /// mode ends with the block: an axis word after it needs a new motion code.
+    fn rigid_tap(&mut self, line: usize, block: &Block) -> Result<()> {
+        let fail = |m: &str| Err(self.error(line, format!("G33.1: {m}")));
+        if self.plane != Plane::Xy {
+            return fail("rigid tapping is read in the XY plane (G17) only");
+        }
+        if block.axes[3..].iter().any(Option::is_some) {
+            return fail("rotary axis words in a rigid tap");
+        }
+        let incremental = self.distance == Distance::Incremental;
+        for i in 0..2 {
+            if let Some(n) = block.axes[i] {
+                let v = self.length(n);
+                let at = if incremental { self.pos[i] + v } else { v };
+                if (at - self.pos[i]).abs() > 1e-9 || !self.known[i] {
+                    return fail(
+                        "X or Y off the point where the tool stands: the tap would run on a \
+                        slant to it; position over the hole first and give only Z",
+                    );
+                }
+            }
+        }
+        let Some(z) = block.axes[2] else {
+            return fail("Z (the hole's bottom) is missing");
+        };
+        let z = self.length(z);
+        let bottom = if incremental { self.pos[2] + z } else { z };
+        let Some(k) = block.letter('K') else {
+            return fail("K (the distance per revolution) is missing");
+        };
+        let pitch = self.length(k).abs();
+        let factor = block.letter('I').map_or(1.0, |i| i.value);
+        let Some(rpm) = self.rpm.filter(|r| *r > 0.0) else {
+            return fail("no spindle speed (S) before it: the tap feeds at K × S");
+        };
+        let down = pitch * rpm;
+        if !(pitch > 0.0 && (1e-3..=1e9).contains(&down)) {
+            return fail("K × S is out of range");
+        }
+        if !(factor.is_finite() && factor > 0.0 && factor <= 100.0) {
+            return fail("the return's speed factor I must be positive");
+        }
+        if !self.known[2] {
+            return fail("the tool's Z is not known before the tap");
+        }
+        let top = self.pos[2];
+        if bottom == top {
+            return fail("Z is where the tool stands: the tap has no depth");
+        }
+        let from = self.points.len();
+        self.check_room(line, "G33.1", 2)?;
+        let mut q = self.pos;
+        q[2] = bottom;
+        self.push(line, &q, Feed::Programmed(down / 60.0));
+        q[2] = top;
+        self.push(line, &q, Feed::Programmed(down * factor / 60.0));
+        self.motion = None;
+        let tap = Tap {
+            pitch: Some(pitch),
+            rpm: Some(rpm),
+            left_hand: self.spindle_reversed(),
+        };
+        self.tapping(line, "G33.1".into(), from, tap);
         Ok(())
     }
 
@@ -2720,15 +2827,78 @@ impl<'a> Interpreter<'a> {
         for n in notes {
             self.warn(line, format!("{text}: {n}"));
         }
+        let from = self.points.len();
+        self.run_steps(line, &steps)?;
         if number == 84 {
-            self.tapping(line, text.to_string());
+            let tap = self.sinumerik_tap(args);
+            self.tapping(line, text.to_string(), from, tap);
         }
-        self.run_steps(line, &steps)
+        Ok(())
     }
 
-    /// Records a tapping cycle run at `line` ([`Toolpath::taps`]).
-    pub(super) fn tapping(&mut self, line: usize, name: String) {
-        self.taps.push(crate::toolpath::TapCycle { line, name });
+    /// CYCLE84's pitch PIT (mm, converted), speed SST (else the S in force) and hand: a
+    /// negative PIT or MPIT is a left-hand thread; without either, the spindle's direction.
+    fn sinumerik_tap(&self, args: &[Option<f64>]) -> Tap {
+        let get = |k: usize| args.get(k).copied().flatten().filter(|v| *v != 0.0);
+        let pitch = get(8);
+        let left_hand = match pitch.or(get(7)) {
+            Some(p) => p < 0.0,
+            None => self.spindle_reversed(),
+        };
+        Tap {
+            pitch: pitch.map(f64::abs),
+            rpm: get(10).map(f64::abs).or(self.rpm),
+            left_hand,
+        }
+    }
+
+    /// The spindle's last direction switch is M4 (counter-clockwise).
+    pub(super) fn spindle_reversed(&self) -> bool {
+        self.switches
+            .iter()
+            .rev()
+            .find(|s| {
+                matches!(
+                    s.switch,
+                    Switch::SpindleClockwise | Switch::SpindleCounterClockwise
+                )
+            })
+            .is_some_and(|s| s.switch == Switch::SpindleCounterClockwise)
+    }
+
+    /// Records one hole of a tapping cycle whose moves were made from CL point `from` on
+    /// ([`Toolpath::taps`]): the run of feed moves after its first, into the hole and out.
+    pub(super) fn tapping(&mut self, line: usize, name: String, from: usize, tap: Tap) {
+        let pts = &self.points;
+        let fed = |i: usize| matches!(pts[i].feed, Feed::Programmed(_));
+        let Some(a) = (from..pts.len()).find(|&i| fed(i)) else {
+            return;
+        };
+        let b = (a..pts.len()).find(|&i| !fed(i)).unwrap_or(pts.len());
+        let mm_per_min = |i: usize| match pts[i].feed {
+            Feed::Programmed(v) => v * 60.0,
+            _ => 0.0,
+        };
+        let (feed_in, feed_out) = (mm_per_min(a), mm_per_min(b - 1));
+        let dwell = self
+            .dwells
+            .iter()
+            .filter(|d| d.point == a)
+            .map(|d| d.seconds)
+            .sum();
+        let axis = self.frame_now().r * Vector3::z();
+        self.taps.push(crate::toolpath::TapCycle {
+            line,
+            name,
+            points: a..b,
+            feed_in,
+            feed_out,
+            pitch: tap.pitch,
+            rpm: tap.rpm,
+            left_hand: tap.left_hand,
+            dwell,
+            axis,
+        });
     }
 
     /// Cycles are read in the XY plane only.

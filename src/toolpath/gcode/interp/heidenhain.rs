@@ -1531,12 +1531,25 @@ impl Interpreter<'_> {
         for n in notes {
             self.warn(line, format!("cycle {number}: {n}"));
         }
-        if matches!(number, 207 | 209) {
-            self.tapping(line, format!("CYCL DEF {number} (at line {def_line})"));
-        }
         self.known[2] = true;
         self.warn_unknown(line);
+        let from = self.points.len();
         self.run_steps(line, &steps)?;
+        if matches!(number, 207 | 209) {
+            // Q239: the pitch, negative for a left-hand thread.
+            let pitch = self.q(239).filter(|p| *p != 0.0);
+            let tap = super::Tap {
+                pitch: pitch.map(f64::abs),
+                rpm: self.klartext.spindle_rpm,
+                left_hand: pitch.is_some_and(|p| p < 0.0),
+            };
+            self.tapping(
+                line,
+                format!("CYCL DEF {number} (at line {def_line})"),
+                from,
+                tap,
+            );
+        }
         self.tangent = None;
         Ok(())
     }
