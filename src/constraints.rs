@@ -562,7 +562,10 @@ impl SpanProblem {
     ///   `≥`. (The pairs of one end alone, `L(b) ≤ U(b)`, say that b is below the
     ///   acceleration-limited b* there, which `b_max` holds already; the rows with q' = 0, a
     ///   bound on b alone, are in b* too.)
-    pub fn interval_rows(&self, k: usize, mut f: impl FnMut(IntervalRow)) {
+    ///
+    /// `cache` keeps the last two stations' bounds on ü (a pass over the intervals in either
+    /// direction computes each station's once).
+    pub fn interval_rows(&self, k: usize, cache: &mut LineCache, mut f: impl FnMut(IntervalRow)) {
         let du = self.du(k);
         match self.ramp {
             Ramp::Constant => {
@@ -614,35 +617,29 @@ impl SpanProblem {
                 // ü⁰ ≥ (b_{k+1} − 3 b_k)/(4Δu): against each upper bound on ü⁰ a row, and against
                 // each lower bound on ü¹ (ü⁰ = S − ü¹) another. (A linear b has P at the mean.)
                 let quarter = 0.25 * inv;
-                self.each_udd_line(k, |p| {
-                    if p.upper {
-                        // (y − 3x)/(4Δu) ≤ α_p + β_p x
-                        f(IntervalRow {
-                            cx: -3.0 * quarter - p.beta,
-                            cy: quarter,
-                            d: p.alpha,
-                            scale: p.alpha.abs(),
-                            limits: [Some((p.axis, p.max, p.per_limit)), None],
-                        });
-                    }
-                });
-                self.each_udd_line(k + 1, |q| {
-                    if !q.upper {
-                        // α_q + β_q y ≤ (3y − x)/(4Δu)
-                        f(IntervalRow {
-                            cx: quarter,
-                            cy: q.beta - 3.0 * quarter,
-                            d: -q.alpha,
-                            scale: q.alpha.abs(),
-                            limits: [Some((q.axis, q.max, -q.per_limit)), None],
-                        });
-                    }
-                });
-                self.each_udd_line(k, |p| {
-                    self.each_udd_line(k + 1, |q| {
-                        if q.upper != p.upper {
-                            return;
-                        }
+                let (start, end) = cache.pair(self, k);
+                for p in start.iter().filter(|p| p.upper) {
+                    // (y − 3x)/(4Δu) ≤ α_p + β_p x
+                    f(IntervalRow {
+                        cx: -3.0 * quarter - p.beta,
+                        cy: quarter,
+                        d: p.alpha,
+                        scale: p.alpha.abs(),
+                        limits: [Some((p.axis, p.max, p.per_limit)), None],
+                    });
+                }
+                for q in end.iter().filter(|q| !q.upper) {
+                    // α_q + β_q y ≤ (3y − x)/(4Δu)
+                    f(IntervalRow {
+                        cx: quarter,
+                        cy: q.beta - 3.0 * quarter,
+                        d: -q.alpha,
+                        scale: q.alpha.abs(),
+                        limits: [Some((q.axis, q.max, -q.per_limit)), None],
+                    });
+                }
+                for p in start {
+                    for q in end.iter().filter(|q| q.upper == p.upper) {
                         // upper: (y − x)/Δu ≤ α_p + β_p x + α_q + β_q y; lower: ≥, negated.
                         let s = if p.upper { 1.0 } else { -1.0 };
                         f(IntervalRow {
@@ -655,8 +652,8 @@ impl SpanProblem {
                                 Some((q.axis, q.max, s * q.per_limit)),
                             ],
                         });
-                    })
-                });
+                    }
+                }
             }
         }
     }
@@ -698,13 +695,15 @@ impl SpanProblem {
         if self.ramp == Ramp::Constant {
             return None;
         }
+        let range: Vec<(f64, f64)> = (0..b.len())
+            .map(|i| self.udd_range(i, b[i].max(0.0)))
+            .collect();
         Some(
             (0..self.intervals())
                 .map(|k| {
                     let (x, y) = (b[k].max(0.0), b[k + 1].max(0.0));
                     let s = (y - x) / self.du(k);
-                    let (l0, u0) = self.udd_range(k, x);
-                    let (l1, u1) = self.udd_range(k + 1, y);
+                    let ((l0, u0), (l1, u1)) = (range[k], range[k + 1]);
                     // ü⁰ ≥ (y − 3x)/(4Δu): b well above 0 inside ([`SpanProblem::interval_rows`]).
                     let floor = (y - 3.0 * x) / (4.0 * self.du(k));
                     let (lo, hi) = (l0.max(s - u1).max(floor), u0.min(s - l1));
@@ -793,6 +792,40 @@ pub struct IntervalRow {
     /// The limits in `d`: (axis, whether it is a_max (else a_min), ∂d/∂limit); the second
     /// only for a [`Ramp::Linear`] row, which joins a row of each end.
     pub limits: [Option<(usize, bool, f64)>; 2],
+}
+
+/// The bounds on ü of the last two stations [`SpanProblem::interval_rows`] asked for.
+#[derive(Debug)]
+pub struct LineCache {
+    at: [usize; 2],
+    lines: [Vec<UddLine>; 2],
+}
+
+impl Default for LineCache {
+    fn default() -> Self {
+        LineCache {
+            at: [usize::MAX; 2],
+            lines: [Vec::new(), Vec::new()],
+        }
+    }
+}
+
+impl LineCache {
+    /// Stations k's and k + 1's lines, computing those not kept.
+    fn pair(&mut self, p: &SpanProblem, k: usize) -> (&[UddLine], &[UddLine]) {
+        for i in [k, k + 1] {
+            if !self.at.contains(&i) {
+                // The slot not holding the other station of the pair.
+                let slot = usize::from(self.at[0] == k || self.at[0] == k + 1);
+                self.at[slot] = i;
+                let lines = &mut self.lines[slot];
+                lines.clear();
+                p.each_udd_line(i, |l| lines.push(l));
+            }
+        }
+        let a = usize::from(self.at[1] == k);
+        (&self.lines[a], &self.lines[1 - a])
+    }
 }
 
 /// A line `ü ≤ α + β b` (upper) or `ü ≥ α + β b` of one acceleration row at a station.

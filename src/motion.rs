@@ -202,7 +202,13 @@ impl Interval {
                     a1,
                     s0: alpha,
                     s1: alpha,
-                    law: Law::Quadratic,
+                    // Where the ends' ü are the chord's (most intervals), b is linear: the same
+                    // motion, evaluated the cheaper way.
+                    law: if alpha == 0.0 {
+                        Law::Linear
+                    } else {
+                        Law::Quadratic
+                    },
                 }
             }
             (Some(a), _) => {

@@ -300,8 +300,9 @@ fn linear_rows(p: &SpanProblem, scale: f64) -> Vec<LinearRow> {
             });
         }
     }
+    let mut cache = crate::constraints::LineCache::default();
     for k in 0..n {
-        p.interval_rows(k, |r| {
+        p.interval_rows(k, &mut cache, |r| {
             // cx x_k + cy x_{k+1} ≤ d/B, divided by the row's scale (so h is about 1).
             let norm = scale / r.scale;
             let mut coefs: Vec<(usize, f64)> = Vec::with_capacity(2);

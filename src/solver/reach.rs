@@ -26,7 +26,7 @@
 //! path and the cross-check of the convex solve, not its replacement.
 
 use super::{SpanSolution, Status};
-use crate::constraints::{Bound, SpanProblem};
+use crate::constraints::{Bound, LineCache, SpanProblem};
 
 /// A line in (x, y) = (b_k, b_{k+1}): y ≤ α + βx (upper) or y ≥ α + βx (lower), and the limit
 /// it comes from.
@@ -45,6 +45,8 @@ struct IntervalRows {
     /// x ≤ value / x ≥ value (rows with no b_{k+1} term), and the limit each comes from.
     x_max: (f64, Bound),
     x_min: (f64, Bound),
+    /// The stations' bounds on ü (one problem's: an `IntervalRows` serves one pass).
+    cache: LineCache,
 }
 
 impl IntervalRows {
@@ -87,13 +89,15 @@ impl IntervalRows {
             beta: 0.0,
             src: next.lo_by,
         });
-        p.interval_rows(k, |r| {
+        let mut cache = std::mem::take(&mut self.cache);
+        p.interval_rows(k, &mut cache, |r| {
             if lattice_only && !is_lattice_row(r.cx, r.cy) {
                 return;
             }
             let axis = r.limits[0].map_or(0, |l| l.0);
             self.le(r.cx, r.cy, r.d, axis);
         });
+        self.cache = cache;
     }
 
     /// The x in `[x_min, x_max]` for which some y meets every row (with the limits that set
@@ -250,9 +254,10 @@ pub fn solve_lattice(p: &SpanProblem) -> Result<SpanSolution, Infeasible> {
 /// out by more than a relative `tol` of its limit.
 pub fn lattice_violations(p: &SpanProblem, b: &[f64], tol: f64) -> Vec<usize> {
     let mut out = Vec::new();
+    let mut cache = LineCache::default();
     for k in 0..p.intervals() {
         let mut broken = false;
-        p.interval_rows(k, |r| {
+        p.interval_rows(k, &mut cache, |r| {
             broken |=
                 !is_lattice_row(r.cx, r.cy) && r.cx * b[k] + r.cy * b[k + 1] > r.d + tol * r.scale;
         });
