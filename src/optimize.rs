@@ -1135,8 +1135,25 @@ impl Plan<'_> {
     }
 
     /// The reach pass on one span, its infeasibility in words.
-    fn reach(&self, si: usize, p: &SpanProblem) -> Result<SpanSolution> {
-        solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))
+    ///
+    /// Where its profile stands still on an interval inside the span (b = 0 at both ends, no
+    /// motion), the optimum of the same stations instead ([`solver::optimal`]): on rows that
+    /// are not max-closed the pass's pointwise-largest b at one station can leave the next
+    /// nothing but 0. The 20 COPP paths end with q' falling to 0 over their last interval,
+    /// where the stations' bounds on ü are steep lines in b; under the linear-ü law the
+    /// largest b one station before the end left the next none, and every path failed (the
+    /// cone program's optimum has b = 0.0039 there). The convex program never stands still
+    /// where motion is possible: its objective, the time, would be infinite.
+    fn reach(&self, si: usize, p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution> {
+        let g = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
+        if interval_times(p, &g).is_ok() {
+            return Ok(g);
+        }
+        tracing::debug!("span {si}: the reach profile stands still on an interval; its optimum");
+        match solver::optimal(p, &g, settings) {
+            Ok(o) if interval_times(p, &o).is_ok() => Ok(o),
+            _ => Ok(g),
+        }
     }
 
     /// Span `si` on a uniform grid (every CL knot, each segment divided so the spans share
@@ -1170,7 +1187,7 @@ impl Plan<'_> {
     fn bisect(&self, si: usize, options: &Options, p: SpanProblem) -> Result<Round> {
         let span = &self.path.spans[si];
         let chord = options.verify.chord.as_ref();
-        let g = self.reach(si, &p)?;
+        let g = self.reach(si, &p, &options.solver)?;
         let t = self.times(si, &p, &g)?;
         let n = p.intervals();
         let all: Vec<usize> = (0..n).collect();
@@ -1178,7 +1195,7 @@ impl Plan<'_> {
             0.5 * (p.u[k] + p.u[k + 1])
         });
         self.check_travel(si, &pf)?;
-        let gf = self.reach(si, &pf)?;
+        let gf = self.reach(si, &pf, &options.solver)?;
         let tf = self.times(si, &pf, &gf)?;
         let time = tf.iter().sum();
         let e: Vec<f64> = (0..n)
@@ -1961,7 +1978,7 @@ impl Plan<'_> {
         // convex solver's infeasibility certificate cannot.
         let greedy = match greedy {
             Some(g) => g,
-            None => self.reach(si, p)?,
+            None => self.reach(si, p, &options.solver)?,
         };
         if self.machine.has_jerk() {
             if options.solver_kind == SolverKind::Reach {
