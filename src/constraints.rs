@@ -568,7 +568,8 @@ impl SpanProblem {
     pub fn interval_rows(&self, k: usize, cache: &mut LineCache, mut f: impl FnMut(IntervalRow)) {
         let du = self.du(k);
         match self.ramp {
-            Ramp::Constant => {
+            Ramp::Linear if !self.steep(k, cache) => self.linear_rows(k, du, cache, &mut f),
+            _ => {
                 let inv = 1.0 / (2.0 * du);
                 for (e, at_end) in [(k, false), (k + 1, true)] {
                     let (dq, ddq) = (self.jets.dq(e), self.jets.ddq(e));
@@ -606,54 +607,82 @@ impl SpanProblem {
                     }
                 }
             }
-            Ramp::Linear => {
-                let inv = 1.0 / du;
-                // b stays well above 0 inside: as a quadratic Bézier on the interval b has the
-                // control points b_k, P = b_k + Δu ü⁰ (= b_{k+1} − Δu ü¹) and b_{k+1}, and
-                // P ≥ (b_k + b_{k+1})/4 keeps b ≥ 0, and from or to rest (b = 0 at an end) keeps
-                // ü away from 0 there, so the interval takes finite time, at most twice the
-                // linear law's. Near a stop, without it, a convex b bottoms out below 0 between
-                // two small b, or reaches b = 0 at a station with ü = 0 or still braking. It is
-                // ü⁰ ≥ (b_{k+1} − 3 b_k)/(4Δu): against each upper bound on ü⁰ a row, and against
-                // each lower bound on ü¹ (ü⁰ = S − ü¹) another. (A linear b has P at the mean.)
-                let quarter = 0.25 * inv;
-                let (start, end) = cache.pair(self, k);
-                for p in start.iter().filter(|p| p.upper) {
-                    // (y − 3x)/(4Δu) ≤ α_p + β_p x
-                    f(IntervalRow {
-                        cx: -3.0 * quarter - p.beta,
-                        cy: quarter,
-                        d: p.alpha,
-                        scale: p.alpha.abs(),
-                        limits: [Some((p.axis, p.max, p.per_limit)), None],
-                    });
-                }
-                for q in end.iter().filter(|q| !q.upper) {
-                    // α_q + β_q y ≤ (3y − x)/(4Δu)
-                    f(IntervalRow {
-                        cx: quarter,
-                        cy: q.beta - 3.0 * quarter,
-                        d: -q.alpha,
-                        scale: q.alpha.abs(),
-                        limits: [Some((q.axis, q.max, -q.per_limit)), None],
-                    });
-                }
-                for p in start {
-                    for q in end.iter().filter(|q| q.upper == p.upper) {
-                        // upper: (y − x)/Δu ≤ α_p + β_p x + α_q + β_q y; lower: ≥, negated.
-                        let s = if p.upper { 1.0 } else { -1.0 };
-                        f(IntervalRow {
-                            cx: s * (-inv - p.beta),
-                            cy: s * (inv - q.beta),
-                            d: s * (p.alpha + q.alpha),
-                            scale: p.alpha.abs() + q.alpha.abs(),
-                            limits: [
-                                Some((p.axis, p.max, s * p.per_limit)),
-                                Some((q.axis, q.max, s * q.per_limit)),
-                            ],
-                        });
-                    }
-                }
+        }
+    }
+
+    /// Whether a bound on ü at an end of interval `k` is steeper in b than 1/Δu:
+    /// |q''/q'| Δu > 1 for an axis that bounds ü there. Such an interval takes the constant
+    /// law's rows ([`SpanProblem::interval_rows`]) and its ü is its chord's
+    /// ([`SpanProblem::ramp_ends`]): with ü linear its rows join two steep lines into one that
+    /// is not max-closed. The 20 COPP paths end with q' falling to 0 over their last
+    /// intervals, and there the reach pass's largest b one station before the end left the
+    /// next none (taking only the intervals where every bound is steep, or where the
+    /// parameter's speed falls by half, left the greedy profile 0.09 % above the optimum of the
+    /// same 1,000 stations, and the refined solves of the twenty paths 6 times slower). On a
+    /// curve an axis turning round makes its own bound steep, so those intervals too keep the
+    /// constant law (NX's Röders finish on the machine's limits: 637k stations, where the
+    /// linear law everywhere took 407k and the constant law 2.7 M); as Δu falls there are
+    /// fewer of them.
+    fn steep(&self, k: usize, cache: &mut LineCache) -> bool {
+        let du = self.du(k);
+        let (a, b) = cache.pair(self, k);
+        a.iter().chain(b).any(|l| l.beta.abs() * du > 1.0)
+    }
+
+    /// [`SpanProblem::interval_rows`] under [`Ramp::Linear`] on an interval that is not
+    /// [steep](SpanProblem::steep).
+    fn linear_rows(
+        &self,
+        k: usize,
+        du: f64,
+        cache: &mut LineCache,
+        f: &mut impl FnMut(IntervalRow),
+    ) {
+        let inv = 1.0 / du;
+        // b stays well above 0 inside: as a quadratic Bézier on the interval b has the
+        // control points b_k, P = b_k + Δu ü⁰ (= b_{k+1} − Δu ü¹) and b_{k+1}, and
+        // P ≥ (b_k + b_{k+1})/4 keeps b ≥ 0, and from or to rest (b = 0 at an end) keeps
+        // ü away from 0 there, so the interval takes finite time, at most twice the
+        // linear law's. Near a stop, without it, a convex b bottoms out below 0 between
+        // two small b, or reaches b = 0 at a station with ü = 0 or still braking. It is
+        // ü⁰ ≥ (b_{k+1} − 3 b_k)/(4Δu): against each upper bound on ü⁰ a row, and against
+        // each lower bound on ü¹ (ü⁰ = S − ü¹) another. (A linear b has P at the mean.)
+        let quarter = 0.25 * inv;
+        let (start, end) = cache.pair(self, k);
+        for p in start.iter().filter(|p| p.upper) {
+            // (y − 3x)/(4Δu) ≤ α_p + β_p x
+            f(IntervalRow {
+                cx: -3.0 * quarter - p.beta,
+                cy: quarter,
+                d: p.alpha,
+                scale: p.alpha.abs(),
+                limits: [Some((p.axis, p.max, p.per_limit)), None],
+            });
+        }
+        for q in end.iter().filter(|q| !q.upper) {
+            // α_q + β_q y ≤ (3y − x)/(4Δu)
+            f(IntervalRow {
+                cx: quarter,
+                cy: q.beta - 3.0 * quarter,
+                d: -q.alpha,
+                scale: q.alpha.abs(),
+                limits: [Some((q.axis, q.max, -q.per_limit)), None],
+            });
+        }
+        for p in start {
+            for q in end.iter().filter(|q| q.upper == p.upper) {
+                // upper: (y − x)/Δu ≤ α_p + β_p x + α_q + β_q y; lower: ≥, negated.
+                let s = if p.upper { 1.0 } else { -1.0 };
+                f(IntervalRow {
+                    cx: s * (-inv - p.beta),
+                    cy: s * (inv - q.beta),
+                    d: s * (p.alpha + q.alpha),
+                    scale: p.alpha.abs() + q.alpha.abs(),
+                    limits: [
+                        Some((p.axis, p.max, s * p.per_limit)),
+                        Some((q.axis, q.max, s * q.per_limit)),
+                    ],
+                });
             }
         }
     }
@@ -698,11 +727,15 @@ impl SpanProblem {
         let range: Vec<(f64, f64)> = (0..b.len())
             .map(|i| self.udd_range(i, b[i].max(0.0)))
             .collect();
+        let mut cache = LineCache::default();
         Some(
             (0..self.intervals())
                 .map(|k| {
                     let (x, y) = (b[k].max(0.0), b[k + 1].max(0.0));
                     let s = (y - x) / self.du(k);
+                    if self.steep(k, &mut cache) {
+                        return [0.5 * s; 2];
+                    }
                     let ((l0, u0), (l1, u1)) = (range[k], range[k + 1]);
                     // ü⁰ ≥ (y − 3x)/(4Δu): b well above 0 inside ([`SpanProblem::interval_rows`]).
                     let floor = (y - 3.0 * x) / (4.0 * self.du(k));
