@@ -672,6 +672,11 @@ impl Warm {
         let s_old = old.slopes.as_deref();
         let n = p.u.len();
         let last = old_p.intervals() - 1;
+        let shape = Shape {
+            a: Some(a_old),
+            slopes: s_old,
+            ends: None,
+        };
         let mut slopes = Vec::with_capacity(n.saturating_sub(1));
         let mut k = 0;
         for j in 0..n.saturating_sub(1) {
@@ -679,16 +684,7 @@ impl Warm {
             while k < last && old_p.u[k + 1] <= mid {
                 k += 1;
             }
-            let iv = Interval::of(
-                &old_p.u,
-                &old.b,
-                Shape {
-                    a: Some(a_old),
-                    slopes: s_old,
-                    ends: None,
-                },
-                k,
-            );
+            let iv = Interval::of(&old_p.u, &old.b, shape, k);
             slopes.push([
                 iv.slope_at_x(p.u[j] - old_p.u[k]),
                 iv.slope_at_x(p.u[j + 1] - old_p.u[k]),
@@ -705,16 +701,7 @@ impl Warm {
             while k < last && old_p.u[k + 1] <= u {
                 k += 1;
             }
-            let iv = Interval::of(
-                &old_p.u,
-                &old.b,
-                Shape {
-                    a: Some(a_old),
-                    slopes: s_old,
-                    ends: None,
-                },
-                k,
-            );
+            let iv = Interval::of(&old_p.u, &old.b, shape, k);
             let (bu, au) = iv.at_x(u - old_p.u[k]);
             b.push(bu);
             a.push(au);
