@@ -638,7 +638,7 @@ pub(crate) fn predicted_marks(
     verify: &VerifyOptions,
     mark: f64,
 ) -> Result<Vec<Mark>> {
-    let brief = verify.period / 64.0;
+    let brief = verify.period * BRIEF_SHARE;
     let mut out = Vec::new();
     for (si, (p, s)) in problems.iter().zip(solutions).enumerate() {
         let Some(ends) = s.ends.as_deref() else {
@@ -848,6 +848,10 @@ struct Round {
 /// The share of the re-simulation's tolerance above which an interval's estimated excess
 /// between stations ([`SpanProblem::overshoot`]) has the adaptive refinement halve it.
 const OVERSHOOT_MARK: f64 = 0.25;
+
+/// Intervals shorter than this share of the servo period are not halved for their estimated
+/// excess ([`OVERSHOOT_MARK`], [`predicted_marks`]): no servo instant is likely inside.
+const BRIEF_SHARE: f64 = 1.0 / 64.0;
 
 /// One round of the jerk-limited adaptive refinement of one span: G and F both solved by the
 /// SCP.
@@ -1146,7 +1150,9 @@ impl Plan<'_> {
     /// where motion is possible: its objective, the time, would be infinite.
     fn reach(&self, si: usize, p: &SpanProblem, settings: &SolverSettings) -> Result<SpanSolution> {
         let g = solver::reach::solve(p).map_err(|inf| self.infeasible(si, p, &inf))?;
-        if interval_times(p, &g).is_ok() {
+        // (A scan of b, not the interval times: this runs on every grid of every round, and
+        // the times are computed next by the caller that needs them.)
+        if !g.b.windows(2).any(|w| w[0] <= 0.0 && w[1] <= 0.0) {
             return Ok(g);
         }
         tracing::debug!("span {si}: the reach profile stands still on an interval; its optimum");
@@ -1206,7 +1212,7 @@ impl Plan<'_> {
         // 1e-10° with the estimate unchanged: there ü is huge and the jets' terms cancel).
         let (mark, brief) = (
             OVERSHOOT_MARK * options.verify.tolerance,
-            options.verify.period / 64.0,
+            options.verify.period * BRIEF_SHARE,
         );
         let over = match gf.ends.as_deref() {
             Some(ends) => (0..n)

@@ -7,6 +7,9 @@ use feedopt::toolpath::Toolpath;
 use feedopt::toolpath::gcode::{Dialect, Settings, parse_configured};
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::feedopt;
+
 /// A fresh directory for one test, with `files` (relative path, text) written into it.
 fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -332,14 +335,6 @@ fn sinumerik_name_l_and_extcall_read_spf_files() {
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-fn feedopt(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
 }
 
 /// On the command line: `--subprogram-dir` reaches the reader; a warning and `check`'s

@@ -14,7 +14,7 @@ use feedopt::toolpath::{Feed, Toolpath};
 use nalgebra::Vector3;
 
 mod common;
-use common::{UP, machine, toolpath};
+use common::{UP, feedopt, machine, toolpath};
 
 const XYZ: &str = r#"{"name": "xyz", "kinematics": {"type": "xyz"},
     "axes": {"X": {"velocity": 500, "acceleration": 5000},
@@ -577,14 +577,6 @@ fn a_repeated_pass_runs_at_the_air_feed() {
     let (v2, by2) = at(2);
     assert_eq!(by2, Bound::Process(ProcessLimit::Air));
     assert!((v2 - 100.0).abs() < 1e-6, "{v2}");
-}
-
-fn feedopt(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
 }
 
 const POCKET: [&str; 3] = [

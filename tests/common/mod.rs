@@ -33,3 +33,12 @@ pub fn toolpath(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_s: Option<f64>)
 
 /// The tool pointing up.
 pub const UP: Vector3<f64> = Vector3::new(0.0, 0.0, 1.0);
+
+/// Runs the `feedopt` binary with `args` from the crate's root.
+pub fn feedopt(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_feedopt"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
