@@ -1088,7 +1088,7 @@ fn solve_piece(
     };
     let mut best: Option<(SpanSolution, f64)> = None;
     let (mut status, mut iterations, mut solve_time) = (Status::Optimal, 0, 0.0);
-    let mut carried: Vec<bool> = Vec::new();
+    let mut carried = Carried::default();
     let program = Program::new(p, jd, &bbar, a_ends, options, start.fresh);
     // Whether (bbar, abar) is an iterate of this SCP (feasible), not the start.
     let mut from_iterate = false;
@@ -1169,7 +1169,7 @@ fn solve_piece(
                     *b *= 0.25;
                 }
                 (abar, sbar, last_time) = (None, None, None);
-                carried.clear();
+                carried = Carried::default();
                 continue;
             }
             Err(e) => return Err(e),
@@ -1411,6 +1411,78 @@ struct Program<'a> {
     hot: Option<Vec<bool>>,
     /// Who solves a linear subproblem.
     lp_solver: LpSolver,
+}
+
+/// What one subproblem of an SCP leaves the next: its active rows (by candidate) and its last
+/// LP's solution.
+#[derive(Default)]
+struct Carried {
+    active: Vec<bool>,
+    lp: Option<WarmLp>,
+}
+
+/// The last linear subproblem's solution, kept to start the next one from (the same
+/// subproblem with more rows, or the next SCP iterate's): its primal and each row's multiplier,
+/// by the row's identity (equalities, velocity rows, candidates; NaN where a candidate was not
+/// stated).
+struct WarmLp {
+    x: Vec<f64>,
+    eq: Vec<f64>,
+    tied: Vec<f64>,
+    lin: Vec<f64>,
+    cands: Vec<f64>,
+}
+
+impl WarmLp {
+    fn of(
+        program: &Program,
+        sol: &super::banded::LpSolution,
+        active: &[bool],
+        tie: bool,
+    ) -> WarmLp {
+        let mut d = sol.duals.iter().copied();
+        let eq = d.by_ref().take(program.eq.len()).collect();
+        let tied = if tie {
+            d.by_ref().take(program.tied.len()).collect()
+        } else {
+            vec![f64::NAN; program.tied.len()]
+        };
+        let lin = d.by_ref().take(program.lin.len()).collect();
+        let cands = active
+            .iter()
+            .map(|&a| {
+                if a {
+                    d.next().unwrap_or(f64::NAN)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        WarmLp {
+            x: sol.x.clone(),
+            eq,
+            tied,
+            lin,
+            cands,
+        }
+    }
+
+    /// The multipliers in the row order of a subproblem with `active` candidates.
+    fn duals(&self, active: &[bool], tie: bool) -> Vec<f64> {
+        let mut d = self.eq.clone();
+        if tie {
+            d.extend_from_slice(&self.tied);
+        }
+        d.extend_from_slice(&self.lin);
+        d.extend(
+            active
+                .iter()
+                .zip(&self.cands)
+                .filter(|(a, _)| **a)
+                .map(|(_, v)| *v),
+        );
+        d
+    }
 }
 
 /// What Clarabel returned for one subproblem ([`Program::clarabel`]).
@@ -1800,7 +1872,7 @@ impl<'a> Program<'a> {
 
     /// One convex subproblem, the jerk rows linearised at the profile (`bbar`, `abar`; without
     /// `abar`, the acceleration-limited reach profile, whose b̄ inside an interval is
-    /// interpolated linearly). `carried`: the previous subproblem's active rows, updated.
+    /// interpolated linearly). `carried`: what the previous subproblem left, updated.
     /// One subproblem by Clarabel: `all`'s first `n_eq` rows equalities, then the velocity
     /// bounds and `n_rows` active rows (non-negative cone), then the cones.
     fn clarabel(
@@ -1853,7 +1925,7 @@ impl<'a> Program<'a> {
         sbar: Option<&[[f64; 2]]>,
         tie: bool,
         settings: &SolverSettings,
-        carried: &mut Vec<bool>,
+        carried: &mut Carried,
     ) -> Result<SpanSolution> {
         let (p, lay, scale) = (self.p, &self.lay, self.scale);
         let n = p.intervals();
@@ -1912,7 +1984,19 @@ impl<'a> Program<'a> {
         }
         let mut vals = Vec::with_capacity(self.cands.len());
         self.values(&zbar, &bbar_sites, &mut vals);
-        let keep = carried.len() == self.cands.len();
+        let keep = carried.active.len() == self.cands.len();
+        let warm = &mut carried.lp;
+        // A subproblem from a warm profile (abar given) without an LP solution to start from
+        // starts its LP at that profile, multipliers unknown.
+        if warm.is_none() && abar.is_some() {
+            *warm = Some(WarmLp {
+                x: zbar.clone(),
+                eq: vec![f64::NAN; self.eq.len()],
+                tied: vec![f64::NAN; self.tied.len()],
+                lin: vec![f64::NAN; self.lin.len()],
+                cands: vec![f64::NAN; self.cands.len()],
+            });
+        }
         // With free slopes, b and ü at a station are independent: the stations' acceleration
         // rows (the first N − 1 sites) are always stated, as what bounds ü where no other row
         // binds it.
@@ -1922,7 +2006,7 @@ impl<'a> Program<'a> {
             .iter()
             .enumerate()
             .map(|(r, c)| {
-                (keep && carried[r])
+                (keep && carried.active[r])
                     || vals[r] >= ACTIVE_AT
                     || (!keep
                         && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
@@ -1960,7 +2044,19 @@ impl<'a> Program<'a> {
             // settle it (the COPP paths: the same cycle times to 5e-7).
             let banded = if self.n_soc == 0 && self.lp_solver == LpSolver::Banded {
                 let started = std::time::Instant::now();
-                let r = super::banded::solve(&q, &all, n_eq, settings.tol_feas, 1e-2 * gap);
+                let duals = warm.as_ref().map(|w| w.duals(&active, tie));
+                let start = warm
+                    .as_ref()
+                    .zip(duals.as_ref())
+                    .map(|(w, d)| super::banded::WarmStart { x: &w.x, duals: d });
+                let r = super::banded::solve(
+                    &q,
+                    &all,
+                    n_eq,
+                    settings.tol_feas,
+                    1e-2 * gap,
+                    start.as_ref(),
+                );
                 solve_time += started.elapsed().as_secs_f64();
                 r.map_err(|e| tracing::debug!("  banded LP: {e:?}; Clarabel instead"))
                     .ok()
@@ -1970,6 +2066,7 @@ impl<'a> Program<'a> {
             let (x_new, status) = match banded {
                 Some(sol) => {
                     iterations += sol.iterations;
+                    *warm = Some(WarmLp::of(self, &sol, &active, tie));
                     (sol.x, Status::Optimal)
                 }
                 None => {
@@ -2001,7 +2098,7 @@ impl<'a> Program<'a> {
                 self.cands.len()
             );
             if added == 0 {
-                *carried = std::mem::take(&mut active);
+                carried.active = active;
                 break (x_new, status);
             }
         };
