@@ -447,10 +447,13 @@ impl Interval {
             return self.du;
         }
         let (mut lo, mut hi) = (x0, self.du);
-        // A first guess from the motion at x0: x ≈ x0 + √b dτ + ü dτ²/2.
+        // A first guess from the motion at x0: x ≈ x0 + u̇ dτ + ü dτ²/2 + u⃛ dτ³/6.
         let dt = tau - t0;
         let (b0, a0) = (self.cubic_b(x0).max(0.0), self.cubic_a(x0));
-        let mut x = (x0 + b0.sqrt() * dt + 0.5 * a0 * dt * dt).clamp(x0, self.du);
+        let ud0 = b0.sqrt();
+        let jerk0 = self.cubic_slope(x0) * ud0;
+        let guess = x0 + ud0 * dt + 0.5 * a0 * dt * dt + jerk0 * dt * dt * dt / 6.0;
+        let mut x = guess.clamp(x0, self.du);
         let mut t = t0 + self.cubic_time(x0, x);
         for _ in 0..100 {
             let err = t - tau;
@@ -462,7 +465,18 @@ impl Interval {
             if err.abs() <= 1e-14 * dur || hi - lo <= 1e-15 * self.du {
                 break;
             }
-            let mut next = x - err * self.cubic_b(x).max(0.0).sqrt();
+            let ud = self.cubic_b(x).max(0.0).sqrt();
+            let mut next = x - err * ud;
+            // Newton's step leaves T(next) − τ ≈ ½ T'' (next − x)² = −ü err² / (2 u̇) (T' =
+            // 1/u̇, T'' = −ü/u̇³): where that is within the tolerance, next is the answer, and
+            // the integral to it is not needed (one quadrature a servo instant, not two).
+            if next > lo
+                && next < hi
+                && ud > 0.0
+                && self.cubic_a(x).abs() * err * err <= 2e-15 * dur * ud
+            {
+                return next;
+            }
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
