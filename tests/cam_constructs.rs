@@ -151,6 +151,56 @@ fn mcall_cycle83_at_three_positions() {
     assert_eq!(last, Some(v(40.0, 0.0, 20.0)));
 }
 
+/// Round 20: a Fusion 360 program for a hobby control (Makera Carvera: `Z15`, `G19 G3 Y-1.169
+/// Z-3 J0.317 K0`) written to Fanuc by `feedopt gcode --dialect fanuc` is read in the Fanuc
+/// dialect, where `Z-3` counts increments (-0.003 mm). Its lead-in arc then fails "arc end point
+/// is not on the circle" with nothing about the reading: the warning that named it is not
+/// shown with an error. The arc's error now names the first word read so and the option.
+#[test]
+fn an_arc_that_fails_under_increment_input_names_the_reading() {
+    use feedopt::machine::DecimalPointInput;
+    use feedopt::toolpath::gcode::{Settings, parse_configured};
+    let text = "G90 G94\nG17\nG21\nG0 X35.764 Y-1.487\nZ15\nG1 Z-2.683 F1000\n\
+                G19 G3 Y-1.169 Z-3 J0.317 K0\nG1 Y-0.852\nM30\n";
+    let read = |setting: Option<DecimalPointInput>| {
+        let settings = Settings {
+            decimal_point_input: setting,
+            ..Settings::default()
+        };
+        parse_configured(
+            Path::new("t.nc"),
+            text,
+            Dialect::Fanuc.spec(),
+            None,
+            &settings,
+        )
+    };
+    let message = match read(None) {
+        Err(feedopt::error::Error::Parse { line, message, .. }) => {
+            assert_eq!(line, 7, "{message}");
+            message
+        }
+        other => panic!("expected the arc's error, got {other:?}"),
+    };
+    for needle in [
+        "not on the circle",
+        "line 5: `Z15` as 0.015 mm",
+        "--decimal-point-input calculator",
+    ] {
+        assert!(message.contains(needle), "{needle}: {message}");
+    }
+    // Read as written, the arc closes: a quarter turn of radius 0.317 mm down to Z-3.
+    let tp = read(Some(DecimalPointInput::Calculator)).unwrap().0;
+    assert_close(tp.points.last().unwrap().p, v(35.764, -0.852, -3.0), 1e-9);
+    // With increments chosen, the reading is the user's: the arc's error stays as it was.
+    match read(Some(DecimalPointInput::Increment)) {
+        Err(feedopt::error::Error::Parse { message, .. }) => {
+            assert!(!message.contains("decimal point"), "{message}")
+        }
+        other => panic!("expected the arc's error, got {other:?}"),
+    }
+}
+
 fn context(axes: &str, reference: [Vec<f64>; 6], work_offset: [f64; 3]) -> MachineContext {
     MachineContext {
         file: "m.json".into(),

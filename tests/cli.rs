@@ -1447,10 +1447,16 @@ fn interpolate_and_gcode_detect_the_input_dialect_as_solve_does() {
     ]);
     assert_success(&out);
     // A program nothing in which names a dialect is read in the output's: Fanuc reads `X10`
-    // (no decimal point) as 10 µm, LinuxCNC as 10 mm.
+    // (no decimal point) as 10 µm, LinuxCNC as 10 mm. Where the two readings differ so, the
+    // written program would not be the one `solve` reads (round 20: a Fusion program's `Z3`
+    // clearance written as `Z0.003`): an error until `--input-dialect` says which is meant.
     w.write("plain.nc", "G21 G90 G0 X0 Y0 Z5\nG1 X10 F3000\nM30\n");
-    for (dialect, x) in [("fanuc", "X0.010"), ("linuxcnc", "X10.000")] {
-        let out = w.run(&[
+    for (dialect, input, x) in [
+        ("fanuc", Some("fanuc"), "X0.010"),
+        ("fanuc", Some("linuxcnc"), "X10.000"),
+        ("linuxcnc", None, "X10.000"),
+    ] {
+        let mut args = vec![
             "gcode",
             "-m",
             "machine.json",
@@ -1461,9 +1467,82 @@ fn interpolate_and_gcode_detect_the_input_dialect_as_solve_does() {
             dialect,
             "-o",
             "plain-out.nc",
-        ]);
+        ];
+        if let Some(input) = input {
+            args.extend(["--input-dialect", input]);
+        }
+        let out = w.run(&args);
         assert_success(&out);
         let text = std::fs::read_to_string(w.path("plain-out.nc")).unwrap();
         assert!(text.contains(x), "{dialect}: {text}");
     }
+    assert_error(
+        &w.run(&[
+            "gcode",
+            "-m",
+            "machine.json",
+            "plain.nc",
+            "--stations",
+            STATIONS,
+            "--dialect",
+            "fanuc",
+            "-o",
+            "plain-out2.nc",
+        ]),
+        &["plain.nc:1", "`Z5`", "0.005 mm", "--input-dialect"],
+    );
+}
+
+/// Round 20: a Fusion 360 program for a hobby control (MPCNC post: `G0 Z3 F300`, no `O`
+/// number, nothing naming a dialect) written by `feedopt gcode --dialect fanuc` was read as a
+/// Fanuc program, whose `Z3` counts increments: the written program's clearance plane was
+/// `Z0.003`, every rapid between cuts 0.003 mm over the part, where `feedopt solve` read the
+/// same file at Z 3 mm — with one warning among others. The reading now is an error naming
+/// the word, both readings and `--input-dialect`; naming the input's dialect writes it.
+#[test]
+fn gcode_refuses_an_unnamed_dialect_whose_reading_depends_on_the_output() {
+    let w = Work::new();
+    w.write("machine.json", XYZ_MACHINE);
+    w.write(
+        "part.gcode",
+        "G90 G94\nG17\nG21\nG0 Z3 F300\nX3.412 Y49.305 F7500\nG1 Z0.2 F339\nY94.264 F3048\n\
+         G0 Z3 F300\nM5\n",
+    );
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "gcode",
+            "-m",
+            "machine.json",
+            "part.gcode",
+            "--solver",
+            "reach",
+            "-o",
+            "out.nc",
+            "--dialect",
+            "fanuc",
+        ];
+        a.extend_from_slice(extra);
+        w.run(&a)
+    };
+    assert_error(
+        &run(&[]),
+        &[
+            "part.gcode:4",
+            "`Z3`",
+            "0.003 mm",
+            "3 mm",
+            "--input-dialect linuxcnc",
+        ],
+    );
+    assert!(!w.path("out.nc").exists());
+    // Read as `solve` reads it: the clearance plane stays at Z 3 mm.
+    let out = run(&["--input-dialect", "linuxcnc"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let written = w.read("out.nc");
+    assert!(written.contains("Z3.000"), "{written}");
+    assert!(!written.contains("Z0.003"), "{written}");
+    // Named Fanuc, the user's reading: increments, as the control reads them by default.
+    let out = run(&["--input-dialect", "fanuc"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(w.read("out.nc").contains("Z0.003"));
 }

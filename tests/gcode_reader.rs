@@ -1487,6 +1487,25 @@ fn an_o_word_after_other_words_is_named_as_such() {
     err("G21 G90\nN8 O00\n", 2, &["O-word control flow"]);
 }
 
+/// Round 20: a Mastercam program edited by hand (`O0000(ACRYLIC TOP)`, `N1 G21; mm mode`) is
+/// refused in the Fanuc dialect at its `;` comments with the advice to read it as LinuxCNC;
+/// read so, its program number was refused as "O-word control flow (if, while, do, repeat) is
+/// not supported", which sent the user looking for a loop. The message now names the bare O
+/// number as a Fanuc program number and says what to do.
+#[test]
+fn a_bare_program_number_read_as_linuxcnc_is_named() {
+    err_in(
+        Dialect::LinuxCnc,
+        "O0000(ACRYLIC TOP)\nG21\nG0 X1 Y1 Z1\n",
+        1,
+        &[
+            "`O0000`",
+            "a bare `O1234` at the top is a Fanuc program number",
+            "remove it",
+        ],
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // Chamfers and roundings between straight moves (Fanuc `,C` `,R`, Sinumerik `CHR=` `CHF=` `RND=`)
 // ---------------------------------------------------------------------------------------------

@@ -938,6 +938,12 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
                 tool_diameter: options.tool_diameter,
                 decimal_point_input: options.decimal_point_input,
                 subprogram_dirs: options.subprogram_dirs.clone(),
+                // Read in a dialect chosen for it (`feedopt gcode`'s output's), not the
+                // default one `solve` reads it in.
+                dialect_unnamed: detected.dialect_by == "default"
+                    && options
+                        .fallback_dialect
+                        .is_some_and(|d| d != gcode::Dialect::default()),
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

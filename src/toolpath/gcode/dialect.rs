@@ -656,8 +656,10 @@ pub static LINUXCNC: DialectSpec = DialectSpec {
         (
             'O',
             Address::Unsupported(
-                "O-word control flow (if, while, do, repeat) is not supported; O-word \
-                 subroutines (sub, endsub, call, return) are",
+                "LinuxCNC reads an O word only as an O-word statement, and of those feedopt \
+                 reads the subroutines (sub, endsub, call, return), not O-word control flow \
+                 (if, while, do, repeat); a bare `O1234` at the top is a Fanuc program \
+                 number: remove it, or read the program with --dialect fanuc",
             ),
         ),
     ],

@@ -270,6 +270,11 @@ pub(super) struct Interpreter<'a> {
     /// warning was given.
     increments_chosen: bool,
     increments_warned: bool,
+    /// That warning's word and line, `Z15` read as 0.015 mm: named again by an arc that does
+    /// not close, where the reading is the likely cause (warnings are not shown with an error).
+    increments_first: Option<(usize, String, String, String)>,
+    /// [`super::Settings::dialect_unnamed`].
+    pub(super) dialect_unnamed: bool,
     /// The tool the last `T` word selected (`M6` puts it in the spindle).
     prepared_tool: Option<ToolSelect>,
     /// The work offsets, `G10` and `G52` ([`offsets`]).
@@ -370,6 +375,8 @@ impl<'a> Interpreter<'a> {
             increments: spec.integer_increments,
             increments_chosen: false,
             increments_warned: false,
+            increments_first: None,
+            dialect_unnamed: false,
             prepared_tool: None,
             offsets: WorkOffsets::new("G54"),
             machine_point: false,
@@ -425,6 +432,12 @@ impl<'a> Interpreter<'a> {
         // 117 × 0.001 is 0.11700000000000001 in binary: shown to the nanometre.
         let read = crate::error::number((num.value * step * 1e9).round() / 1e9);
         let written = crate::error::number(num.value);
+        self.increments_first = Some((
+            line,
+            text.to_string(),
+            format!("{read}{unit}"),
+            format!("{written}{unit}"),
+        ));
         let name = self.spec.name;
         self.warn(
             line,
@@ -438,6 +451,28 @@ impl<'a> Interpreter<'a> {
                  this warning)"
             ),
         );
+    }
+
+    /// The error for a program whose dialect nothing named
+    /// ([`super::Settings::dialect_unnamed`]) and in which a number without a decimal point
+    /// was read as least input increments by this dialect's default: the word, both readings
+    /// and how to choose one.
+    pub(super) fn increments_unnamed_dialect(&self) -> Option<Error> {
+        let (line, text, read, written) = self.increments_first.as_ref()?;
+        let name = self.spec.name;
+        Some(self.error(
+            *line,
+            format!(
+                "`{text}`: nothing in the program names its dialect, so it is read as a {name} \
+                 program (the written program's dialect), where a number without a decimal \
+                 point counts least input increments: {read}; read as LinuxCNC, as `feedopt \
+                 solve` reads this file, it is {written}. Say which the program means: \
+                 --input-dialect linuxcnc (as written), or --input-dialect {dialect} \
+                 (increments; --decimal-point-input calculator reads {name} numbers as \
+                 written)",
+                dialect = name.to_ascii_lowercase()
+            ),
+        ))
     }
 
     /// Tool-tip mode on a machine programmed in machine coordinates (a four-axis machine) is
@@ -3835,6 +3870,24 @@ impl<'a> Interpreter<'a> {
                         centre_names[a],
                         centre_names[b]
                     );
+                }
+            }
+            // Numbers without a decimal point read as least input increments by default
+            // (`Z-3` as -0.003 mm): a program written for a control that reads them as whole
+            // millimetres (Fusion's hobby posts, read in the Fanuc dialect) fails here first.
+            if let Some((at, text, read, _)) = &self.increments_first {
+                hint.push_str(&format!(
+                    "; numbers without a decimal point are read as least input increments \
+                     (line {at}: `{text}` as {read}, parameter 3401#0 DPI = 0): if the control \
+                     reads them as written, pass --decimal-point-input calculator"
+                ));
+                if self.dialect_unnamed {
+                    hint.push_str(&format!(
+                        " (nothing in the program names its dialect: it is read as the \
+                         written program's, {}; --input-dialect linuxcnc reads it as `feedopt \
+                         solve` does)",
+                        self.spec.name
+                    ));
                 }
             }
             return Err(self.error(

@@ -79,6 +79,19 @@ fn group_end(chars: &[char]) -> Option<usize> {
 
 /// A loop number after `DO` / `END`.
 fn loop_id(word: &str, digits: &str) -> Result<u32, String> {
+    // `WHILE [#1 GT #2] DO1 #1=#1-#3`: a statement after the loop number in the same block.
+    // A Fanuc reads one macro statement in a block; which of them the loop would run is not
+    // for feedopt to guess.
+    let number: String = digits.chars().take_while(char::is_ascii_digit).collect();
+    if !number.is_empty() && number.len() < digits.len() {
+        let rest = &digits[number.len()..];
+        return Err(format!(
+            "`{word}{number}` is followed by `{rest}` in the same block: a Fanuc reads one \
+             macro statement in a block (`WHILE [...] DO{number}`, `END{number}` alone); put \
+             what follows it on lines of its own, one statement a line (after the \
+             `{word}{number}` line to run them in the loop)"
+        ));
+    }
     if digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit()) {
         return Err(format!(
             "`{word}{digits}`: {word} takes a loop number (`{word} 1`)"
@@ -370,6 +383,20 @@ mod tests {
             }))
         );
         assert!(matches!(statement("WHILE #1 LT 3 DO1"), Some(Err(_))));
+        // A shop's `WHILE [...] DO1 #1=#1-#3 IF [...] THEN #1=#2` on one line: named, with
+        // what to do, instead of "DO takes a loop number".
+        let Some(Err(e)) = statement("WHILE [ #1 GT #2 ] DO1 #1= #1 - #3") else {
+            panic!("a statement after DO1 must be an error")
+        };
+        assert!(e.contains("`DO1` is followed by `#1=#1-#3`"), "{e}");
+        assert!(
+            e.contains("on lines of its own, one statement a line"),
+            "{e}"
+        );
+        let Some(Err(e)) = statement("END1 G0 X5.") else {
+            panic!("a word after END1 must be an error")
+        };
+        assert!(e.contains("`END1` is followed by `G0X5.`"), "{e}");
         assert!(matches!(statement("IF [#1 LT 3]"), Some(Err(_))));
         assert!(matches!(statement("END"), Some(Err(_))));
         assert_eq!(statement("G1 X10. F100."), None);

@@ -377,6 +377,14 @@ pub struct Settings {
     /// the main program's own directory, in order (the CLI's `--subprogram-dir`). See
     /// [`subprograms`] for the file names each dialect's calls look for.
     pub subprogram_dirs: Vec<std::path::PathBuf>,
+    /// Nothing named the program's dialect (neither the program, nor its extension, nor the
+    /// user): it is read in one chosen for it (`feedopt gcode` reads it in the written
+    /// program's). A number without a decimal point that this dialect reads as least input
+    /// increments, where nothing chose that reading, is then an error naming it: the default
+    /// dialect, LinuxCNC's, which `feedopt solve` reads such a program in, reads it as
+    /// written, and the two readings are two paths (a Fusion 360 program's `Z3` clearance
+    /// written to Fanuc as `Z0.003`).
+    pub dialect_unnamed: bool,
 }
 
 /// As [`parse_assumed`], under the operator's `settings`.
@@ -398,7 +406,13 @@ pub fn parse_configured(
     interp.block_delete = settings.block_delete;
     interp.tool_diameter = settings.tool_diameter;
     interp.set_decimal_point_input(settings.decimal_point_input);
+    interp.dialect_unnamed = settings.dialect_unnamed;
     program.run(spec, &mut interp, source)?;
+    if settings.dialect_unnamed
+        && let Some(message) = interp.increments_unnamed_dialect()
+    {
+        return Err(program.localize(message, source));
+    }
     interp.note_units();
     interp.note_assumed_parameters();
     let assumed = interp.assumed;
