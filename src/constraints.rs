@@ -1104,17 +1104,28 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
         };
     }
     let lines = &lines[..nl];
+    // The "ü ≤" and "ü ≥" lines apart, each in the order given (the envelopes take the first
+    // of equal lines).
+    const MAX_LINES: usize = 2 * crate::kinematics::MAX_AXES;
+    let (mut ups, mut lows) = ([(0.0, 0.0, 0u16); MAX_LINES], [(0.0, 0.0, 0u16); MAX_LINES]);
+    let (mut nu, mut nw) = (0, 0);
+    for l in lines {
+        if l.3 {
+            ups[nu] = (l.0, l.1, l.2);
+            nu += 1;
+        } else {
+            lows[nw] = (l.0, l.1, l.2);
+            nw += 1;
+        }
+    }
+    let (ups, lows) = (&ups[..nu], &lows[..nw]);
     let upper = |b: f64| {
-        lines
-            .iter()
-            .filter(|l| l.3)
+        ups.iter()
             .map(|l| (l.0 + l.1 * b, l.2))
             .fold((f64::INFINITY, 0u16), |m, x| if x.0 < m.0 { x } else { m })
     };
     let lower = |b: f64| {
-        lines
-            .iter()
-            .filter(|l| !l.3)
+        lows.iter()
             .map(|l| (l.0 + l.1 * b, l.2))
             .fold(
                 (f64::NEG_INFINITY, 0u16),
@@ -1122,25 +1133,29 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
             )
     };
     // Breakpoints: every pairwise intersection inside (0, b_hi).
-    let mut pts: Vec<f64> = Vec::with_capacity(2 + nl * (nl - 1) / 2);
-    pts.push(0.0);
-    pts.push(b_hi);
+    let mut pts = [0.0; 2 + MAX_LINES * (MAX_LINES - 1) / 2];
+    let mut np = 2;
+    pts[1] = b_hi;
     for (i, a) in lines.iter().enumerate() {
         for c in &lines[i + 1..] {
             if a.1 != c.1 {
                 let b = (c.0 - a.0) / (a.1 - c.1);
                 if b > 0.0 && b < b_hi {
-                    pts.push(b);
+                    pts[np] = b;
+                    np += 1;
                 }
             }
         }
     }
-    pts.sort_by(f64::total_cmp);
+    let pts = &mut pts[..np];
+    pts.sort_unstable_by(f64::total_cmp);
     // The gap U(b) − L(b) is concave and ≥ 0 at b = 0: the feasible b form [0, b*].
     let gap = |b: f64| upper(b).0 - lower(b).0;
     let mut b_star = b_hi;
+    let mut g1 = gap(pts[0]);
     for w in pts.windows(2) {
-        let (g0, g1) = (gap(w[0]), gap(w[1]));
+        let g0 = g1;
+        g1 = gap(w[1]);
         if g1 < 0.0 {
             b_star = if g0 > 0.0 {
                 w[0] + (w[1] - w[0]) * g0 / (g0 - g1)
@@ -1164,6 +1179,9 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
             let mid = 0.5 * (prev + p);
             keep |= upper(mid).1 | lower(mid).1;
             prev = p;
+        }
+        if p >= b_star {
+            break;
         }
     }
     // The rows meeting at b = 0 and at b* (vertices) are edges adjacent to the kept ones.
