@@ -1297,18 +1297,22 @@ impl Lin {
     }
     /// `self + w·col` (merged with a term of the same column).
     fn plus(mut self, col: usize, w: f64) -> Lin {
+        self.plus_in_place(col, w);
+        self
+    }
+    fn plus_in_place(&mut self, col: usize, w: f64) {
         if let Some(t) = self.terms[..self.len].iter_mut().find(|t| t.0 == col) {
             t.1 += w;
         } else {
             self.terms[self.len] = (col, w);
             self.len += 1;
         }
-        self
     }
     /// `self + w·other`.
+    #[inline]
     fn add(mut self, other: &Lin, w: f64) -> Lin {
         for &(c, v) in &other.terms[..other.len] {
-            self = self.plus(c, v * w);
+            self.plus_in_place(c, v * w);
         }
         self.constant += other.constant * w;
         self
