@@ -75,8 +75,10 @@ const DYNAMIC_REG: f64 = 1e-13;
 const STEP_FRACTION: f64 = 0.99;
 /// A row's rounding allowance, relative to the sum of its terms' magnitudes ([`Lp::rows_hold`]).
 const TERMS_TOL: f64 = 1e-13;
-/// Passes of Ruiz equilibration of the rows and columns.
-const RUIZ_PASSES: usize = 10;
+/// Passes of Ruiz equilibration of the rows and columns. Four give the jerk subproblems the
+/// same iterates as ten did (the same interior-point iterations on the COPP paths, 2026-11-27),
+/// for less of an LP's set-up, which the warm starts made a larger share of its time.
+const RUIZ_PASSES: usize = 4;
 /// Steps of iterative refinement per KKT solve.
 const REFINE: usize = 1;
 /// A warm start's products s λ (scaled problem).
