@@ -1528,6 +1528,7 @@ impl Interpreter<'_> {
             offset,
         )
         .map_err(|e| self.error(line, format!("{e} (CYCL DEF at line {def_line})")))?;
+        self.cycle_along_tool(line, &format!("cycle {number}"))?;
         for n in notes {
             self.warn(line, format!("cycle {number}: {n}"));
         }
