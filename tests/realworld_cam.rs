@@ -80,7 +80,10 @@ fn every_real_program_reads_with_defaults() {
              with the tool axis 81.101° off Z (B81.101 C1903.826)",
         ),
     ] {
-        let e = read(file, machine).err().expect("an error").to_string();
+        let e = match read(file, machine) {
+            Ok(_) => panic!("{file}: read without an error"),
+            Err(e) => e.to_string(),
+        };
         assert!(
             e.contains(says) && e.contains("post these holes under a tilted working plane"),
             "{file}: {e}"

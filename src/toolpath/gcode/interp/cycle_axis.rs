@@ -74,7 +74,7 @@ impl Interpreter<'_> {
             return Ok(());
         };
         let off = tool.angle(&Vector3::z()).to_degrees();
-        if !(off > ALONG_DEG) {
+        if off.is_nan() || off <= ALONG_DEG {
             return Ok(());
         }
         let at = if self.vector != Vector3::z() {
