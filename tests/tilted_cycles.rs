@@ -113,6 +113,13 @@ fn fanuc_cycle_under_g43_4_with_a_tilted_tool_is_an_error_naming_the_angle() {
     ] {
         assert!(e.contains(part), "{part:?} not in: {e}");
     }
+    // Haas's G234 (TCPC) alike.
+    let haas = mori_tap("-54.736").replace("G43.4 G90", "G234 G90");
+    let e = fails(Dialect::Fanuc, &bc_table(), "t.nc", &haas);
+    assert!(
+        e.contains("t.nc:6: G74:") && e.contains("tool-tip control (G234)"),
+        "{e}"
+    );
     // Every cycle, not only taps: G81 and the G43.5 tool vector alike.
     let text = "G21 G90 G17\nG43.5 X0 Y0 Z10 I0 J-1 K1 H1\nG99 G81 X5 Y0 Z-2 R2 F100\nG80\nM30\n";
     let e = fails(Dialect::Fanuc, &head_table(), "t.nc", text);
@@ -181,8 +188,8 @@ fn sinumerik_cycle_under_traori_with_a_tilted_tool_is_an_error() {
     assert!(near(fed(&tp)[0], [10.0, 0.0, -5.0]), "{:?}", fed(&tp));
 }
 
-/// Heidenhain cycle 200 called under M128 with the head at B+30: an error naming the cycle and
-/// PLANE; at B+0 the cycle's moves are as before.
+/// Heidenhain cycle 200 called under M128 (or FUNCTION TCPM) with the head at B+30: an error
+/// naming the cycle and PLANE; at B+0 the cycle's moves are as before.
 #[test]
 fn heidenhain_cycle_under_m128_with_a_tilted_tool_is_an_error() {
     let text = |b: &str| {
@@ -206,6 +213,13 @@ fn heidenhain_cycle_under_m128_with_a_tilted_tool_is_an_error() {
     ] {
         assert!(e.contains(part), "{part:?} not in: {e}");
     }
+    // FUNCTION TCPM alike, named so.
+    let tcpm = text("+30").replace("5 M128", "5 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS");
+    let e = fails(Dialect::Heidenhain, &head_table(), "t.h", &tcpm);
+    assert!(
+        e.contains("t.h:18: cycle 200:") && e.contains("tool-tip control (FUNCTION TCPM)"),
+        "{e}"
+    );
     let tp = read(Dialect::Heidenhain, &head_table(), "t.h", &text("+0"));
     assert!(near(fed(&tp)[0], [10.0, 0.0, -10.0]), "{:?}", fed(&tp));
 }

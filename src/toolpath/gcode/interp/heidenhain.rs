@@ -1139,6 +1139,7 @@ impl Interpreter<'_> {
         if self.tcp != Tcp::On {
             self.non_tcp_warned = false;
         }
+        self.tcp_code = "FUNCTION TCPM".into();
         self.switch_tcp(Tcp::On);
         Ok(())
     }
