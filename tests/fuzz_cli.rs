@@ -155,10 +155,18 @@ fn fuzz_short_shared() {
     // The excerpts keep the header and start every window at a straight move with X and Y,
     // so they read as the whole programs do (a seed that fails leaves its mutations on the
     // error path).
+    // The two NX five-axis programs call cycles under a tilted tool, which no longer read
+    // (round 21, `realworld_cam.rs`): an excerpt that reaches one ends in that error, as the
+    // whole program does; its mutations still explore the blocks before it.
     let messages: Vec<String> = c
         .figures
         .iter()
         .flat_map(|(t, f)| f.seed_messages.iter().map(move |m| format!("{t}: {m}")))
+        .filter(|m| {
+            !(m.contains("../shared/realworld/cam/nx_")
+                && m.contains("a drilling or tapping cycle under tool-tip control")
+                && m.contains("and no tilted working plane"))
+        })
         .collect();
     assert!(
         messages.is_empty(),

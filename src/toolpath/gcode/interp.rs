@@ -4,6 +4,7 @@ use nalgebra::Vector3;
 use std::path::Path;
 
 mod axes;
+mod cycle_axis;
 mod heidenhain;
 pub(super) use heidenhain::KlartextWords;
 
@@ -201,6 +202,8 @@ pub(super) struct Interpreter<'a> {
     surface_speed: bool,
     motion: Option<Motion>,
     tcp: Tcp,
+    /// The code that switched tool-tip mode on last (`G43.4`, `TRAORI`, `M128`), for messages.
+    tcp_code: String,
     /// Modal position in program (frame) coordinates: X Y Z in mm, A B C in degrees.
     pos: [f64; 6],
     /// X Y Z set by an absolute word.
@@ -338,6 +341,7 @@ impl<'a> Interpreter<'a> {
             surface_speed: false,
             motion: spec.initial_motion,
             tcp: Tcp::Off,
+            tcp_code: String::new(),
             pos: [0.0; 6],
             known: [false; 3],
             g92_params: None,
@@ -1145,6 +1149,9 @@ impl<'a> Interpreter<'a> {
                     if t == Tcp::On {
                         self.no_tcp_on_machine_coordinates(line)?;
                     }
+                    if t != Tcp::Off {
+                        self.tcp_code = code_name(text);
+                    }
                     if t != self.tcp {
                         self.non_tcp_warned = false;
                     }
@@ -1588,8 +1595,10 @@ impl<'a> Interpreter<'a> {
                 && block.axes[..2].iter().any(Option::is_some)
             {
                 let from = self.points.len();
+                let name = format!("MCALL CYCLE{}", call.number);
                 let run = self
-                    .cycle_plane(line, &format!("MCALL CYCLE{}", call.number))
+                    .cycle_plane(line, &name)
+                    .and_then(|()| self.cycle_along_tool(line, &name))
                     .and_then(|()| self.run_steps(line, &call.steps));
                 if let Some(tap) = call.tap {
                     self.tapping(line, "MCALL CYCLE84".into(), from, tap);
@@ -2497,6 +2506,7 @@ impl<'a> Interpreter<'a> {
                 ),
             ));
         }
+        self.cycle_along_tool(line, &format!("G{}", c.code))?;
         let incremental = self.distance == Distance::Incremental;
         if let Some(r) = block.radius {
             let r = self.length(r);
@@ -2647,6 +2657,7 @@ impl<'a> Interpreter<'a> {
     /// runs on a slant to the point), and the spindle must turn at a known speed. Its motion
     /// mode ends with the block: an axis word after it needs a new motion code.
     fn rigid_tap(&mut self, line: usize, block: &Block) -> Result<()> {
+        self.cycle_along_tool(line, "G33.1")?;
         let fail = |m: &str| Err(self.error(line, format!("G33.1: {m}")));
         if self.plane != Plane::Xy {
             return fail("rigid tapping is read in the XY plane (G17) only");
@@ -2857,6 +2868,7 @@ impl<'a> Interpreter<'a> {
         args: &[Option<f64>],
     ) -> Result<()> {
         self.cycle_plane(line, text)?;
+        self.cycle_along_tool(line, text)?;
         let (steps, notes) = cycles::sinumerik_steps(number, args, self.rpm)
             .map_err(|e| self.error(line, format!("{text}: {e}")))?;
         for n in notes {

@@ -67,7 +67,7 @@ impl Interpreter<'_> {
 
     /// The rotary axes' positions (degrees) of program position `q`: its A B C and their work
     /// offsets.
-    fn rotary_positions(&self, q: &[f64; 6]) -> [f64; 3] {
+    pub(super) fn rotary_positions(&self, q: &[f64; 6]) -> [f64; 3] {
         let s = self.offsets.shift();
         [q[3] + s[3], q[4] + s[4], q[5] + s[5]]
     }

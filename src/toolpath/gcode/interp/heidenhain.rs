@@ -1139,6 +1139,7 @@ impl Interpreter<'_> {
         if self.tcp != Tcp::On {
             self.non_tcp_warned = false;
         }
+        self.tcp_code = "FUNCTION TCPM".into();
         self.switch_tcp(Tcp::On);
         Ok(())
     }
@@ -1528,6 +1529,7 @@ impl Interpreter<'_> {
             offset,
         )
         .map_err(|e| self.error(line, format!("{e} (CYCL DEF at line {def_line})")))?;
+        self.cycle_along_tool(line, &format!("cycle {number}"))?;
         for n in notes {
             self.warn(line, format!("cycle {number}: {n}"));
         }
