@@ -17,20 +17,9 @@ use std::path::Path;
 const HEADER: &str = "0 BEGIN PGM T MM\n1 BLK FORM 0.1 Z X+0 Y+0 Z-20\n\
                       2 BLK FORM 0.2 X+100 Y+100 Z+0\n3 TOOL CALL 1 Z S5000\n";
 
-/// An A/C table (LinuxCNC xyzac-trt, the table's centre at the origin), no jerk limits, A at
-/// 60 °/s and 600 °/s², the linear axes far faster than the tip needs here.
+/// The A/C table of `common::AC_TABLE` and its context.
 fn ac_table() -> (Machine, MachineContext) {
-    let m = common::machine(
-        r#"{"name": "A/C table", "kinematics": {"type": "table_table_ac",
-              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
-              "y-offset": 0, "z-offset": 0, "conventional-directions": true},
-            "axes": {"X": {"velocity": 500, "acceleration": 5000},
-                     "Y": {"velocity": 500, "acceleration": 5000},
-                     "Z": {"velocity": 500, "acceleration": 5000},
-                     "A": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
-                     "C": {"velocity": 120, "acceleration": 1200}},
-            "feed": {"max": 2000}}"#,
-    );
+    let m = common::machine(common::AC_TABLE);
     let ctx = MachineContext::new(&m, &feedopt::machine::References::default());
     (m, ctx)
 }

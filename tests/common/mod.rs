@@ -7,6 +7,25 @@ use feedopt::machine::Machine;
 use feedopt::toolpath::{ClPoint, Feed, Toolpath};
 use nalgebra::Vector3;
 
+/// An A/C trunnion (LinuxCNC's xyzac-trt, the table's centre at the origin), no jerk limits, A
+/// at 60 °/s and 600 °/s², the linear axes far faster than a tip needs in a test.
+pub const AC_TABLE: &str = r#"{"name": "A/C table", "kinematics": {"type": "table_table_ac",
+      "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+      "y-offset": 0, "z-offset": 0, "conventional-directions": true},
+    "axes": {"X": {"velocity": 500, "acceleration": 5000},
+             "Y": {"velocity": 500, "acceleration": 5000},
+             "Z": {"velocity": 500, "acceleration": 5000},
+             "A": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
+             "C": {"velocity": 120, "acceleration": 1200}},
+    "feed": {"max": 2000}}"#;
+
+/// Every one of `parts` is in the message `e`.
+pub fn assert_mentions(e: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(e.contains(part), "{part:?} not in: {e}");
+    }
+}
+
 /// A machine from JSON text (must be valid).
 pub fn machine(json: &str) -> Machine {
     Machine::from_json("test.json".as_ref(), json).expect("valid machine")
