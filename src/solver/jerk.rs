@@ -2023,7 +2023,13 @@ impl<'a> Program<'a> {
         let gap = settings.tol_gap.max(1e-5);
         let (mut iterations, mut solve_time, mut rounds) = (0, 0.0, 0);
         let (x, status) = loop {
-            let mut all = Rows::default();
+            // Sized once: appending grew it, row by row, through a few reallocations per LP.
+            let fixed = [&self.eq, &self.tied, &self.lin, &self.soc];
+            let n_active = active.iter().filter(|a| **a).count();
+            let mut all = Rows::with_capacity(
+                fixed.iter().map(|r| r.len()).sum::<usize>() + n_active,
+                fixed.iter().map(|r| r.v.len()).sum::<usize>() + 4 * n_active,
+            );
             all.append(&self.eq);
             // `tie`: a' constant per interval (σ⁰ = σ¹, the quadratic law).
             let mut n_eq = self.eq.len();

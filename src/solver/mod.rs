@@ -254,6 +254,17 @@ pub(crate) struct Rows {
 }
 
 impl Rows {
+    /// Empty, with room for `rows` rows of `entries` entries in all.
+    pub(crate) fn with_capacity(rows: usize, entries: usize) -> Rows {
+        Rows {
+            i: Vec::with_capacity(entries),
+            j: Vec::with_capacity(entries),
+            v: Vec::with_capacity(entries),
+            h: Vec::with_capacity(rows),
+            start: Vec::with_capacity(rows + 1),
+        }
+    }
+
     pub(crate) fn push(&mut self, coefs: &[(usize, f64)], h: f64) {
         let r = self.h.len();
         self.start.push(self.v.len());
