@@ -18,35 +18,38 @@ use feedopt::toolpath::gcode::{Dialect, parse_for};
 use feedopt::toolpath::{Feed, MachineContext, Toolpath};
 use std::path::Path;
 
+/// The axes and feed of both B/C machines below (their kinematics apart).
+const BC_AXES: &str = r#""axes": {"X": {"velocity": 500, "acceleration": 5000},
+    "Y": {"velocity": 500, "acceleration": 5000},
+    "Z": {"velocity": 500, "acceleration": 5000},
+    "B": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
+    "C": {"velocity": 60, "acceleration": 600}},
+  "feed": {"max": 2000}"#;
+
+/// A B/C machine of `name` and `kinematics` (JSON), with [`BC_AXES`].
+fn bc_machine(name: &str, kinematics: &str) -> MachineContext {
+    let m = common::machine(&format!(
+        r#"{{"name": "{name}", "kinematics": {kinematics}, {BC_AXES}}}"#
+    ));
+    MachineContext::new(&m, &References::default())
+}
+
 /// A B/C trunnion as the Mori NMV5000's machine file (B about −Y in the file's convention).
 fn bc_table() -> MachineContext {
-    let m = common::machine(
-        r#"{"name": "B/C table", "kinematics": {"type": "table_table_bc",
-              "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
-              "x-offset": 0, "z-offset": 0, "tool-offset": 0,
-              "conventional-directions": false, "work-offset": [0, 0, 0]},
-            "axes": {"X": {"velocity": 500, "acceleration": 5000},
-                     "Y": {"velocity": 500, "acceleration": 5000},
-                     "Z": {"velocity": 500, "acceleration": 5000},
-                     "B": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
-                     "C": {"velocity": 60, "acceleration": 600}},
-            "feed": {"max": 2000}}"#,
-    );
-    MachineContext::new(&m, &References::default())
+    bc_machine(
+        "B/C table",
+        r#"{"type": "table_table_bc", "x-rot-point": 0, "y-rot-point": 0, "z-rot-point": 0,
+            "x-offset": 0, "z-offset": 0, "tool-offset": 0,
+            "conventional-directions": false, "work-offset": [0, 0, 0]}"#,
+    )
 }
 
 /// A B head over a C table, as the DMU 70 eVo's machine file.
 fn head_table() -> MachineContext {
-    let m = common::machine(
-        r#"{"name": "B head, C table", "kinematics": {"type": "head_table", "pivot_length": 200},
-            "axes": {"X": {"velocity": 500, "acceleration": 5000},
-                     "Y": {"velocity": 500, "acceleration": 5000},
-                     "Z": {"velocity": 500, "acceleration": 5000},
-                     "B": {"velocity": 60, "acceleration": 600, "min": -120, "max": 120},
-                     "C": {"velocity": 60, "acceleration": 600}},
-            "feed": {"max": 2000}}"#,
-    );
-    MachineContext::new(&m, &References::default())
+    bc_machine(
+        "B head, C table",
+        r#"{"type": "head_table", "pivot_length": 200}"#,
+    )
 }
 
 /// An A/C trunnion (LinuxCNC xyzac-trt).

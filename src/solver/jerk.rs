@@ -1471,6 +1471,18 @@ impl WarmLp {
         }
     }
 
+    /// A start at `x` with every multiplier unknown.
+    fn at(program: &Program, x: Vec<f64>) -> WarmLp {
+        let unknown = |rows: usize| vec![f64::NAN; rows];
+        WarmLp {
+            x,
+            eq: unknown(program.eq.len()),
+            tied: unknown(program.tied.len()),
+            lin: unknown(program.lin.len()),
+            cands: unknown(program.cands.len()),
+        }
+    }
+
     /// The multipliers in the row order of a subproblem with `active` candidates.
     fn duals(&self, active: &[bool], tie: bool) -> Vec<f64> {
         let mut d = self.eq.clone();
@@ -1993,13 +2005,7 @@ impl<'a> Program<'a> {
         // A subproblem from a warm profile (abar given) without an LP solution to start from
         // starts its LP at that profile, multipliers unknown.
         if warm.is_none() && abar.is_some() {
-            *warm = Some(WarmLp {
-                x: zbar.clone(),
-                eq: vec![f64::NAN; self.eq.len()],
-                tied: vec![f64::NAN; self.tied.len()],
-                lin: vec![f64::NAN; self.lin.len()],
-                cands: vec![f64::NAN; self.cands.len()],
-            });
+            *warm = Some(WarmLp::at(self, zbar.clone()));
         }
         // With free slopes, b and ü at a station are independent: the stations' acceleration
         // rows (the first N − 1 sites) are always stated, as what bounds ü where no other row
@@ -2024,12 +2030,15 @@ impl<'a> Program<'a> {
         let (mut iterations, mut solve_time, mut rounds) = (0, 0.0, 0);
         let (x, status) = loop {
             // Sized once: appending grew it, row by row, through a few reallocations per LP.
-            let fixed = [&self.eq, &self.tied, &self.lin, &self.soc];
+            let tied: &[&Rows] = if tie { &[&self.tied] } else { &[] };
+            let fixed = [&self.eq, &self.lin, &self.soc]
+                .into_iter()
+                .chain(tied.iter().copied());
             let n_active = active.iter().filter(|a| **a).count();
-            let mut all = Rows::with_capacity(
-                fixed.iter().map(|r| r.len()).sum::<usize>() + n_active,
-                fixed.iter().map(|r| r.v.len()).sum::<usize>() + 4 * n_active,
-            );
+            let (rows, entries) = fixed.fold((n_active, 4 * n_active), |(r, e), b| {
+                (r + b.len(), e + b.v.len())
+            });
+            let mut all = Rows::with_capacity(rows, entries);
             all.append(&self.eq);
             // `tie`: a' constant per interval (σ⁰ = σ¹, the quadratic law).
             let mut n_eq = self.eq.len();
