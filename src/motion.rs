@@ -350,7 +350,27 @@ impl Interval {
     /// panel, where 8-point Gauss–Legendre checked against its two halves took 24; the time
     /// integrals are 5–9 % of a jerk-limited solve (SCP steps and the re-simulation's servo
     /// instants).
+    ///
+    /// First, the 7-point Gauss–Kronrod rule with its embedded 3-point Gauss rule: where they
+    /// agree within the same 1e-13, the 7-point value is taken (its error is far below the
+    /// 3-point rule's, which the difference estimates). A servo instant's panel, a millisecond
+    /// of motion over which b barely changes, passes so with 7 evaluations instead of 15;
+    /// an interval's whole time, where b changes more, fails it and takes the rule above.
     fn cubic_time(&self, p: f64, q: f64) -> f64 {
+        // The 7-point Kronrod nodes (±XK7[1] = ±√(3/5) and 0 are the 3-point Gauss nodes) and
+        // weights, and the Gauss weights 5/9 and 8/9.
+        const XK7: [f64; 3] = [
+            0.960_491_268_708_020_3,
+            0.774_596_669_241_483_4,
+            0.434_243_749_346_802_6,
+        ];
+        const WK7: [f64; 4] = [
+            0.104_656_226_026_467_27,
+            0.268_488_089_868_333_44,
+            0.401_397_414_775_962_2,
+            0.450_916_538_658_474_14,
+        ];
+        const WG3: [f64; 2] = [5.0 / 9.0, 8.0 / 9.0];
         // Nodes and weights of QUADPACK's qk15: the Kronrod nodes (the odd ones, 1, 3, 5 and
         // the centre, are the 7-point Gauss nodes) and weights, and the Gauss weights.
         const XK: [f64; 8] = [
@@ -416,6 +436,22 @@ impl Interval {
         }
         if q <= p {
             return 0.0;
+        }
+        {
+            let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
+            let f = |x: f64| 1.0 / self.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
+            let centre = f(c);
+            let (mut k, mut g) = (WK7[3] * centre, WG3[1] * centre);
+            for j in 0..3 {
+                let pair = f(c - h * XK7[j]) + f(c + h * XK7[j]);
+                k += WK7[j] * pair;
+                if j == 1 {
+                    g += WG3[0] * pair;
+                }
+            }
+            if (k - g).abs() <= 1e-13 * k.abs() {
+                return h * k;
+            }
         }
         let whole = gk(self, p, q);
         let mut budget = 4096;
@@ -1171,6 +1207,60 @@ mod tests {
             let back = m.at(0.3 * dur);
             assert!((back.x - iv.at(0.3 * dur, dur).x).abs() <= 1e-12 * du);
         }
+    }
+
+    /// The time over a panel, short (a servo instant's: the 7-point rule) or the whole
+    /// interval (where that rule's check fails and the adaptive 15-point rule answers), against
+    /// composite Simpson on 20,000 sub-panels (error of order 1e-17 here), on 300 pseudo-random
+    /// cubic intervals whose b stays above a hundredth of its largest value.
+    #[test]
+    fn panel_times_match_composite_simpson() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut checked, mut short) = (0, 0);
+        while checked < 300 {
+            let du = 10f64.powf(-3.0 + 3.0 * next());
+            let b0 = 10f64.powf(-2.0 + 4.0 * next());
+            let scale = b0 / du;
+            let iv = cubic(
+                b0,
+                scale * (next() - 0.5),
+                scale / du * (2.0 * next() - 1.0),
+                scale / du * (2.0 * next() - 1.0),
+                du,
+            );
+            let (lo, hi) = (iv.cubic_b_min(), iv.b0.max(iv.b1));
+            if lo <= 1e-2 * hi {
+                continue;
+            }
+            let p = du * next();
+            let len = du * 10f64.powf(-4.0 * next());
+            let q = (p + len).min(du);
+            for (p, q) in [(p, q), (0.0, du)] {
+                let n = 20_000;
+                let h = (q - p) / n as f64;
+                let f = |x: f64| 1.0 / iv.cubic_b(x).sqrt();
+                let simpson: f64 = (0..n)
+                    .map(|k| {
+                        let x = p + k as f64 * h;
+                        h / 6.0 * (f(x) + 4.0 * f(x + 0.5 * h) + f(x + h))
+                    })
+                    .sum();
+                let t = iv.cubic_time(p, q);
+                assert!(
+                    (t - simpson).abs() <= 2e-13 * simpson,
+                    "{iv:?} on [{p}, {q}]: {t} vs {simpson}"
+                );
+            }
+            short += usize::from(q - p < 1e-2 * du);
+            checked += 1;
+        }
+        assert!(short > 50, "only {short} short panels");
     }
 
     /// A cubic whose b reaches 0 inside the interval stalls.
