@@ -79,6 +79,8 @@ const TERMS_TOL: f64 = 1e-13;
 /// same iterates as ten did (the same interior-point iterations on the COPP paths, 2026-11-27),
 /// for less of an LP's set-up, which the warm starts made a larger share of its time.
 const RUIZ_PASSES: usize = 4;
+/// Entries per row of the products' unrolled form ([`Lp`]).
+const WIDTH: usize = 4;
 /// Steps of iterative refinement per KKT solve (the corrector's and the cold start's; the
 /// predictor's has none).
 const REFINE: usize = 1;
@@ -113,12 +115,19 @@ pub(crate) struct WarmStart<'a> {
     pub duals: &'a [f64],
 }
 
-/// The problem with rows scaled, in row-major form.
+/// The problem with rows scaled, in row-major form, every row `width` entries long.
+///
+/// A shorter row is padded with zero coefficients on its first column: they add nothing to a
+/// product, a maximum of magnitudes or the KKT matrix ([`Kkt::pairs`] skips them), so every
+/// value is the one of the unpadded rows, and the products with A, which an iteration computes
+/// six times, run without a loop per row where rows are at most four entries long (the jerk
+/// subproblems': 80 % of their rows have four entries, the others one or two).
 struct Lp {
     /// Columns.
     n: usize,
-    /// Row `r` has the entries `start[r]..start[r + 1]` of `col`, `val`.
-    start: Vec<usize>,
+    /// Entries per row: the longest row's length, at least [`WIDTH`].
+    width: usize,
+    /// Row `r` has the entries `r * width..(r + 1) * width` of `col`, `val`.
     col: Vec<usize>,
     val: Vec<f64>,
     /// Right-hand sides: the first `n_eq` rows are equalities, the others `≤`.
@@ -133,13 +142,23 @@ impl Lp {
     }
 
     fn entries(&self, r: usize) -> std::ops::Range<usize> {
-        self.start[r]..self.start[r + 1]
+        r * self.width..(r + 1) * self.width
     }
 
     /// `out[r] = (A z)_r` for every row.
     fn mul(&self, z: &[f64], out: &mut [f64]) {
-        for (r, o) in out.iter_mut().enumerate() {
-            *o = self.entries(r).map(|t| self.val[t] * z[self.col[t]]).sum();
+        if self.width == WIDTH {
+            let rows = self
+                .col
+                .chunks_exact(WIDTH)
+                .zip(self.val.chunks_exact(WIDTH));
+            for (o, (c, v)) in out.iter_mut().zip(rows) {
+                *o = v[0] * z[c[0]] + v[1] * z[c[1]] + v[2] * z[c[2]] + v[3] * z[c[3]];
+            }
+        } else {
+            for (r, o) in out.iter_mut().enumerate() {
+                *o = self.entries(r).map(|t| self.val[t] * z[self.col[t]]).sum();
+            }
         }
     }
 
@@ -167,10 +186,25 @@ impl Lp {
     /// `out = Aᵀ y` (`out` overwritten).
     fn mul_t(&self, y: &[f64], out: &mut [f64]) {
         out.fill(0.0);
-        for (r, &w) in y.iter().enumerate() {
-            if w != 0.0 {
-                for t in self.entries(r) {
-                    out[self.col[t]] += self.val[t] * w;
+        if self.width == WIDTH {
+            let rows = self
+                .col
+                .chunks_exact(WIDTH)
+                .zip(self.val.chunks_exact(WIDTH));
+            for (&w, (c, v)) in y.iter().zip(rows) {
+                if w != 0.0 {
+                    out[c[0]] += v[0] * w;
+                    out[c[1]] += v[1] * w;
+                    out[c[2]] += v[2] * w;
+                    out[c[3]] += v[3] * w;
+                }
+            }
+        } else {
+            for (r, &w) in y.iter().enumerate() {
+                if w != 0.0 {
+                    for t in self.entries(r) {
+                        out[self.col[t]] += self.val[t] * w;
+                    }
                 }
             }
         }
@@ -278,9 +312,10 @@ impl Kkt {
         for r in lp.n_eq..lp.rows() {
             self.pair_start.push(self.pairs.len());
             let es = lp.entries(r);
-            for a in es.clone() {
+            // (Not the padding: a zero coefficient adds nothing.)
+            for a in es.clone().filter(|&a| lp.val[a] != 0.0) {
                 let pa = self.pos_col[lp.col[a]];
-                for b in es.start..=a {
+                for b in (es.start..=a).filter(|&b| lp.val[b] != 0.0) {
                     let pb = self.pos_col[lp.col[b]];
                     let v = lp.val[a] * lp.val[b];
                     // A repeated column's diagonal pair counts twice off the diagonal only.
@@ -532,12 +567,15 @@ fn solve_from(
 ) -> Result<LpSolution, Unsolved> {
     let n = q.len();
     // Rows scaled to unit largest coefficient (before Ruiz's passes below; they start from
-    // it).
+    // it), each padded to `width` entries.
+    let width = (0..rows.len())
+        .map(|r| rows.triplets(r).len())
+        .fold(WIDTH, usize::max);
     let mut lp = Lp {
         n,
-        start: Vec::with_capacity(rows.len() + 1),
-        col: Vec::with_capacity(rows.v.len()),
-        val: Vec::with_capacity(rows.v.len()),
+        width,
+        col: Vec::with_capacity(rows.len() * width),
+        val: Vec::with_capacity(rows.len() * width),
         rhs: Vec::with_capacity(rows.len()),
         n_eq,
         q: q.to_vec(),
@@ -550,14 +588,18 @@ fn solve_from(
         let big = ts.clone().fold(0.0_f64, |m, t| m.max(rows.v[t].abs()));
         let scale = if big > 0.0 { 1.0 / big } else { 1.0 };
         row_scale.push(scale);
-        lp.start.push(lp.col.len());
+        let first = ts.clone().next().map_or(0, |t| rows.j[t]);
+        let len = ts.len();
         for t in ts {
             lp.col.push(rows.j[t]);
             lp.val.push(rows.v[t] * scale);
         }
+        for _ in len..width {
+            lp.col.push(first);
+            lp.val.push(0.0);
+        }
         lp.rhs.push(rows.h[r] * scale);
     }
-    lp.start.push(lp.col.len());
     // Ruiz equilibration (as Clarabel's): rows and columns scaled alternately towards unit
     // largest coefficient, z = C ẑ; then the objective to unit largest coefficient (`cost`).
     let mut col_scale = vec![1.0; n];
