@@ -130,6 +130,11 @@ struct Lp {
     /// Row `r` has the entries `r * width..(r + 1) * width` of `col`, `val`.
     col: Vec<usize>,
     val: Vec<f64>,
+    /// The same entries column by column (without the padding), each column's in row order:
+    /// column `j` has `t_start[j]..t_start[j + 1]` of `t_row`, `t_val` ([`Lp::transpose`]).
+    t_start: Vec<usize>,
+    t_row: Vec<u32>,
+    t_val: Vec<f64>,
     /// Right-hand sides: the first `n_eq` rows are equalities, the others `≤`.
     rhs: Vec<f64>,
     n_eq: usize,
@@ -183,29 +188,40 @@ impl Lp {
         })
     }
 
-    /// `out = Aᵀ y` (`out` overwritten).
+    /// `out = Aᵀ y` (`out` overwritten), column by column: each sum in row order, as adding
+    /// the rows' multiples one after the other would give it, without the chain of stores and
+    /// loads that makes through the same few columns.
     fn mul_t(&self, y: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
-        if self.width == WIDTH {
-            let rows = self
-                .col
-                .chunks_exact(WIDTH)
-                .zip(self.val.chunks_exact(WIDTH));
-            for (&w, (c, v)) in y.iter().zip(rows) {
-                if w != 0.0 {
-                    out[c[0]] += v[0] * w;
-                    out[c[1]] += v[1] * w;
-                    out[c[2]] += v[2] * w;
-                    out[c[3]] += v[3] * w;
-                }
+        for (j, o) in out.iter_mut().enumerate() {
+            let es = self.t_start[j]..self.t_start[j + 1];
+            *o = self.t_row[es.clone()]
+                .iter()
+                .zip(&self.t_val[es])
+                .fold(0.0, |acc, (&r, &v)| acc + v * y[r as usize]);
+        }
+    }
+
+    /// Fills the column-by-column copy of the entries ([`Lp::mul_t`]); after the scaling.
+    fn transpose(&mut self) {
+        let mut count = vec![0usize; self.n + 1];
+        for (&c, &v) in self.col.iter().zip(&self.val) {
+            if v != 0.0 {
+                count[c + 1] += 1;
             }
-        } else {
-            for (r, &w) in y.iter().enumerate() {
-                if w != 0.0 {
-                    for t in self.entries(r) {
-                        out[self.col[t]] += self.val[t] * w;
-                    }
-                }
+        }
+        for j in 0..self.n {
+            count[j + 1] += count[j];
+        }
+        self.t_start.clone_from(&count);
+        let nnz = count[self.n];
+        self.t_row.resize(nnz, 0);
+        self.t_val.resize(nnz, 0.0);
+        for (t, (&c, &v)) in self.col.iter().zip(&self.val).enumerate() {
+            if v != 0.0 {
+                let at = count[c];
+                self.t_row[at] = (t / self.width) as u32;
+                self.t_val[at] = v;
+                count[c] += 1;
             }
         }
     }
@@ -233,7 +249,8 @@ struct Kkt {
     scale: Vec<f64>,
     /// The scaled K without its regularisation, in band storage.
     k0: Vec<f64>,
-    /// Per inequality row, its coefficient products' places in the band ([`Kkt::pairs`]).
+    /// Per place in the band, the inequality rows whose coefficient products add there:
+    /// `pairs[pair_start[i]..pair_start[i + 1]]` of (row, product) ([`Kkt::pairs`]).
     pair_start: Vec<usize>,
     pairs: Vec<(u32, f64)>,
 }
@@ -303,14 +320,15 @@ impl Kkt {
         &mut self.band[i * (self.bw + 1) + (i - j)]
     }
 
-    /// Where each inequality row's products of coefficients go in the band: per row, the
-    /// entries `pairs[pair_start[r]..pair_start[r + 1]]` of (band index, coefficient product).
+    /// Which inequality rows' products of coefficients add at each place of the band, place by
+    /// place, each place's in row order (a stable counting sort of the products as the rows
+    /// give them): [`Kkt::factor`] then sums each place's in the order adding the rows one
+    /// after the other would, without the chain of stores and loads that makes.
     fn pairs(&mut self, lp: &Lp) {
         let s1 = self.bw + 1;
-        self.pair_start.clear();
-        self.pairs.clear();
+        // (Place, inequality row, product), row by row.
+        let mut products: Vec<(u32, u32, f64)> = Vec::new();
         for r in lp.n_eq..lp.rows() {
-            self.pair_start.push(self.pairs.len());
             let es = lp.entries(r);
             // (Not the padding: a zero coefficient adds nothing.)
             for a in es.clone().filter(|&a| lp.val[a] != 0.0) {
@@ -321,22 +339,34 @@ impl Kkt {
                     // A repeated column's diagonal pair counts twice off the diagonal only.
                     let v = if a != b && pa == pb { 2.0 * v } else { v };
                     let (i, j) = if pa >= pb { (pa, pb) } else { (pb, pa) };
-                    self.pairs.push(((i * s1 + (i - j)) as u32, v));
+                    products.push(((i * s1 + (i - j)) as u32, (r - lp.n_eq) as u32, v));
                 }
             }
         }
-        self.pair_start.push(self.pairs.len());
+        let mut count = vec![0usize; self.band.len() + 1];
+        for &(at, _, _) in &products {
+            count[at as usize + 1] += 1;
+        }
+        for i in 0..self.band.len() {
+            count[i + 1] += count[i];
+        }
+        self.pair_start.clone_from(&count);
+        self.pairs.clear();
+        self.pairs.resize(products.len(), (0, 0.0));
+        for &(at, r, v) in &products {
+            self.pairs[count[at as usize]] = (r, v);
+            count[at as usize] += 1;
+        }
     }
 
     /// Fills and factorises K for inequality weights `w` (one per inequality row), with ρ =
     /// [`STATIC_REG`] and δ = [`EQ_REG`].
     fn factor(&mut self, lp: &Lp, w: &[f64]) {
         let (rho, delta) = (STATIC_REG, EQ_REG);
-        self.band.fill(0.0);
-        for (r, &wr) in w.iter().enumerate() {
-            for &(at, v) in &self.pairs[self.pair_start[r]..self.pair_start[r + 1]] {
-                self.band[at as usize] += wr * v;
-            }
+        for (at, b) in self.band.iter_mut().enumerate() {
+            *b = self.pairs[self.pair_start[at]..self.pair_start[at + 1]]
+                .iter()
+                .fold(0.0, |acc, &(r, v)| acc + w[r as usize] * v);
         }
         for j in 0..lp.n {
             let p = self.pos_col[j];
@@ -576,6 +606,9 @@ fn solve_from(
         width,
         col: Vec::with_capacity(rows.len() * width),
         val: Vec::with_capacity(rows.len() * width),
+        t_start: Vec::new(),
+        t_row: Vec::new(),
+        t_val: Vec::new(),
         rhs: Vec::with_capacity(rows.len()),
         n_eq,
         q: q.to_vec(),
@@ -637,6 +670,7 @@ fn solve_from(
     for qj in &mut lp.q {
         *qj *= cost;
     }
+    lp.transpose();
     let m = lp.rows() - n_eq;
     let kkt = Kkt::new(&lp)?;
     let (h, f) = (&lp.rhs[n_eq..], &lp.rhs[..n_eq]);
