@@ -1375,6 +1375,28 @@ enum Kind {
     Jerk(u8, bool),
 }
 
+/// What a site's jerk rows `(2/3)√b̄ L/j + b/(3 b̄) ≤ 1` share ([`Program::jerk_weights`]):
+/// `w` = (2/3)√b̄ B (times L/j) and `x` = B x/(3 b̄) (b = B x).
+#[derive(Clone, Copy, Default)]
+struct JerkFactors {
+    w: f64,
+    x: f64,
+}
+
+impl JerkFactors {
+    /// At b̄ (> 0; none otherwise) and the site's x, with the scale B.
+    fn at(scale: f64, bbar: f64, x: f64) -> JerkFactors {
+        if bbar > 0.0 {
+            JerkFactors {
+                w: 2.0 * bbar.sqrt() * scale / 3.0,
+                x: scale * x / (3.0 * bbar),
+            }
+        } else {
+            JerkFactors::default()
+        }
+    }
+}
+
 /// The values at one site of the expressions its rows are built from.
 #[derive(Clone, Copy, Default)]
 struct SiteValues {
@@ -1793,8 +1815,16 @@ impl<'a> Program<'a> {
     }
 
     /// The value of candidate `c` (it holds iff ≤ 1) from its site's expression values and
-    /// the linearisation point's b̄ there.
-    fn value(&self, c: (u32, Kind), v: &SiteValues, bbar: f64) -> f64 {
+    /// the linearisation point's b̄ there; a jerk row's from the site's [`JerkFactors`] and
+    /// the limit's inverse `inv_jerk[axis][lower]`.
+    fn value(
+        &self,
+        c: (u32, Kind),
+        v: &SiteValues,
+        bbar: f64,
+        f: &JerkFactors,
+        inv_jerk: &[[f64; 2]; MAX_AXES],
+    ) -> f64 {
         let site = &self.sites[c.0 as usize];
         let b = self.scale;
         match c.1 {
@@ -1811,8 +1841,11 @@ impl<'a> Program<'a> {
                 if bbar <= 0.0 {
                     return 0.0;
                 }
-                let (k_x, k_y, k_s) = self.jerk_weights(site, j as usize, lower, bbar);
-                k_x * v.x + k_y * v.y + k_s * v.slope
+                // jerk_weights' row, its factors common to the site's rows taken out.
+                let j = j as usize;
+                let d3 = site.d3.expect("a jerk site has q'''");
+                let l = d3[j] * v.x + 3.0 * site.jets.ddq[j] * v.y + site.jets.dq[j] * v.slope;
+                f.w * l * inv_jerk[j][usize::from(lower)] + f.x
             }
         }
     }
@@ -1832,12 +1865,22 @@ impl<'a> Program<'a> {
         )
     }
 
-    /// Every candidate's value at z (the site expressions evaluated once per site).
+    /// Every candidate's value at z (the site expressions, and what the jerk rows share, once
+    /// per site: a square root and a division per site rather than per row; the candidates'
+    /// values are 6 % of a jerk-limited solve on the COPP paths).
     fn values(&self, z: &[f64], bbar_sites: &[f64], out: &mut Vec<f64>) {
         out.clear();
+        let mut inv_jerk = [[0.0; 2]; MAX_AXES];
+        for (inv, lim) in inv_jerk.iter_mut().zip(&self.jd.limits) {
+            if let Some(l) = lim {
+                *inv = [1.0 / l.max, 1.0 / l.min];
+            }
+        }
         let mut last = u32::MAX;
         let mut sv = SiteValues::default();
+        let mut f = JerkFactors::default();
         for &c in &self.cands {
+            let bbar = bbar_sites[c.0 as usize];
             if c.0 != last {
                 let s = &self.sites[c.0 as usize];
                 sv = SiteValues {
@@ -1846,9 +1889,10 @@ impl<'a> Program<'a> {
                     slope: s.slope.eval(z),
                     chord: s.chord.eval(z),
                 };
+                f = JerkFactors::at(self.scale, bbar, sv.x);
                 last = c.0;
             }
-            out.push(self.value(c, &sv, bbar_sites[c.0 as usize]));
+            out.push(self.value(c, &sv, bbar, &f, &inv_jerk));
         }
     }
 
