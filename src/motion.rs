@@ -351,11 +351,13 @@ impl Interval {
     /// integrals are 5–9 % of a jerk-limited solve (SCP steps and the re-simulation's servo
     /// instants).
     ///
-    /// First, the 7-point Gauss–Kronrod rule with its embedded 3-point Gauss rule: where they
-    /// agree within the same 1e-13, the 7-point value is taken (its error is far below the
-    /// 3-point rule's, which the difference estimates). A servo instant's panel, a millisecond
-    /// of motion over which b barely changes, passes so with 7 evaluations instead of 15;
-    /// an interval's whole time, where b changes more, fails it and takes the rule above.
+    /// On a panel shorter than an eighth of the interval, first the 7-point Gauss–Kronrod rule
+    /// with its embedded 3-point Gauss rule: where they agree within the same 1e-13, the
+    /// 7-point value is taken (its error is far below the 3-point rule's, which the difference
+    /// estimates). A servo instant's panel, a millisecond of motion over which b barely
+    /// changes, passes so with 7 evaluations instead of 15 (91 % of them on COPP path 3 with
+    /// jerk limits). An interval's whole time, where b changes more, mostly failed the check:
+    /// it takes the rule above directly.
     fn cubic_time(&self, p: f64, q: f64) -> f64 {
         // The 7-point Kronrod nodes (±XK7[1] = ±√(3/5) and 0 are the 3-point Gauss nodes) and
         // weights, and the Gauss weights 5/9 and 8/9.
@@ -437,7 +439,7 @@ impl Interval {
         if q <= p {
             return 0.0;
         }
-        {
+        if q - p < 0.125 * self.du {
             let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
             let f = |x: f64| 1.0 / self.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
             let centre = f(c);
