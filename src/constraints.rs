@@ -415,6 +415,35 @@ impl SpanProblem {
         p
     }
 
+    /// The same problem with every interval `k` of `ks` (`(k, m)`, sorted by k, distinct)
+    /// divided into `m` equal parts, as [`crate::optimize`]'s local refinement divides them:
+    /// the existing stations keep their data, only the new ones are evaluated (each inside one
+    /// CL move, whose feed cap it takes, as [`SpanProblem::with_inserted`]'s). The same
+    /// problem, bit for bit, as [`SpanProblem::at_stations_within`] on the divided stations,
+    /// which evaluated every station again each round.
+    pub fn with_divided(
+        &self,
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        chord: Option<&Chord>,
+        ks: &[(usize, usize)],
+    ) -> SpanProblem {
+        let u = divide(&self.u, ks);
+        let mut p = self.empty_like(u.len());
+        let mut i = 0;
+        for &x in &u {
+            if i < self.u.len() && self.u[i] == x {
+                p.copy_station(self, i);
+                i += 1;
+            } else {
+                let cap = span.interval_cap(x);
+                p.push_station(span, kin, machine, chord, x, cap);
+            }
+        }
+        p
+    }
+
     /// The stations `i` with `keep[i]` (the first and the last must be kept), as a problem.
     pub fn select(&self, keep: &[bool]) -> SpanProblem {
         let n = keep.iter().filter(|&&k| k).count();
@@ -1194,6 +1223,25 @@ pub fn essential_rows(jet: &AxisJets, limits: &[Limit], b_max: f64) -> (u16, f64
         Bound::None
     };
     (keep, b_star, by)
+}
+
+/// Stations `u` with every interval k of `ks` (pairs (k, m), sorted by k, distinct k) divided
+/// into m equal parts.
+pub(crate) fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
+    let extra: usize = ks.iter().map(|&(_, m)| m.saturating_sub(1)).sum();
+    let mut out = Vec::with_capacity(u.len() + extra);
+    let mut next = ks.iter().peekable();
+    for k in 0..u.len() - 1 {
+        out.push(u[k]);
+        if let Some(&&(_, m)) = next.peek().filter(|(kk, _)| *kk == k) {
+            for j in 1..m {
+                out.push(u[k] + (u[k + 1] - u[k]) * j as f64 / m as f64);
+            }
+            next.next();
+        }
+    }
+    out.push(u[u.len() - 1]);
+    out
 }
 
 #[cfg(test)]

@@ -27,7 +27,7 @@ use crate::kinematics::Kinematics;
 use crate::machine::{KinematicsSpec, Machine};
 use crate::schedule::Schedule;
 use crate::solver::interval_times;
-use crate::solver::jerk::{JerkData, JerkOptions, Warm};
+use crate::solver::jerk::{JerkData, JerkOptions, MidBounds, Warm};
 use crate::solver::{self, SolverKind, SolverSettings, SpanSolution, Status};
 use crate::toolpath::joint_csv::JointPath;
 use crate::toolpath::{Input, Toolpath};
@@ -311,6 +311,7 @@ fn optimize_path(
     // on other stations): its keys, every input's bits, would only be built and dropped (2.5 %
     // of a COPP path's jerk-limited solve).
     let reuse = reuse::Reuse::new(options.reuse_spans && path.spans.len() > 1);
+    let mid_bounds = (0..path.spans.len()).map(|_| Default::default()).collect();
     let plan = Plan {
         machine,
         weights: span_weights(&path),
@@ -319,6 +320,7 @@ fn optimize_path(
         path,
         progress,
         reuse,
+        mid_bounds,
     };
     let (mut unconverged, mut error_target) = (None, None);
     let (mut lv, mut refinement, error_estimate) = match options.stations {
@@ -683,25 +685,6 @@ pub(crate) fn marked_parts(
         ks.dedup_by_key(|k| k.0);
     }
     split
-}
-
-/// Stations `u` with every interval k of `ks` (pairs (k, m), sorted by k, distinct k) divided
-/// into m equal parts.
-pub(crate) fn divide(u: &[f64], ks: &[(usize, usize)]) -> Vec<f64> {
-    let extra: usize = ks.iter().map(|&(_, m)| m.saturating_sub(1)).sum();
-    let mut out = Vec::with_capacity(u.len() + extra);
-    let mut next = ks.iter().peekable();
-    for k in 0..u.len() - 1 {
-        out.push(u[k]);
-        if let Some(&&(_, m)) = next.peek().filter(|(kk, _)| *kk == k) {
-            for j in 1..m {
-                out.push(u[k] + (u[k + 1] - u[k]) * j as f64 / m as f64);
-            }
-            next.next();
-        }
-    }
-    out.push(u[u.len() - 1]);
-    out
 }
 
 /// Into how many equal parts a local refinement divides an interval whose re-simulation
@@ -1089,6 +1072,9 @@ struct Plan<'a> {
     progress: &'a dyn Progress,
     /// The answers of the span problems solved so far.
     reuse: reuse::Reuse,
+    /// Per span, its last jerk-limited solve's collocation bounds, which the next one (a
+    /// local refinement's) takes where its intervals are the same ([`JerkData::new`]).
+    mid_bounds: Vec<std::sync::Mutex<Option<MidBounds>>>,
 }
 
 impl Plan<'_> {
@@ -1897,13 +1883,12 @@ impl Plan<'_> {
             .into_par_iter()
             .map(|(si, ks)| {
                 let old = &lv.problems[si];
-                let u = divide(&old.u, &ks);
-                let mut p = SpanProblem::at_stations_within(
+                let mut p = old.with_divided(
                     &self.path.spans[si],
                     &self.kin,
                     self.machine,
-                    u,
                     options.verify.chord.as_ref(),
+                    &ks,
                 );
                 self.check_travel(si, &p)?;
                 (p.b_start, p.b_end, p.ramp) = (old.b_start, old.b_end, old.ramp);
@@ -2003,6 +1988,10 @@ impl Plan<'_> {
                         .into(),
                 ));
             }
+            let kept = self.mid_bounds[si]
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take();
             let jd = JerkData::new(
                 &self.path.spans[si],
                 &self.kin,
@@ -2010,7 +1999,11 @@ impl Plan<'_> {
                 p,
                 options.verify.chord.as_ref(),
                 options.solver.worker_threads(),
+                kept.as_ref(),
             );
+            *self.mid_bounds[si]
+                .lock()
+                .unwrap_or_else(|e| e.into_inner()) = Some(jd.bounds(p));
             let warm = previous
                 .and_then(|(op, os)| Warm::resample(op, os, p))
                 .map(|w| Warm { local, ..w });
@@ -2119,6 +2112,7 @@ mod tests {
 
     #[test]
     fn divide_splits_the_listed_intervals_into_equal_parts() {
+        use crate::constraints::divide;
         let u = [0.0, 1.0, 3.0, 4.0];
         let out = divide(&u, &[(1, 4), (2, 2)]);
         assert_eq!(out, vec![0.0, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0]);

@@ -462,7 +462,7 @@ impl Study<'_> {
         let mut grid = self.grid.clone();
         for (u, ks) in grid.iter_mut().zip(&split) {
             if !ks.is_empty() {
-                *u = optimize::divide(u, ks);
+                *u = crate::constraints::divide(u, ks);
             }
         }
         (grid.iter().map(Vec::len).sum::<usize>() <= max_stations).then_some(grid)

@@ -335,9 +335,44 @@ const ACTIVE_ROUNDS: usize = 6;
 /// Samples of a constant-jerk end interval at which the jerk is bounded.
 const REST_SAMPLES: usize = 8;
 
+/// The velocity bounds and acceleration rows ([`point_bound`]) of a [`JerkData`]'s collocation
+/// points, with where they lie: what a later build of the same span on other stations takes
+/// instead of evaluating them again ([`JerkData::new`]).
+///
+/// A local refinement divides some intervals and keeps the others whole: their collocation
+/// points are the same points, and the acceleration polygon's presolve there was 7 % of a
+/// jerk-limited COPP path's solve, each round. Kept per span between rounds: 26 bytes a
+/// collocation point (the velocity bound, the row mask, θ) and 8 a station.
+#[derive(Debug, Clone, Default)]
+pub struct MidBounds {
+    u: Vec<f64>,
+    mid_start: Vec<usize>,
+    theta: Vec<f64>,
+    b_max: Vec<f64>,
+    essential: Vec<u16>,
+}
+
+impl MidBounds {
+    /// Per interval k of `u`, the interval of `self.u` with the same ends, if any.
+    fn matches(&self, u: &[f64]) -> Vec<Option<usize>> {
+        let mut j = 0;
+        (0..u.len().saturating_sub(1))
+            .map(|k| {
+                while j + 1 < self.u.len() && self.u[j] < u[k] {
+                    j += 1;
+                }
+                (j + 1 < self.u.len() && self.u[j] == u[k] && self.u[j + 1] == u[k + 1])
+                    .then_some(j)
+            })
+            .collect()
+    }
+}
+
 impl JerkData {
     /// Evaluates q''' at the stations of `p`, the geometry at the collocation points and the
-    /// end-interval bounds (on `threads` threads, 0: as many as the machine has).
+    /// end-interval bounds (on `threads` threads, 0: as many as the machine has). `previous`:
+    /// the bounds of an earlier build of the same span ([`JerkData::bounds`]), taken where an
+    /// interval and its collocation points are the same (the same values, bit for bit).
     pub fn new(
         span: &Span,
         kin: &Kinematics,
@@ -345,6 +380,7 @@ impl JerkData {
         p: &SpanProblem,
         chord: Option<&Chord>,
         threads: usize,
+        previous: Option<&MidBounds>,
     ) -> JerkData {
         let knots = span.spline.knots();
         let last_seg = knots.len() - 2;
@@ -375,27 +411,47 @@ impl JerkData {
         for k in 0..n {
             mid_start.push(mid_start[k] + collocation(k, n, rs, re).points.len());
         }
-        let midpoint = |(k, th, velocity_only): (usize, f64, bool)| {
+        // Per interval, where `previous` has its collocation points' bounds.
+        let kept: Vec<Option<usize>> = match previous {
+            Some(prev) => prev
+                .matches(&p.u)
+                .into_iter()
+                .enumerate()
+                .map(|(k, m)| {
+                    let points = collocation(k, n, rs, re).points;
+                    m.map(|j| prev.mid_start[j])
+                        .filter(|&at| prev.theta.get(at..at + points.len()) == Some(points))
+                })
+                .collect(),
+            None => vec![None; n],
+        };
+        let midpoint = |(k, i, th, velocity_only): (usize, usize, f64, bool)| {
             let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
             let seg = span.spline.segment(um);
             let w = span.spline.eval_in(seg, um);
             let jets = kin.axis_jets(&w);
-            let cap = span.feed_cap(seg, um);
-            let pb = point_bound(
-                machine,
-                &p.acceleration,
-                &jets,
-                &w,
-                span.kind,
-                (cap, None),
-                chord,
-            );
+            let (b_max, essential) = match (previous, kept[k]) {
+                (Some(prev), Some(at)) => (prev.b_max[at + i], prev.essential[at + i]),
+                _ => {
+                    let cap = span.feed_cap(seg, um);
+                    let pb = point_bound(
+                        machine,
+                        &p.acceleration,
+                        &jets,
+                        &w,
+                        span.kind,
+                        (cap, None),
+                        chord,
+                    );
+                    (pb.b_max, pb.essential)
+                }
+            };
             Midpoint {
                 theta: th,
                 d3: kin.axis_third_derivatives(&w, &span.spline.d3_in(seg, um)),
                 jets,
-                b_max: pb.b_max,
-                essential: pb.essential,
+                b_max,
+                essential,
                 velocity_only,
             }
         };
@@ -412,7 +468,8 @@ impl JerkData {
                     let set = collocation(k, n, rs, re);
                     set.points
                         .iter()
-                        .map(move |&th| (k, th, set.velocity_only.contains(&th)))
+                        .enumerate()
+                        .map(move |(i, &th)| (k, i, th, set.velocity_only.contains(&th)))
                 })
                 .map(midpoint)
                 .collect();
@@ -439,6 +496,18 @@ impl JerkData {
 }
 
 impl JerkData {
+    /// Its collocation points' bounds, for a later build of the same span on stations `p.u`
+    /// ([`JerkData::new`]).
+    pub fn bounds(&self, p: &SpanProblem) -> MidBounds {
+        MidBounds {
+            u: p.u.clone(),
+            mid_start: self.mid_start.clone(),
+            theta: self.mid.iter().map(|m| m.theta).collect(),
+            b_max: self.mid.iter().map(|m| m.b_max).collect(),
+            essential: self.mid.iter().map(|m| m.essential).collect(),
+        }
+    }
+
     /// The longest time an axis takes to ramp its acceleration from 0 to its limit at its jerk
     /// limit, max_j a_j / j_j (s; 0 without jerk limits): about how early a jerk-limited
     /// profile leaves a velocity plateau of the acceleration-limited one.
