@@ -106,7 +106,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use super::dialect::{DialectSpec, Semicolon, Subprograms};
+use super::dialect::{DialectSpec, LINUXCNC, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
@@ -1417,7 +1417,42 @@ impl Program {
                 continue;
             };
             let text = text.trim();
-            if text.is_empty() || text.starts_with('%') {
+            if text.is_empty() {
+                continue;
+            }
+            if let Some(rest) = text.strip_prefix('%') {
+                let rest = rest.trim();
+                if !rest.is_empty() {
+                    // A `%` line is the tape's start or end mark only when it is `%` alone.
+                    // LinuxCNC (rs274ngc `Interp::open`) takes a first line as the percent line
+                    // when nothing but blanks follows the `%`; otherwise it reads the file from
+                    // its first line as G-code, where `%` is no word: the line is refused.
+                    // (Round 20: an MPCNC start file's `% vfd enable`, written for another
+                    // control, was skipped in silence.) Other dialects: skipped, with a warning.
+                    if spec.name == LINUXCNC.name {
+                        return Err(self.located(
+                            Error::parse(
+                                source,
+                                number,
+                                format!(
+                                    "`{text}`: a `%` line with text after it is no tape start \
+                                     or end mark, which LinuxCNC reads only as `%` alone; it \
+                                     reads this line as G-code and refuses it (`%` is no word). \
+                                     If the program is for another control that takes it as a \
+                                     command, make it a comment `({rest})` or remove it"
+                                ),
+                            ),
+                            &stack,
+                        ));
+                    }
+                    interp.warn(
+                        number,
+                        format!(
+                            "`{text}`: a `%` line with text after it, skipped as a tape start or \
+                             end mark (`{rest}` is not read)"
+                        ),
+                    );
+                }
                 continue;
             }
             run_blocks += 1;
