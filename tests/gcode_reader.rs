@@ -1860,3 +1860,39 @@ fn a_percent_line_with_text_is_refused_as_linuxcnc_does_and_warned_elsewhere() {
         plain.warnings
     );
 }
+
+/// Fadal's fixture offsets (Fadal VMC programming manual: `E1`…`E48` select a fixture offset,
+/// `E0` cancels it): a Polish shop's Fadal programs (round 22) write `G90 G0 X0 Y0 E1` and park
+/// with `E0 X0. Y250.`. Read in the Fanuc dialect (the programs start `N1 O1`), the E word was
+/// skipped in silence; it is now an offset selection, whose values the program does not give:
+/// a warning naming it, as for `G55` without `G10`. An E that names no fixture offset is an
+/// error; Haas `G187 P2 E0.005` (a smoothing tolerance) is no offset.
+#[test]
+fn fadal_fixture_offset_words_are_offset_selections() {
+    let text = "N1 O1 (PLAN)\nN2 G0 G90 M6 T10\nN3 G90 G0 X0. Y0 E1\nN4 Z5.\n\
+                N5 G1 Z-0.3 F200.\nN6 G1 X160.\nN7 G0 Z50.\nN8 E0 X0. Y250.\nN9 M2\n";
+    let tp = ok_in(Dialect::Fanuc, text);
+    let w: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("E0"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(w[0].line, 8);
+    assert!(w[0].message.contains("E1"), "{}", w[0].message);
+    err_in(
+        Dialect::Fanuc,
+        &text.replace("E1", "E2.5"),
+        3,
+        &["`E2.5`", "fixture offset"],
+    );
+    let haas = ok_in(
+        Dialect::Fanuc,
+        "O1\nG187 P2 E0.005\nG0 X0. Y0. Z5.\nG1 X10. F100.\nM30\n",
+    );
+    assert!(
+        !haas.warnings.iter().any(|w| w.message.contains("E0")),
+        "{:?}",
+        haas.warnings
+    );
+}
