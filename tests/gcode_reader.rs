@@ -1861,8 +1861,8 @@ fn a_percent_line_with_text_is_refused_as_linuxcnc_does_and_warned_elsewhere() {
     );
 }
 
-/// Fadal's fixture offsets (Fadal VMC programming manual: `E1`…`E48` select a fixture offset,
-/// `E0` cancels it): a Polish shop's Fadal programs (round 22) write `G90 G0 X0 Y0 E1` and park
+/// Fadal's fixture offsets (`E1`…`E48` select a fixture offset, `E0` cancels it; Autodesk's
+/// Fusion post "Fadal": "output E-codes or … G54-G59 for WCS offsets"): a Polish shop's Fadal programs (round 22) write `G90 G0 X0 Y0 E1` and park
 /// with `E0 X0. Y250.`. Read in the Fanuc dialect (the programs start `N1 O1`), the E word was
 /// skipped in silence; it is now an offset selection, whose values the program does not give:
 /// a warning naming it, as for `G55` without `G10`. An E that names no fixture offset is an
