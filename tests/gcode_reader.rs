@@ -1896,3 +1896,64 @@ fn fadal_fixture_offset_words_are_offset_selections() {
         haas.warnings
     );
 }
+
+/// Fadal subroutines (a Polish shop's Fadal programs, round 22): `L100` (or `L0100`) … `M17`
+/// defines subroutine 1; the definitions come first and an `M30` after the last one ends
+/// them, the main program following it; `L101` calls subroutine 1 once, `L102` twice. With
+/// a canned cycle defined with `L0` (no hole where it is defined, Fanuc's K0/L0), the
+/// subroutine's positions are the holes. They were an error at `L100` (round 8's message).
+#[test]
+fn fadal_subroutines_run_where_called() {
+    let text = "N1 O1 (OTW)\nN2 L100\nN3 X-10. Y5.\nN4 X10. Y5.\nN5 M17\n\nN6 M30\n\n\
+                N7 G0 G90 G80 G17\nN8 G0 G90 X0 Y0\nN9 Z20.\n\
+                N10 G98 G81 X0 Y0 Z-3. R2. F60. L0\nN11 L102\nN12 G80\nN13 G0 Z50.\nN14 M2\n";
+    let tp = ok_in(Dialect::Fanuc, text);
+    let bottoms: Vec<(f64, f64)> = tp
+        .points
+        .iter()
+        .filter(|p| (p.p.z + 3.0).abs() < 1e-9)
+        .map(|p| (p.p.x, p.p.y))
+        .collect();
+    assert_eq!(
+        bottoms,
+        [(-10.0, 5.0), (10.0, 5.0), (-10.0, 5.0), (10.0, 5.0)]
+    );
+    // The M30 that ends the definitions does not end the program.
+    assert_eq!(tp.points.last().map(|p| p.p.z), Some(50.0));
+    err_in(
+        Dialect::Fanuc,
+        "N1 O1\nN2 L100\nN3 X1. Y1.\nN4 M30\n",
+        2,
+        &["L1", "no M17"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "N1 O1\nN2 L100\nN3 X1. Y1.\nN4 M17\nN5 M30\nN6 G0 X0. Y0. Z5.\nN7 L301\n",
+        7,
+        &["`L301`", "L3"],
+    );
+}
+
+/// The same motion code twice in a block (a Fadal program's `G0 G90 G0 X0 Y0 E1`, round 22)
+/// moves as once on a Fanuc, which takes the last G code of a group given twice; LinuxCNC
+/// refuses two G codes of one modal group, and two different motion codes stay an error.
+#[test]
+fn the_same_motion_code_twice_is_read_in_the_fanuc_dialect() {
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "O1\nG0 G90 G0 X1. Y2. Z3.\nG1 X5. F100.\nM30\n",
+    );
+    assert_eq!(tp.points.last().map(|p| p.p.x), Some(5.0));
+    err_in(
+        Dialect::LinuxCnc,
+        "G0 G90 G0 X1 Y2 Z3\n",
+        1,
+        &["two motion codes"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG0 G1 X1. Y2. Z3.\n",
+        2,
+        &["two motion codes"],
+    );
+}

@@ -1122,7 +1122,19 @@ impl<'a> Interpreter<'a> {
                     }
                 }
                 Action::Motion(m) => {
-                    if let Some((other, _)) = motion_code {
+                    // The same motion code twice (a Fadal program's `G0 G90 G0 X0 Y0 E1`,
+                    // round 22) moves as once, whichever of the two counts: a Fanuc reads the
+                    // last G code of a group given twice (its operator's manuals, G code
+                    // list: "the G code specified last is valid"). LinuxCNC refuses any two
+                    // of one group (rs274ngc NCE_TWO_G_CODES_USED_FROM_SAME_MODAL_GROUP), and
+                    // two different ones stay an error everywhere.
+                    let repeated = motion_code.is_some_and(|(other, _)| {
+                        self.spec.subprograms == Subprograms::OPrograms
+                            && code_name(other) == code_name(text)
+                    });
+                    if let Some((other, _)) = motion_code
+                        && !repeated
+                    {
                         return Err(self.error(
                             line,
                             format!("two motion codes in one block: {other} and {text}"),
@@ -1499,8 +1511,10 @@ impl<'a> Interpreter<'a> {
                 line,
                 format!(
                     "`L{}`: an L word with no G10, canned cycle or M98 in the block to read it; \
-                     on a Fadal control L defines or calls a subprogram (L900, L901) or repeats \
-                     a move (G3 … L14), which feedopt does not read: post the program for a \
+                     on a Fadal control L calls a subprogram (L901: subroutine 9 once), which \
+                     feedopt reads when the file defines it (L900 … M17, before an M30 that \
+                     ends the definitions), or repeats a move (G3 … L14), which feedopt does \
+                     not read: write the repeated moves out, or post the program for a \
                      Fanuc-style control (M98 P… calls, moves written out)",
                     l.value
                 ),
