@@ -1833,26 +1833,27 @@ fn linuxcnc_rigid_tapping_g33_1_feeds_at_k_times_s_and_back_at_i_times_that() {
 /// blanks follows the `%` (rs274ngc `Interp::open`: `if (line[index] == '%') { for
 /// (index--; (index >= 0) && (isspace(line[index])); index--); if (index == -1) percent_flag
 /// = true; … else … going back to line 0 }`), and then reads the line as G-code, where `%` is
-/// no word: an error naming the line. In the other dialects it is skipped with a warning
-/// naming the text (it was skipped in silence).
+/// no word, and refuses it. The line moves nothing: a warning naming it and saying so (it was
+/// skipped in silence); in the other dialects a warning naming the text.
 #[test]
-fn a_percent_line_with_text_is_refused_as_linuxcnc_does_and_warned_elsewhere() {
+fn a_percent_line_with_text_is_named() {
     let text = "%\nG21 G90\n% vfd enable\nG0 X0 Y0 Z5\nG1 X10 F100\nM2\n%\n";
-    err_in(
-        Dialect::LinuxCnc,
-        text,
-        3,
-        &["`% vfd enable`", "`%` alone", "(vfd enable)"],
-    );
-    let tp = ok_in(Dialect::Fanuc, &text.replace("X10", "X10."));
-    let w: Vec<_> = tp
-        .warnings
-        .iter()
-        .filter(|w| w.message.contains("vfd enable"))
-        .collect();
-    assert_eq!(w.len(), 1, "{:?}", tp.warnings);
-    assert_eq!(w[0].line, 3);
-    // `%` alone, at the start and the end, stays the tape mark: no warning, no error.
+    for (dialect, text, needle) in [
+        (Dialect::LinuxCnc, text.to_string(), "refuses it"),
+        (Dialect::Fanuc, text.replace("X10", "X10."), "is not read"),
+    ] {
+        let tp = ok_in(dialect, &text);
+        let w: Vec<_> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("`% vfd enable`"))
+            .collect();
+        assert_eq!(w.len(), 1, "{:?}", tp.warnings);
+        assert_eq!(w[0].line, 3);
+        assert!(w[0].message.contains(needle), "{}", w[0].message);
+        assert_eq!(tp.points.last().map(|p| p.p.x), Some(10.0));
+    }
+    // `%` alone, at the start and the end, stays the tape mark: no warning.
     let plain = ok(&text.replace("% vfd enable\n", ""));
     assert!(
         !plain.warnings.iter().any(|w| w.message.contains('%')),

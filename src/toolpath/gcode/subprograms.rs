@@ -1511,32 +1511,27 @@ impl Program {
                     // A `%` line is the tape's start or end mark only when it is `%` alone.
                     // LinuxCNC (rs274ngc `Interp::open`) takes a first line as the percent line
                     // when nothing but blanks follows the `%`; otherwise it reads the file from
-                    // its first line as G-code, where `%` is no word: the line is refused.
-                    // (Round 20: an MPCNC start file's `% vfd enable`, written for another
-                    // control, was skipped in silence.) Other dialects: skipped, with a warning.
-                    if spec.name == LINUXCNC.name {
-                        return Err(self.located(
-                            Error::parse(
-                                source,
-                                number,
-                                format!(
-                                    "`{text}`: a `%` line with text after it is no tape start \
-                                     or end mark, which LinuxCNC reads only as `%` alone; it \
-                                     reads this line as G-code and refuses it (`%` is no word). \
-                                     If the program is for another control that takes it as a \
-                                     command, make it a comment `({rest})` or remove it"
-                                ),
-                            ),
-                            &stack,
-                        ));
-                    }
-                    interp.warn(
-                        number,
+                    // its first line as G-code, where `%` is no word: it refuses the line, and
+                    // the program does not run. (Round 20: an MPCNC start file's `% vfd
+                    // enable`, `% LED ON`, written for another sender or control, were skipped
+                    // in silence.) The line moves nothing on any reading: a warning naming it,
+                    // as for an M code the control does not know.
+                    let message = if spec.name == LINUXCNC.name {
+                        format!(
+                            "`{text}`: a `%` line with text after it is no tape start or end \
+                             mark, which LinuxCNC reads only as `%` alone: it reads this line \
+                             as G-code and refuses it (`%` is no word), so the program does not \
+                             run on LinuxCNC as written; skipped here (it moves nothing). If \
+                             it is a command for another sender or control, keep it; for \
+                             LinuxCNC make it a comment `({rest})`"
+                        )
+                    } else {
                         format!(
                             "`{text}`: a `%` line with text after it, skipped as a tape start or \
                              end mark (`{rest}` is not read)"
-                        ),
-                    );
+                        )
+                    };
+                    interp.warn(number, message);
                 }
                 continue;
             }
