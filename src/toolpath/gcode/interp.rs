@@ -1432,11 +1432,10 @@ impl<'a> Interpreter<'a> {
         // Fusion post "Fadal", $Revision 42984: property onlyENumbers, "Set to 'Yes' to output
         // E-codes or 'No' to output G54-G59 for WCS offsets", and its format 1 header `G90 G94
         // G17 H0 E0`; the Polish shop's programs of round 22: `G90 G0 X0 Y0 E1`, and `E0 X0.
-        // Y250.` to park). They were skipped in silence: a
-        // Fanuc has no E word on a mill. Read as an offset selected without its values (taken
-        // as equal to the one in force, with a warning, as `G55` without `G10`). Not in a
-        // block that gives E to another code: Haas `G187 E` (smoothing tolerance), macro
-        // arguments `G65 … E` (#8).
+        // Y250.` to park). They were skipped in silence: a Fanuc has no E word on a mill.
+        // Read as an offset selected without its values (taken as equal to the one in force,
+        // with a warning, as `G55` without `G10`). Not in a block that gives E to another
+        // code: Haas `G187 E` (smoothing tolerance), macro arguments `G65 … E` (#8).
         if self.spec.subprograms == Subprograms::OPrograms
             && let Some(e) = block.letter('E')
             && !block

@@ -433,7 +433,7 @@ fn fadal_subroutine(block: &str) -> Option<(u32, u32)> {
     (1..=99).contains(&number).then_some((number, count))
 }
 
-/// Whether the block is `M17` (or `M30`, with `end`) alone, after a block number.
+/// Whether the block is `M<code>` alone (`M17`, `M30`), after a block number.
 fn lone_m(block: &str, code: u32) -> bool {
     let t = strip_block_number(block).trim();
     t.strip_prefix(['M', 'm'])
