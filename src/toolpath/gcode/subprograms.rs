@@ -1507,7 +1507,8 @@ impl Program {
             }
             if let Some(rest) = text.strip_prefix('%') {
                 let rest = rest.trim();
-                if !rest.is_empty() {
+                // (Sinumerik's `%_N_NAME_SPF` and `%MPF123` head programs: not such lines.)
+                if !rest.is_empty() && self.style != Subprograms::Procs {
                     // A `%` line is the tape's start or end mark only when it is `%` alone.
                     // LinuxCNC (rs274ngc `Interp::open`) takes a first line as the percent line
                     // when nothing but blanks follows the `%`; otherwise it reads the file from
