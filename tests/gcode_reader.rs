@@ -1827,3 +1827,134 @@ fn linuxcnc_rigid_tapping_g33_1_feeds_at_k_times_s_and_back_at_i_times_that() {
         assert!(e.contains("test.ngc:") && e.contains(says), "{text}: {e}");
     }
 }
+
+/// A `%` line with text after it (an MPCNC user's start file: `% vfd enable`, round 20) is no
+/// tape start or end mark. LinuxCNC takes a line as its percent line only when nothing but
+/// blanks follows the `%` (rs274ngc `Interp::open`: `if (line[index] == '%') { for
+/// (index--; (index >= 0) && (isspace(line[index])); index--); if (index == -1) percent_flag
+/// = true; … else … going back to line 0 }`), and then reads the line as G-code, where `%` is
+/// no word, and refuses it. The line moves nothing: a warning naming it and saying so (it was
+/// skipped in silence); in the other dialects a warning naming the text.
+#[test]
+fn a_percent_line_with_text_is_named() {
+    let text = "%\nG21 G90\n% vfd enable\nG0 X0 Y0 Z5\nG1 X10 F100\nM2\n%\n";
+    for (dialect, text, needle) in [
+        (Dialect::LinuxCnc, text.to_string(), "refuses it"),
+        (Dialect::Fanuc, text.replace("X10", "X10."), "is not read"),
+    ] {
+        let tp = ok_in(dialect, &text);
+        let w: Vec<_> = tp
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("`% vfd enable`"))
+            .collect();
+        assert_eq!(w.len(), 1, "{:?}", tp.warnings);
+        assert_eq!(w[0].line, 3);
+        assert!(w[0].message.contains(needle), "{}", w[0].message);
+        assert_eq!(tp.points.last().map(|p| p.p.x), Some(10.0));
+    }
+    // `%` alone, at the start and the end, stays the tape mark: no warning.
+    let plain = ok(&text.replace("% vfd enable\n", ""));
+    assert!(
+        !plain.warnings.iter().any(|w| w.message.contains('%')),
+        "{:?}",
+        plain.warnings
+    );
+}
+
+/// Fadal's fixture offsets (`E1`…`E48` select a fixture offset, `E0` cancels it; Autodesk's
+/// Fusion post "Fadal": "output E-codes or … G54-G59 for WCS offsets"): a Polish shop's Fadal programs (round 22) write `G90 G0 X0 Y0 E1` and park
+/// with `E0 X0. Y250.`. Read in the Fanuc dialect (the programs start `N1 O1`), the E word was
+/// skipped in silence; it is now an offset selection, whose values the program does not give:
+/// a warning naming it, as for `G55` without `G10`. An E that names no fixture offset is an
+/// error; Haas `G187 P2 E0.005` (a smoothing tolerance) is no offset.
+#[test]
+fn fadal_fixture_offset_words_are_offset_selections() {
+    let text = "N1 O1 (PLAN)\nN2 G0 G90 M6 T10\nN3 G90 G0 X0. Y0 E1\nN4 Z5.\n\
+                N5 G1 Z-0.3 F200.\nN6 G1 X160.\nN7 G0 Z50.\nN8 E0 X0. Y250.\nN9 M2\n";
+    let tp = ok_in(Dialect::Fanuc, text);
+    let w: Vec<_> = tp
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("E0"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", tp.warnings);
+    assert_eq!(w[0].line, 8);
+    assert!(w[0].message.contains("E1"), "{}", w[0].message);
+    err_in(
+        Dialect::Fanuc,
+        &text.replace("E1", "E2.5"),
+        3,
+        &["`E2.5`", "fixture offset"],
+    );
+    let haas = ok_in(
+        Dialect::Fanuc,
+        "O1\nG187 P2 E0.005\nG0 X0. Y0. Z5.\nG1 X10. F100.\nM30\n",
+    );
+    assert!(
+        !haas.warnings.iter().any(|w| w.message.contains("E0")),
+        "{:?}",
+        haas.warnings
+    );
+}
+
+/// Fadal subroutines (a Polish shop's Fadal programs, round 22): `L100` (or `L0100`) … `M17`
+/// defines subroutine 1; the definitions come first and an `M30` after the last one ends
+/// them, the main program following it; `L101` calls subroutine 1 once, `L102` twice. With
+/// a canned cycle defined with `L0` (no hole where it is defined, Fanuc's K0/L0), the
+/// subroutine's positions are the holes. They were an error at `L100` (round 8's message).
+#[test]
+fn fadal_subroutines_run_where_called() {
+    let text = "N1 O1 (OTW)\nN2 L100\nN3 X-10. Y5.\nN4 X10. Y5.\nN5 M17\n\nN6 M30\n\n\
+                N7 G0 G90 G80 G17\nN8 G0 G90 X0 Y0\nN9 Z20.\n\
+                N10 G98 G81 X0 Y0 Z-3. R2. F60. L0\nN11 L102\nN12 G80\nN13 G0 Z50.\nN14 M2\n";
+    let tp = ok_in(Dialect::Fanuc, text);
+    let bottoms: Vec<(f64, f64)> = tp
+        .points
+        .iter()
+        .filter(|p| (p.p.z + 3.0).abs() < 1e-9)
+        .map(|p| (p.p.x, p.p.y))
+        .collect();
+    assert_eq!(
+        bottoms,
+        [(-10.0, 5.0), (10.0, 5.0), (-10.0, 5.0), (10.0, 5.0)]
+    );
+    // The M30 that ends the definitions does not end the program.
+    assert_eq!(tp.points.last().map(|p| p.p.z), Some(50.0));
+    err_in(
+        Dialect::Fanuc,
+        "N1 O1\nN2 L100\nN3 X1. Y1.\nN4 M30\n",
+        2,
+        &["L1", "no M17"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "N1 O1\nN2 L100\nN3 X1. Y1.\nN4 M17\nN5 M30\nN6 G0 X0. Y0. Z5.\nN7 L301\n",
+        7,
+        &["`L301`", "L3"],
+    );
+}
+
+/// The same motion code twice in a block (a Fadal program's `G0 G90 G0 X0 Y0 E1`, round 22)
+/// moves as once on a Fanuc, which takes the last G code of a group given twice; LinuxCNC
+/// refuses two G codes of one modal group, and two different motion codes stay an error.
+#[test]
+fn the_same_motion_code_twice_is_read_in_the_fanuc_dialect() {
+    let tp = ok_in(
+        Dialect::Fanuc,
+        "O1\nG0 G90 G0 X1. Y2. Z3.\nG1 X5. F100.\nM30\n",
+    );
+    assert_eq!(tp.points.last().map(|p| p.p.x), Some(5.0));
+    err_in(
+        Dialect::LinuxCnc,
+        "G0 G90 G0 X1 Y2 Z3\n",
+        1,
+        &["two motion codes"],
+    );
+    err_in(
+        Dialect::Fanuc,
+        "O1\nG0 G1 X1. Y2. Z3.\n",
+        2,
+        &["two motion codes"],
+    );
+}

@@ -1985,3 +1985,26 @@ fn moves_in_a_tilted_plane_draw_no_tool_tip_warning() {
     ));
     assert_eq!(tip(&tp), 1, "{:?}", tp.warnings);
 }
+
+/// Activating a preset (cycle 247) resets cycle 7's datum shift: the TNC's cycle manuals
+/// (cycle 247 PRESETTING, its notes: the control resets the datum shift, mirroring, rotation
+/// and scaling when it activates a preset from the preset table). A Polish shop's program
+/// (round 22, `fi104.H`) relies on it: `247`, `CYCL DEF 7.1 IX-60`, a bore; `247`, `CYCL DEF
+/// 7.1 IX+60`, the other bore, at X+60. Keeping the shift put it at X0, quietly.
+#[test]
+fn presetting_again_resets_the_datum_shift() {
+    let text = format!(
+        "{HEADER}4 CYCL DEF 247 DATUM SETTING ~\n    Q339=+1    ;PRESET NUMBER\n\
+         5 CYCL DEF 7.0 DATUM SHIFT\n6 CYCL DEF 7.1 IX-60\n7 L X+0 Y+0 Z+5 R0 FMAX\n\
+         8 CYCL DEF 247 DATUM SETTING ~\n    Q339=+1    ;PRESET NUMBER\n\
+         9 CYCL DEF 7.0 DATUM SHIFT\n10 CYCL DEF 7.1 IX+60\n11 L X+0 Y+0 Z+5 R0 FMAX\n"
+    );
+    let tp = read(&text);
+    assert!(
+        tp.points
+            .iter()
+            .any(|p| close(p.p, v(-60.0, 0.0, 5.0), 1e-9))
+    );
+    let last = tp.points.last().unwrap().p;
+    assert!(close(last, v(60.0, 0.0, 5.0), 1e-9), "{last}");
+}

@@ -496,6 +496,25 @@ impl<'a> Interpreter<'a> {
         }
     }
 
+    /// Selects the work offset `name` (`G55`, Fadal `E2`): see [`offsets`].
+    fn select_work_offset(&mut self, line: usize, name: String) {
+        let before = self.offsets.shift();
+        let used = if self.saw_rotary { 0..6 } else { 0..3 };
+        if let Some(warning) = self.offsets.select(&name, used) {
+            self.warn(line, warning);
+        }
+        if !self.points.is_empty() {
+            self.offset_changes.push(OffsetChange {
+                point: self.points.len(),
+                line,
+                name,
+                origin: self.offsets.origin(),
+                given: self.offsets.origin_given(),
+            });
+        }
+        self.shift_changed(before);
+    }
+
     fn error(&self, line: usize, message: impl Into<String>) -> Error {
         Error::parse(self.source, line, message)
     }
@@ -1103,7 +1122,19 @@ impl<'a> Interpreter<'a> {
                     }
                 }
                 Action::Motion(m) => {
-                    if let Some((other, _)) = motion_code {
+                    // The same motion code twice (a Fadal program's `G0 G90 G0 X0 Y0 E1`,
+                    // round 22) moves as once, whichever of the two counts: a Fanuc reads the
+                    // last G code of a group given twice (its operator's manuals, G code
+                    // list: "the G code specified last is valid"). LinuxCNC refuses any two
+                    // of one group (rs274ngc NCE_TWO_G_CODES_USED_FROM_SAME_MODAL_GROUP), and
+                    // two different ones stay an error everywhere.
+                    let repeated = motion_code.is_some_and(|(other, _)| {
+                        self.spec.subprograms == Subprograms::OPrograms
+                            && code_name(other) == code_name(text)
+                    });
+                    if let Some((other, _)) = motion_code
+                        && !repeated
+                    {
                         return Err(self.error(
                             line,
                             format!("two motion codes in one block: {other} and {text}"),
@@ -1236,21 +1267,7 @@ impl<'a> Interpreter<'a> {
                         Some(p) if code.contains('.') => format!("{code} P{}", p.value),
                         _ => code,
                     };
-                    let before = self.offsets.shift();
-                    let used = if self.saw_rotary { 0..6 } else { 0..3 };
-                    if let Some(warning) = self.offsets.select(&name, used) {
-                        self.warn(line, warning);
-                    }
-                    if !self.points.is_empty() {
-                        self.offset_changes.push(OffsetChange {
-                            point: self.points.len(),
-                            line,
-                            name: name.clone(),
-                            origin: self.offsets.origin(),
-                            given: self.offsets.origin_given(),
-                        });
-                    }
-                    self.shift_changed(before);
+                    self.select_work_offset(line, name);
                 }
                 Action::SetOffset(numbering) => set_offset = Some((text.as_str(), numbering)),
                 Action::LocalOffset => local_offset = true,
@@ -1409,6 +1426,35 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
+        // Fadal (read in the Fanuc dialect: its programs start `N1 O1`): `E1`…`E48` select a
+        // fixture offset, as G54… do, and `E0` cancels it, the machine's coordinates then
+        // standing for the program's, in the block they are written in and after it (Autodesk's
+        // Fusion post "Fadal", $Revision 42984: property onlyENumbers, "Set to 'Yes' to output
+        // E-codes or 'No' to output G54-G59 for WCS offsets", and its format 1 header `G90 G94
+        // G17 H0 E0`; the Polish shop's programs of round 22: `G90 G0 X0 Y0 E1`, and `E0 X0.
+        // Y250.` to park). They were skipped in silence: a Fanuc has no E word on a mill.
+        // Read as an offset selected without its values (taken as equal to the one in force,
+        // with a warning, as `G55` without `G10`). Not in a block that gives E to another
+        // code: Haas `G187 E` (smoothing tolerance), macro arguments `G65 … E` (#8).
+        if self.spec.subprograms == Subprograms::OPrograms
+            && let Some(e) = block.letter('E')
+            && !block
+                .actions
+                .iter()
+                .any(|(text, _, _)| matches!(code_name(text).as_str(), "G187" | "G65"))
+        {
+            if e.value.fract() != 0.0 || !(0.0..=48.0).contains(&e.value) {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "`E{}`: on a Fadal control E selects a fixture offset, E1 to E48 (E0 \
+                         cancels it); this is none, and a Fanuc mill has no E word",
+                        e.value
+                    ),
+                ));
+            }
+            self.select_work_offset(line, format!("E{}", e.value as u32));
+        }
         // `S`: the spindle speed, rpm (not in a dwell, where Sinumerik's `G4 S` counts
         // revolutions; Klartext's comes with `TOOL CALL`).
         if self.spec.spaces != Spaces::Klartext
@@ -1464,8 +1510,10 @@ impl<'a> Interpreter<'a> {
                 line,
                 format!(
                     "`L{}`: an L word with no G10, canned cycle or M98 in the block to read it; \
-                     on a Fadal control L defines or calls a subprogram (L900, L901) or repeats \
-                     a move (G3 … L14), which feedopt does not read: post the program for a \
+                     on a Fadal control L calls a subprogram (L901: subroutine 9 once), which \
+                     feedopt reads when the file defines it (L900 … M17, before an M30 that \
+                     ends the definitions), or repeats a move (G3 … L14), which feedopt does \
+                     not read: write the repeated moves out, or post the program for a \
                      Fanuc-style control (M98 P… calls, moves written out)",
                     l.value
                 ),

@@ -9,7 +9,12 @@
 //!   `O0100`), which runs to `M99` or the next header. `M98 P<n> L<count>` calls it `count`
 //!   times (`L0`: not at all); without L a P of more than four digits that names no program
 //!   in the file packs the count before a four-digit number (`M98 P32000`: O2000 three
-//!   times, Fanuc's form).
+//!   times, Fanuc's form). Fadal subroutines, in the same dialect: `L0100` (or `L100`) heads
+//!   subroutine 1's definition, which runs to `M17`; the definitions come before the main
+//!   program, and an `M30` after the last one ends them (the main program follows it, and
+//!   runs from there; the lines before the first definition are its start). `L0102` (`L102`)
+//!   calls subroutine 1 twice: a block of that word alone, in a file that defines Fadal
+//!   subroutines. A move repeat (`G3 I-4.5 L14`) is not read: an error.
 //! * **Sinumerik** ([`Subprograms::Procs`]): `PROC NAME …` or `%_N_NAME_SPF` (with or
 //!   without a `PROC NAME` line after it) starts subprogram NAME, which runs to `RET`, `M17`
 //!   or the next header. A header before any code starts the main program. A block with the
@@ -106,7 +111,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use super::dialect::{DialectSpec, Semicolon, Subprograms};
+use super::dialect::{DialectSpec, LINUXCNC, Semicolon, Subprograms};
 use super::expr::Variables;
 use super::interp::{Call, Interpreter};
 use super::klartext::{self, LabelOp};
@@ -412,6 +417,34 @@ fn fanuc_header(block: &str) -> Option<String> {
     }
     let n: u64 = digits.parse().ok()?;
     Some(format!("O{n}"))
+}
+
+/// A Fadal subroutine word alone in its block (after a block number): `L0100` or `L100` →
+/// (1, 0), `L901` → (9, 1). The digits are the subroutine's number (1–99) and a count, two
+/// digits each: count 0 heads the subroutine's definition, 1–99 calls it that many times.
+fn fadal_subroutine(block: &str) -> Option<(u32, u32)> {
+    let t = strip_block_number(block).trim();
+    let digits = t.strip_prefix(['L', 'l'])?;
+    if !(3..=4).contains(&digits.len()) || !digits.chars().all(|c| c.is_ascii_digit()) {
+        return None;
+    }
+    let n: u32 = digits.parse().ok()?;
+    let (number, count) = (n / 100, n % 100);
+    (1..=99).contains(&number).then_some((number, count))
+}
+
+/// Whether the block is `M<code>` alone (`M17`, `M30`), after a block number.
+fn lone_m(block: &str, code: u32) -> bool {
+    let t = strip_block_number(block).trim();
+    t.strip_prefix(['M', 'm'])
+        .and_then(|d| d.parse::<u32>().ok())
+        .is_some_and(|m| m == code)
+}
+
+/// A Fadal subroutine's section name (`L1` … `L99`).
+fn fadal_name(name: &str) -> bool {
+    name.strip_prefix('L')
+        .is_some_and(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()))
 }
 
 /// A Sinumerik header: `PROC NAME(…)` → (NAME, false), `%_N_NAME_SPF` → (NAME, false),
@@ -997,9 +1030,51 @@ impl Program {
         let mut current = 0usize;
         // The current section has a block of code (a header after code starts a new one).
         let mut has_code = false;
+        // Fadal (read in the Fanuc dialect): the subroutine being defined (its section and
+        // header line), and whether one was closed since the main program's last code.
+        let mut fadal: Option<(usize, usize)> = None;
+        let mut after_fadal = false;
         for i in 0..self.lines.len() {
             let number = self.lines[i].number;
             let block = self.first_block(i);
+            if self.style == Subprograms::OPrograms {
+                // Fadal subroutines: `L0100` (or `L100`) … `M17` defines subroutine 1; the
+                // definitions come first, and an `M30` after the last one ends them: the
+                // main program follows it (the Polish shop's Fadal programs of round 22:
+                // `N2 L100`, hole positions, `N7 M17`, …, `N11 M30`, then the main program
+                // calling `L101`). Neither the header, the `M17` nor that `M30` is run.
+                let sub = fadal_subroutine(block);
+                if let Some((k, header)) = fadal {
+                    if lone_m(block, 17) {
+                        fadal = None;
+                        after_fadal = true;
+                    } else if let Some((n, 0)) = sub {
+                        return Err(Error::parse(
+                            source,
+                            number,
+                            format!(
+                                "Fadal subroutine L{n} defined inside {} (line {header}), \
+                                 which has no M17 before it: end each definition with M17",
+                                self.sections[k].name
+                            ),
+                        ));
+                    } else {
+                        self.sections[k].lines.push(i);
+                    }
+                    continue;
+                }
+                if let Some((n, 0)) = sub {
+                    let k = self.add_section(source, format!("L{n}"), number)?;
+                    fadal = Some((k, number));
+                    continue;
+                }
+                if after_fadal && !block.trim().is_empty() {
+                    after_fadal = false;
+                    if lone_m(block, 30) {
+                        continue;
+                    }
+                }
+            }
             let header = match self.style {
                 Subprograms::OPrograms => fanuc_header(block).map(|n| (n, false)),
                 _ => sinumerik_header(block),
@@ -1035,6 +1110,16 @@ impl Program {
                     self.sections[current].lines.push(i);
                 }
             }
+        }
+        if let Some((k, header)) = fadal {
+            return Err(Error::parse(
+                source,
+                header,
+                format!(
+                    "Fadal subroutine {} has no M17 after it: end its definition with M17",
+                    self.sections[k].name
+                ),
+            ));
         }
         Ok(())
     }
@@ -1417,7 +1502,38 @@ impl Program {
                 continue;
             };
             let text = text.trim();
-            if text.is_empty() || text.starts_with('%') {
+            if text.is_empty() {
+                continue;
+            }
+            if let Some(rest) = text.strip_prefix('%') {
+                let rest = rest.trim();
+                // (Sinumerik's `%_N_NAME_SPF` and `%MPF123` head programs: not such lines.)
+                if !rest.is_empty() && self.style != Subprograms::Procs {
+                    // A `%` line is the tape's start or end mark only when it is `%` alone.
+                    // LinuxCNC (rs274ngc `Interp::open`) takes a first line as the percent line
+                    // when nothing but blanks follows the `%`; otherwise it reads the file from
+                    // its first line as G-code, where `%` is no word: it refuses the line, and
+                    // the program does not run. (Round 20: an MPCNC start file's `% vfd
+                    // enable`, `% LED ON`, written for another sender or control, were skipped
+                    // in silence.) The line moves nothing on any reading: a warning naming it,
+                    // as for an M code the control does not know.
+                    let message = if spec.name == LINUXCNC.name {
+                        format!(
+                            "`{text}`: a `%` line with text after it is no tape start or end \
+                             mark, which LinuxCNC reads only as `%` alone: it reads this line \
+                             as G-code and refuses it (`%` is no word), so the program does not \
+                             run on LinuxCNC as written; skipped here (it moves nothing). If \
+                             it is a command for another sender or control, keep it; for \
+                             LinuxCNC make it a comment `({rest})`"
+                        )
+                    } else {
+                        format!(
+                            "`{text}`: a `%` line with text after it, skipped as a tape start or \
+                             end mark (`{rest}` is not read)"
+                        )
+                    };
+                    interp.warn(number, message);
+                }
                 continue;
             }
             run_blocks += 1;
@@ -1602,6 +1718,20 @@ impl Program {
                     // Definitions were taken apart by the scan.
                     OWord::Sub => {}
                 }
+                continue;
+            }
+            // A Fadal subroutine call `L0102` / `L102`: subroutine 1, twice (only in a file that
+            // defines Fadal subroutines; elsewhere a bare L is the interpreter's error).
+            if self.style == Subprograms::OPrograms
+                && let Some((n, runs)) = fadal_subroutine(text)
+                && runs > 0
+                && self.by_name.keys().any(|k| fadal_name(k))
+            {
+                let call = Call {
+                    text: strip_block_number(text).trim().to_string(),
+                    targets: vec![(format!("L{n}"), u64::from(runs))],
+                };
+                self.enter(spec, &mut stack, call, number, source)?;
                 continue;
             }
             if self.style == Subprograms::OPrograms

@@ -1253,6 +1253,18 @@ impl Interpreter<'_> {
             }
             247 => {
                 let preset = self.vars.value("Q339");
+                // Activating a preset resets the datum shift of cycle 7 (and mirroring,
+                // rotation and scaling, which feedopt refuses anyway): Heidenhain's cycle
+                // manuals (TNC 640 / iTNC 530, cycle 247 PRESETTING, its notes) say the
+                // control resets them when it activates a preset from the preset table. A
+                // Polish shop's TNC programs rely on it (round 22, `fi104.H`: `247` +
+                // `CYCL DEF 7.1 IX-60`, a bore; `247` + `CYCL DEF 7.1 IX+60`, the other bore at
+                // X+60, where keeping the shift would put it at X0).
+                if self.klartext.datum_shift != Vector3::zeros() {
+                    self.klartext.datum_shift = Vector3::zeros();
+                    self.klartext.tilted_shift = None;
+                    self.set_klartext_frame();
+                }
                 match self.klartext.preset {
                     None => {
                         self.klartext.preset = Some(preset);
