@@ -1076,8 +1076,11 @@ fn cut_band(
         band.each(j, ua, ub, |i, cell| {
             let [lo, hi] = run[i - ua];
             note(i, cell.remove(lo, hi));
+            if i < sa || i > sb {
+                return;
+            }
             let h = end_hits[i - ua];
-            if h[0] <= h[1] && cell.top() > h[1] && i >= sa && i <= sb {
+            if h[0] <= h[1] && cell.top() > h[1] {
                 candidates.push(i);
             }
         });
