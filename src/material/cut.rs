@@ -40,11 +40,15 @@
 //! three poses at the default sample step, so this is a third to a half of the crossings.
 //!
 //! **Which dexels.** Each pose's tool lies inside the cylinder of radius R about its axis
-//! from h = 0 to L_f, so its XY footprint lies inside the capsule of radius R about the
-//! projected axis segment, and (tilted) inside the rectangle of half-width R along it that
-//! reaches only R·|O_z| past its ends (`axis_row`); each grid row visits only the cells of
-//! that capsule ([`capsule_row`]) and rectangle, pose by pose (tilted), or of the capsule
-//! about the segment P₀P₁ (vertical). A cell outside the footprint is one the tool does not
+//! from h = 0 to L_f, so its XY footprint lies inside the rectangle of half-width R along
+//! the projected axis that reaches only R·|O_z| past its ends (`axis_row`), and within R of
+//! the axis segment from its corner centre (r_c above the tip) to the flutes' top, so inside
+//! the capsule of radius R about that segment projected (`Footprint::of_pose`; for a
+//! ball-nose tool tilted far from the vertical, as on the LinuxCNC impeller, the capsule
+//! about the tip's end held a strip behind the ball that no tool point reaches: leaving it
+//! out took 7 % of the check's instructions, 19.05 → 17.78 G). Each grid row visits only
+//! the cells of that capsule ([`capsule_row`]) and rectangle, pose by pose (tilted), or of
+//! the capsule about the segment P₀P₁ (vertical). A cell outside the footprint is one the tool does not
 //! cross, so skipping it changes nothing. The work of a step is thus its footprint's cells
 //! times its poses, not its bounding box's. The shank check at a tilted step's end pose reads
 //! only the lines its shank may cross: the shank (radius R about the axis above the flutes'
@@ -601,6 +605,20 @@ impl Footprint {
         }
     }
 
+    /// A tilted pose's: tip `p`, corner centre `c` (on the axis r_c above the tip) and
+    /// flutes' top `t` (XY). The tool lies within R of the axis segment from c to t (the
+    /// corner: a point at height h < r_c and radius r(h) lies (R − r_c + s)² + (r_c − h)² =
+    /// (R − r_c)² + 2 (R − r_c) s + r_c² ≤ R² from c, s = √(r_c² − (r_c − h)²) ≤ r_c), so in
+    /// the capsule about c t, which for a ball-nose tool leaves out the strip of about
+    /// R·|O_xy| behind the tip that the capsule about p t holds and no tool point reaches;
+    /// and in the rectangle about p t lengthened by `ends` (module doc).
+    fn of_pose(p: [f64; 2], c: [f64; 2], t: [f64; 2], r: f64, ends: f64) -> Footprint {
+        Footprint {
+            axis: Rectangle::new(p, t, r, ends),
+            ..Footprint::new(c, t, r, f64::INFINITY)
+        }
+    }
+
     /// [`capsule_row`].
     fn capsule_row(&self, y: f64) -> Option<[f64; 2]> {
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -781,8 +799,10 @@ fn plan_step<'t>(
             .map(|j| {
                 let (p, o) = step.pose(j as f64 / (poses - 1) as f64);
                 let top = p + o * tool.flute_length;
+                let centre = p + o * tool.corner_radius;
                 let ends = r * o.z.abs();
-                let foot = Footprint::new([p.x, p.y], [top.x, top.y], r, ends);
+                let foot =
+                    Footprint::of_pose([p.x, p.y], [centre.x, centre.y], [top.x, top.y], r, ends);
                 (Pose::new(tool, &p, &o), foot)
             })
             .collect()
@@ -1484,6 +1504,54 @@ mod tests {
             let inside = |row: Option<[f64; 2]>| row.is_some_and(|[x0, x1]| x0 <= q.x && q.x <= x1);
             assert!(inside(capsule_row(a, b, r, q.y)));
             assert!(!inside(axis_row(a, b, r, r * o.z.abs(), q.y)) || o.z.abs() > 0.999);
+        }
+    }
+
+    /// Every point of a tilted flat, ball or bull-nose tool, on its surface or inside, lies in
+    /// its pose's footprint: the capsule about its corner centre and flutes' top, and the
+    /// rectangle about its tip and top ([`Footprint::of_pose`]).
+    #[test]
+    fn a_tilted_tool_lies_in_its_footprint() {
+        let mut rnd = crate::test_rng(17);
+        for tool in [
+            Tool::new(6.0, 3.0, 12.0, 2).unwrap(),
+            Tool::new(6.0, 0.0, 12.0, 2).unwrap(),
+            Tool::new(6.0, 1.2, 12.0, 2).unwrap(),
+        ] {
+            let r = tool.radius();
+            for case in 0..200 {
+                let oz = if case % 4 == 0 {
+                    -0.2 - rnd()
+                } else {
+                    0.05 + rnd()
+                };
+                let o = Vector3::new(rnd() - 0.5, rnd() - 0.5, oz).normalize();
+                let p = Vector3::new(rnd(), rnd(), rnd());
+                let (c, t) = (p + o * tool.corner_radius, p + o * tool.flute_length);
+                let foot = Footprint::of_pose([p.x, p.y], [c.x, c.y], [t.x, t.y], r, r * o.z.abs());
+                let e1 = o.cross(&Vector3::x()).normalize();
+                let e2 = o.cross(&e1);
+                for k in 0..400 {
+                    let h = match k % 4 {
+                        0 => tool.corner_radius * rnd(),
+                        _ => tool.flute_length * rnd(),
+                    };
+                    // Half of them on the surface.
+                    let rho = tool.radius_at(h) * if k % 2 == 0 { 1.0 } else { rnd().sqrt() };
+                    let phi = std::f64::consts::TAU * rnd();
+                    let x = p + o * h + (e1 * phi.cos() + e2 * phi.sin()) * rho;
+                    let [x0, x1] = foot.capsule_row(x.y).unwrap();
+                    assert!(
+                        x0 <= x.x && x.x <= x1,
+                        "{tool:?} {x:?} outside [{x0}, {x1}]"
+                    );
+                    let [u0, u1] = foot.axis_row(x.y).unwrap();
+                    assert!(
+                        u0 <= x.x && x.x <= u1,
+                        "{tool:?} {x:?} outside [{u0}, {u1}]"
+                    );
+                }
+            }
         }
     }
 
