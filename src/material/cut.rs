@@ -695,6 +695,35 @@ fn join_row(run: &mut [[f64; 2]], starts: &mut [f64], before: &[[f64; 2]], row: 
     }
 }
 
+/// The runs of a step of two poses (the first line joined with the second by [`join_row`]) in
+/// one pass over the cells rather than three: the same values (the same comparisons; a
+/// minimum or a maximum of numbers does not depend on the order it is taken in).
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn runs_of_two(run: &mut [[f64; 2]], starts: &mut [f64], a: &[[f64; 2]], b: &[[f64; 2]]) {
+    for (((run, n), a), b) in run.iter_mut().zip(starts.iter_mut()).zip(a).zip(b) {
+        let (hit_a, hit_b) = (a[0] <= a[1], b[0] <= b[1]);
+        *n = if hit_a { 1.0 } else { 0.0 } + if hit_b & !hit_a { 1.0 } else { 0.0 };
+        run[0] = if b[0] < a[0] { b[0] } else { a[0] };
+        run[1] = if b[1] > a[1] { b[1] } else { a[1] };
+    }
+}
+
+/// [`runs_of_two`] for a step of three poses (the default sample step's on a tilted tool are
+/// two or three).
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
+fn runs_of_three(run: &mut [[f64; 2]], starts: &mut [f64], [a, b, c]: [&[[f64; 2]]; 3]) {
+    for ((((run, n), a), b), c) in run.iter_mut().zip(starts.iter_mut()).zip(a).zip(b).zip(c) {
+        let (hit_a, hit_b, hit_c) = (a[0] <= a[1], b[0] <= b[1], c[0] <= c[1]);
+        *n = if hit_a { 1.0 } else { 0.0 }
+            + if hit_b & !hit_a { 1.0 } else { 0.0 }
+            + if hit_c & !hit_b { 1.0 } else { 0.0 };
+        let lo = if b[0] < a[0] { b[0] } else { a[0] };
+        let hi = if b[1] > a[1] { b[1] } else { a[1] };
+        run[0] = if c[0] < lo { c[0] } else { lo };
+        run[1] = if c[1] > hi { c[1] } else { hi };
+    }
+}
+
 /// The crossings of a tilted step's last pose with the dexel lines, kept for the next step,
 /// whose first pose it is (shared poses, module doc).
 #[derive(Debug, Clone, Default)]
@@ -1036,12 +1065,20 @@ fn cut_band(
         // (at least three poses) leaves several runs, taken apart cell by
         // cell below, the ones a miss ended kept aside. (A miss is
         // [∞, −∞], which min and max leave out exactly.)
-        run.clear();
-        run.extend_from_slice(line(0));
-        starts.clear();
-        starts.extend(run.iter().map(|h| f64::from(u8::from(h[0] <= h[1]))));
-        for k in 1..poses {
-            join_row(run, starts, line(k - 1), line(k));
+        run.resize(width, NO_HIT);
+        starts.resize(width, 0.0);
+        if poses == 2 {
+            runs_of_two(run, starts, line(0), line(1));
+        } else if poses == 3 {
+            runs_of_three(run, starts, [line(0), line(1), line(2)]);
+        } else {
+            run.copy_from_slice(line(0));
+            for (n, h) in starts.iter_mut().zip(run.iter()) {
+                *n = f64::from(u8::from(h[0] <= h[1]));
+            }
+            for k in 1..poses {
+                join_row(run, starts, line(k - 1), line(k));
+            }
         }
         ended.clear();
         // (Two poses make one run at most.)
@@ -1552,6 +1589,47 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The runs of two and of three poses in one pass are [`join_row`]'s, pose after pose, bit
+    /// for bit, on lines of crossings and misses.
+    #[test]
+    fn runs_in_one_pass_are_join_rows() {
+        let mut rnd = crate::test_rng(19);
+        let mut line = |n: usize| -> Vec<[f64; 2]> {
+            (0..n)
+                .map(|_| {
+                    if rnd() < 0.3 {
+                        NO_HIT
+                    } else {
+                        let lo = 10.0 * rnd() - 5.0;
+                        [lo, lo + 3.0 * rnd()]
+                    }
+                })
+                .collect()
+        };
+        let n = 999;
+        let lines: Vec<Vec<[f64; 2]>> = (0..3).map(|_| line(n)).collect();
+        for poses in [2, 3] {
+            let (mut run, mut starts) = (lines[0].clone(), vec![0.0; n]);
+            for (s, h) in starts.iter_mut().zip(&run) {
+                *s = f64::from(u8::from(h[0] <= h[1]));
+            }
+            for k in 1..poses {
+                join_row(&mut run, &mut starts, &lines[k - 1], &lines[k]);
+            }
+            let (mut run1, mut starts1) = (vec![[0.0; 2]; n], vec![7.0; n]);
+            if poses == 2 {
+                runs_of_two(&mut run1, &mut starts1, &lines[0], &lines[1]);
+            } else {
+                runs_of_three(&mut run1, &mut starts1, [&lines[0], &lines[1], &lines[2]]);
+            }
+            for c in 0..n {
+                assert_eq!(run[c].map(f64::to_bits), run1[c].map(f64::to_bits), "{c}");
+                assert_eq!(starts[c].to_bits(), starts1[c].to_bits(), "{c}");
+            }
+            assert!(starts.iter().any(|&s| s == 2.0) || poses == 2);
         }
     }
 
