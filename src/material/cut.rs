@@ -48,15 +48,16 @@
 //! about the tip's end held a strip behind the ball that no tool point reaches: leaving it
 //! out took 7 % of the check's instructions, 19.05 → 17.78 G). Each grid row visits only
 //! the cells of that capsule ([`capsule_row`]) and rectangle, pose by pose (tilted), or of
-//! the capsule about the segment P₀P₁ (vertical). A cell outside the footprint is one the tool does not
-//! cross, so skipping it changes nothing. The work of a step is thus its footprint's cells
-//! times its poses, not its bounding box's. The shank check at a tilted step's end pose reads
-//! only the lines its shank may cross: the shank (radius R about the axis above the flutes'
-//! top T) lies, seen from above, in the half-infinite strip of half-width R from T along the
-//! projected axis, lengthened by R·|O_z| behind T (`shank_shadow`); elsewhere its depth is 0.
-//! (A tool buried beyond its flutes has material above them on every line they cross, but
-//! its shank reaches only the lines near their top end: on the LinuxCNC impeller, reading
-//! only those took 9 % of the instructions off the check, 21.3 → 19.4 G.)
+//! the capsule about the segment P₀P₁ (vertical). A cell outside the footprint is one the
+//! tool does not cross, so skipping it changes nothing. The work of a step is thus its
+//! footprint's cells times its poses, not its bounding box's. The shank check at a tilted
+//! step's end pose reads only the lines its shank may cross: the shank (radius R about the
+//! axis above the flutes' top T) lies, seen from above, in the half-infinite strip of
+//! half-width R from T along the projected axis, lengthened by R·|O_z| behind T
+//! (`shank_shadow`); elsewhere its depth is 0. (A tool buried beyond its flutes has material
+//! above them on every line they cross, but its shank reaches only the lines near their top
+//! end: on the LinuxCNC impeller, reading only those took 9 % of the instructions off the
+//! check, 21.3 → 19.4 G.)
 //!
 //! **Engagement of a sample** (the tool at the step's end pose P, axis O, feed direction f):
 //! - removed volume ΔV (mm³) and engaged cross-section `A = ΔV / Δs` (mm²) normal to the feed,
