@@ -1630,7 +1630,7 @@ mod tests {
                 assert_eq!(run[c].map(f64::to_bits), run1[c].map(f64::to_bits), "{c}");
                 assert_eq!(starts[c].to_bits(), starts1[c].to_bits(), "{c}");
             }
-            assert!(starts.iter().any(|&s| s == 2.0) || poses == 2);
+            assert!(starts.contains(&2.0) || poses == 2);
         }
     }
 
