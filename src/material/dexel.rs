@@ -198,6 +198,15 @@ impl Dexel {
             if cut.length == 0.0 {
                 return cut;
             }
+            // The commonest cut of a tunnel: [lo, hi] reaches from inside or above the first
+            // interval's bottom (a < lo ≤ c) to inside or below the second's top (b ≤ hi < d),
+            // widening the gap. Of the four parts below, [a, min(b, lo)] and [max(c, hi), d]
+            // stay (both not empty) and the other two are empty ([hi, b]: hi ≥ b; [c, lo]:
+            // lo ≤ c): the same two intervals, told without counting them.
+            if f[0] < lo && lo <= l[0] && f[1] <= hi && hi < l[1] {
+                self.iv = [[f[0], smaller(f[1], lo)], [larger(l[0], hi), l[1]]];
+                return cut;
+            }
             // What stays of each interval: its parts below lo and above hi (either the
             // whole interval where [lo, hi] misses it, the other empty: f[1] ≤ lo gives
             // [f[0], f[1]] and [hi, f[1]], hi > lo ≥ f[1]), those not empty kept in order

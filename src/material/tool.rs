@@ -395,7 +395,10 @@ fn crossings_row(
         } else {
             (b0, b1)
         };
-        let any = (cylinder || sphere) && lo.is_finite() && hi.is_finite();
+        // `lo` and `hi` finite, as `Pose::hit` asks, in half the instructions: where the
+        // tool crosses, lo = +∞ comes only with hi = +∞ and hi = −∞ with lo = −∞ (lo ≤ hi or
+        // a NaN, which both comparisons refuse), so these two tests tell the same.
+        let any = (cylinder || sphere) && lo > f64::NEG_INFINITY && hi < f64::INFINITY;
         *h = if any { [p.z + lo, p.z + hi] } else { NO_HIT };
     }
 }
