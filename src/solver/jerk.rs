@@ -341,16 +341,24 @@ const REST_SAMPLES: usize = 8;
 ///
 /// A local refinement divides some intervals and keeps the others whole: their collocation
 /// points are the same points, and the acceleration polygon's presolve there was 7 % of a
-/// jerk-limited COPP path's solve, each round. Kept per span between rounds: 26 bytes a
-/// collocation point (the velocity bound, the row mask, θ) and 8 a station.
+/// jerk-limited COPP path's solve, each round. Kept per span between rounds: 10 bytes a
+/// collocation point (the velocity bound, the row mask) and 13 an interval (its first
+/// station, where its points start, how many: [`collocation`]'s three sets differ in length).
 #[derive(Debug, Clone, Default)]
 pub struct MidBounds {
     u: Vec<f64>,
-    mid_start: Vec<usize>,
-    theta: Vec<f64>,
+    mid_start: Vec<u32>,
+    points: Vec<u8>,
     b_max: Vec<f64>,
     essential: Vec<u16>,
 }
+
+// An interval's collocation set is told by its length ([`MidBounds`]).
+const _: () = assert!(
+    COLLOCATION.len() != COLLOCATION_NEAR_REST.len()
+        && COLLOCATION.len() != COLLOCATION_AT_REST.len()
+        && COLLOCATION_NEAR_REST.len() != COLLOCATION_AT_REST.len()
+);
 
 impl MidBounds {
     /// Per interval k of `u`, the interval of `self.u` with the same ends, if any.
@@ -418,9 +426,9 @@ impl JerkData {
                 .into_iter()
                 .enumerate()
                 .map(|(k, m)| {
-                    let points = collocation(k, n, rs, re).points;
-                    m.map(|j| prev.mid_start[j])
-                        .filter(|&at| prev.theta.get(at..at + points.len()) == Some(points))
+                    let points = collocation(k, n, rs, re).points.len();
+                    m.filter(|&j| usize::from(prev.points[j]) == points)
+                        .map(|j| prev.mid_start[j] as usize)
                 })
                 .collect(),
             None => vec![None; n],
@@ -501,8 +509,12 @@ impl JerkData {
     pub fn bounds(&self, p: &SpanProblem) -> MidBounds {
         MidBounds {
             u: p.u.clone(),
-            mid_start: self.mid_start.clone(),
-            theta: self.mid.iter().map(|m| m.theta).collect(),
+            mid_start: self.mid_start.iter().map(|&m| m as u32).collect(),
+            points: self
+                .mid_start
+                .windows(2)
+                .map(|w| (w[1] - w[0]) as u8)
+                .collect(),
             b_max: self.mid.iter().map(|m| m.b_max).collect(),
             essential: self.mid.iter().map(|m| m.essential).collect(),
         }
