@@ -388,8 +388,7 @@ impl SpanProblem {
 
     /// The same problem with a station added inside every interval `k` of `split` (sorted,
     /// distinct), at `at(k)` (strictly between u_k and u_{k+1}); the existing stations keep
-    /// their data, only the new ones are evaluated. Every CL knot is a station, so each
-    /// interval lies within one CL move and a new station takes that move's feed cap.
+    /// their data, only the new ones are evaluated ([`SpanProblem::with_added`]).
     pub fn with_inserted(
         &self,
         span: &Span,
@@ -399,28 +398,15 @@ impl SpanProblem {
         split: &[usize],
         at: impl Fn(usize) -> f64,
     ) -> SpanProblem {
-        let n = self.u.len() + split.len();
-        let mut p = self.empty_like(n);
-        let mut next = split.iter().peekable();
-        for i in 0..self.u.len() {
-            p.copy_station(self, i);
-            if next.peek() == Some(&&i) {
-                next.next();
-                let u = at(i);
-                debug_assert!(u > self.u[i] && u < self.u[i + 1]);
-                let cap = span.interval_cap(u);
-                p.push_station(span, kin, machine, chord, u, cap);
-            }
-        }
-        p
+        let added: Vec<(usize, f64)> = split.iter().map(|&k| (k, at(k))).collect();
+        self.with_added(span, kin, machine, chord, &added)
     }
 
     /// The same problem with every interval `k` of `ks` (`(k, m)`, sorted by k, distinct)
-    /// divided into `m` equal parts, as [`crate::optimize`]'s local refinement divides them:
-    /// the existing stations keep their data, only the new ones are evaluated (each inside one
-    /// CL move, whose feed cap it takes, as [`SpanProblem::with_inserted`]'s). The same
-    /// problem, bit for bit, as [`SpanProblem::at_stations_within`] on the divided stations,
-    /// which evaluated every station again each round.
+    /// divided into `m` equal parts at [`divide`]'s stations, as [`crate::optimize`]'s local
+    /// refinement divides them ([`SpanProblem::with_added`]). The same problem, bit for bit,
+    /// as [`SpanProblem::at_stations_within`] on the divided stations, which evaluated every
+    /// station again each round.
     pub fn with_divided(
         &self,
         span: &Span,
@@ -429,16 +415,37 @@ impl SpanProblem {
         chord: Option<&Chord>,
         ks: &[(usize, usize)],
     ) -> SpanProblem {
-        let u = divide(&self.u, ks);
-        let mut p = self.empty_like(u.len());
-        let mut i = 0;
-        for &x in &u {
-            if i < self.u.len() && self.u[i] == x {
-                p.copy_station(self, i);
-                i += 1;
-            } else {
-                let cap = span.interval_cap(x);
-                p.push_station(span, kin, machine, chord, x, cap);
+        let u = &self.u;
+        let added: Vec<(usize, f64)> = ks
+            .iter()
+            .flat_map(|&(k, m)| {
+                (1..m).map(move |j| (k, u[k] + (u[k + 1] - u[k]) * j as f64 / m as f64))
+            })
+            .collect();
+        self.with_added(span, kin, machine, chord, &added)
+    }
+
+    /// The same problem with the stations `added` (`(k, u)`: u strictly inside interval k, in
+    /// order): the existing stations keep their data, only the new ones are evaluated. Every
+    /// CL knot is a station, so each interval lies within one CL move and a new station takes
+    /// that move's feed cap.
+    fn with_added(
+        &self,
+        span: &Span,
+        kin: &Kinematics,
+        machine: &Machine,
+        chord: Option<&Chord>,
+        added: &[(usize, f64)],
+    ) -> SpanProblem {
+        let mut p = self.empty_like(self.u.len() + added.len());
+        let mut next = added.iter().peekable();
+        for i in 0..self.u.len() {
+            p.copy_station(self, i);
+            while let Some(&&(_, u)) = next.peek().filter(|(k, _)| *k == i) {
+                next.next();
+                debug_assert!(u >= self.u[i] && u <= self.u[i + 1]);
+                let cap = span.interval_cap(u);
+                p.push_station(span, kin, machine, chord, u, cap);
             }
         }
         p

@@ -359,8 +359,8 @@ impl Interval {
     /// jerk limits). An interval's whole time, where b changes more, mostly failed the check:
     /// it takes the rule above directly.
     fn cubic_time(&self, p: f64, q: f64) -> f64 {
-        // The 7-point Kronrod nodes (±XK7[1] = ±√(3/5) and 0 are the 3-point Gauss nodes) and
-        // weights, and the Gauss weights 5/9 and 8/9.
+        // The 7-point Kronrod nodes but the centre (±XK7[1] = ±√(3/5) and 0 are the 3-point
+        // Gauss nodes) and weights, and the Gauss weights 5/9 and 8/9.
         const XK7: [f64; 3] = [
             0.960_491_268_708_020_3,
             0.774_596_669_241_483_4,
@@ -373,9 +373,10 @@ impl Interval {
             0.450_916_538_658_474_14,
         ];
         const WG3: [f64; 2] = [5.0 / 9.0, 8.0 / 9.0];
-        // Nodes and weights of QUADPACK's qk15: the Kronrod nodes (the odd ones, 1, 3, 5 and
-        // the centre, are the 7-point Gauss nodes) and weights, and the Gauss weights.
-        const XK: [f64; 8] = [
+        // Nodes and weights of QUADPACK's qk15: the Kronrod nodes but the centre (the odd ones,
+        // 1, 3, 5, and the centre are the 7-point Gauss nodes) and weights, and the Gauss
+        // weights (each rule's centre weight last).
+        const XK: [f64; 7] = [
             0.991_455_371_120_812_6,
             0.949_107_912_342_758_5,
             0.864_864_423_359_769_1,
@@ -383,7 +384,6 @@ impl Interval {
             0.586_087_235_467_691_1,
             0.405_845_151_377_397_2,
             0.207_784_955_007_898_5,
-            0.0,
         ];
         const WK: [f64; 8] = [
             0.022_935_322_010_529_22,
@@ -401,20 +401,26 @@ impl Interval {
             0.381_830_050_505_118_9,
             0.417_959_183_673_469_4,
         ];
-        /// (Kronrod's value, |Kronrod − Gauss|) on [p, q].
-        fn gk(iv: &Interval, p: f64, q: f64) -> (f64, f64) {
+        /// (Kronrod's value, |Kronrod − Gauss|) on [p, q] of a Gauss–Kronrod pair: the Kronrod
+        /// nodes `xk` but the centre, whose odd ones are the Gauss nodes, and the weights `wk`,
+        /// `wg`, each rule's centre weight last.
+        fn pair(iv: &Interval, p: f64, q: f64, xk: &[f64], wk: &[f64], wg: &[f64]) -> (f64, f64) {
             let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
             let f = |x: f64| 1.0 / iv.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
             let centre = f(c);
-            let (mut k, mut g) = (WK[7] * centre, WG[3] * centre);
-            for j in 0..7 {
-                let pair = f(c - h * XK[j]) + f(c + h * XK[j]);
-                k += WK[j] * pair;
+            let (mut k, mut g) = (wk[xk.len()] * centre, wg[xk.len() / 2] * centre);
+            for (j, x) in xk.iter().enumerate() {
+                let pair = f(c - h * x) + f(c + h * x);
+                k += wk[j] * pair;
                 if j % 2 == 1 {
-                    g += WG[j / 2] * pair;
+                    g += wg[j / 2] * pair;
                 }
             }
             (h * k, (h * (k - g)).abs())
+        }
+        /// The 15-point pair.
+        fn gk(iv: &Interval, p: f64, q: f64) -> (f64, f64) {
+            pair(iv, p, q, &XK, &WK, &WG)
         }
         // `tol`: absolute, split between the halves, so the total error stays within the
         // whole's; `budget`: panels left, so a sharp peak of 1/√b (b nearly 0 inside) cannot
@@ -440,19 +446,9 @@ impl Interval {
             return 0.0;
         }
         if q - p < 0.125 * self.du {
-            let (c, h) = (0.5 * (p + q), 0.5 * (q - p));
-            let f = |x: f64| 1.0 / self.cubic_b(x).max(f64::MIN_POSITIVE).sqrt();
-            let centre = f(c);
-            let (mut k, mut g) = (WK7[3] * centre, WG3[1] * centre);
-            for j in 0..3 {
-                let pair = f(c - h * XK7[j]) + f(c + h * XK7[j]);
-                k += WK7[j] * pair;
-                if j == 1 {
-                    g += WG3[0] * pair;
-                }
-            }
-            if (k - g).abs() <= 1e-13 * k.abs() {
-                return h * k;
+            let (k, err) = pair(self, p, q, &XK7, &WK7, &WG3);
+            if err <= 1e-13 * k.abs() {
+                return k;
             }
         }
         let whole = gk(self, p, q);
@@ -914,18 +910,22 @@ mod tests {
         }
     }
 
+    /// Pseudo-random numbers in [0, 1) from `seed` (xorshift).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// Two independent closed forms agree on 2,000 pseudo-random intervals (every sign of α
     /// and ü, b varying up to a thousandfold): the time to x (invariant a² − αb) and the
     /// position at τ (the linear ODE ẍ = a_0 + αx).
     #[test]
     fn time_and_position_closed_forms_agree() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x2545_f491_4f6c_dd1du64);
         let mut checked = 0;
         while checked < 2000 {
             let du = 10f64.powf(-3.0 + 3.0 * next());
@@ -1217,13 +1217,7 @@ mod tests {
     /// cubic intervals whose b stays above a hundredth of its largest value.
     #[test]
     fn panel_times_match_composite_simpson() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15u64);
         let (mut checked, mut short) = (0, 0);
         while checked < 300 {
             let du = 10f64.powf(-3.0 + 3.0 * next());
