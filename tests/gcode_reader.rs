@@ -1958,3 +1958,79 @@ fn the_same_motion_code_twice_is_read_in_the_fanuc_dialect() {
         &["two motion codes"],
     );
 }
+
+/// The length of the path through a toolpath's points.
+fn path_length(tp: &Toolpath) -> f64 {
+    tp.points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum()
+}
+
+/// grbl's homing cycle `$H` (grbl wiki, "Grbl v1.1 Commands": "`$H` - Run homing cycle"; the
+/// homed position is machine zero when homing in grbl's default positive direction: "If you
+/// home in a positive direction your position will be 0", Grbl_Esp32 wiki "Machine Space and
+/// Homing"). gSender's programs (Sienci-Labs/gsender `examples/gcode/KB-435 test.gcode`) start
+/// `G21` / `$H` / `G10 L20 P1 X0 Y0 Z50` / `G54`, so the start is home and the work offset is
+/// set from there; the line was refused as "unexpected character `$`". Read as the start at
+/// home (the machine file's reference, else machine zero, as for `G28`): the program solves,
+/// the path starting at home.
+#[test]
+fn grbl_homing_at_the_start_places_the_program() {
+    let tp = ok("G21\n$H\nG10 L20 P1 X0 Y0 Z50\nG54\nG0 X10 Y0 Z50\nG1 X20 F100\nM2\n");
+    assert!(
+        (path_length(&tp) - 20.0).abs() < 1e-9,
+        "{}",
+        path_length(&tp)
+    );
+    assert!(
+        !tp.warnings
+            .iter()
+            .any(|w| w.message.contains("not programmed yet")),
+        "{:?}",
+        tp.warnings
+    );
+    assert!(
+        tp.warnings
+            .iter()
+            .any(|w| w.line == 2 && w.message.contains("`$H`")),
+        "{:?}",
+        tp.warnings
+    );
+}
+
+/// `$H` after moves (gSender's `KB-850 test.nc` homes again after an `M0` part change, line
+/// 21425): the axes go home as grbl's default homing cycles order them, `HOMING_CYCLE_0` Z,
+/// then `HOMING_CYCLE_1` X and Y (grbl `config.h`), timed as rapids, with a warning that the
+/// switch search is not; grblHAL's `$HX` homes X alone. Other system commands move nothing
+/// (`$X` unlock, `$$` report, `$22=1` a setting): a warning each; a jog `$J=…` and check mode
+/// `$C` are errors naming the line.
+#[test]
+fn grbl_homing_after_moves_and_other_system_commands() {
+    let tp = ok("G21\nG0 X5 Y5 Z-5\n$X\n$22=1\n$H\nM2\n");
+    let last: Vec<Vector3<f64>> = tp.points.iter().rev().take(2).map(|p| p.p).collect();
+    assert_close(last[1], v(5.0, 5.0, 0.0), 1e-9);
+    assert_close(last[0], v(0.0, 0.0, 0.0), 1e-9);
+    assert!(
+        tp.warnings.iter().any(|w| w.line == 5
+            && w.message.contains("homing cycle")
+            && w.message.contains("Z first")),
+        "{:?}",
+        tp.warnings
+    );
+    for line in [3, 4] {
+        assert!(
+            tp.warnings
+                .iter()
+                .any(|w| w.line == line && w.message.contains("moves nothing")),
+            "{:?}",
+            tp.warnings
+        );
+    }
+    let one = ok("G21\nG0 X5 Y5 Z-5\n$HX\nM2\n");
+    assert_close(one.points.last().unwrap().p, v(0.0, 5.0, -5.0), 1e-9);
+    err("G21\nG0 X5 Y5 Z-5\n$J=G91 X10 F100\nM2\n", 3, &["jog"]);
+    err("G21\n$C\nG0 X5 Y5 Z-5\nM2\n", 2, &["check mode"]);
+    err(
+        "G21\n$Q\nG0 X5 Y5 Z-5\nM2\n",
+        2,
+        &["not a grbl system command"],
+    );
+}

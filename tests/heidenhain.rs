@@ -2008,3 +2008,16 @@ fn presetting_again_resets_the_datum_shift() {
     let last = tp.points.last().unwrap().p;
     assert!(close(last, v(60.0, 0.0, 5.0), 1e-9), "{last}");
 }
+
+/// `L Z 25.000 FMAX`: an APT post's Klartext (aamorim1913/AptPostProcessor
+/// `tests/parts-tools/boss/12.h`, line 12) writes a blank between the address and its value.
+/// The TNC's program format joins them (`L Z+25 FMAX`, as its editor stores a block); feedopt
+/// refuses the block, and the message now says what is wrong and how to write it (it was "`Z`
+/// has no value", which reads as if the value were missing).
+#[test]
+fn a_value_apart_from_its_address_is_named() {
+    let m =
+        fails("0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+50 R0 FMAX\n2 L Z 25.000 FMAX\n3 END PGM T MM\n");
+    assert!(m.contains(":3:"), "{m}");
+    assert!(m.contains("`Z 25.000`") && m.contains("`Z+25.000`"), "{m}");
+}

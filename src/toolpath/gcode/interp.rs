@@ -2400,11 +2400,79 @@ impl<'a> Interpreter<'a> {
                 v
             };
         }
+        self.go_to_reference(line, code, k, &named, via)
+    }
+
+    /// grbl's homing cycle, `$H` (every axis it homes: Z first, then X and Y, as grbl's and
+    /// grblHAL's default `HOMING_CYCLE_0` (Z) and `HOMING_CYCLE_1` (X, Y) order it), or one
+    /// axis, grblHAL's `$HX`, `$HY`, `$HZ`, `$HA`, …: the axes go to the machine's home
+    /// position, the machine file's `reference` (G28's point), else machine zero — where grbl
+    /// sets machine position 0 when homing in its default (positive) direction. Before any
+    /// move, the program starts there (every axis at once: the start is not a path); after
+    /// one, each group is a rapid to home, and the cycle's switch search at the homing rates
+    /// (`$24`, `$25`, pull-off `$27`) is not timed: said with the line.
+    pub(super) fn homing(&mut self, line: usize, text: &str, axes: &[usize]) -> Result<()> {
+        let present: Vec<usize> = match self.machine.and_then(|m| m.axes.as_ref()) {
+            Some(names) => (0..6).filter(|&i| names.contains(&AXIS_NAMES[i])).collect(),
+            None => vec![0, 1, 2],
+        };
+        if let Some(&missing) = axes.iter().find(|i| !present.contains(i)) {
+            return Err(self.error(
+                line,
+                format!(
+                    "`{text}` homes {}, an axis this machine does not have",
+                    AXIS_NAMES[missing]
+                ),
+            ));
+        }
+        let started = self.known.iter().any(|&k| k);
+        let groups: Vec<Vec<usize>> = if !axes.is_empty() {
+            vec![axes.to_vec()]
+        } else if !started {
+            vec![present.iter().copied().filter(|&i| i < 3).collect()]
+        } else {
+            vec![
+                vec![2],
+                present.iter().copied().filter(|&i| i < 2).collect(),
+            ]
+        };
+        if started {
+            self.warn(
+                line,
+                format!(
+                    "`{text}`: grbl's homing cycle is read as rapids to the home position \
+                     (the machine file's reference, else machine zero), {}; the cycle's switch \
+                     search at the homing rates ($24, $25, pull-off $27) is not timed",
+                    if axes.is_empty() {
+                        "Z first, then X and Y (grbl's default order)"
+                    } else {
+                        "that axis alone"
+                    }
+                ),
+            );
+        }
+        for group in groups.iter().filter(|g| !g.is_empty()) {
+            let via = self.pos;
+            self.go_to_reference(line, &format!("`{text}`"), 1, group, via)?;
+        }
+        Ok(())
+    }
+
+    /// The move of `G28`/`G30` (`code`; k: the reference point, 1 for G28's) from `via` to
+    /// the reference point of the `named` axes, shared with grbl's homing cycle.
+    fn go_to_reference(
+        &mut self,
+        line: usize,
+        code: &str,
+        k: usize,
+        named: &[usize],
+        via: [f64; 6],
+    ) -> Result<()> {
         let mut target = via;
         let mut machine_xyz = self.to_machine(Vector3::new(via[0], via[1], via[2]));
         let mut defaulted = Vec::new();
         let mut at = [0.0; 6];
-        for &i in &named {
+        for &i in named {
             // The machine file's reference, else machine zero: the controls' default (Fanuc
             // parameters 1240–1243, LinuxCNC 5161–5169 / 5181–5189 are 0 in machine
             // coordinates, and Fanuc's machine zero is the reference position).
@@ -2468,7 +2536,7 @@ impl<'a> Interpreter<'a> {
         }
         let xyz = self.machine_to_program(machine_xyz);
         target[..3].copy_from_slice(xyz.as_slice());
-        for &i in &named {
+        for &i in named {
             if i >= 3 {
                 self.saw_rotary = true;
             }

@@ -483,6 +483,25 @@ pub(super) fn lex(
             i += used;
             continue;
         }
+        // `L Z 25.000 FMAX` (an APT post's Klartext, aamorim1913/AptPostProcessor
+        // `tests/parts-tools/boss/12.h`): a letter alone and then a number. The TNC writes
+        // the value joined to its address, `Z+25.000` (its program format, as its editor
+        // stores a block); feedopt does not guess that the number belongs to the letter.
+        if word.len() == 1
+            && word.chars().all(|c| c.is_ascii_alphabetic())
+            && let Some(n) = next.as_deref()
+            && n.starts_with(|c: char| c.is_ascii_digit() || matches!(c, '+' | '-' | '.'))
+        {
+            return Err(format!(
+                "`{} {}`: the value stands apart from its address; a Klartext word is written \
+                 joined, as the TNC stores it (`{}{}{}`): join them",
+                words[i],
+                words[i + 1],
+                words[i],
+                if n.starts_with(['+', '-']) { "" } else { "+" },
+                words[i + 1]
+            ));
+        }
         items.push(lex_word(spec, &words[i], &word, vars)?);
         i += 1;
     }

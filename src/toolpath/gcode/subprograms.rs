@@ -1536,6 +1536,31 @@ impl Program {
                 }
                 continue;
             }
+            // grbl's system commands, `$H`, `$X`, `$22=1`, … (not Sinumerik's `$` system
+            // variables, `$P_…`, nor Klartext): gSender's programs home with `$H` and then set
+            // the work offset from there with `G10 L20`.
+            if text.starts_with('$')
+                && !matches!(self.style, Subprograms::Procs | Subprograms::Labels)
+            {
+                match grbl_command(text) {
+                    GrblCommand::Home(axes) => {
+                        if let Err(e) = interp.homing(number, text, &axes) {
+                            return Err(self.located(e, &stack));
+                        }
+                    }
+                    GrblCommand::Still(what) => interp.warn(
+                        number,
+                        format!("`{text}`: grbl's {what}; it moves nothing, skipped"),
+                    ),
+                    GrblCommand::Refused(why) => {
+                        return Err(self.located(
+                            Error::parse(source, number, format!("`{text}`: {why}")),
+                            &stack,
+                        ));
+                    }
+                }
+                continue;
+            }
             run_blocks += 1;
             run_bytes += text.len();
             if run_blocks > MAX_EXPANDED_BLOCKS + self.lines.len()
@@ -2269,4 +2294,81 @@ fn bind_locals(
         vars.set(&format!("#{k}"), v);
     }
     saved
+}
+
+/// What a grbl system command line (`$…`) does, as the grbl 1.1 and grblHAL documents list
+/// them (grbl wiki "Grbl v1.1 Commands": `$$`, `$#`, `$G`, `$I`, `$N`, `$x=value`,
+/// `$Nx=line`, `$C`, `$X`, `$H`, `$J=line`, `$RST=…`, `$SLP`; grblHAL adds `$HX`, `$HY`, …
+/// to home one axis).
+#[derive(Debug, PartialEq)]
+pub(crate) enum GrblCommand {
+    /// `$H`: every axis grbl homes (an empty list); `$HX`: the axes (indices into X Y Z A B C).
+    Home(Vec<usize>),
+    /// A command that moves nothing: what it is.
+    Still(&'static str),
+    /// A command feedopt does not read, why.
+    Refused(String),
+}
+
+pub(crate) fn grbl_command(text: &str) -> GrblCommand {
+    let body: String = text[1..]
+        .chars()
+        .take_while(|&c| c != '(' && c != ';')
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_uppercase();
+    if let Some(axes) = body.strip_prefix('H') {
+        let found: Option<Vec<usize>> = axes.chars().map(|c| "XYZABC".find(c)).collect();
+        return match found {
+            Some(list) => GrblCommand::Home(list),
+            None => GrblCommand::Refused(
+                "not a grbl homing command (`$H`, or grblHAL's `$HX`, `$HY`, `$HZ`, … for one \
+                 axis)"
+                    .into(),
+            ),
+        };
+    }
+    match body.as_str() {
+        "X" => return GrblCommand::Still("alarm unlock (kill alarm lock)"),
+        "$" | "#" | "G" | "I" | "N" => {
+            return GrblCommand::Still("report of its settings or state");
+        }
+        "C" => {
+            return GrblCommand::Refused(
+                "grbl's check mode: the control then parses the blocks that follow without \
+                 moving, which feedopt does not model; remove it to time the program"
+                    .into(),
+            );
+        }
+        "SLP" => {
+            return GrblCommand::Refused(
+                "grbl's sleep: the control disables its steppers and stops until reset, so the \
+                 blocks after it do not run as a program; remove it to time the program"
+                    .into(),
+            );
+        }
+        _ => {}
+    }
+    if body.starts_with("J=") {
+        return GrblCommand::Refused(
+            "a grbl jog, which moves the tool and is not read: write it as a G1 move".into(),
+        );
+    }
+    if body.starts_with("RST=") {
+        return GrblCommand::Still("settings reset (the machine file gives the limits)");
+    }
+    if let Some((key, _)) = body.split_once('=')
+        && !key.is_empty()
+        && (key.chars().all(|c| c.is_ascii_digit())
+            || (key.starts_with('N') && key[1..].chars().all(|c| c.is_ascii_digit())))
+    {
+        return GrblCommand::Still(
+            "setting or startup block, stored for later (the machine file gives the limits)",
+        );
+    }
+    GrblCommand::Refused(
+        "not a grbl system command feedopt knows (`$H` homing, `$X`, `$$`, `$#`, `$G`, `$I`, \
+         `$N`, `$n=value` settings); it may move the tool, so it is not skipped"
+            .into(),
+    )
 }
