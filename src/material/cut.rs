@@ -1131,17 +1131,30 @@ fn cut_band(
             )
         });
         candidates.clear();
-        band.each(j, ua, ub, |i, cell| {
+        let mut remove = |i: usize, cell: &mut super::dexel::Dexel| {
             let [lo, hi] = run[i - ua];
             note(i, cell.remove(lo, hi));
-            if i < sa || i > sb {
-                return;
+        };
+        // The cells in order: those outside the shadow only cut, those inside it also told
+        // as candidates (not one test of the shadow per cell).
+        let (ma, mb) = (sa.max(ua), sb.min(ub));
+        if ma > mb {
+            band.each(j, ua, ub, remove);
+        } else {
+            if ua < ma {
+                band.each(j, ua, ma - 1, &mut remove);
             }
-            let h = end_hits[i - ua];
-            if h[0] <= h[1] && cell.top() > h[1] {
-                candidates.push(i);
+            band.each(j, ma, mb, |i, cell| {
+                remove(i, cell);
+                let h = end_hits[i - ua];
+                if h[0] <= h[1] && cell.top() > h[1] {
+                    candidates.push(i);
+                }
+            });
+            if mb < ub {
+                band.each(j, mb + 1, ub, &mut remove);
             }
-        });
+        }
         if let (Some(&first), Some(&last)) = (candidates.first(), candidates.last()) {
             // Many candidates (a tool buried beyond its flutes): the row's
             // shank spans at once, with vector instructions; few: each alone

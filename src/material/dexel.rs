@@ -402,7 +402,7 @@ impl Band<'_> {
 
     /// `f(i, dexel)` for dexels `ia..=ib` of row `j` (j in [`Band::rows`]), in order, tile by
     /// tile.
-    #[inline]
+    #[inline(always)]
     pub fn each(&mut self, j: usize, ia: usize, ib: usize, mut f: impl FnMut(usize, &mut Dexel)) {
         let row = (j % TILE) * TILE;
         let mut i = ia;
