@@ -75,7 +75,7 @@ use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexels, TILE, index_f64};
+use super::dexel::{Dexels, TILE, index_f64, larger};
 use super::tool::{NO_HIT, Pose, Tool};
 use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
@@ -946,7 +946,7 @@ fn cut_band(
             let top = Vector3::new(x, y, c.z_hi) - pe;
             let bottom = Vector3::new(x, y, c.z_lo) - pe;
             acc.length += c.length;
-            acc.axial_max = acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
+            acc.axial_max = larger(larger(acc.axial_max, top.dot(&oe)), bottom.dot(&oe));
         };
         if vertical {
             let Some((ia, ib)) = vertical_foot.cells((x0, hx), y, (i0, i1)) else {
@@ -1168,7 +1168,7 @@ fn cut_band(
             let many = 4 * candidates.len() > last - first;
             let mut depth = |i: usize, z: [f64; 2], cell: &super::dexel::Dexel| {
                 if z[0] < z[1] && cell.top() > z[0] {
-                    shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
+                    shank = larger(shank, end_pose.shank_depth(cx(i), y, z, cell.intervals()));
                 }
             };
             if many {

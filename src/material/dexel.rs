@@ -632,13 +632,13 @@ impl Dexels {
 /// value `f64::min` gives, by one comparison, without the instructions its handling of NaN
 /// costs on every removal.
 #[inline]
-fn smaller(a: f64, b: f64) -> f64 {
+pub(crate) fn smaller(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
 }
 
 /// The larger of two numbers, neither NaN, as [`smaller`].
 #[inline]
-fn larger(a: f64, b: f64) -> f64 {
+pub(crate) fn larger(a: f64, b: f64) -> f64 {
     if b > a { b } else { a }
 }
 

@@ -17,7 +17,7 @@
 use multiversion::multiversion;
 use nalgebra::Vector3;
 
-use super::dexel::index_f64;
+use super::dexel::{index_f64, larger, smaller};
 
 /// The largest tool diameter (mm) feedopt accepts: 1 m.
 pub const MAX_TOOL_DIAMETER_MM: f64 = 1000.0;
@@ -318,11 +318,12 @@ impl<'a> Pose<'a> {
         let lf = self.tool.flute_length;
         let mut depth = 0.0_f64;
         for iv in intervals {
-            let (a, b) = (iv[0].max(span[0]), iv[1].min(span[1]));
+            // (By comparisons: the ends are numbers, never NaN, as in [`smaller`].)
+            let (a, b) = (larger(iv[0], span[0]), smaller(iv[1], span[1]));
             if b - a > super::dexel::MIN_CUT_MM {
                 // h is linear in z: its largest value over [a, b] at one end.
                 let h = |z: f64| c + (z - p.z) * o.z - lf;
-                depth = depth.max(h(a)).max(h(b));
+                depth = larger(larger(depth, h(a)), h(b));
             }
         }
         depth
