@@ -357,6 +357,10 @@ impl<'a> Pose<'a> {
 /// horizontal), compiled also for the vector instructions of newer processors and chosen by
 /// what the processor running it has (`multiversion`): the same operations in the same order
 /// on every path, so the same crossings bit for bit (Rust never fuses a product and a sum).
+/// Its minima and maxima are comparisons ([`smaller`], [`larger`]; one instruction each in
+/// vector registers), not `f64::min`/`max`, whose handling of NaN costs two more: nothing
+/// here is NaN (the square roots' arguments are clamped at 0 first), and on numbers both give
+/// the same value, so the same crossings as [`Pose::hit`]'s.
 #[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
 fn crossings_row(
     pose: &Pose,
@@ -379,18 +383,18 @@ fn crossings_row(
         let (t0, t1) = ((rc - c) * inv_oz, (lf - c) * inv_oz);
         let bh = -c * o.z;
         let disc = bh * bh - a * (q0 - r * r);
-        let sq = disc.max(0.0).sqrt();
+        let sq = larger(disc, 0.0).sqrt();
         let (w0, w1) = ((-bh - sq) * inv_a, (-bh + sq) * inv_a);
-        let (c0, c1) = (t0.min(t1).max(w0), t0.max(t1).min(w1));
+        let (c0, c1) = (larger(smaller(t0, t1), w0), smaller(larger(t0, t1), w1));
         let cylinder = disc >= 0.0 && c0 <= c1;
         // The ball about P + R O (flat end mill: none).
         let (ex, ey, ez) = (dx - r * o.x, dy - r * o.y, -r * o.z);
         let d2 = r * r - ex * ex - ey * ey;
-        let sq2 = d2.max(0.0).sqrt();
+        let sq2 = larger(d2, 0.0).sqrt();
         let (b0, b1) = (-ez - sq2, -ez + sq2);
         let sphere = ball && d2 >= 0.0;
         let (lo, hi) = if cylinder && sphere {
-            (c0.min(b0), c1.max(b1))
+            (smaller(c0, b0), larger(c1, b1))
         } else if cylinder {
             (c0, c1)
         } else {
@@ -425,8 +429,11 @@ fn shank_row(pose: &Pose, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 
         };
         let bh = -c * o.z;
         let disc = bh * bh - a * (q0 - r * r);
-        let sq = disc.max(0.0).sqrt();
-        let (s0, s1) = (t0.max((-bh - sq) * inv_a), t1.min((-bh + sq) * inv_a));
+        let sq = larger(disc, 0.0).sqrt();
+        let (s0, s1) = (
+            larger(t0, (-bh - sq) * inv_a),
+            smaller(t1, (-bh + sq) * inv_a),
+        );
         *h = if disc >= 0.0 && s0 < s1 {
             [p.z + s0, p.z + s1]
         } else {
