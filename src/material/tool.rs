@@ -393,17 +393,24 @@ fn crossings_row(
         let sq2 = larger(d2, 0.0).sqrt();
         let (b0, b1) = (-ez - sq2, -ez + sq2);
         let sphere = ball && d2 >= 0.0;
-        let (lo, hi) = if cylinder && sphere {
-            (smaller(c0, b0), larger(c1, b1))
-        } else if cylinder {
+        // The union of the parts that cross, each left out as a miss [∞, −∞] (which the
+        // minimum and maximum leave out exactly): no part, a miss.
+        let (m0, m1) = if cylinder {
             (c0, c1)
         } else {
-            (b0, b1)
+            (f64::INFINITY, f64::NEG_INFINITY)
         };
+        let (s0, s1) = if sphere {
+            (b0, b1)
+        } else {
+            (f64::INFINITY, f64::NEG_INFINITY)
+        };
+        let (lo, hi) = (smaller(m0, s0), larger(m1, s1));
         // `lo` and `hi` finite, as `Pose::hit` asks, in half the instructions: where the
         // tool crosses, lo = +∞ comes only with hi = +∞ and hi = −∞ with lo = −∞ (lo ≤ hi or
-        // a NaN, which both comparisons refuse), so these two tests tell the same.
-        let any = (cylinder || sphere) && lo > f64::NEG_INFINITY && hi < f64::INFINITY;
+        // a NaN, which both comparisons refuse), so these two tests tell the same; where no
+        // part crosses, [lo, hi] is the miss and passes them, giving [∞, −∞] = NO_HIT.
+        let any = lo > f64::NEG_INFINITY && hi < f64::INFINITY;
         *h = if any { [p.z + lo, p.z + hi] } else { NO_HIT };
     }
 }
