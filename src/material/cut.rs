@@ -75,7 +75,7 @@ use multiversion::multiversion;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::dexel::{Dexels, TILE, index_f64};
+use super::dexel::{Dexels, TILE, index_f64, larger};
 use super::tool::{NO_HIT, Pose, Tool};
 use crate::base::angle_between;
 use crate::toolpath::{Feed, Toolpath};
@@ -710,19 +710,24 @@ fn runs_of_two(run: &mut [[f64; 2]], starts: &mut [f64], a: &[[f64; 2]], b: &[[f
 }
 
 /// [`runs_of_two`] for a step of three poses (the default sample step's on a tilted tool are
-/// two or three).
+/// two or three); returns whether some cell has two runs (a miss between two crossings, rare),
+/// so that a row where none has is not scanned for them. (Told by an or of the cells'
+/// booleans, which vectorises, where a maximum of their counts did not.)
 #[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
-fn runs_of_three(run: &mut [[f64; 2]], starts: &mut [f64], [a, b, c]: [&[[f64; 2]]; 3]) {
+fn runs_of_three(run: &mut [[f64; 2]], starts: &mut [f64], [a, b, c]: [&[[f64; 2]]; 3]) -> bool {
+    let mut several = false;
     for ((((run, n), a), b), c) in run.iter_mut().zip(starts.iter_mut()).zip(a).zip(b).zip(c) {
         let (hit_a, hit_b, hit_c) = (a[0] <= a[1], b[0] <= b[1], c[0] <= c[1]);
         *n = if hit_a { 1.0 } else { 0.0 }
             + if hit_b & !hit_a { 1.0 } else { 0.0 }
             + if hit_c & !hit_b { 1.0 } else { 0.0 };
+        several |= hit_a & !hit_b & hit_c;
         let lo = if b[0] < a[0] { b[0] } else { a[0] };
         let hi = if b[1] > a[1] { b[1] } else { a[1] };
         run[0] = if c[0] < lo { c[0] } else { lo };
         run[1] = if c[1] > hi { c[1] } else { hi };
     }
+    several
 }
 
 /// The crossings of a tilted step's last pose with the dexel lines, kept for the next step,
@@ -941,7 +946,7 @@ fn cut_band(
             let top = Vector3::new(x, y, c.z_hi) - pe;
             let bottom = Vector3::new(x, y, c.z_lo) - pe;
             acc.length += c.length;
-            acc.axial_max = acc.axial_max.max(top.dot(&oe)).max(bottom.dot(&oe));
+            acc.axial_max = larger(larger(acc.axial_max, top.dot(&oe)), bottom.dot(&oe));
         };
         if vertical {
             let Some((ia, ib)) = vertical_foot.cells((x0, hx), y, (i0, i1)) else {
@@ -1068,10 +1073,12 @@ fn cut_band(
         // [∞, −∞], which min and max leave out exactly.)
         run.resize(width, NO_HIT);
         starts.resize(width, 0.0);
+        // Whether some cell may have two runs or more (two poses make one at most).
+        let mut several = poses > 2;
         if poses == 2 {
             runs_of_two(run, starts, line(0), line(1));
         } else if poses == 3 {
-            runs_of_three(run, starts, [line(0), line(1), line(2)]);
+            several = runs_of_three(run, starts, [line(0), line(1), line(2)]);
         } else {
             run.copy_from_slice(line(0));
             for (n, h) in starts.iter_mut().zip(run.iter()) {
@@ -1082,11 +1089,10 @@ fn cut_band(
             }
         }
         ended.clear();
-        // (Two poses make one run at most.)
         for (c, run) in run
             .iter_mut()
             .enumerate()
-            .take(if poses > 2 { width } else { 0 })
+            .take(if several { width } else { 0 })
         {
             if starts[c] < 2.0 {
                 continue;
@@ -1131,17 +1137,30 @@ fn cut_band(
             )
         });
         candidates.clear();
-        band.each(j, ua, ub, |i, cell| {
+        let mut remove = |i: usize, cell: &mut super::dexel::Dexel| {
             let [lo, hi] = run[i - ua];
             note(i, cell.remove(lo, hi));
-            if i < sa || i > sb {
-                return;
+        };
+        // The cells in order: those outside the shadow only cut, those inside it also told
+        // as candidates (not one test of the shadow per cell).
+        let (ma, mb) = (sa.max(ua), sb.min(ub));
+        if ma > mb {
+            band.each(j, ua, ub, remove);
+        } else {
+            if ua < ma {
+                band.each(j, ua, ma - 1, &mut remove);
             }
-            let h = end_hits[i - ua];
-            if h[0] <= h[1] && cell.top() > h[1] {
-                candidates.push(i);
+            band.each(j, ma, mb, |i, cell| {
+                remove(i, cell);
+                let h = end_hits[i - ua];
+                if h[0] <= h[1] && cell.top() > h[1] {
+                    candidates.push(i);
+                }
+            });
+            if mb < ub {
+                band.each(j, mb + 1, ub, &mut remove);
             }
-        });
+        }
         if let (Some(&first), Some(&last)) = (candidates.first(), candidates.last()) {
             // Many candidates (a tool buried beyond its flutes): the row's
             // shank spans at once, with vector instructions; few: each alone
@@ -1149,7 +1168,7 @@ fn cut_band(
             let many = 4 * candidates.len() > last - first;
             let mut depth = |i: usize, z: [f64; 2], cell: &super::dexel::Dexel| {
                 if z[0] < z[1] && cell.top() > z[0] {
-                    shank = shank.max(end_pose.shank_depth(cx(i), y, z, cell.intervals()));
+                    shank = larger(shank, end_pose.shank_depth(cx(i), y, z, cell.intervals()));
                 }
             };
             if many {
@@ -1624,7 +1643,30 @@ mod tests {
             if poses == 2 {
                 runs_of_two(&mut run1, &mut starts1, &lines[0], &lines[1]);
             } else {
-                runs_of_three(&mut run1, &mut starts1, [&lines[0], &lines[1], &lines[2]]);
+                let several =
+                    runs_of_three(&mut run1, &mut starts1, [&lines[0], &lines[1], &lines[2]]);
+                assert_eq!(several, starts.contains(&2.0));
+                // Without a cell of two runs (the middle pose crossing wherever the others
+                // do), or with no cells, it says none.
+                let hull: Vec<[f64; 2]> = lines[0]
+                    .iter()
+                    .zip(&lines[2])
+                    .zip(&lines[1])
+                    .map(|((a, c), b)| {
+                        if a[0] <= a[1] && c[0] <= c[1] {
+                            [0.0, 1.0]
+                        } else {
+                            *b
+                        }
+                    })
+                    .collect();
+                let (mut r2, mut s2) = (vec![[0.0; 2]; n], vec![0.0; n]);
+                assert!(!runs_of_three(
+                    &mut r2,
+                    &mut s2,
+                    [&lines[0], &hull, &lines[2]]
+                ));
+                assert!(!runs_of_three(&mut [], &mut [], [&[], &[], &[]]));
             }
             for c in 0..n {
                 assert_eq!(run[c].map(f64::to_bits), run1[c].map(f64::to_bits), "{c}");

@@ -17,7 +17,7 @@
 use multiversion::multiversion;
 use nalgebra::Vector3;
 
-use super::dexel::index_f64;
+use super::dexel::{index_f64, larger, smaller};
 
 /// The largest tool diameter (mm) feedopt accepts: 1 m.
 pub const MAX_TOOL_DIAMETER_MM: f64 = 1000.0;
@@ -318,11 +318,12 @@ impl<'a> Pose<'a> {
         let lf = self.tool.flute_length;
         let mut depth = 0.0_f64;
         for iv in intervals {
-            let (a, b) = (iv[0].max(span[0]), iv[1].min(span[1]));
+            // (By comparisons: the ends are numbers, never NaN, as in [`smaller`].)
+            let (a, b) = (larger(iv[0], span[0]), smaller(iv[1], span[1]));
             if b - a > super::dexel::MIN_CUT_MM {
                 // h is linear in z: its largest value over [a, b] at one end.
                 let h = |z: f64| c + (z - p.z) * o.z - lf;
-                depth = depth.max(h(a)).max(h(b));
+                depth = larger(larger(depth, h(a)), h(b));
             }
         }
         depth
@@ -356,6 +357,10 @@ impl<'a> Pose<'a> {
 /// horizontal), compiled also for the vector instructions of newer processors and chosen by
 /// what the processor running it has (`multiversion`): the same operations in the same order
 /// on every path, so the same crossings bit for bit (Rust never fuses a product and a sum).
+/// Its minima and maxima are comparisons ([`smaller`], [`larger`]; one instruction each in
+/// vector registers), not `f64::min`/`max`, whose handling of NaN costs two more: nothing
+/// here is NaN (the square roots' arguments are clamped at 0 first), and on numbers both give
+/// the same value, so the same crossings as [`Pose::hit`]'s.
 #[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2", "aarch64+neon"))]
 fn crossings_row(
     pose: &Pose,
@@ -378,27 +383,34 @@ fn crossings_row(
         let (t0, t1) = ((rc - c) * inv_oz, (lf - c) * inv_oz);
         let bh = -c * o.z;
         let disc = bh * bh - a * (q0 - r * r);
-        let sq = disc.max(0.0).sqrt();
+        let sq = larger(disc, 0.0).sqrt();
         let (w0, w1) = ((-bh - sq) * inv_a, (-bh + sq) * inv_a);
-        let (c0, c1) = (t0.min(t1).max(w0), t0.max(t1).min(w1));
+        let (c0, c1) = (larger(smaller(t0, t1), w0), smaller(larger(t0, t1), w1));
         let cylinder = disc >= 0.0 && c0 <= c1;
         // The ball about P + R O (flat end mill: none).
         let (ex, ey, ez) = (dx - r * o.x, dy - r * o.y, -r * o.z);
         let d2 = r * r - ex * ex - ey * ey;
-        let sq2 = d2.max(0.0).sqrt();
+        let sq2 = larger(d2, 0.0).sqrt();
         let (b0, b1) = (-ez - sq2, -ez + sq2);
         let sphere = ball && d2 >= 0.0;
-        let (lo, hi) = if cylinder && sphere {
-            (c0.min(b0), c1.max(b1))
-        } else if cylinder {
+        // The union of the parts that cross, each left out as a miss [∞, −∞] (which the
+        // minimum and maximum leave out exactly): no part, a miss.
+        let (m0, m1) = if cylinder {
             (c0, c1)
         } else {
-            (b0, b1)
+            (f64::INFINITY, f64::NEG_INFINITY)
         };
+        let (s0, s1) = if sphere {
+            (b0, b1)
+        } else {
+            (f64::INFINITY, f64::NEG_INFINITY)
+        };
+        let (lo, hi) = (smaller(m0, s0), larger(m1, s1));
         // `lo` and `hi` finite, as `Pose::hit` asks, in half the instructions: where the
         // tool crosses, lo = +∞ comes only with hi = +∞ and hi = −∞ with lo = −∞ (lo ≤ hi or
-        // a NaN, which both comparisons refuse), so these two tests tell the same.
-        let any = (cylinder || sphere) && lo > f64::NEG_INFINITY && hi < f64::INFINITY;
+        // a NaN, which both comparisons refuse), so these two tests tell the same; where no
+        // part crosses, [lo, hi] is the miss and passes them, giving [∞, −∞] = NO_HIT.
+        let any = lo > f64::NEG_INFINITY && hi < f64::INFINITY;
         *h = if any { [p.z + lo, p.z + hi] } else { NO_HIT };
     }
 }
@@ -424,8 +436,11 @@ fn shank_row(pose: &Pose, y: f64, x0: f64, hx: f64, i0: usize, out: &mut [[f64; 
         };
         let bh = -c * o.z;
         let disc = bh * bh - a * (q0 - r * r);
-        let sq = disc.max(0.0).sqrt();
-        let (s0, s1) = (t0.max((-bh - sq) * inv_a), t1.min((-bh + sq) * inv_a));
+        let sq = larger(disc, 0.0).sqrt();
+        let (s0, s1) = (
+            larger(t0, (-bh - sq) * inv_a),
+            smaller(t1, (-bh + sq) * inv_a),
+        );
         *h = if disc >= 0.0 && s0 < s1 {
             [p.z + s0, p.z + s1]
         } else {
