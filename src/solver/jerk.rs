@@ -91,13 +91,14 @@ pub struct JerkOptions {
     /// The subproblems' objective.
     pub objective: Objective,
     /// Stations per window: a longer span is cut into windows of about this many stations,
-    /// solved independently and in parallel (see [`solve`]); `usize::MAX`: one piece. 100 (the
-    /// least [`MIN_WINDOW`] allows) rather than 150: a window at a rest end, whose SCP takes
-    /// twice the iterations of the others and whose dense collocation doubles its rows, is
-    /// then smaller, and converges closer (on the 20 COPP paths with jerk limits 4 % fewer
-    /// instructions, paths 1 and 11 3.3e-5 and 3.9e-5 shorter, the others within 5e-6; the
-    /// windowed times 4e-5…8e-5 below the one-piece SCP's, which stops further from the
-    /// optimum at its rest ends).
+    /// solved independently and in parallel (see [`solve`]); `usize::MAX`: one piece. 50 (as
+    /// [`MIN_WINDOW`]) rather than 150: a window at a rest end, whose SCP takes twice the
+    /// iterations of the others and whose dense collocation doubles its rows, is then
+    /// smaller, and converges closer. On the 20 COPP paths with jerk limits (one core, the
+    /// CLI): 2.54 → 2.36 s of CPU for the twenty (100: 2.46 s), paths 1 and 11 3.3e-5 and
+    /// 3.9e-5 shorter, the others within 5e-6; the windowed times 3e-5…8e-5 below the
+    /// one-piece SCP's, which stops further from the optimum at its rest ends. The
+    /// jerk-limited impeller: 9.7 → 8.9 s of CPU, 1193.6237 → 1193.6214 s.
     pub window: usize,
     /// A straight span from rest to rest with the same limits everywhere takes the double-S
     /// profile in closed form ([`super::double_s`]) instead of the programme (an adaptive
@@ -140,7 +141,7 @@ impl Default for JerkOptions {
             convergence: 1e-4,
             max_iterations: 30,
             objective: Objective::default(),
-            window: 100,
+            window: 50,
             closed_form: true,
             lp_solver: LpSolver::default(),
         }
@@ -986,8 +987,9 @@ const FLAT: f64 = 1e-4;
 /// ([`solve_piece`]).
 const MAX_RESCALES: usize = 3;
 
-/// Stations fewer than this apart are not cut.
-const MIN_WINDOW: usize = 100;
+/// Stations fewer than this apart are not cut (100 until 2026-11-27; see
+/// [`JerkOptions::window`]).
+const MIN_WINDOW: usize = 50;
 
 /// A cut needs the starting profile on the velocity bound, set by the same limit, from
 /// `PLATEAU` stations before it to `PLATEAU` after: a jerk-limited profile leaves a plateau
