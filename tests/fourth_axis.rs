@@ -264,3 +264,41 @@ fn a_turn_alone_at_a_programmed_feed_takes_its_programmed_time() {
         assert!((t - 1.1).abs() < 1e-6, "{dialect:?}: rapid {t} s");
     }
 }
+
+/// A block that turns the table while X, Y or Z move is fed differently by the controls:
+/// LinuxCNC (and Sinumerik) along X Y Z, grbl and the Fanuc family over the combined distance.
+/// Where nothing named the dialect (a `.gcode` file of a Vectric rotary post for grbl, read in
+/// the default LinuxCNC dialect), the first such block warns, naming `--dialect fanuc`; not
+/// where the user, the content or LinuxCNC's own `.ngc` extension named it, and not a turn
+/// alone (read alike).
+#[test]
+fn a_rotary_feed_in_an_unnamed_dialect_warns_once() {
+    use feedopt::toolpath::{Input, ReadOptions, read_with};
+    let (_, ctx) = setup('A');
+    let dir = tempfile::tempdir().unwrap();
+    let program = "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 A30 F600\nG1 X10 A90 F600\nG1 X20 A180\nM2\n";
+    let warnings = |name: &str, dialect: Option<Dialect>| -> Vec<(usize, String)> {
+        let path = dir.path().join(name);
+        std::fs::write(&path, program).unwrap();
+        let options = ReadOptions {
+            machine: Some(ctx.clone()),
+            dialect,
+            ..Default::default()
+        };
+        let (input, _) = read_with(&path, &options).unwrap();
+        let Input::Cl(tp) = input else {
+            panic!("a toolpath")
+        };
+        tp.warnings
+            .iter()
+            .filter(|w| w.message.contains("--dialect fanuc"))
+            .map(|w| (w.line, w.message.to_string()))
+            .collect()
+    };
+    let found = warnings("vectric.gcode", None);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].0, 4, "{found:?}");
+    assert!(found[0].1.contains("LinuxCNC"), "{found:?}");
+    assert!(warnings("part.ngc", None).is_empty());
+    assert!(warnings("vectric.gcode", Some(Dialect::LinuxCnc)).is_empty());
+}

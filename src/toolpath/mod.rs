@@ -944,6 +944,12 @@ pub fn read_with(path: &Path, options: &ReadOptions) -> Result<(Input, Detected)
                     && options
                         .fallback_dialect
                         .is_some_and(|d| d != gcode::Dialect::default()),
+                // (`.ngc` is LinuxCNC's own extension, though `detect` does not choose by it:
+                // it is the default dialect.)
+                dialect_defaulted: detected.dialect_by == "default"
+                    && !path
+                        .extension()
+                        .is_some_and(|e| e.eq_ignore_ascii_case("ngc")),
             };
             let (toolpath, assumed) = gcode::parse_configured(
                 path,

@@ -278,6 +278,8 @@ pub(super) struct Interpreter<'a> {
     increments_first: Option<(usize, String, String, String)>,
     /// [`super::Settings::dialect_unnamed`].
     pub(super) dialect_unnamed: bool,
+    /// [`super::Settings::dialect_defaulted`]; cleared once its warning is given.
+    pub(super) dialect_defaulted: bool,
     /// The tool the last `T` word selected (`M6` puts it in the spindle).
     prepared_tool: Option<ToolSelect>,
     /// The work offsets, `G10` and `G52` ([`offsets`]).
@@ -381,6 +383,7 @@ impl<'a> Interpreter<'a> {
             increments_warned: false,
             increments_first: None,
             dialect_unnamed: false,
+            dialect_defaulted: false,
             prepared_tool: None,
             offsets: WorkOffsets::new("G54"),
             machine_point: false,
@@ -3815,6 +3818,19 @@ impl<'a> Interpreter<'a> {
                 "the machine file gives a rotary axis a feed_diameter, which only a \
                  Fanuc-family control's G94 feed outside tool-tip mode uses (Haas settings \
                  34/79): F is read here, and after, without it",
+            );
+        }
+        if rotary > 0.0 && moves_xyz && self.tcp == Tcp::Off && self.dialect_defaulted {
+            // grbl (which feedopt has no dialect for) and the Fanuc family take F over the
+            // combined distance: such a program read in the default dialect runs faster here
+            // than on its control, by the rotary share of every such block.
+            self.dialect_defaulted = false;
+            self.warn(
+                line,
+                format!(
+                    "a block that turns a rotary axis while X, Y or Z move: F is read along X,                      Y and Z, as the {} dialect (the default: nothing named the program's)                      reads it; grbl and Fanuc-family controls take it over the combined                      distance, a degree counting as a unit of length: if the program is for                      one, give --dialect fanuc",
+                    self.spec.name
+                ),
             );
         }
         Ok(if !moves_xyz && rotary > 0.0 {

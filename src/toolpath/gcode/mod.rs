@@ -385,6 +385,11 @@ pub struct Settings {
     /// written, and the two readings are two paths (a Fusion 360 program's `Z3` clearance
     /// written to Fanuc as `Z0.003`).
     pub dialect_unnamed: bool,
+    /// Nothing named the dialect the program is read in (not the user, nor the program's
+    /// content, nor an extension that belongs to one control: `.ngc`, `.mpf`, `.spf`, `.h`):
+    /// where the dialects' readings of a feed differ (a block that turns a rotary axis while
+    /// X, Y or Z move), the first such block warns, naming the other reading.
+    pub dialect_defaulted: bool,
 }
 
 /// As [`parse_assumed`], under the operator's `settings`.
@@ -407,6 +412,7 @@ pub fn parse_configured(
     interp.tool_diameter = settings.tool_diameter;
     interp.set_decimal_point_input(settings.decimal_point_input);
     interp.dialect_unnamed = settings.dialect_unnamed;
+    interp.dialect_defaulted = settings.dialect_defaulted;
     program.run(spec, &mut interp, source)?;
     if settings.dialect_unnamed
         && let Some(message) = interp.increments_unnamed_dialect()
