@@ -270,7 +270,7 @@ fn a_turn_alone_at_a_programmed_feed_takes_its_programmed_time() {
 /// a degree. With u the tip's chord alone, dA/du jumped a hundredfold from knot to knot: the
 /// cubic swung A 1.6° off its chords and bent it within microns, the adaptive refinement
 /// spent 19,265 stations on 42 blocks (the 76,693-line Vectric Skull roughing: 3.2 M stations,
-/// 5.8 GB, and 12 rounds of local refinement that left A over its limits). In the joint chord
+/// 5.8 GB, and 12 rounds of local refinement that left 30 intervals over a limit). In the joint chord
 /// (a degree as a millimetre) A stays on its chords and the path takes 2,257 stations.
 #[test]
 fn a_rotary_program_that_turns_far_for_tiny_tip_moves_stays_on_its_chords() {

@@ -486,7 +486,8 @@ pub const ANGLE_SWING_RAD: f64 = 2.0 * std::f64::consts::PI / 180.0;
 /// (Vectric's rotary programs, Z the radius: A wraps the part) made dA/du jump a
 /// hundredfold from one knot to the next; the cubic through them swung A 3.3° off its chords
 /// and bent it within micrometres, and millions of stations did not resolve the bends (the
-/// re-simulation still found A's acceleration 7 % over after 12 rounds of local refinement).
+/// 76,693-line Skull roughing: 3.2 M stations, 5.8 GB, and after 12 rounds of local
+/// refinement 30 intervals still over a limit, up to 6.7 %).
 /// In the joint chord every axis moves at most one unit of length per unit of u, and the
 /// spline runs along the program's straight blocks.
 pub const ROTARY_MM_PER_RAD: f64 = 180.0 / std::f64::consts::PI;
