@@ -308,3 +308,22 @@ fn a_rotary_program_that_turns_far_for_tiny_tip_moves_stays_on_its_chords() {
         s.stations()
     );
 }
+
+/// A corner of a four-axis program is a corner of the axes' motion, in the chord u measures
+/// (a degree as a millimetre): Z going up 0.5 mm and back while A turns 10° and 10° more is a
+/// turn of 5.7° there, no exact stop, and the block pair takes A's own trapezoid, v/a + d/v =
+/// 0.2 + 0.2 s (the tip's chords alone turned back by 180°: a stop, 0.566 s); X running on
+/// straight while A starts to turn (10 mm, then 10 mm with 90°) is a turn of 84°, a stop.
+#[test]
+fn four_axis_corners_are_corners_of_the_axes_motion() {
+    let (m, ctx) = setup('A');
+    let up_and_back = "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 Z10.5 A10 F600\nG1 Z10 A20\nM2\n";
+    let tp = read(&ctx, Dialect::LinuxCnc, up_and_back).unwrap();
+    let s = solve(&m, &tp);
+    assert_eq!(s.path.spans.len(), 1);
+    let t = s.schedule.cycle_time;
+    assert!((t - 0.4).abs() < 1e-3, "{t} s, want A's 0.4 s");
+    let turn_starts = "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 X10 A0 F600\nG1 X20 A90\nM2\n";
+    let tp = read(&ctx, Dialect::LinuxCnc, turn_starts).unwrap();
+    assert_eq!(solve(&m, &tp).path.spans.len(), 2);
+}
