@@ -21,7 +21,8 @@ use crate::solver::{SpanSolution, interval_times};
 pub struct Station {
     /// Index of the span (rest-to-rest piece) the station belongs to.
     pub span: usize,
-    /// Path parameter within the span (mm of chord, or radians on a reorientation span).
+    /// Path parameter within the span (mm of chord, in joint space on a four-axis machine,
+    /// or radians on a reorientation span).
     pub u: f64,
     /// Tool-tip arc length from the start of the path, mm (for a joint-space path: its
     /// parameter s).

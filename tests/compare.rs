@@ -494,3 +494,28 @@ fn a_turn_alone_at_f_takes_its_programmed_time_in_every_row() {
     assert!(cmp.row("controller").unwrap().verified);
     assert!(cmp.row("feedopt").unwrap().verified);
 }
+
+/// On a four-axis machine u is the chord in joint space (a degree as a millimetre), and the
+/// programmed row still times a block by its feed along X Y Z (LinuxCNC's rule): X 10 mm with
+/// A turning 90° at F600 takes 1 s, not the 9.06 s of F along the joint chord (as on main).
+#[test]
+fn a_four_axis_block_is_timed_by_its_feed_along_the_tip() {
+    let m = common::machine(
+        r#"{"name": "4-axis", "kinematics": {"type": "xyza"},
+            "axes": {"X": {"velocity": 500, "acceleration": 3000},
+                     "Y": {"velocity": 500, "acceleration": 3000},
+                     "Z": {"velocity": 500, "acceleration": 3000},
+                     "A": {"velocity": 100, "acceleration": 500, "min": -720, "max": 720}},
+            "feed": {"max": 500}}"#,
+    );
+    let tp = feedopt::toolpath::gcode::parse(
+        Path::new("xa.ngc"),
+        "G21 G90 G94\nG1 X0 Y0 Z0 A0 F600\nG1 X10 A90\nM2\n",
+        feedopt::toolpath::gcode::Dialect::LinuxCnc,
+    )
+    .expect("reads");
+    let cmp = compare(&m, &Input::Cl(tp), "xa", &CompareOptions::default()).expect("compare");
+    let t = cmp.row("programmed").expect("row").cycle_time_s;
+    // (Plus one servo period's ramp in and out: 1.001 s.)
+    assert!((t - 1.001).abs() <= 1e-6, "programmed: {t} s, want 1.001 s");
+}

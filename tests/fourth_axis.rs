@@ -302,3 +302,66 @@ fn a_rotary_feed_in_an_unnamed_dialect_warns_once() {
     assert!(warnings("part.ngc", None).is_empty());
     assert!(warnings("vectric.gcode", Some(Dialect::LinuxCnc)).is_empty());
 }
+
+/// A Vectric-style rotary program (A wraps the part, Z is the radius): some blocks turn A far
+/// while the tip moves microns (`A12.4` for 9 µm of Z), the next ones move Z far for a tenth of
+/// a degree. With u the tip's chord alone, dA/du jumped a hundredfold from knot to knot: the
+/// cubic swung A 1.6° off its chords and bent it within microns, the adaptive refinement
+/// spent 19,265 stations on 42 blocks (the 76,693-line Vectric Skull roughing: 3.2 M stations,
+/// 5.8 GB, and 12 rounds of local refinement that left 30 intervals over a limit). In the joint chord
+/// (a degree as a millimetre) A stays on its chords and the path takes 2,257 stations.
+#[test]
+fn a_rotary_program_that_turns_far_for_tiny_tip_moves_stays_on_its_chords() {
+    let (m, ctx) = setup('A');
+    let steps = [
+        (0.11, 5.0),
+        (12.4, 0.009),
+        (0.99, 0.044),
+        (3.1, -0.03),
+        (0.33, -1.4),
+        (8.9, 0.3),
+        (0.11, -4.0),
+    ];
+    let mut program = String::from("G21 G90 G94\nG0 X10 Y0 Z40 A0\nG1 Z35 F2190\n");
+    let (mut a, mut z) = (0.0, 35.0);
+    for i in 0..42 {
+        let (da, dz) = steps[i % steps.len()];
+        a += da;
+        z += dz;
+        program.push_str(&format!("G1 A{a:.3} Z{z:.3}\n"));
+    }
+    program.push_str("M2\n");
+    let tp = read(&ctx, Dialect::LinuxCnc, &program).unwrap();
+    let s = solve(&m, &tp);
+    let (mm, rad) = s.path.deviation();
+    assert!(
+        rad.to_degrees() <= 0.0111,
+        "A strays {}° from its chords",
+        rad.to_degrees()
+    );
+    assert!(mm <= 0.0061, "the tip strays {mm} mm from its chords");
+    assert!(
+        s.stations() < 5_000,
+        "{} stations for 42 blocks",
+        s.stations()
+    );
+}
+
+/// A corner of a four-axis program is a corner of the axes' motion, in the chord u measures
+/// (a degree as a millimetre): Z going up 0.5 mm and back while A turns 10° and 10° more is a
+/// turn of 5.7° there, no exact stop, and the block pair takes A's own trapezoid, v/a + d/v =
+/// 0.2 + 0.2 s (the tip's chords alone turned back by 180°: a stop, 0.566 s); X running on
+/// straight while A starts to turn (10 mm, then 10 mm with 90°) is a turn of 84°, a stop.
+#[test]
+fn four_axis_corners_are_corners_of_the_axes_motion() {
+    let (m, ctx) = setup('A');
+    let up_and_back = "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 Z10.5 A10 F600\nG1 Z10 A20\nM2\n";
+    let tp = read(&ctx, Dialect::LinuxCnc, up_and_back).unwrap();
+    let s = solve(&m, &tp);
+    assert_eq!(s.path.spans.len(), 1);
+    let t = s.schedule.cycle_time;
+    assert!((t - 0.4).abs() < 1e-3, "{t} s, want A's 0.4 s");
+    let turn_starts = "G21 G90 G94\nG0 X0 Y0 Z10 A0\nG1 X10 A0 F600\nG1 X20 A90\nM2\n";
+    let tp = read(&ctx, Dialect::LinuxCnc, turn_starts).unwrap();
+    assert_eq!(solve(&m, &tp).path.spans.len(), 2);
+}

@@ -10,7 +10,8 @@
 //!
 //! **Blocks.** A block is one knot interval of a span: one programmed move (CL point to CL
 //! point) of the fitted path. Its length L = Δu is the tool tip's chord length on a moving span
-//! (mm; u is the chord-length parameter, exact at the CL points), the tool's rotation (radians)
+//! (mm; u is the chord-length parameter, exact at the CL points; on a four-axis machine the
+//! chord in joint space, a degree as a millimetre, and a feed caps u̇ at F Δu / |ΔP|), the tool's rotation (radians)
 //! on a pure reorientation, and Δs on a joint-space path. Its *joint direction* is
 //! d = Δq / L per axis (the change of each machine axis over the block per unit of u), from the
 //! inverse kinematics at the block's two ends.
@@ -56,6 +57,11 @@ pub struct Block {
     pub direction: [f64; MAX_AXES],
     /// What moves along the block.
     pub kind: SpanKind,
+    /// The tool tip's travel per unit of u over the block, |ΔP| / Δu: 1 where u is the tip's
+    /// chord; less on a four-axis machine's moving span, whose u also counts the rotary
+    /// axis's turn ([`crate::geometry::ROTARY_MM_PER_RAD`]), so that a feed F of the tip
+    /// caps u̇ at F / (|ΔP| / Δu) ([`Block::u_rate_cap`]).
+    pub tip_per_u: f64,
     /// Source line of the CL point the block ends at.
     pub line: usize,
 }
@@ -64,6 +70,12 @@ impl Block {
     /// L = Δu.
     pub fn length(&self) -> f64 {
         self.u1 - self.u0
+    }
+
+    /// The cap on u̇ that a cap `cap` on the tip's speed makes on a moving block (`None` where
+    /// the tip does not move along it).
+    pub fn u_rate_cap(&self, cap: f64) -> Option<f64> {
+        (self.tip_per_u > 0.0).then(|| cap / self.tip_per_u)
     }
 }
 
@@ -84,10 +96,16 @@ pub fn blocks(path: &Path, kin: &Kinematics) -> Vec<Block> {
                 d[j] = (jets[k + 1].q[j] - jets[k].q[j]) / len;
             }
             let mut dir = [0.0; MAX_AXES];
+            let mut tip_per_u = 1.0;
             if span.kind == SpanKind::Moving {
                 let (a, b) = (span.eval(knots[k]).value, span.eval(knots[k + 1]).value);
                 for j in 0..3 {
                     dir[j] = b[j] - a[j];
+                }
+                // (1 within rounding where u is the tip's chord.)
+                let r = dir[..3].iter().map(|x| x * x).sum::<f64>().sqrt() / len;
+                if (r - 1.0).abs() > 1e-9 {
+                    tip_per_u = r;
                 }
             } else {
                 dir[..na].copy_from_slice(&d[..na]);
@@ -104,6 +122,7 @@ pub fn blocks(path: &Path, kin: &Kinematics) -> Vec<Block> {
                 joint_direction: d,
                 direction: dir,
                 kind: span.kind,
+                tip_per_u,
                 line: span.lines[k + 1],
             });
         }
@@ -170,7 +189,9 @@ pub fn programmed_feed(
     for b in &blocks {
         let span = &path.spans[b.span];
         let f = match b.kind {
-            SpanKind::Moving => span.feed_caps[b.index],
+            SpanKind::Moving => b
+                .u_rate_cap(span.feed_caps[b.index])
+                .unwrap_or_else(|| axis_limits(machine, na, &b.joint_direction).0),
             SpanKind::Joint => f64::INFINITY,
             // (Each piece's own Δu over the move's whole time counted a move the geometry
             // cut into pieces once per piece: B0 B90 B0 at F9.8, 41,878 s for 1,102 s.)
@@ -327,6 +348,10 @@ pub fn plan_controller(
         let (v, a) = axis_limits(machine, na, &b.joint_direction);
         // Of the tip's speed on a moving span, of the rate of turn on a reorientation.
         let cap = path.spans[b.span].feed_caps[b.index];
+        let cap = match b.kind {
+            SpanKind::Moving => b.u_rate_cap(cap).unwrap_or(f64::INFINITY),
+            _ => cap,
+        };
         let nominal = v.min(cap);
         if !nominal.is_finite() {
             return Err(Error::Usage(format!(

@@ -752,6 +752,7 @@ fn nodes(
         &angles,
         kin.uses_orientation(),
         geometry.corner_angle_deg,
+        machine.kinematics.machine_coordinates(),
     );
     let spans = &solution.path.spans;
     let timeline = Timeline::new(&solution.schedule, &solution.problems, &solution.solutions)?;
