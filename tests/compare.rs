@@ -457,6 +457,19 @@ fn dwells_count_in_every_row_as_in_solve() {
     );
 }
 
+/// A VMC with a rotary table on `letter` (A, B or C: 100 °/s, 500 °/s²).
+fn four_axis(letter: char) -> feedopt::machine::Machine {
+    common::machine(&format!(
+        r#"{{"name": "4-axis", "kinematics": {{"type": "xyz{}"}},
+            "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
+                     "Y": {{"velocity": 500, "acceleration": 3000}},
+                     "Z": {{"velocity": 500, "acceleration": 3000}},
+                     "{letter}": {{"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}},
+            "feed": {{"max": 500}}}}"#,
+        letter.to_ascii_lowercase()
+    ))
+}
+
 /// A table turned alone at F, out and back (round 10: NX's Mazak Nexus 510 four-axis sample):
 /// every row times each block at its programmed rate of turn, F = 100 °/min, 54 s a block.
 /// The programmed row counted the move's whole time on every piece the geometry cut it into at
@@ -464,14 +477,7 @@ fn dwells_count_in_every_row_as_in_solve() {
 /// feedopt ran the turn at B's limits (2.2 s).
 #[test]
 fn a_turn_alone_at_f_takes_its_programmed_time_in_every_row() {
-    let m = common::machine(
-        r#"{"name": "4-axis", "kinematics": {"type": "xyzb"},
-            "axes": {"X": {"velocity": 500, "acceleration": 3000},
-                     "Y": {"velocity": 500, "acceleration": 3000},
-                     "Z": {"velocity": 500, "acceleration": 3000},
-                     "B": {"velocity": 100, "acceleration": 500, "min": -720, "max": 720}},
-            "feed": {"max": 500}}"#,
-    );
+    let m = four_axis('B');
     let tp = feedopt::toolpath::gcode::parse(
         Path::new("turn.ngc"),
         "G21 G90 G94\nG1 X0 Y0 Z0 B0 F100\nG1 B90\nB0\nM2\n",
@@ -500,14 +506,7 @@ fn a_turn_alone_at_f_takes_its_programmed_time_in_every_row() {
 /// A turning 90° at F600 takes 1 s, not the 9.06 s of F along the joint chord (as on main).
 #[test]
 fn a_four_axis_block_is_timed_by_its_feed_along_the_tip() {
-    let m = common::machine(
-        r#"{"name": "4-axis", "kinematics": {"type": "xyza"},
-            "axes": {"X": {"velocity": 500, "acceleration": 3000},
-                     "Y": {"velocity": 500, "acceleration": 3000},
-                     "Z": {"velocity": 500, "acceleration": 3000},
-                     "A": {"velocity": 100, "acceleration": 500, "min": -720, "max": 720}},
-            "feed": {"max": 500}}"#,
-    );
+    let m = four_axis('A');
     let tp = feedopt::toolpath::gcode::parse(
         Path::new("xa.ngc"),
         "G21 G90 G94\nG1 X0 Y0 Z0 A0 F600\nG1 X10 A90\nM2\n",

@@ -95,10 +95,11 @@ pub struct JerkOptions {
     /// [`MIN_WINDOW`]) rather than 150: a window at a rest end, whose SCP takes twice the
     /// iterations of the others and whose dense collocation doubles its rows, is then
     /// smaller, and converges closer. On the 20 COPP paths with jerk limits (one core, the
-    /// CLI): 2.54 → 2.36 s of CPU for the twenty (100: 2.46 s), paths 1 and 11 3.3e-5 and
-    /// 3.9e-5 shorter, the others within 5e-6; the windowed times 3e-5…8e-5 below the
-    /// one-piece SCP's, which stops further from the optimum at its rest ends. The
-    /// jerk-limited impeller: 9.7 → 8.9 s of CPU, 1193.6237 → 1193.6214 s.
+    /// CLI, alternating runs): 150 → 100 stations 2.54 → 2.46 s of CPU for the twenty, 100 →
+    /// 50 2.52–2.58 → 2.35–2.37 s; paths 1 and 11 3.3e-5 and 3.9e-5 shorter, the others within
+    /// 5e-6; the windowed times 3e-5…8e-5 below the one-piece SCP's, which stops further from
+    /// the optimum at its rest ends. The jerk-limited impeller: 9.5–9.9 (150) and 9.4–9.5 (100)
+    /// → 8.9 s (50) of CPU, 1193.6237 → 1193.6214 s.
     pub window: usize,
     /// A straight span from rest to rest with the same limits everywhere takes the double-S
     /// profile in closed form ([`super::double_s`]) instead of the programme (an adaptive
@@ -1166,7 +1167,7 @@ fn solve_piece(
     options: &JerkOptions,
 ) -> Result<SpanSolution> {
     let mut provisional = false;
-    scp(
+    match scp(
         p,
         jd,
         start,
@@ -1174,14 +1175,13 @@ fn solve_piece(
         settings,
         options,
         Some(&mut provisional),
-    )
-    .or_else(|e| {
-        if !provisional {
-            return Err(e);
+    ) {
+        Err(e) if provisional => {
+            tracing::debug!("SCP: {e}; again without a provisional first subproblem");
+            scp(p, jd, start, a_ends, settings, options, None)
         }
-        tracing::debug!("SCP: {e}; again without a provisional first subproblem");
-        scp(p, jd, start, a_ends, settings, options, None)
-    })
+        answer => answer,
+    }
 }
 
 /// [`solve_piece`]'s iteration; `provisional`: whether the first subproblem may be provisional,
