@@ -202,9 +202,10 @@ impl JerkData {
                 b_max,
                 essential,
                 velocity_only,
+                eager,
             } = m;
             out.extend([theta.to_bits(), b_max.to_bits(), u64::from(*essential)]);
-            out.push(u64::from(*velocity_only));
+            out.push(u64::from(*velocity_only) | (u64::from(*eager) << 1));
             out.extend(
                 jets.dq
                     .iter()
@@ -219,16 +220,45 @@ impl JerkData {
 
 /// Where inside each interval velocity, acceleration and jerk are also bounded (as fractions
 /// of the interval): b is cubic between stations and may bulge above both ends, and the
-/// geometry's curvature varies in between. At [`VELOCITY_ONLY`] only the velocity bound.
-pub const COLLOCATION: [f64; 5] = [0.1, 0.25, 0.5, 0.75, 0.9];
+/// geometry's curvature varies in between. Only the rows at [`EAGER`] and the velocity bounds
+/// at [`VELOCITY_ONLY`] are stated from the start; the others are *lazy*: they join a
+/// subproblem where its solution breaks them ([`Program::solve`]), so that they cost an LP
+/// rows only where they bind.
+///
+/// With rows at ¼, ½, ¾ alone, the jerk of the SCP's answer bulged between them: on the 20 COPP
+/// paths with jerk limits (1,000 stations) the first 1 ms re-simulation found it over its
+/// limit by 0.1–0.5 % in 115–124 intervals of every path, all at θ ≈ 0.36–0.39 and 0.61–0.64,
+/// and the local refinement that divided them, solved their windows again and re-simulated
+/// the path twice more was 41 % of the twenty's CPU time (2.31 s; 1.36 s stopped after the
+/// first re-simulation). Each point added moved the bulge: with ⅜ and ⅝, 17–23 intervals per
+/// path, between 0.1 and ¼ (velocity only there then); with acceleration and jerk at 0.1 and
+/// 0.9, 2–3, at 0.43–0.45 and 0.55–0.57; with 7/16 and 9/16, 13 in all twenty, at 0.16–0.19
+/// and 0.82–0.84; with 0.175 and 0.825, none: every path verified at its first re-simulation.
+/// Stated from the start, those rows made every LP twice as costly (the first pass's LPs
+/// 0.75 → 1.49 s of CPU; the twenty 2.22 s against 2.34); lazy, the twenty took 1.76–1.84 s
+/// against 2.30–2.42 (2026-11-27, alternating runs). The cycle times came out 0.8e-4–1.2e-4
+/// longer at 1,000 stations, where the bulges had let the jerk exceed its limit between
+/// points (the discretisation's own error there is 9e-4: at 4,000 stations both give the
+/// same times to 3e-6).
+pub const COLLOCATION: [f64; 11] = [
+    0.1, 0.175, 0.25, 0.375, 0.4375, 0.5, 0.5625, 0.625, 0.75, 0.825, 0.9,
+];
 
-/// The points of [`COLLOCATION`] where only the velocity bound (axes and feed cap) is stated:
-/// on a feed plateau b sits on its cap at both stations while ü there is free (nothing else
+/// The points of [`COLLOCATION`] whose rows are stated in every subproblem from the start
+/// (those within [`ACTIVE_AT`] of their bound); the other points' rows are lazy. At a point
+/// all of whose rows are lazy, no velocity bound is stated (the eager points' and
+/// [`VELOCITY_ONLY`]'s hold b there) and every acceleration row is a candidate: the polygon's
+/// presolve that picks the few that are edges of it ([`point_bound`]) cost more than
+/// evaluating the others (the twenty 1.92 → 1.81 s without it).
+pub const EAGER: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// The points of [`COLLOCATION`] where the velocity bound (axes and feed cap) is stated from
+/// the start, and the other rows are lazy ([`EAGER`]): on a feed plateau b sits on its cap at both stations while ü there is free (nothing else
 /// binds it), and the cubic through them then bulged over the cap just inside a station,
 /// where ¼, ½, ¾ did not look (θ ≈ 0.1 or 0.9 in every feed excess the re-simulation found on
 /// the jerk-limited impeller, up to 0.6 %; each interval solved again found the next, for
-/// 10–12 rounds of local refinement; with these, 5–6). Acceleration and jerk rows there too
-/// cost the 20 COPP jerk paths 20 % more time for nothing the re-simulation needed.
+/// 10–12 rounds of local refinement; with these, 5–6). Acceleration and jerk rows there from
+/// the start cost the 20 COPP jerk paths 20 % more time (before [`EAGER`]).
 pub const VELOCITY_ONLY: [f64; 2] = [0.1, 0.9];
 
 /// The collocation points of the intervals next to a rest end ([`NEAR_REST`]): there b grows
@@ -274,21 +304,26 @@ pub struct Collocation {
     /// The points (of `points`) with only the velocity bound ([`VELOCITY_ONLY`]; none next to
     /// a rest end, where the jerk is what bulges between points).
     pub velocity_only: &'static [f64],
+    /// The points (of `points`) whose rows are all stated from the start ([`EAGER`]; every
+    /// point next to a rest end).
+    pub eager: &'static [f64],
 }
 
 /// The collocation points of interval `k` of `n`.
 pub fn collocation(k: usize, n: usize, rest_start: bool, rest_end: bool) -> Collocation {
     let from_rest = |m: usize| (rest_start && k < m) || (rest_end && k + m >= n);
-    let (points, velocity_only): (&'static [f64], &'static [f64]) = if from_rest(AT_REST) {
-        (&COLLOCATION_AT_REST, &[])
-    } else if from_rest(NEAR_REST) {
-        (&COLLOCATION_NEAR_REST, &[])
-    } else {
-        (&COLLOCATION, &VELOCITY_ONLY)
-    };
+    let (points, velocity_only, eager): (&'static [f64], &'static [f64], &'static [f64]) =
+        if from_rest(AT_REST) {
+            (&COLLOCATION_AT_REST, &[], &COLLOCATION_AT_REST)
+        } else if from_rest(NEAR_REST) {
+            (&COLLOCATION_NEAR_REST, &[], &COLLOCATION_NEAR_REST)
+        } else {
+            (&COLLOCATION, &VELOCITY_ONLY, &EAGER)
+        };
     Collocation {
         points,
         velocity_only,
+        eager,
     }
 }
 
@@ -304,8 +339,12 @@ pub struct Midpoint {
     /// The acceleration rows that are edges of the polygon there
     /// ([`crate::constraints::essential_rows`]).
     pub essential: u16,
-    /// Only the velocity bound is stated here ([`VELOCITY_ONLY`]).
+    /// Its velocity bound is stated from the start, its other rows are lazy
+    /// ([`VELOCITY_ONLY`]).
     pub velocity_only: bool,
+    /// Every row of it is stated from the start ([`EAGER`]); otherwise all but the velocity
+    /// bound of a [`VELOCITY_ONLY`] point are lazy.
+    pub eager: bool,
 }
 
 /// Inside an interval b may not dip below this share of the chord between its stations: the
@@ -318,6 +357,12 @@ pub const DIP: f64 = 0.5;
 /// A row joins the active set when its value reaches this fraction of its bound (see
 /// [`subproblem`]).
 const ACTIVE_AT: f64 = 0.85;
+
+/// Once a subproblem's solution breaks a row it left out, the lazy rows ([`COLLOCATION`])
+/// within this fraction of their bound join with it (the others', [`ACTIVE_AT`]). Taking only
+/// the broken ones took three LPs per subproblem where two did (the 20 COPP paths with jerk
+/// limits 2.11 s against 1.94 s); 0.85 and 0.99 did as well as 0.95.
+const LAZY_AT: f64 = 0.95;
 
 /// The first active set of a subproblem started from a warm profile also takes the rows within
 /// this share of their bound at the sites next to a fresh station (one a refinement inserted,
@@ -427,6 +472,8 @@ impl JerkData {
             (right, left)
         };
         let na = p.n_axes();
+        // Both acceleration rows of every axis ([`crate::constraints::essential_rows`]' mask).
+        let every_row = u16::try_from((1u32 << (2 * na)) - 1).unwrap_or(u16::MAX);
         let limits: Vec<Option<Limit>> = machine.axes.iter().take(na).map(|a| a.jerk).collect();
         let n = p.intervals();
         let rest = rest_bounds(span, kin, machine, p);
@@ -450,13 +497,15 @@ impl JerkData {
                 .collect(),
             None => vec![None; n],
         };
-        let midpoint = |(k, i, th, velocity_only): (usize, usize, f64, bool)| {
+        let midpoint = |(k, i, th, velocity_only, eager): (usize, usize, f64, bool, bool)| {
             let um = p.u[k] + th * (p.u[k + 1] - p.u[k]);
             let seg = span.spline.segment(um);
             let w = span.spline.eval_in(seg, um);
             let jets = kin.axis_jets(&w);
             let (b_max, essential) = match (previous, kept[k]) {
                 (Some(prev), Some(at)) => (prev.b_max[at + i], prev.essential[at + i]),
+                // Every row lazy: no velocity bound, every acceleration row ([`EAGER`]).
+                _ if !eager && !velocity_only => (f64::INFINITY, every_row),
                 _ => {
                     let cap = span.feed_cap(seg, um);
                     let pb = point_bound(
@@ -478,6 +527,7 @@ impl JerkData {
                 b_max,
                 essential,
                 velocity_only,
+                eager,
             }
         };
         // Chunks of intervals (their first stations and collocation points) in parallel.
@@ -491,10 +541,10 @@ impl JerkData {
             let mids: Vec<Midpoint> = (k0..k1.min(n))
                 .flat_map(|k| {
                     let set = collocation(k, n, rs, re);
-                    set.points
-                        .iter()
-                        .enumerate()
-                        .map(move |(i, &th)| (k, i, th, set.velocity_only.contains(&th)))
+                    set.points.iter().enumerate().map(move |(i, &th)| {
+                        let velocity_only = set.velocity_only.contains(&th);
+                        (k, i, th, velocity_only, set.eager.contains(&th))
+                    })
                 })
                 .map(midpoint)
                 .collect();
@@ -1513,6 +1563,8 @@ struct Site<'a> {
     essential: u16,
     /// The velocity bound (infinite: none; the stations' bounds are always stated).
     b_max: f64,
+    /// Its rows but the velocity bound are lazy ([`EAGER`]).
+    lazy: bool,
     at: BbarAt,
 }
 
@@ -1595,6 +1647,9 @@ struct Program<'a> {
     hot: Option<Vec<bool>>,
     /// Who solves a linear subproblem.
     lp_solver: LpSolver,
+    /// Per candidate: it is lazy ([`COLLOCATION`]): it joins a subproblem only where its
+    /// solution breaks it (or, once one is broken, comes within [`LAZY_AT`] of its bound).
+    lazy: Vec<bool>,
 }
 
 /// What one subproblem of an SCP leaves the next: its active rows (by candidate) and its last
@@ -1794,6 +1849,7 @@ impl<'a> Program<'a> {
                 d3: None,
                 essential: p.essential[i],
                 b_max: f64::INFINITY,
+                lazy: false,
                 at: BbarAt::Station(i),
             });
         }
@@ -1809,31 +1865,29 @@ impl<'a> Program<'a> {
                     d3: Some(d3),
                     essential: 0,
                     b_max: f64::INFINITY,
+                    lazy: false,
                     at: BbarAt::Station(e),
                 });
             }
             // At x = θΔu: b(x) = b_k + 2x a_k + (x² − x³/(3Δu)) σ⁰ + (x³/(3Δu)) σ¹,
             // a(x) = a_k + (x − x²/(2Δu)) σ⁰ + (x²/(2Δu)) σ¹, a'(x) = (1 − θ) σ⁰ + θ σ¹.
+            // (The interval's expressions once, not per point: with the lazy points, eleven.)
+            let (xk, yk, xk1) = (x(k), y(k), x(k + 1));
+            let (s0, s1) = (sv(k, 0), sv(k, 1));
             for m in &jd.mid[jd.mid_start[k]..jd.mid_start[k + 1]] {
                 let (th, xx) = (m.theta, m.theta * du);
                 let (w0, w1) = (xx * xx - xx.powi(3) / (3.0 * du), xx.powi(3) / (3.0 * du));
                 let (v0, v1) = (xx - xx * xx / (2.0 * du), xx * xx / (2.0 * du));
                 sites.push(Site {
-                    xb: x(k)
-                        .add(&y(k), 2.0 * xx)
-                        .add(&sv(k, 0), w0)
-                        .add(&sv(k, 1), w1),
-                    ya: y(k).add(&sv(k, 0), v0).add(&sv(k, 1), v1),
-                    slope: Lin::default().add(&sv(k, 0), 1.0 - th).add(&sv(k, 1), th),
-                    chord: if m.velocity_only {
-                        Lin::default()
-                    } else {
-                        Lin::default().add(&x(k), 1.0 - th).add(&x(k + 1), th)
-                    },
+                    xb: xk.add(&yk, 2.0 * xx).add(&s0, w0).add(&s1, w1),
+                    ya: yk.add(&s0, v0).add(&s1, v1),
+                    slope: Lin::default().add(&s0, 1.0 - th).add(&s1, th),
+                    chord: Lin::default().add(&xk, 1.0 - th).add(&xk1, th),
                     jets: (&m.jets).into(),
-                    d3: (!m.velocity_only).then_some(&m.d3),
-                    essential: if m.velocity_only { 0 } else { m.essential },
+                    d3: Some(&m.d3),
+                    essential: m.essential,
                     b_max: m.b_max,
+                    lazy: !m.eager,
                     at: BbarAt::Inside {
                         k,
                         theta: th,
@@ -1858,10 +1912,12 @@ impl<'a> Program<'a> {
                 .collect()
         });
         let mut cands = Vec::new();
+        let mut lazy = Vec::new();
         for (s, site) in sites.iter().enumerate() {
             let s = s as u32;
             if site.b_max.is_finite() {
                 cands.push((s, Kind::Velocity));
+                lazy.push(false);
             }
             if site.chord.len > 0 {
                 cands.push((s, Kind::Dip));
@@ -1887,6 +1943,7 @@ impl<'a> Program<'a> {
                     }
                 }
             }
+            lazy.resize(cands.len(), site.lazy);
         }
 
         // Cones: c_i² ≤ x_i, and d_k (c_k + c_{k+1}) ≥ 1 (turned by 45° as in super::clarabel).
@@ -1923,6 +1980,7 @@ impl<'a> Program<'a> {
             scale,
             sites,
             cands,
+            lazy,
             eq,
             tied,
             lin,
@@ -2025,8 +2083,9 @@ impl<'a> Program<'a> {
 
     /// Every candidate's value at z (the site expressions, and what the jerk rows share, once
     /// per site: a square root and a division per site rather than per row; the candidates'
-    /// values are 6 % of a jerk-limited solve on the COPP paths).
-    fn values(&self, z: &[f64], bbar_sites: &[f64], out: &mut Vec<f64>) {
+    /// values are 6 % of a jerk-limited solve on the COPP paths). Those `skip` marks are not
+    /// evaluated (0 in `out`).
+    fn values(&self, z: &[f64], bbar_sites: &[f64], skip: Option<&[bool]>, out: &mut Vec<f64>) {
         out.clear();
         let mut inv_jerk = [[0.0; 2]; MAX_AXES];
         for (inv, lim) in inv_jerk.iter_mut().zip(&self.jd.limits) {
@@ -2037,7 +2096,11 @@ impl<'a> Program<'a> {
         let mut last = u32::MAX;
         let mut sv = SiteValues::default();
         let mut f = JerkFactors::default();
-        for &c in &self.cands {
+        for (r, &c) in self.cands.iter().enumerate() {
+            if skip.is_some_and(|s| s[r]) {
+                out.push(0.0);
+                continue;
+            }
             let bbar = bbar_sites[c.0 as usize];
             if c.0 != last {
                 let s = &self.sites[c.0 as usize];
@@ -2196,9 +2259,10 @@ impl<'a> Program<'a> {
 
         // Active set over every row but the equalities and the velocity bounds at the stations:
         // most are far from binding. Start with those within ACTIVE_AT of their bound at the
-        // linearisation point (and the previous subproblem's), solve, add every omitted row the
-        // solution violates (with those near it), and solve again until none is: the result is
-        // the optimum of the full subproblem (the omitted rows hold at it).
+        // linearisation point (but the lazy ones, [`COLLOCATION`]) and the previous
+        // subproblem's, solve, add every omitted row the solution violates (with those near
+        // it), and solve again until none is: the result is the optimum of the full
+        // subproblem (the omitted rows hold at it).
         let mut zbar = vec![0.0; nv];
         for i in 1..n {
             zbar[lay.x(i)] = bbar[i] / scale;
@@ -2209,7 +2273,7 @@ impl<'a> Program<'a> {
             } / scale;
         }
         let mut vals = Vec::with_capacity(self.cands.len());
-        self.values(&zbar, &bbar_sites, &mut vals);
+        self.values(&zbar, &bbar_sites, None, &mut vals);
         let keep = carried.active.len() == self.cands.len();
         let warm = &mut carried.lp;
         // A subproblem from a warm profile (abar given) without an LP solution to start from
@@ -2227,11 +2291,17 @@ impl<'a> Program<'a> {
             .enumerate()
             .map(|(r, c)| {
                 (keep && carried.active[r])
-                    || vals[r] >= ACTIVE_AT
-                    || (!keep
-                        && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
-                        && vals[r] >= ACTIVE_NEAR_FRESH)
-                    || (!tie && c.0 < n_station_sites && matches!(c.1, Kind::Acceleration(..)))
+                    || if self.lazy[r] {
+                        false
+                    } else {
+                        vals[r] >= ACTIVE_AT
+                            || (!keep
+                                && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
+                                && vals[r] >= ACTIVE_NEAR_FRESH)
+                            || (!tie
+                                && c.0 < n_station_sites
+                                && matches!(c.1, Kind::Acceleration(..)))
+                    }
             })
             .collect();
         // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
@@ -2310,13 +2380,14 @@ impl<'a> Program<'a> {
             // [`ACTIVE_ROUNDS`] rounds, every row (a start far from the optimum can otherwise
             // uncover a few rows per round for many rounds).
             rounds += 1;
-            self.values(&x_new, &bbar_sites, &mut vals);
+            // (The rows it had hold at its solution: only the others are read.)
+            self.values(&x_new, &bbar_sites, Some(&active), &mut vals);
             let violated = active.iter().zip(&vals).any(|(a, &v)| !a && v > 1.0 + 1e-9);
             let every = rounds >= ACTIVE_ROUNDS;
             let mut added = 0;
             if violated {
-                for (act, &v) in active.iter_mut().zip(&vals) {
-                    if !*act && (every || v > ACTIVE_AT) {
+                for ((act, &v), &lazy) in active.iter_mut().zip(&vals).zip(&self.lazy) {
+                    if !*act && (every || v > if lazy { LAZY_AT } else { ACTIVE_AT }) {
                         *act = true;
                         added += 1;
                     }
@@ -2399,7 +2470,9 @@ struct Subsolution {
 
 #[cfg(test)]
 mod tests {
-    use super::{COLLOCATION, LOCAL_REACH, NEAR_REST, VELOCITY_ONLY, collocation, local_cuts};
+    use super::{
+        COLLOCATION, EAGER, LOCAL_REACH, NEAR_REST, VELOCITY_ONLY, collocation, local_cuts,
+    };
 
     /// Away from rest ends the velocity-only points are [`VELOCITY_ONLY`], each one of the
     /// interval's points; next to a rest end there are none (whatever the sets' sizes).
@@ -2410,12 +2483,16 @@ mod tests {
             for (rs, re) in [(false, false), (true, false), (false, true), (true, true)] {
                 let c = collocation(k, n, rs, re);
                 assert!(c.velocity_only.iter().all(|t| c.points.contains(t)));
+                assert!(c.eager.iter().all(|t| c.points.contains(t)));
+                assert!(c.eager.iter().all(|t| !c.velocity_only.contains(t)));
                 let near = (rs && k < NEAR_REST) || (re && k + NEAR_REST >= n);
                 if near {
                     assert!(c.velocity_only.is_empty(), "k {k} ({rs}, {re})");
+                    assert_eq!(c.eager, c.points, "k {k} ({rs}, {re})");
                 } else {
                     assert_eq!(c.points, &COLLOCATION[..]);
                     assert_eq!(c.velocity_only, &VELOCITY_ONLY[..]);
+                    assert_eq!(c.eager, &EAGER[..]);
                 }
             }
         }
