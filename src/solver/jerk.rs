@@ -1650,6 +1650,10 @@ struct Program<'a> {
     /// Per candidate: it is lazy ([`COLLOCATION`]): it joins a subproblem only where its
     /// solution breaks it (or, once one is broken, comes within [`LAZY_AT`] of its bound).
     lazy: Vec<bool>,
+    /// Per candidate, its value's weights on its site's x, y and a' ([`Program::values`]):
+    /// of the value itself (velocity, acceleration; relative to the bound), or, for a jerk
+    /// row, of what the site's factors ([`JerkFactors`]) then scale.
+    weights: Vec<[f64; 3]>,
 }
 
 /// What one subproblem of an SCP leaves the next: its active rows (by candidate) and its last
@@ -1946,6 +1950,43 @@ impl<'a> Program<'a> {
             lazy.resize(cands.len(), site.lazy);
         }
 
+        let mut inv_jerk = [[0.0; 2]; MAX_AXES];
+        for (inv, lim) in inv_jerk.iter_mut().zip(&jd.limits) {
+            if let Some(l) = lim {
+                *inv = [1.0 / l.max, 1.0 / l.min];
+            }
+        }
+        let weights = cands
+            .iter()
+            .map(|&(s, kind)| {
+                let site = &sites[s as usize];
+                match kind {
+                    Kind::Velocity => [scale / site.b_max, 0.0, 0.0],
+                    Kind::Dip => [0.0; 3],
+                    Kind::Acceleration(j, lower) => {
+                        let j = j as usize;
+                        let lim = &p.acceleration[j];
+                        let a = if lower { lim.min } else { lim.max };
+                        [
+                            scale * site.jets.ddq[j] / a,
+                            scale * site.jets.dq[j] / a,
+                            0.0,
+                        ]
+                    }
+                    Kind::Jerk(j, lower) => {
+                        let j = j as usize;
+                        let d3 = site.d3.expect("a jerk site has q'''");
+                        let inv = inv_jerk[j][usize::from(lower)];
+                        [
+                            d3[j] * inv,
+                            3.0 * site.jets.ddq[j] * inv,
+                            site.jets.dq[j] * inv,
+                        ]
+                    }
+                }
+            })
+            .collect();
+
         // Cones: c_i² ≤ x_i, and d_k (c_k + c_{k+1}) ≥ 1 (turned by 45° as in super::clarabel).
         let mut soc = Rows::default();
         for i in (1..n).filter(|_| !lay.lp) {
@@ -1981,6 +2022,7 @@ impl<'a> Program<'a> {
             sites,
             cands,
             lazy,
+            weights,
             eq,
             tied,
             lin,
@@ -2030,42 +2072,6 @@ impl<'a> Program<'a> {
             .collect()
     }
 
-    /// The value of candidate `c` (it holds iff ≤ 1) from its site's expression values and
-    /// the linearisation point's b̄ there; a jerk row's from the site's [`JerkFactors`] and
-    /// the limit's inverse `inv_jerk[axis][lower]`.
-    fn value(
-        &self,
-        c: (u32, Kind),
-        v: &SiteValues,
-        bbar: f64,
-        f: &JerkFactors,
-        inv_jerk: &[[f64; 2]; MAX_AXES],
-    ) -> f64 {
-        let site = &self.sites[c.0 as usize];
-        let b = self.scale;
-        match c.1 {
-            Kind::Velocity => v.x * b / site.b_max,
-            // 1 + (DIP·chord − b)/b̄: above 1 where b dips below its share of the chord.
-            Kind::Dip => 1.0 + (DIP * v.chord - v.x) * b / bbar.max(f64::MIN_POSITIVE),
-            Kind::Acceleration(j, lower) => {
-                let j = j as usize;
-                let lim = &self.p.acceleration[j];
-                let a = if lower { lim.min } else { lim.max };
-                b * (site.jets.ddq[j] * v.x + site.jets.dq[j] * v.y) / a
-            }
-            Kind::Jerk(j, lower) => {
-                if bbar <= 0.0 {
-                    return 0.0;
-                }
-                // jerk_weights' row, its factors common to the site's rows taken out.
-                let j = j as usize;
-                let d3 = site.d3.expect("a jerk site has q'''");
-                let l = d3[j] * v.x + 3.0 * site.jets.ddq[j] * v.y + site.jets.dq[j] * v.slope;
-                f.w * l * inv_jerk[j][usize::from(lower)] + f.x
-            }
-        }
-    }
-
     /// The jerk row `(2/3)√b̄ L/j + b/(3 b̄) ≤ 1` with `L = B (q''' x + 3 q'' y + q' a'/B)`
     /// as coefficients on (x, y, a'/B).
     fn jerk_weights(&self, site: &Site, j: usize, lower: bool, bbar: f64) -> (f64, f64, f64) {
@@ -2087,12 +2093,6 @@ impl<'a> Program<'a> {
     /// evaluated (0 in `out`).
     fn values(&self, z: &[f64], bbar_sites: &[f64], skip: Option<&[bool]>, out: &mut Vec<f64>) {
         out.clear();
-        let mut inv_jerk = [[0.0; 2]; MAX_AXES];
-        for (inv, lim) in inv_jerk.iter_mut().zip(&self.jd.limits) {
-            if let Some(l) = lim {
-                *inv = [1.0 / l.max, 1.0 / l.min];
-            }
-        }
         let mut last = u32::MAX;
         let mut sv = SiteValues::default();
         let mut f = JerkFactors::default();
@@ -2113,7 +2113,17 @@ impl<'a> Program<'a> {
                 f = JerkFactors::at(self.scale, bbar, sv.x);
                 last = c.0;
             }
-            out.push(self.value(c, &sv, bbar, &f, &inv_jerk));
+            let w = &self.weights[r];
+            let l = w[0] * sv.x + w[1] * sv.y + w[2] * sv.slope;
+            out.push(match c.1 {
+                // jerk_weights' row, its factors common to the site's rows taken out.
+                Kind::Jerk(..) => f.w * l + f.x,
+                // 1 + (DIP·chord − b)/b̄: above 1 where b dips below its share of the chord.
+                Kind::Dip => {
+                    1.0 + (DIP * sv.chord - sv.x) * self.scale / bbar.max(f64::MIN_POSITIVE)
+                }
+                Kind::Velocity | Kind::Acceleration(..) => l,
+            });
         }
     }
 
