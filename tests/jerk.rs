@@ -397,6 +397,27 @@ fn copp_jerk_paths_verify_and_match_topp3() {
     }
 }
 
+/// The first pass's answer keeps every limit between its collocation points: on three COPP
+/// paths with jerk limits the first 1 ms re-simulation passes, with no round of local
+/// refinement allowed and nothing slowed down. With jerk rows at ¼, ½, ¾ of each interval alone
+/// (before the lazy points of `jerk::COLLOCATION`), it found the jerk 0.1–0.5 % over its limit
+/// in about 120 intervals of each.
+#[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared")]
+fn copp_jerk_first_pass_keeps_the_limits_between_collocation_points() {
+    let dir = copp_data::data_dir().expect("../shared is present (cfg shared_data)");
+    let options = Options {
+        local_rounds: 0,
+        ..copp_options()
+    };
+    for idx in [0, 7, 13] {
+        let (m, path, _) = copp_case(&dir, idx);
+        let sol = optimize_joint(&m, &path, &options).expect("solve");
+        assert_verified_with_jerk(&sol, &format!("path {idx}"));
+        assert_eq!(sol.slowed_down, None, "path {idx}");
+    }
+}
+
 /// Issue 6's acceptance on all twenty paths (run by hand in release: the mean time and every
 /// verification; the solve time is measured by `benches/copp.rs`).
 #[test]
