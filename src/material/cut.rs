@@ -73,10 +73,13 @@
 //! mostly behind the tool, reached by the shared first pose: it saved 8.6 M of the 99.3 M
 //! computed crossings (the rest a copy, and a skipped end pose's crossings computed again by the
 //! next step), while the tests cost more than all it saved (12.6 → 17.4 G instructions, Valgrind
-//! with AVX2). Not kept. Time, by `perf` on two threads (AVX-512): `crossings_row` 24 %,
-//! `cut_band`'s own loops (spans, runs, the removal tests, the shank's candidates) 33 %, the
-//! removals 16 % (heap dexels half of it), the shank's rows 3 %, the footprints' rows 4 %; the
-//! main thread's reading before the cut and the final volume, freeing and output after it, 5 %.
+//! with AVX2). Not kept. Nor would sweeping the ball exactly (one capsule per step, as a
+//! vertical tool's) spare the poses there: of the crossings that take material, the flute
+//! cylinder's part takes some in 76 %, the ball alone in 24 %. Time, by `perf` on two threads
+//! (AVX-512): `crossings_row` 24 %, `cut_band`'s own loops (spans, runs, the removal tests,
+//! the shank's candidates) 33 %, the removals 16 % (heap dexels half of it), the shank's rows
+//! 3 %, the footprints' rows 4 %; the main thread's reading before the cut and the final
+//! volume, freeing and output after it, 5 %.
 //!
 //! **Engagement of a sample** (the tool at the step's end pose P, axis O, feed direction f):
 //! - removed volume ΔV (mm³) and engaged cross-section `A = ΔV / Δs` (mm²) normal to the feed,
