@@ -253,8 +253,9 @@ pub const COLLOCATION: [f64; 11] = [
 pub const EAGER: [f64; 3] = [0.25, 0.5, 0.75];
 
 /// The points of [`COLLOCATION`] where the velocity bound (axes and feed cap) is stated from
-/// the start, and the other rows are lazy ([`EAGER`]): on a feed plateau b sits on its cap at both stations while ü there is free (nothing else
-/// binds it), and the cubic through them then bulged over the cap just inside a station,
+/// the start, and the other rows are lazy ([`EAGER`]): on a feed plateau b sits on its cap at
+/// both stations while ü there is free (nothing else binds it), and the cubic through them
+/// then bulged over the cap just inside a station,
 /// where ¼, ½, ¾ did not look (θ ≈ 0.1 or 0.9 in every feed excess the re-simulation found on
 /// the jerk-limited impeller, up to 0.6 %; each interval solved again found the next, for
 /// 10–12 rounds of local refinement; with these, 5–6). Acceleration and jerk rows there from
