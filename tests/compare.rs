@@ -457,17 +457,9 @@ fn dwells_count_in_every_row_as_in_solve() {
     );
 }
 
-/// A VMC with a rotary table on `letter` (A, B or C: 100 °/s, 500 °/s²).
+/// A VMC with a rotary table on `letter` ([`common::four_axis_json`]).
 fn four_axis(letter: char) -> feedopt::machine::Machine {
-    common::machine(&format!(
-        r#"{{"name": "4-axis", "kinematics": {{"type": "xyz{}"}},
-            "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
-                     "Y": {{"velocity": 500, "acceleration": 3000}},
-                     "Z": {{"velocity": 500, "acceleration": 3000}},
-                     "{letter}": {{"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}},
-            "feed": {{"max": 500}}}}"#,
-        letter.to_ascii_lowercase()
-    ))
+    common::machine(&common::four_axis_json(letter))
 }
 
 /// A table turned alone at F, out and back (round 10: NX's Mazak Nexus 510 four-axis sample):

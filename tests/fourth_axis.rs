@@ -1,6 +1,8 @@
 //! Four-axis machines (`xyza`, `xyzb`, `xyzc`): programs in machine coordinates, X Y Z and the
 //! angle the axes' own positions, each block a straight move of all four.
 
+mod common;
+
 use std::path::Path;
 
 use feedopt::machine::{Machine, references_from_json};
@@ -8,17 +10,9 @@ use feedopt::optimize::{Options, Solution, optimize};
 use feedopt::toolpath::gcode::{Dialect, parse_for};
 use feedopt::toolpath::{MachineContext, Toolpath};
 
-/// A VMC with a rotary table on `letter` (A 100 °/s, 500 °/s²).
+/// A VMC with a rotary table on `letter` ([`common::four_axis_json`]).
 fn machine_json(letter: char) -> String {
-    format!(
-        r#"{{"name": "4-axis", "kinematics": {{"type": "xyz{}"}},
-            "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
-                     "Y": {{"velocity": 500, "acceleration": 3000}},
-                     "Z": {{"velocity": 500, "acceleration": 3000}},
-                     "{letter}": {{"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}},
-            "feed": {{"max": 500}}}}"#,
-        letter.to_ascii_lowercase()
-    )
+    common::four_axis_json(letter)
 }
 
 fn setup(letter: char) -> (Machine, MachineContext) {

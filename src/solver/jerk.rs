@@ -235,11 +235,11 @@ impl JerkData {
 /// 0.9, 2–3, at 0.43–0.45 and 0.55–0.57; with 7/16 and 9/16, 13 in all twenty, at 0.16–0.19
 /// and 0.82–0.84; with 0.175 and 0.825, none: every path verified at its first re-simulation.
 /// Stated from the start, those rows made every LP twice as costly (the first pass's LPs
-/// 0.75 → 1.49 s of CPU; the twenty 2.22 s against 2.34); lazy, the twenty took 1.76–1.84 s
-/// against 2.30–2.42 (2026-11-27, alternating runs). The cycle times came out 0.8e-4–1.2e-4
-/// longer at 1,000 stations, where the bulges had let the jerk exceed its limit between
-/// points (the discretisation's own error there is 9e-4: at 4,000 stations both give the
-/// same times to 3e-6).
+/// 0.75 → 1.49 s of CPU; the twenty 2.22 s against 2.34); lazy (with [`Program::values`]
+/// reading only the rows an LP left out), the twenty took 1.73–1.77 s against 2.36–2.39
+/// (2026-11-27, alternating runs). The cycle times came out 0.8e-4–1.2e-4 longer at 1,000
+/// stations, where the bulges had let the jerk exceed its limit between points (1,000 and
+/// 4,000 stations differ by 9e-4; at 4,000 both builds give the same times to 3e-6).
 pub const COLLOCATION: [f64; 11] = [
     0.1, 0.175, 0.25, 0.375, 0.4375, 0.5, 0.5625, 0.625, 0.75, 0.825, 0.9,
 ];
@@ -372,6 +372,7 @@ const ACTIVE_AT: f64 = 0.85;
 /// the broken ones took three LPs per subproblem where two did (the 20 COPP paths with jerk
 /// limits 2.11 s against 1.94 s); 0.85 and 0.99 did as well as 0.95.
 const LAZY_AT: f64 = 0.95;
+const _: () = assert!(LAZY_AT > ACTIVE_AT);
 
 /// The first active set of a subproblem started from a warm profile also takes the rows within
 /// this share of their bound at the sites next to a fresh station (one a refinement inserted,
@@ -1656,9 +1657,6 @@ struct Program<'a> {
     hot: Option<Vec<bool>>,
     /// Who solves a linear subproblem.
     lp_solver: LpSolver,
-    /// Per candidate: it is lazy ([`COLLOCATION`]): it joins a subproblem only where its
-    /// solution breaks it (or, once one is broken, comes within [`LAZY_AT`] of its bound).
-    lazy: Vec<bool>,
     /// Per candidate, its value's weights on its site's x, y and a' ([`Program::values`]):
     /// of the value itself (velocity, acceleration; relative to the bound), or, for a jerk
     /// row, of what the site's factors ([`JerkFactors`]) then scale.
@@ -1925,12 +1923,10 @@ impl<'a> Program<'a> {
                 .collect()
         });
         let mut cands = Vec::new();
-        let mut lazy = Vec::new();
         for (s, site) in sites.iter().enumerate() {
             let s = s as u32;
             if site.b_max.is_finite() {
                 cands.push((s, Kind::Velocity));
-                lazy.push(false);
             }
             if site.chord.len > 0 {
                 cands.push((s, Kind::Dip));
@@ -1956,7 +1952,6 @@ impl<'a> Program<'a> {
                     }
                 }
             }
-            lazy.resize(cands.len(), site.lazy);
         }
 
         let mut inv_jerk = [[0.0; 2]; MAX_AXES];
@@ -2030,7 +2025,6 @@ impl<'a> Program<'a> {
             scale,
             sites,
             cands,
-            lazy,
             weights,
             eq,
             tied,
@@ -2041,6 +2035,13 @@ impl<'a> Program<'a> {
             hot,
             lp_solver: options.lp_solver,
         }
+    }
+
+    /// Whether candidate `c` is lazy ([`COLLOCATION`]): it joins a subproblem only where its
+    /// solution breaks it (or, once one is broken, comes within [`LAZY_AT`] of its bound). A
+    /// site's velocity bound never is.
+    fn is_lazy(&self, c: (u32, Kind)) -> bool {
+        c.1 != Kind::Velocity && self.sites[c.0 as usize].lazy
     }
 
     fn is_rest(&self, k: usize) -> bool {
@@ -2310,17 +2311,14 @@ impl<'a> Program<'a> {
             .enumerate()
             .map(|(r, c)| {
                 (keep && carried.active[r])
-                    || if self.lazy[r] {
-                        false
-                    } else {
-                        vals[r] >= ACTIVE_AT
-                            || (!keep
-                                && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
-                                && vals[r] >= ACTIVE_NEAR_FRESH)
-                            || (!tie
-                                && c.0 < n_station_sites
-                                && matches!(c.1, Kind::Acceleration(..)))
-                    }
+                    || ((vals[r] >= ACTIVE_AT
+                        || (!keep
+                            && self.hot.as_ref().is_some_and(|h| h[c.0 as usize])
+                            && vals[r] >= ACTIVE_NEAR_FRESH)
+                        || (!tie
+                            && c.0 < n_station_sites
+                            && matches!(c.1, Kind::Acceleration(..))))
+                        && !self.is_lazy(*c))
             })
             .collect();
         // The duality gap of a subproblem only moves the next linearisation point; 1e-5 of the
@@ -2405,8 +2403,10 @@ impl<'a> Program<'a> {
             let every = rounds >= ACTIVE_ROUNDS;
             let mut added = 0;
             if violated {
-                for ((act, &v), &lazy) in active.iter_mut().zip(&vals).zip(&self.lazy) {
-                    if !*act && (every || v > if lazy { LAZY_AT } else { ACTIVE_AT }) {
+                // (LAZY_AT is above ACTIVE_AT: a row's laziness is looked up only between.)
+                for ((act, &v), &c) in active.iter_mut().zip(&vals).zip(&self.cands) {
+                    let near = v > LAZY_AT || (v > ACTIVE_AT && !self.is_lazy(c));
+                    if !*act && (every || near) {
                         *act = true;
                         added += 1;
                     }

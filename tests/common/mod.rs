@@ -19,6 +19,19 @@ pub const AC_TABLE: &str = r#"{"name": "A/C table", "kinematics": {"type": "tabl
              "C": {"velocity": 120, "acceleration": 1200}},
     "feed": {"max": 2000}}"#;
 
+/// A VMC with a rotary table on `letter` (A, B or C: 100 °/s, 500 °/s²), as machine-file JSON.
+pub fn four_axis_json(letter: char) -> String {
+    format!(
+        r#"{{"name": "4-axis", "kinematics": {{"type": "xyz{}"}},
+            "axes": {{"X": {{"velocity": 500, "acceleration": 3000}},
+                     "Y": {{"velocity": 500, "acceleration": 3000}},
+                     "Z": {{"velocity": 500, "acceleration": 3000}},
+                     "{letter}": {{"velocity": 100, "acceleration": 500, "min": -720, "max": 720}}}},
+            "feed": {{"max": 500}}}}"#,
+        letter.to_ascii_lowercase()
+    )
+}
+
 /// Every one of `parts` is in the message `e`.
 pub fn assert_mentions(e: &str, parts: &[&str]) {
     for part in parts {
