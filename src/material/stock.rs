@@ -76,12 +76,105 @@ impl Stock {
         }
     }
 
+    /// The cells `i` (of `n` along X, centres x = `x0` + (i + ½)·`hx`) whose vertical line at
+    /// `y` has material ([`Stock::column`] is `Some`): a run `ia..=ib`, if any; and the
+    /// column's length there (the same on every line of a box or a cylinder), mm.
+    ///
+    /// The same cells as asking [`Stock::column`] cell by cell: the run is found by bisection
+    /// on that very test, which is monotone on each side of the stock's middle (x is
+    /// increasing in i, and so is every rounded operation of the test in its argument).
+    pub fn row_cells(&self, y: f64, x0: f64, hx: f64, n: usize) -> Option<(usize, usize, f64)> {
+        let inside = |i: usize| {
+            let x = x0 + (super::dexel::index_f64(i) + 0.5) * hx;
+            self.column(x, y).is_some()
+        };
+        let length = match *self {
+            Stock::Box { min, max } => max[2] - min[2],
+            Stock::Cylinder { z, .. } => z[1] - z[0],
+        };
+        if n == 0 {
+            return None;
+        }
+        // The cells on either side of the middle: the test is non-decreasing in i up to the
+        // first, non-increasing from the second; if neither has material, none has.
+        let [bx0, _, bx1, _] = self.xy_bounds();
+        let mid = 0.5 * (bx0 + bx1);
+        let c = (((mid - x0) / hx - 0.5).floor().max(0.0) as usize).min(n - 1);
+        let m = if inside(c) {
+            c
+        } else if c + 1 < n && inside(c + 1) {
+            c + 1
+        } else {
+            return None;
+        };
+        // The first cell with material in 0..=m and the last in m..n (bisection).
+        let (mut lo, mut hi) = (0, m);
+        while lo < hi {
+            let k = lo + (hi - lo) / 2;
+            if inside(k) { hi = k } else { lo = k + 1 }
+        }
+        let ia = lo;
+        let (mut lo, mut hi) = (m, n - 1);
+        while lo < hi {
+            let k = hi - (hi - lo) / 2;
+            if inside(k) { lo = k } else { hi = k - 1 }
+        }
+        Some((ia, lo, length))
+    }
+
     /// The exact volume, mm³.
     pub fn volume(&self) -> f64 {
         match *self {
             Stock::Box { min, max } => (0..3).map(|k| max[k] - min[k]).product(),
             Stock::Cylinder { radius, z, .. } => {
                 std::f64::consts::PI * radius * radius * (z[1] - z[0])
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng as rng;
+
+    /// [`Stock::row_cells`] finds the cells [`Stock::column`] gives material, row by row, on
+    /// grids that reach past the stock, start inside it or lie beside it.
+    #[test]
+    fn row_cells_are_the_columns_cell_by_cell() {
+        let mut rnd = rng(11);
+        for case in 0..400 {
+            let s = if case % 2 == 0 {
+                let (a, b) = (-5.0 + 10.0 * rnd(), -5.0 + 10.0 * rnd());
+                Stock::Box {
+                    min: [a, b, -3.0],
+                    max: [a + 0.1 + 8.0 * rnd(), b + 0.1 + 8.0 * rnd(), 1.0],
+                }
+            } else {
+                Stock::Cylinder {
+                    center: [-5.0 + 10.0 * rnd(), -5.0 + 10.0 * rnd()],
+                    radius: 0.05 + 6.0 * rnd(),
+                    z: [-2.0, 4.5],
+                }
+            };
+            let (x0, hx) = (-12.0 + 8.0 * rnd(), 0.02 + 0.5 * rnd());
+            let n = 1 + (60.0 * rnd()) as usize;
+            for k in 0..40 {
+                let y = -12.0 + 24.0 * f64::from(k) / 39.0;
+                let want: Vec<usize> = (0..n)
+                    .filter(|&i| s.column(x0 + (i as f64 + 0.5) * hx, y).is_some())
+                    .collect();
+                let got = s.row_cells(y, x0, hx, n);
+                match (want.first(), want.last(), got) {
+                    (None, None, None) => {}
+                    (Some(&a), Some(&b), Some((ia, ib, length))) => {
+                        assert_eq!((ia, ib), (a, b), "{s:?} x0 {x0} hx {hx} n {n} y {y}");
+                        assert_eq!(want.len(), b - a + 1);
+                        let c = s.column(x0 + (a as f64 + 0.5) * hx, y).unwrap();
+                        assert_eq!(length, c[1] - c[0]);
+                    }
+                    _ => panic!("{s:?} x0 {x0} hx {hx} n {n} y {y}: {want:?} vs {got:?}"),
+                }
             }
         }
     }
