@@ -409,6 +409,24 @@ pub(super) fn lex(
             words.insert(2, number);
         }
     }
+    // `CP IPA+90 IZ-0.5 DR+FQ1` (hyperMILL's post for a DMU 100 P duoblock, round 28): the
+    // next word joined to the direction. A direction is the sign alone, so a letter after
+    // it can only start another word: `DR+ FQ1`.
+    let mut k = 0;
+    while k < words.len() {
+        let w = &words[k];
+        if w.len() > 3
+            && w.is_char_boundary(3)
+            && w[..2].eq_ignore_ascii_case("DR")
+            && matches!(w.as_bytes()[2], b'+' | b'-')
+            && w[3..].starts_with(|c: char| c.is_ascii_alphabetic())
+        {
+            let rest = w[3..].to_string();
+            words[k].truncate(3);
+            words.insert(k + 1, rest);
+        }
+        k += 1;
+    }
     let mut items = Vec::new();
     let mut i = 0;
     if let Some((n, key, action)) = keyword_at(spec, &words) {
