@@ -2729,7 +2729,7 @@ impl<'a> Interpreter<'a> {
         self.check_room(
             line,
             &format!("G{} with {repeats} repeats", c.code),
-            repeats.saturating_mul(steps.len() + 2),
+            repeats.saturating_mul(steps.len() + 3),
         )?;
         for k in 0..repeats {
             let mut xy = [self.pos[0], self.pos[1]];
@@ -2758,6 +2758,10 @@ impl<'a> Interpreter<'a> {
                 self.pos = q;
             }
             self.known[2] = true;
+            let shift = cycles::g87_shift(&h);
+            if shift > 0.0 {
+                self.run_steps(line, &[cycles::Step::ShiftX(shift)])?;
+            }
             self.rapid_z(line, r);
             let from = self.points.len();
             self.run_steps(line, &steps)?;
