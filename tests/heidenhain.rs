@@ -231,6 +231,10 @@ fn a_word_joined_to_the_arc_direction_is_the_next_word() {
     );
     assert_eq!(arc_end.feed, Feed::Programmed(20.0));
     assert_eq!(a.points.last().unwrap().feed, Feed::Programmed(5.0));
+    // A word that starts with a character of several bytes is no direction and no panic
+    // (the fuzzer's `\u{fffd}FMAX` found the first version of this split slicing inside one).
+    let e = fails(&format!("{HEADER}4 L X+10 Y+0 Z+0 \u{fffd}FMAX\n"));
+    assert!(e.contains("unexpected word"), "{e}");
     // A sign followed by a digit is still no direction.
     let e = fails(&format!(
         "{HEADER}4 L X+10 Y+0 Z+0 F600\n5 CC X+0 Y+0\n6 CP IPA+90 DR+5\n"

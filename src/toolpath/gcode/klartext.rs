@@ -414,14 +414,15 @@ pub(super) fn lex(
     // it can only start another word: `DR+ FQ1`.
     let mut k = 0;
     while k < words.len() {
-        let w = &words[k];
-        if w.len() > 3
-            && w.is_char_boundary(3)
-            && w[..2].eq_ignore_ascii_case("DR")
-            && matches!(w.as_bytes()[2], b'+' | b'-')
-            && w[3..].starts_with(|c: char| c.is_ascii_alphabetic())
+        // Bytes, not `str` slices: a word may hold any character (an ASCII letter at byte 3
+        // makes 3 a character boundary).
+        let b = words[k].as_bytes();
+        if b.len() > 3
+            && b[..2].eq_ignore_ascii_case(b"DR")
+            && matches!(b[2], b'+' | b'-')
+            && b[3].is_ascii_alphabetic()
         {
-            let rest = w[3..].to_string();
+            let rest = words[k][3..].to_string();
             words[k].truncate(3);
             words.insert(k + 1, rest);
         }
