@@ -70,6 +70,53 @@ fn g83_peck_cycle_moves_and_time() {
     assert_eq!(tp.points.last().map(|p| p.p), Some(v(6.0, 0.0, 2.0)));
 }
 
+/// Fanuc G87 back boring shifts the oriented tool by Q (+X assumed, as G76) at the initial
+/// level, rapids down through the hole to R, shifts back, feeds up to Z, shifts again, rapids
+/// to the initial level and shifts back. The shifts were not modelled (round 28: a Fusion
+/// Fanuc post's `G87 … Q0.01 P0`): moves of the tool left out in silence. Without Q the
+/// tool goes straight down and up, as before.
+#[test]
+fn g87_back_boring_shifts_by_q_around_the_rapid_through_the_hole() {
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1\nG21 G90 G0 X0 Y0 Z10.\nG98 G87 X5. Y2. Z-4. R-12. Q0.5 F60.\nG80\n",
+    );
+    let xz: Vec<(f64, f64)> = tp.points[1..].iter().map(|p| (p.p.x, p.p.z)).collect();
+    let want = [
+        (5.0, 10.0),  // over the hole at the initial level
+        (5.5, 10.0),  // shift
+        (5.5, -12.0), // rapid down to R, below the hole
+        (5.0, -12.0), // shift back
+        (5.0, -4.0),  // feed up to Z
+        (5.5, -4.0),  // shift
+        (5.5, 10.0),  // rapid to the initial level
+        (5.0, 10.0),  // shift back
+    ];
+    assert_eq!(xz.len(), want.len(), "{xz:?}");
+    for (a, b) in xz.iter().zip(want) {
+        assert!(
+            (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9,
+            "{xz:?}"
+        );
+    }
+    assert!(tp.points[1..].iter().all(|p| p.p.y == 2.0));
+    // Only the bore is fed: 8 mm at 1 mm/s.
+    assert!((feed_time(&tp) - 8.0).abs() < 1e-9, "{}", feed_time(&tp));
+    let fed = tp.points[1..]
+        .iter()
+        .filter(|p| p.feed != Feed::Rapid)
+        .count();
+    assert_eq!(fed, 1);
+    // Without Q: down, up, out, no shifts.
+    let tp = gcode(
+        Dialect::Fanuc,
+        "O1\nG21 G90 G0 X0 Y0 Z10.\nG98 G87 X5. Y2. Z-4. R-12. F60.\nG80\n",
+    );
+    let z: Vec<f64> = tp.points[1..].iter().map(|p| p.p.z).collect();
+    assert_eq!(z, vec![10.0, -12.0, -4.0, 10.0]);
+    assert!(tp.points[1..].iter().all(|p| p.p.x == 5.0));
+}
+
 /// A peck cycle (G83, G73) without a peck depth Q, or with Q ≤ 0, is drilled in one pass
 /// with a warning naming the block and saying that the controls refuse it (Fanuc alarm
 /// PS0045 "address Q not found", LinuxCNC "Q must be positive") and what to write. Until

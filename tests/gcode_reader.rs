@@ -1458,6 +1458,59 @@ fn an_arc_off_its_circle_names_what_the_block_shows() {
     }
 }
 
+/// A post for a control set to read arc centres absolute (LinuxCNC after G90.1, Mach3's and
+/// UCCNC's absolute IJ mode) that does not write G90.1 (round 28: a 3,460-line 3-axis
+/// program in a public repository, every arc `G2 X… Y… Z… I… J…` with I J the centre's
+/// coordinates) failed at its first arc with only the two radii. The message now names that
+/// reading, its centre and what to write; the dialect option where the program is not read
+/// as LinuxCNC's. Readings as an offset still follow when they fit too.
+#[test]
+fn an_arc_whose_centre_words_are_absolute_names_g90_1() {
+    let text = "G21 G90 G17\nG0 X-2. Y-4. Z5.\nG1 Z0. F100.\nG2 X-2. Y4. Z-1. I1. J0.\n";
+    err_in(
+        Dialect::LinuxCnc,
+        text,
+        4,
+        &[
+            "not on the circle",
+            "I J read as the centre's coordinates would fit, centre (1, 0) mm",
+            "absolute arc centres",
+            "write G90.1 ahead of its first arc",
+        ],
+    );
+    match parse(Path::new("abs.ngc"), text, Dialect::LinuxCnc) {
+        Err(Error::Parse { message, .. }) => {
+            assert!(!message.contains("--dialect"), "{message}");
+            assert!(!message.contains("these would fit"), "{message}");
+        }
+        other => panic!("expected the radius error, got {other:?}"),
+    }
+    err_in(
+        Dialect::Fanuc,
+        &format!("O1\n{text}"),
+        5,
+        &[
+            "centre (1, 0) mm",
+            "write G90.1 ahead of its first arc and read it with --dialect linuxcnc",
+        ],
+    );
+    // With G90.1 the same program reads, the arc about (1, 0), radius 5, clockwise from
+    // (-2, -4) through (-4, 0) to (-2, 4).
+    let tp = ok(&format!("G90.1\n{text}"));
+    assert_close(
+        tp.points.last().expect("points").p,
+        v(-2.0, 4.0, -1.0),
+        1e-9,
+    );
+    let arc: Vec<_> = tp.points.iter().filter(|q| q.line == 5).collect();
+    assert!(arc.len() > 4, "{} points on the arc", arc.len());
+    for q in &arc {
+        let r = (q.p.x - 1.0).hypot(q.p.y);
+        assert!((r - 5.0).abs() < 1e-6, "{:?} off the circle (r {r})", q.p);
+        assert!(q.p.x <= -2.0 + 1e-9, "{:?}: the long way round", q.p);
+    }
+}
+
 /// NX writes a posted program into an "Information listing" (round 10: the Mazak Nexus 510,
 /// Mitsubishi VR33 and Okuma 7000M samples) whose header starts with a rule of `=`. The error
 /// said "unexpected character `=`"; it now says that the line is not G-code and what to do.

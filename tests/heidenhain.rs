@@ -206,6 +206,42 @@ fn cp_by_incremental_angle_is_a_helix_and_cc_y_z_is_the_yz_plane() {
     assert!(e.contains(":7:"), "{e}");
 }
 
+/// hyperMILL's post for a DMU 100 P duoblock (round 28) writes the feed joined to the
+/// direction: `CP IPA+90 IZ-0.5 DR+FQ1`. It was refused ("the direction is DR+ or DR-");
+/// a direction is its sign alone, so what follows is the next word: DR+ and F Q1.
+#[test]
+fn a_word_joined_to_the_arc_direction_is_the_next_word() {
+    let joined = format!(
+        "{HEADER}4 FN 0: Q1=1200\n5 L X+10 Y+0 Z+0 F600\n6 CC X+0 Y+0\n\
+         7 CP IPA+90 IZ-0.5 DR+FQ1\n8 L X-5 F300\n"
+    );
+    let spaced = joined.replace("DR+FQ1", "DR+ FQ1");
+    let (a, b) = (read(&joined), read(&spaced));
+    assert_eq!(a.points.len(), b.points.len());
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert!(close(p.p, q.p, 1e-12), "{:?} {:?}", p.p, q.p);
+        assert_eq!(p.feed, q.feed);
+    }
+    // The arc turns +90° about Z from (10, 0) to (0, 10), at Q1 = 1200 mm/min, 0.5 down.
+    let arc_end = a.points.iter().rfind(|p| p.line == 8).unwrap();
+    assert!(
+        close(arc_end.p, v(0.0, 10.0, -0.5), 1e-9),
+        "{:?}",
+        arc_end.p
+    );
+    assert_eq!(arc_end.feed, Feed::Programmed(20.0));
+    assert_eq!(a.points.last().unwrap().feed, Feed::Programmed(5.0));
+    // A word that starts with a character of several bytes is no direction and no panic
+    // (the fuzzer's `\u{fffd}FMAX` found the first version of this split slicing inside one).
+    let e = fails(&format!("{HEADER}4 L X+10 Y+0 Z+0 \u{fffd}FMAX\n"));
+    assert!(e.contains("unexpected word"), "{e}");
+    // A sign followed by a digit is still no direction.
+    let e = fails(&format!(
+        "{HEADER}4 L X+10 Y+0 Z+0 F600\n5 CC X+0 Y+0\n6 CP IPA+90 DR+5\n"
+    ));
+    assert!(e.contains("the direction is DR+ or DR-"), "{e}");
+}
+
 #[test]
 fn ln_tool_vectors_under_m128_on_a_five_axis_machine() {
     let m = common::machine(

@@ -21,7 +21,7 @@
 //! | G85 | feed to Z, feed back to R |
 //! | G86 | feed to Z, rapid out (spindle stopped) |
 //! | G76 | fine boring: feed to Z, dwell P, shift Q in +X (the shift direction is Fanuc parameter 5101 RD1/RD2: +X assumed), rapid out, shift back |
-//! | G87 | back boring: rapid to R (below the hole), feed up to Z, rapid to the initial level (the shifts of the oriented tool are not modelled) |
+//! | G87 | back boring: shift Q in +X (as G76), rapid to R (below the hole), shift back, feed up to Z, shift Q, rapid to the initial level, shift back |
 //! | G88 | feed to Z, dwell P, (the operator retracts by hand: not timed, a warning), rapid out |
 //! | G89 | feed to Z, dwell P, feed back to R |
 //!
@@ -228,12 +228,24 @@ pub struct Hole {
     pub kind: Kind,
     pub r: f64,
     pub bottom: f64,
-    /// Peck depth (G73, G83) or shift (G76), mm.
+    /// Peck depth (G73, G83) or shift (G76, G87), mm.
     pub q: Option<f64>,
     pub dwell: f64,
     /// Return level: the initial level (G98) or R (G99).
     pub clear: f64,
     pub initial: f64,
+}
+
+/// G87's shift of the oriented tool, mm (Q; the direction is Fanuc parameter 5101 RD1/RD2:
+/// +X assumed, as for G76): the tool shifts by it at the initial level, rapids down to R
+/// (below the hole) and shifts back, feeds up to Z, shifts again, rapids to the initial level
+/// and shifts back (Fanuc's "back boring cycle G87").
+pub fn g87_shift(h: &Hole) -> f64 {
+    if h.kind == Kind::G87 {
+        h.q.unwrap_or(0.0).abs()
+    } else {
+        0.0
+    }
 }
 
 /// Pecks from `top` to `bottom` (downwards) of `q` each: the depths reached.
@@ -312,7 +324,22 @@ pub fn fanuc_steps(h: &Hole) -> Result<(Vec<Step>, Option<&'static str>), String
                 s.push(ShiftX(-shift));
             }
         }
-        Kind::G87 => s.extend([Feed(h.bottom, None), Rapid(h.initial.max(h.bottom))]),
+        // The shift before the rapid down to R is the interpreter's (`g87_shift`): it
+        // comes before the rapid to R, which is not one of these steps.
+        Kind::G87 => {
+            let shift = g87_shift(h);
+            if shift > 0.0 {
+                s.push(ShiftX(-shift));
+            }
+            s.push(Feed(h.bottom, None));
+            if shift > 0.0 {
+                s.push(ShiftX(shift));
+            }
+            s.push(Rapid(h.initial.max(h.bottom)));
+            if shift > 0.0 {
+                s.push(ShiftX(-shift));
+            }
+        }
         Kind::G88 => {
             note = Some("G88 stops for a manual retract: the operator's time is not counted");
             s.extend([Feed(h.bottom, None), Dwell(h.dwell), Rapid(h.clear)]);

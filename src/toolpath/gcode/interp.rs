@@ -2729,7 +2729,7 @@ impl<'a> Interpreter<'a> {
         self.check_room(
             line,
             &format!("G{} with {repeats} repeats", c.code),
-            repeats.saturating_mul(steps.len() + 2),
+            repeats.saturating_mul(steps.len() + 3),
         )?;
         for k in 0..repeats {
             let mut xy = [self.pos[0], self.pos[1]];
@@ -2758,6 +2758,10 @@ impl<'a> Interpreter<'a> {
                 self.pos = q;
             }
             self.known[2] = true;
+            let shift = cycles::g87_shift(&h);
+            if shift > 0.0 {
+                self.run_steps(line, &[cycles::Step::ShiftX(shift)])?;
+            }
             self.rapid_z(line, r);
             let from = self.points.len();
             self.run_steps(line, &steps)?;
@@ -4004,16 +4008,44 @@ impl<'a> Interpreter<'a> {
                         mm(f1)
                     ));
                 }
-                if !readings.is_empty() {
+                // I J K as the centre's coordinates: a post for a control set to read arc
+                // centres absolute (LinuxCNC's G90.1, Mach3's and UCCNC's absolute IJ mode)
+                // that does not say so in the program. Every arc of such a program fails
+                // the same way, so this reading comes first.
+                let absolute = fits(word(a), word(b));
+                if absolute {
+                    let dialect = if self.spec.name == "LinuxCNC" {
+                        String::new()
+                    } else {
+                        " and read it with --dialect linuxcnc".to_string()
+                    };
                     hint = format!(
-                        "; these would fit: {}. {} {} are the centre's offset from the start \
+                        "; {} {} read as the centre's coordinates would fit, centre ({}, {}) \
+                         mm: the post writes absolute arc centres, as a control set so reads \
+                         them (LinuxCNC after G90.1; Mach3's and UCCNC's absolute IJ mode), \
+                         but the program does not say so: if this control reads them so, \
+                         write G90.1 ahead of its first arc{dialect}",
+                        centre_names[a],
+                        centre_names[b],
+                        mm(word(a)),
+                        mm(word(b))
+                    );
+                }
+                if !readings.is_empty() {
+                    hint.push_str(&format!(
+                        "; {} would fit: {}. {} {} are the centre's offset from the start \
                          point, with its sign: the post wrote them wrong; post the program \
                          again (the arc ends where the next move starts, so each reading \
                          gives another path)",
+                        if absolute {
+                            "read as an offset, these"
+                        } else {
+                            "these"
+                        },
                         readings.join("; or "),
                         centre_names[a],
                         centre_names[b]
-                    );
+                    ));
                 }
             }
             // Numbers without a decimal point read as least input increments by default

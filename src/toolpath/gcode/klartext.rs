@@ -409,6 +409,25 @@ pub(super) fn lex(
             words.insert(2, number);
         }
     }
+    // `CP IPA+90 IZ-0.5 DR+FQ1` (hyperMILL's post for a DMU 100 P duoblock, round 28): the
+    // next word joined to the direction. A direction is the sign alone, so a letter after
+    // it can only start another word: `DR+ FQ1`.
+    let mut k = 0;
+    while k < words.len() {
+        // Bytes, not `str` slices: a word may hold any character (an ASCII letter at byte 3
+        // makes 3 a character boundary).
+        let b = words[k].as_bytes();
+        if b.len() > 3
+            && b[..2].eq_ignore_ascii_case(b"DR")
+            && matches!(b[2], b'+' | b'-')
+            && b[3].is_ascii_alphabetic()
+        {
+            let rest = words[k][3..].to_string();
+            words[k].truncate(3);
+            words.insert(k + 1, rest);
+        }
+        k += 1;
+    }
     let mut items = Vec::new();
     let mut i = 0;
     if let Some((n, key, action)) = keyword_at(spec, &words) {
