@@ -17,7 +17,10 @@
 //! a flat end mill or a plunge, at the closest approach for a level move, on the capsule the
 //! ball sweeps for a ball-nose tool on a ramp (in closed form, `Capsule::bottom`), and is found
 //! by golden-section search (to 1e-9 mm) for a bull-nose tool on a ramp. Each dexel is thus
-//! cut exactly.
+//! cut exactly. A level step that starts where the step before it (a vertical tool's) ended
+//! leaves out the cells behind its start, whose sweep is the tool at its start, which the step
+//! before removed ([`behind_cells`]; their shank is still read): on NX's Röders finish, mostly
+//! level moves of 0.75 mm steps, two fifths of its cells, the same check byte for byte.
 //!
 //! **Removal, tilted tool** (sound, conservative). The tool passes through poses at
 //! t = j/m (P linear, the axis interpolated and normalised) with m chosen so that no point of
@@ -284,6 +287,65 @@ pub fn vertical_sweep(
         golden_min(g, ta, tb)
     };
     Some([lo, z(ta).max(z(tb)) + tool.flute_length])
+}
+
+/// A run of cells `a..=b` of a grid row, if not empty.
+type Run = Option<(usize, usize)>;
+
+/// The cells `ia..=ib` of the row at `y` split into those behind a level step's start `p0`
+/// (moving to `p1`) and the rest, each a run if not empty: `(behind, rest)`.
+///
+/// Behind the start (the closest point of the move to the cell's line is its start, t ≤ 0:
+/// (p0 − x)·(p1 − p0) ≥ 0 seen from above), the level step's sweep on a line is the tool's
+/// at its start ([`vertical_sweep`]: z constant, the lower end f(d(t)) least at the closest
+/// approach, clamped to t = 0; the upper end p0.z + L_f). Where the step before it was a
+/// vertical tool's ending at `p0`, that step's sweep on the line holds the tool there (its
+/// end pose), so it has removed all of it: cutting again takes nothing (at most a sliver of
+/// rounding, which a removal leaves, [`super::dexel::MIN_CUT_MM`]). The cells are split at the
+/// line x where (p0 − x)·Δ = 0; a cell on it either way is right (its sweep there is the
+/// start's to rounding).
+fn behind_cells(
+    p0: &Vector3<f64>,
+    p1: &Vector3<f64>,
+    y: f64,
+    (x0, hx): (f64, f64),
+    (ia, ib): (usize, usize),
+) -> (Run, Run) {
+    let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
+    let ay = p0.y - y;
+    if dx == 0.0 {
+        // (p0 − x)·Δ = ay·dy on the whole row.
+        return if ay * dy >= 0.0 {
+            (Some((ia, ib)), None)
+        } else {
+            (None, Some((ia, ib)))
+        };
+    }
+    // The cell whose centre is the last (dx > 0) or the first (dx < 0) behind: x ≤ xc or
+    // x ≥ xc, xc = p0.x + ay·dy/dx.
+    let xc = p0.x + ay * dy / dx;
+    let k = ((xc - x0) / hx - 0.5).clamp(-1.0, 1e15);
+    let run = |a: usize, b: usize| (a <= b).then_some((a, b));
+    if dx > 0.0 {
+        // Behind: the cells up to floor(k).
+        let last = k.floor();
+        if last < ia as f64 {
+            return (None, Some((ia, ib)));
+        }
+        let last = (last as usize).min(ib);
+        (Some((ia, last)), run(last + 1, ib))
+    } else {
+        // Behind: the cells from ceil(k).
+        let first = k.ceil();
+        if first > ib as f64 {
+            return (None, Some((ia, ib)));
+        }
+        let first = (first.max(0.0) as usize).max(ia);
+        (
+            Some((first, ib)),
+            if first > ia { run(ia, first - 1) } else { None },
+        )
+    }
 }
 
 /// [`vertical_sweep`]'s lower end on a run of dexel lines of one grid row, for a level move
@@ -759,6 +821,9 @@ pub(crate) struct SharedPose {
     /// The pose (tip, axis) and the number of the step it ended.
     pose: Option<(Vector3<f64>, Vector3<f64>)>,
     step: u64,
+    /// The tip where the last step ended, if that step's tool was vertical: a level step
+    /// starting there finds the cells behind its start swept already ([`behind_cells`]).
+    vertical_end: Option<Vector3<f64>>,
     /// Per grid row.
     rows: Vec<SharedRow>,
 }
@@ -782,6 +847,7 @@ impl SharedPose {
         SharedPose {
             pose: None,
             step: 0,
+            vertical_end: None,
             rows: vec![SharedRow::default(); rows],
         }
     }
@@ -794,6 +860,9 @@ struct StepPlan<'t> {
     vertical: bool,
     /// A level move or a ramp of a flat or ball-nose tool: rows at once.
     level: bool,
+    /// A level step whose start is where the step before it (vertical, the same tool) ended:
+    /// the cells behind its start are left out of its cut ([`behind_cells`]).
+    behind: bool,
     ramp: bool,
     /// Every pose once (tilted): the tool there and its projected axis segment.
     pose_list: Vec<(Pose<'t>, Footprint)>,
@@ -889,6 +958,8 @@ fn plan_step<'t>(
     // This step's number; its first pose's crossings where the previous step's last pose is it.
     let (prev, this) = (shared.step, shared.step + 1);
     let reuse = !vertical && shared.pose == Some((pose_list[0].0.tip(), pose_list[0].0.axis()));
+    let behind = level && shared.vertical_end == Some(step.p0);
+    shared.vertical_end = vertical.then_some(step.p1);
     shared.step = this;
     shared.pose = pose_list.last().map(|l| (l.0.tip(), l.0.axis()));
     StepPlan {
@@ -896,6 +967,7 @@ fn plan_step<'t>(
         poses,
         vertical,
         level,
+        behind,
         ramp,
         pose_list,
         vertical_foot,
@@ -928,6 +1000,7 @@ fn cut_band(
         poses,
         vertical,
         level,
+        behind,
         ramp,
         ref pose_list,
         ref vertical_foot,
@@ -973,6 +1046,30 @@ fn cut_band(
         if vertical {
             let Some((ia, ib)) = vertical_foot.cells((x0, hx), y, (i0, i1)) else {
                 continue;
+            };
+            // A level step that starts where the step before it ended: the cells behind its
+            // start are not cut again ([`behind_cells`]), their shank only read.
+            let (ia, ib) = if behind {
+                let (p, hi) = (&step.p0, step.p0.z + tool.flute_length);
+                let r2 = tool.radius() * tool.radius();
+                let (b, rest) = behind_cells(&step.p0, &step.p1, y, (x0, hx), (ia, ib));
+                if let Some((ba, bb)) = b {
+                    band.each(j, ba, bb, |i, cell| {
+                        let (ex, ey) = (cx(i) - p.x, y - p.y);
+                        if ex * ex + ey * ey <= r2 {
+                            shank = shank.max(cell.top() - hi);
+                        }
+                    });
+                }
+                match rest {
+                    Some(r) => r,
+                    None => {
+                        acc.shank = acc.shank.max(shank);
+                        continue;
+                    }
+                }
+            } else {
+                (ia, ib)
             };
             // A level move or a ramp: the row's ends at once
             // ([`level_row`], [`ramp_row`]; a ramp's cells it leaves to
@@ -1743,6 +1840,99 @@ mod tests {
 
     /// Random tilted and vertical passes into a block: the cut and the reference remove the
     /// same material, dexel by dexel.
+    /// A level step that starts where a vertical tool's step ended leaves out the cells
+    /// behind its start ([`behind_cells`]): the same dexels and removed lengths as the plain
+    /// reference, and the same samples (removed volume, depths, shank) as the step cut
+    /// without the step before's end known, which cuts every cell of its footprint. Flutes
+    /// short enough that the shank meets the material above them.
+    #[test]
+    fn a_level_step_after_a_vertical_one_cuts_as_every_cell() {
+        let mut rnd = crate::test_rng(9);
+        let stock = Stock::Box {
+            min: [0.0, 0.0, -5.0],
+            max: [12.0, 9.0, 0.0],
+        };
+        let mut level = 0;
+        for case in 0..8 {
+            let dia = 2.0 + 2.0 * rnd();
+            let rc = if case % 2 == 0 { 0.0 } else { 0.5 * dia };
+            let tool = Tool::new(dia, rc, rc + 0.4, 2).unwrap();
+            let cell = 0.1 + 0.1 * rnd();
+            let mut d = Dexels::new(&stock, cell);
+            let mut alone = d.clone();
+            let mut cells = d.dense_reference(&stock);
+            let delta = pose_spacing(&tool, cell);
+            let top = -(rc + 0.6);
+            // First an uneven top: pockets of other depths, by a longer tool.
+            let rough = Tool::new(1.5 * dia, 0.0, 6.0, 2).unwrap();
+            for _ in 0..6 {
+                let at = |r: &mut dyn FnMut() -> f64, z: f64| {
+                    Vector3::new(1.0 + 10.0 * r(), 1.0 + 7.0 * r(), z)
+                };
+                let z = -(rc + 0.5) * rnd();
+                let (p0, p1) = (at(&mut rnd, z), at(&mut rnd, z));
+                let step = Step {
+                    p0,
+                    p1,
+                    o0: Vector3::z(),
+                    o1: Vector3::z(),
+                };
+                let delta = pose_spacing(&rough, cell);
+                reference_step(&d, &mut cells, &rough, &step, delta);
+                for g in [&mut d, &mut alone] {
+                    cut_step(g, &rough, &step, delta, &mut SharedPose::new(g.ny));
+                }
+            }
+            let mut p = Vector3::new(6.0, 4.5, top);
+            let mut shared = SharedPose::new(d.ny);
+            let mut shank = 0.0_f64;
+            for _ in 0..40 {
+                // Mostly level, of lengths below and above the tool's radius, along the axes
+                // and not; now and then a ramp to another level.
+                let z = if rnd() < 0.2 { top - 3.0 * rnd() } else { p.z };
+                let len = [0.05, 0.3, 1.0, 2.5][(4.0 * rnd()) as usize % 4];
+                let a = if rnd() < 0.3 {
+                    std::f64::consts::FRAC_PI_2 * (4.0 * rnd()).floor()
+                } else {
+                    std::f64::consts::TAU * rnd()
+                };
+                let p1 = Vector3::new(
+                    (p.x + len * a.cos()).clamp(1.0, 11.0),
+                    (p.y + len * a.sin()).clamp(1.0, 8.0),
+                    z,
+                );
+                if p1.z == p.z && p1 != p {
+                    level += 1;
+                }
+                let step = Step {
+                    p0: p,
+                    p1,
+                    o0: Vector3::z(),
+                    o1: Vector3::z(),
+                };
+                let want = reference_step(&d, &mut cells, &tool, &step, delta);
+                let got = cut_step(&mut d, &tool, &step, delta, &mut shared);
+                let each = cut_step(&mut alone, &tool, &step, delta, &mut SharedPose::new(d.ny));
+                assert_eq!(got, each);
+                let length = got.removed / (d.hx * d.hy);
+                assert!(
+                    (length - want).abs() <= 1e-12 * want.max(1.0),
+                    "{length} {want}"
+                );
+                shank = shank.max(got.shank_depth);
+                p = p1;
+            }
+            assert!(shank > 0.1, "case {case}: the shank met no material");
+            for j in 0..d.ny {
+                for i in 0..d.nx {
+                    assert_eq!(d.dexel(i, j).intervals(), &cells[j * d.nx + i][..]);
+                    assert_eq!(d.dexel(i, j), alone.dexel(i, j));
+                }
+            }
+        }
+        assert!(level > 150, "{level} level steps");
+    }
+
     #[test]
     fn the_cut_agrees_with_a_plain_reference() {
         let mut rnd = crate::test_rng(3);
