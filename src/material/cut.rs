@@ -20,7 +20,8 @@
 //! cut exactly. A level step that starts where the step before it (a vertical tool's) ended
 //! leaves out the cells behind its start, whose sweep is the tool at its start, which the step
 //! before removed ([`behind_cells`]; their shank is still read): on NX's Röders finish, mostly
-//! level moves of 0.75 mm steps, two fifths of its cells, the same check byte for byte.
+//! level moves of 0.75 mm steps, two fifths of its cells, the same check byte for byte. A
+//! rising ramp does so too where no material stands above the start's flutes' top.
 //!
 //! **Removal, tilted tool** (sound, conservative). The tool passes through poses at
 //! t = j/m (P linear, the axis interpolated and normalised) with m chosen so that no point of
@@ -292,18 +293,21 @@ pub fn vertical_sweep(
 /// A run of cells `a..=b` of a grid row, if not empty.
 type Run = Option<(usize, usize)>;
 
-/// The cells `ia..=ib` of the row at `y` split into those behind a level step's start `p0`
-/// (moving to `p1`) and the rest, each a run if not empty: `(behind, rest)`.
+/// The cells `ia..=ib` of the row at `y` split into those behind a step's start `p0` (moving
+/// to `p1`, a vertical tool) and the rest, each a run if not empty: `(behind, rest)`.
 ///
 /// Behind the start (the closest point of the move to the cell's line is its start, t ≤ 0:
-/// (p0 − x)·(p1 − p0) ≥ 0 seen from above), the level step's sweep on a line is the tool's
-/// at its start ([`vertical_sweep`]: z constant, the lower end f(d(t)) least at the closest
-/// approach, clamped to t = 0; the upper end p0.z + L_f). Where the step before it was a
-/// vertical tool's ending at `p0`, that step's sweep on the line holds the tool there (its
-/// end pose), so it has removed all of it: cutting again takes nothing (at most a sliver of
-/// rounding, which a removal leaves, [`super::dexel::MIN_CUT_MM`]). The cells are split at the
-/// line x where (p0 − x)·Δ = 0; a cell on it either way is right (its sweep there is the
-/// start's to rounding).
+/// (p0 − x)·(p1 − p0) ≥ 0 seen from above), the distance d(t) from the line only grows along
+/// the step. On a level step the sweep on the line is then the tool's at its start
+/// ([`vertical_sweep`]: the lower end z + f(d(t)) least at t = 0, the upper end p0.z + L_f);
+/// on a rising ramp its lower end is the start's too (z and f(d(t)) both grow) and its upper
+/// end is higher. Where the step before it was a vertical tool's ending at `p0`, that step's
+/// sweep on the line holds the tool there (its end pose), so it has removed all of the start's
+/// interval: cutting again takes nothing on a level step, and on a rising ramp only material
+/// above the start's flutes' top, p0.z + L_f (at most a sliver of rounding besides, which a
+/// removal leaves, [`super::dexel::MIN_CUT_MM`]). The cells are split at the line x where
+/// (p0 − x)·Δ = 0; a cell on it either way is right (its sweep there is the start's to
+/// rounding).
 fn behind_cells(
     p0: &Vector3<f64>,
     p1: &Vector3<f64>,
@@ -860,8 +864,9 @@ struct StepPlan<'t> {
     vertical: bool,
     /// A level move or a ramp of a flat or ball-nose tool: rows at once.
     level: bool,
-    /// A level step whose start is where the step before it (vertical, the same tool) ended:
-    /// the cells behind its start are left out of its cut ([`behind_cells`]).
+    /// A level step or a rising ramp whose start is where the step before it (vertical, the
+    /// same tool) ended: the cells behind its start are left out of its cut
+    /// ([`behind_cells`]).
     behind: bool,
     ramp: bool,
     /// Every pose once (tilted): the tool there and its projected axis segment.
@@ -958,7 +963,7 @@ fn plan_step<'t>(
     // This step's number; its first pose's crossings where the previous step's last pose is it.
     let (prev, this) = (shared.step, shared.step + 1);
     let reuse = !vertical && shared.pose == Some((pose_list[0].0.tip(), pose_list[0].0.axis()));
-    let behind = level && shared.vertical_end == Some(step.p0);
+    let behind = (level || ramp && step.p1.z > step.p0.z) && shared.vertical_end == Some(step.p0);
     shared.vertical_end = vertical.then_some(step.p1);
     shared.step = this;
     shared.pose = pose_list.last().map(|l| (l.0.tip(), l.0.axis()));
@@ -1047,26 +1052,55 @@ fn cut_band(
             let Some((ia, ib)) = vertical_foot.cells((x0, hx), y, (i0, i1)) else {
                 continue;
             };
-            // A level step that starts where the step before it ended: the cells behind its
-            // start are not cut again ([`behind_cells`]), their shank only read.
-            let (ia, ib) = if behind {
+            // A level step or a rising ramp that starts where the step before it ended: the
+            // cells behind its start are not cut again ([`behind_cells`]): a level step's
+            // shank only read there, a ramp's cells cut only where material stands above the
+            // start's flutes' top (the cut and the shank as below). In cell order, as without
+            // the skip (the sums add up in one order): the cells behind before the rest where
+            // they lie to its left, after it where to its right.
+            let behind_row = |band: &mut super::dexel::Band,
+                              note: &mut dyn FnMut(usize, super::dexel::Cut),
+                              shank: &mut f64,
+                              (ba, bb): (usize, usize)| {
                 let (p, hi) = (&step.p0, step.p0.z + tool.flute_length);
                 let r2 = tool.radius() * tool.radius();
-                let (b, rest) = behind_cells(&step.p0, &step.p1, y, (x0, hx), (ia, ib));
-                if let Some((ba, bb)) = b {
-                    band.each(j, ba, bb, |i, cell| {
-                        let (ex, ey) = (cx(i) - p.x, y - p.y);
-                        if ex * ex + ey * ey <= r2 {
-                            shank = shank.max(cell.top() - hi);
+                band.each(j, ba, bb, |i, cell| {
+                    let x = cx(i);
+                    let (ex, ey) = (x - p.x, y - p.y);
+                    let d2 = ex * ex + ey * ey;
+                    if level {
+                        if d2 <= r2 {
+                            *shank = shank.max(cell.top() - hi);
                         }
-                    });
-                }
-                match rest {
-                    Some(r) => r,
-                    None => {
-                        acc.shank = acc.shank.max(shank);
-                        continue;
+                    } else if d2 <= r2 * (1.0 + 1e-9) && cell.top() > hi {
+                        // (Within R of the start, in rounding: the sweep says.)
+                        if let Some([lo, h]) = vertical_sweep(tool, &step.p0, &step.p1, x, y) {
+                            note(i, cell.remove(lo, h));
+                            if let Some([_, top]) = cell.extent() {
+                                *shank = shank.max(top - h);
+                            }
+                        }
                     }
+                });
+            };
+            let mut after = None;
+            let (ia, ib) = if behind {
+                match behind_cells(&step.p0, &step.p1, y, (x0, hx), (ia, ib)) {
+                    (Some(b), Some(rest)) if b.0 > rest.1 => {
+                        after = Some(b);
+                        rest
+                    }
+                    (Some(b), rest) => {
+                        behind_row(band, &mut note, &mut shank, b);
+                        match rest {
+                            Some(r) => r,
+                            None => {
+                                acc.shank = acc.shank.max(shank);
+                                continue;
+                            }
+                        }
+                    }
+                    (None, rest) => rest.unwrap_or((ia, ib)),
                 }
             } else {
                 (ia, ib)
@@ -1104,6 +1138,9 @@ fn cut_band(
                     }
                 }
             });
+            if let Some(b) = after {
+                behind_row(band, &mut note, &mut shank, b);
+            }
             acc.shank = acc.shank.max(shank);
             continue;
         }
@@ -1840,11 +1877,12 @@ mod tests {
 
     /// Random tilted and vertical passes into a block: the cut and the reference remove the
     /// same material, dexel by dexel.
-    /// A level step that starts where a vertical tool's step ended leaves out the cells
-    /// behind its start ([`behind_cells`]): the same dexels and removed lengths as the plain
-    /// reference, and the same samples (removed volume, depths, shank) as the step cut
-    /// without the step before's end known, which cuts every cell of its footprint. Flutes
-    /// short enough that the shank meets the material above them.
+    /// A level step or a rising ramp that starts where a vertical tool's step ended leaves
+    /// out the cells behind its start ([`behind_cells`]): the same dexels and removed lengths
+    /// as the plain reference, and the same samples (removed volume, depths, shank) as the
+    /// step cut without the step before's end known, which cuts every cell of its footprint.
+    /// Flutes short enough that the shank meets the material above them (and a rising ramp
+    /// cuts some behind its start).
     #[test]
     fn a_level_step_after_a_vertical_one_cuts_as_every_cell() {
         let mut rnd = crate::test_rng(9);
@@ -1852,7 +1890,7 @@ mod tests {
             min: [0.0, 0.0, -5.0],
             max: [12.0, 9.0, 0.0],
         };
-        let mut level = 0;
+        let (mut level, mut rising) = (0, 0);
         for case in 0..8 {
             let dia = 2.0 + 2.0 * rnd();
             let rc = if case % 2 == 0 { 0.0 } else { 0.5 * dia };
@@ -1903,6 +1941,8 @@ mod tests {
                 );
                 if p1.z == p.z && p1 != p {
                     level += 1;
+                } else if p1.z > p.z && (p1.x, p1.y) != (p.x, p.y) {
+                    rising += 1;
                 }
                 let step = Step {
                     p0: p,
@@ -1930,7 +1970,10 @@ mod tests {
                 }
             }
         }
-        assert!(level > 150, "{level} level steps");
+        assert!(
+            level > 150 && rising > 20,
+            "{level} level steps, {rising} rising ramps"
+        );
     }
 
     #[test]
