@@ -347,7 +347,7 @@ fn behind_cells(
         let first = (first.max(0.0) as usize).max(ia);
         (
             Some((first, ib)),
-            if first > ia { run(ia, first - 1) } else { None },
+            first.checked_sub(1).and_then(|e| run(ia, e)),
         )
     }
 }
@@ -1877,6 +1877,17 @@ mod tests {
 
     /// Random tilted and vertical passes into a block: the cut and the reference remove the
     /// same material, dexel by dexel.
+    /// A step of a vertical tool from `p0` to `p1`.
+    fn vertical_step(p0: Vector3<f64>, p1: Vector3<f64>) -> Step {
+        let o = Vector3::z();
+        Step {
+            p0,
+            p1,
+            o0: o,
+            o1: o,
+        }
+    }
+
     /// A level step or a rising ramp that starts where a vertical tool's step ended leaves
     /// out the cells behind its start ([`behind_cells`]): the same dexels and removed lengths
     /// as the plain reference, and the same samples (removed volume, depths, shank) as the
@@ -1909,12 +1920,7 @@ mod tests {
                 };
                 let z = -(rc + 0.5) * rnd();
                 let (p0, p1) = (at(&mut rnd, z), at(&mut rnd, z));
-                let step = Step {
-                    p0,
-                    p1,
-                    o0: Vector3::z(),
-                    o1: Vector3::z(),
-                };
+                let step = vertical_step(p0, p1);
                 let delta = pose_spacing(&rough, cell);
                 reference_step(&d, &mut cells, &rough, &step, delta);
                 for g in [&mut d, &mut alone] {
@@ -1944,12 +1950,7 @@ mod tests {
                 } else if p1.z > p.z && (p1.x, p1.y) != (p.x, p.y) {
                     rising += 1;
                 }
-                let step = Step {
-                    p0: p,
-                    p1,
-                    o0: Vector3::z(),
-                    o1: Vector3::z(),
-                };
+                let step = vertical_step(p, p1);
                 let want = reference_step(&d, &mut cells, &tool, &step, delta);
                 let got = cut_step(&mut d, &tool, &step, delta, &mut shared);
                 let each = cut_step(&mut alone, &tool, &step, delta, &mut SharedPose::new(d.ny));
